@@ -1,0 +1,321 @@
+/* app/main.c — the `raystream` command: parses options, builds the scene, BVH, devices and
+ * scheduler, runs the render with a progress bar, writes the image and prints a summary.
+ * The only place that calls exit() (by returning from main) and that handles signals. */
+#include <omp.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "app/options.h"
+#include "app/progress.h"
+#include "core/alloc.h"
+#include "core/image_io.h"
+#include "cpu/cpu_device.h"
+#include "gpu/gpu_device.h"
+#include "scenes/builtin.h"
+#include "scheduler/render.h"
+
+#ifndef RS_VERSION
+#define RS_VERSION "0.0.0"
+#endif
+
+static atomic_int g_cancel;
+
+static void on_sigint(int sig)
+{
+    (void)sig;
+    atomic_store(&g_cancel, 1);
+}
+
+static void install_sigint(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    /* the first Ctrl-C asks for a clean stop; a second one kills as usual */
+    sa.sa_flags = SA_RESETHAND;
+    sigaction(SIGINT, &sa, NULL);
+}
+
+static int fail(int code, const char *what)
+{
+    const char *msg = rs_error_message();
+    fprintf(stderr, "raystream: %s%s%s\n", what ? what : "", what && *msg ? ": " : "", msg);
+    return code;
+}
+
+static int cmd_version(void)
+{
+    const char *why = "";
+    int n;
+    printf("raystream %s\n", RS_VERSION);
+    if (rs_gpu_compiled()) {
+        n = rs_gpu_count(&why);
+        if (n > 0)
+            printf("  CUDA:        yes (%d device%s)\n", n, n == 1 ? "" : "s");
+        else
+            printf("  CUDA:        yes, built in; no usable device (%s)\n", why);
+    } else {
+        printf("  CUDA:        no (built without the CUDA toolkit)\n");
+    }
+    printf("  OpenMP:      yes, %d threads available\n", omp_get_max_threads());
+    printf("  OpenImageIO: %s\n", rs_image_library_version());
+    return RS_EXIT_OK;
+}
+
+static int cmd_scenes(void)
+{
+    int i;
+    const char *name, *desc;
+    for (i = 0; (name = rs_builtin_name(i, &desc)) != NULL; ++i)
+        printf("builtin:%-12s %s\n", name, desc);
+    return RS_EXIT_OK;
+}
+
+static void human(double v, char *buf, size_t n)
+{
+    if (v >= 1e9)
+        snprintf(buf, n, "%.2f G", v / 1e9);
+    else if (v >= 1e6)
+        snprintf(buf, n, "%.2f M", v / 1e6);
+    else if (v >= 1e3)
+        snprintf(buf, n, "%.2f k", v / 1e3);
+    else
+        snprintf(buf, n, "%.0f ", v);
+}
+
+/* Creates the devices named on the command line.  A gpu that cannot be used becomes the CPU
+ * fallback device (one warning line).  Returns the count, or -1 after printing an error. */
+static int create_devices(const rs_cli_options *o, int threads, rs_device **devs)
+{
+    int i, n = 0;
+    for (i = 0; i < o->n_devices; ++i) {
+        const rs_device_spec *d = &o->devices[i];
+        rs_status st;
+        if (!d->is_gpu) {
+            st = rs_cpu_device_create(d->threads ? d->threads : threads, "cpu", &devs[n]);
+        } else {
+            st = rs_gpu_device_create(d->index, &devs[n]);
+            if (st != RS_OK) {
+                /* alone, the fallback may use every core; beside a cpu device, one of them */
+                int ft = o->n_devices == 1 ? threads : 1;
+                char name[48];
+                fprintf(stderr, "raystream: warning: %s; gpu:%d runs on the CPU fallback (%d thread%s)\n",
+                        rs_error_message(), d->index, ft, ft == 1 ? "" : "s");
+                rs_error_clear();
+                snprintf(name, sizeof name, "gpu-fallback:%d", d->index);
+                st = rs_cpu_device_create(ft, name, &devs[n]);
+            }
+        }
+        if (st != RS_OK) {
+            while (n > 0)
+                rs_device_destroy(devs[--n]);
+            fail(RS_EXIT_RUNTIME, "creating devices");
+            return -1;
+        }
+        n++;
+    }
+    return n;
+}
+
+static int cmd_render(const rs_cli_options *o)
+{
+    rs_scene *scene = NULL;
+    rs_bvh *bvh = NULL;
+    rs_device *devs[RS_MAX_DEVICES];
+    rs_sched *sched = NULL;
+    rs_film *film = NULL;
+    float *rgb = NULL;
+    int n_devs = 0, i, code = RS_EXIT_OK, threads;
+    char out_default[96];
+    const char *out, *name;
+    rs_render_settings st;
+    rs_render_stats stats;
+    rs_render_hooks hooks;
+    rs_progress progress;
+    rs_sched_config cfg;
+    rs_status rst;
+    double t0, bvh_ms;
+    rs_geom geom;
+
+    /* ---- the scene ---- */
+    if (strncmp(o->scene, "builtin:", 8) != 0) {
+        struct stat sb;
+        if (stat(o->scene, &sb) != 0)
+            fprintf(stderr, "raystream: %s: no such scene file (built-in scenes are named "
+                            "builtin:NAME; see 'raystream scenes')\n",
+                    o->scene);
+        else
+            fprintf(stderr, "raystream: %s: scene files are not supported yet; use a built-in "
+                            "scene (see 'raystream scenes')\n",
+                    o->scene);
+        return RS_EXIT_USAGE;
+    }
+    name = o->scene + 8;
+    if (rs_builtin_create(name, &scene) != RS_OK)
+        return fail(RS_EXIT_USAGE, o->scene);
+
+    /* ---- settings ---- */
+    memset(&st, 0, sizeof st);
+    st.width = o->width ? o->width : scene->width;
+    st.height = o->height ? o->height : scene->height;
+    if (o->width && !o->height)
+        st.height = (uint32_t)(0.5 + (double)o->width * scene->height / scene->width);
+    if (!o->width && o->height)
+        st.width = (uint32_t)(0.5 + (double)o->height * scene->width / scene->height);
+    if (st.width < 1)
+        st.width = 1;
+    if (st.height < 1)
+        st.height = 1;
+    st.spp = o->spp;
+    st.max_depth = o->max_depth;
+    st.seed = o->seed;
+    st.sampling = o->sampling;
+    st.wave_paths = o->wave_paths;
+    threads = o->threads ? o->threads : omp_get_num_procs();
+    st.threads = threads;
+
+    /* ---- the output is checked before any work ---- */
+    if (o->output) {
+        out = o->output;
+    } else {
+        snprintf(out_default, sizeof out_default, "%s.png", name);
+        out = out_default;
+    }
+    rst = rs_image_check_output(out);
+    if (rst != RS_OK) {
+        rs_scene_destroy(scene);
+        return fail(rst == RS_ERR_ARG ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
+    }
+
+    /* ---- BVH, devices, scheduler, film ---- */
+    geom = rs_scene_geom(scene);
+    t0 = rs_now_s();
+    if (rs_bvh_build(&geom, NULL, &bvh) != RS_OK) {
+        code = fail(RS_EXIT_RUNTIME, "building the BVH");
+        goto done;
+    }
+    bvh_ms = 1e3 * (rs_now_s() - t0);
+    n_devs = create_devices(o, threads, devs);
+    if (n_devs < 0) {
+        n_devs = 0;
+        code = RS_EXIT_RUNTIME;
+        goto done;
+    }
+    for (i = 0; i < n_devs; ++i)
+        if (rs_device_upload(devs[i], &geom, bvh) != RS_OK) {
+            char what[96];
+            snprintf(what, sizeof what, "uploading the scene to %s", devs[i]->name);
+            code = fail(RS_EXIT_RUNTIME, what);
+            goto done;
+        }
+    cfg.chunk_size = o->chunk_size;
+    cfg.queue_capacity = 0;
+    if (rs_sched_create(devs, n_devs, &cfg, &sched) != RS_OK ||
+        rs_film_create(st.width, st.height, &film) != RS_OK) {
+        code = fail(RS_EXIT_RUNTIME, "starting the render");
+        goto done;
+    }
+    rgb = (float *)rs_alloc((size_t)st.width * st.height * 3, sizeof *rgb);
+    if (!rgb) {
+        fprintf(stderr, "raystream: out of memory for a %ux%u image\n", st.width, st.height);
+        code = RS_EXIT_RUNTIME;
+        goto done;
+    }
+
+    /* ---- render ---- */
+    install_sigint();
+    rs_progress_begin(&progress, !o->quiet);
+    hooks.progress = rs_progress_update;
+    hooks.user = &progress;
+    hooks.cancel = &g_cancel;
+    rst = rs_render(scene, sched, &st, &hooks, film, &stats);
+    rs_progress_end(&progress);
+    signal(SIGINT, SIG_DFL);
+    if (rst != RS_OK && rst != RS_ERR_CANCELLED) {
+        code = fail(RS_EXIT_RUNTIME, "render failed");
+        goto done;
+    }
+    if (rst == RS_ERR_CANCELLED) {
+        rs_error_clear();
+        code = RS_EXIT_INTERRUPTED;
+    }
+
+    /* ---- output ---- */
+    rs_film_resolve(film, rgb);
+    if (rs_image_write(out, st.width, st.height, rgb) != RS_OK) {
+        code = fail(RS_EXIT_RUNTIME, NULL);
+        goto done;
+    }
+
+    if (!o->quiet) {
+        char sps[32], rps[32], rays[32];
+        double secs = stats.seconds > 0 ? stats.seconds : 1e-9;
+        uint64_t rays_total = stats.rays_closest + stats.rays_shadow;
+        human((double)stats.paths_done / secs, sps, sizeof sps);
+        human((double)rays_total / secs, rps, sizeof rps);
+        human((double)rays_total, rays, sizeof rays);
+        fprintf(stderr,
+                "%s %s at %ux%u, %u spp (%s sampling, max depth %u, seed %llu) in %.2f s: "
+                "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
+                "BVH: %u nodes over %u primitives, built in %.2f ms. ",
+                code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered",
+                o->scene, st.width, st.height, st.spp, rs_sampling_name(st.sampling),
+                st.max_depth, (unsigned long long)st.seed, stats.seconds, sps, rps, rays,
+                (unsigned long long)stats.rays_closest, (unsigned long long)stats.rays_shadow,
+                bvh->n_nodes, bvh->n_prims, bvh_ms);
+        for (i = 0; i < n_devs; ++i) {
+            rs_device_stats ds;
+            int alive;
+            rs_sched_device_stats(sched, i, &ds, &alive);
+            human((double)ds.rays, rays, sizeof rays);
+            fprintf(stderr, "%s %s (%d thread%s) traced %srays in %llu chunks (%.0f%%)%s%s",
+                    i == 0 ? "Devices:" : ";", devs[i]->name, devs[i]->threads,
+                    devs[i]->threads == 1 ? "" : "s", rays, (unsigned long long)ds.chunks,
+                    rays_total ? 100.0 * (double)ds.rays / (double)rays_total : 0.0,
+                    alive ? "" : " and then failed", i + 1 == n_devs ? ". " : "");
+        }
+        fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", stats.shade_s, stats.trace_s);
+        if (film->nonfinite)
+            fprintf(stderr, "%llu non-finite samples were dropped. ",
+                    (unsigned long long)film->nonfinite);
+        if (code == RS_EXIT_INTERRUPTED)
+            fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", out,
+                    (unsigned long long)stats.paths_done, (unsigned long long)stats.paths_total,
+                    rs_film_min_count(film));
+        else
+            fprintf(stderr, "Wrote %s.\n", out);
+    } else if (code == RS_EXIT_INTERRUPTED) {
+        fprintf(stderr, "raystream: interrupted; wrote a partial image (%llu of %llu samples) to %s\n",
+                (unsigned long long)stats.paths_done, (unsigned long long)stats.paths_total, out);
+    }
+
+done:
+    rs_sched_destroy(sched);
+    for (i = 0; i < n_devs; ++i)
+        rs_device_destroy(devs[i]);
+    rs_film_destroy(film);
+    rs_free(rgb);
+    rs_bvh_destroy(bvh);
+    rs_scene_destroy(scene);
+    return code;
+}
+
+int main(int argc, char **argv)
+{
+    rs_cli_options o;
+    int rc = rs_cli_parse(argc, argv, &o);
+    if (rc != RS_EXIT_OK)
+        return rc;
+    switch (o.command) {
+    case RS_CMD_HELP: rs_cli_print_help(o.scene); return RS_EXIT_OK;
+    case RS_CMD_VERSION: return cmd_version();
+    case RS_CMD_SCENES: return cmd_scenes();
+    case RS_CMD_RENDER: return cmd_render(&o);
+    }
+    return RS_EXIT_OK;
+}

@@ -1,0 +1,276 @@
+/* app/options.c — parsing and help text for the command line. */
+#include "app/options.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int usage_error(const char *fmt, const char *a, const char *b)
+{
+    fprintf(stderr, "raystream: ");
+    fprintf(stderr, fmt, a, b);
+    fprintf(stderr, " (see 'raystream --help')\n");
+    return RS_EXIT_USAGE;
+}
+
+/* A whole number in [lo, hi], written in decimal with nothing else around it. */
+static int parse_u64(const char *opt, const char *text, uint64_t lo, uint64_t hi, uint64_t *out)
+{
+    char *end;
+    unsigned long long v;
+    char range[96];
+    if (!text || !*text)
+        return usage_error("%s needs a value%s", opt, "");
+    if (text[0] == '-' || text[0] == '+' || text[0] == ' ')
+        goto bad;
+    errno = 0;
+    v = strtoull(text, &end, 10);
+    if (errno || *end != '\0' || end == text)
+        goto bad;
+    if (v < lo || v > hi) {
+        snprintf(range, sizeof range, " must be between %" PRIu64 " and %" PRIu64, lo, hi);
+        fprintf(stderr, "raystream: %s %s:%s (see 'raystream --help')\n", opt, text, range);
+        return RS_EXIT_USAGE;
+    }
+    *out = v;
+    return RS_EXIT_OK;
+bad:
+    if (text[0] == '-' && strspn(text + 1, "0123456789") == strlen(text + 1) && text[1]) {
+        fprintf(stderr, "raystream: %s %s: must be a positive whole number (see 'raystream --help')\n",
+                opt, text);
+        return RS_EXIT_USAGE;
+    }
+    return usage_error("%s: '%s' is not a whole number", opt, text);
+}
+
+static int parse_u32(const char *opt, const char *text, uint32_t lo, uint32_t hi, uint32_t *out)
+{
+    uint64_t v;
+    int rc = parse_u64(opt, text, lo, hi, &v);
+    if (rc == RS_EXIT_OK)
+        *out = (uint32_t)v;
+    return rc;
+}
+
+static int parse_devices(const char *text, rs_cli_options *o)
+{
+    char buf[256];
+    char *tok, *save = NULL;
+    if (strlen(text) >= sizeof buf)
+        return usage_error("--devices: list too long: '%s'%s", text, "");
+    strcpy(buf, text);
+    o->n_devices = 0;
+    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        rs_device_spec d = {0, 0, 0};
+        char *colon = strchr(tok, ':');
+        uint32_t v;
+        int i;
+        if (colon)
+            *colon = '\0';
+        if (strcmp(tok, "cpu") == 0) {
+            if (colon && parse_u32("--devices cpu:THREADS", colon + 1, 1, 1024, &v))
+                return RS_EXIT_USAGE;
+            d.threads = colon ? (int)v : 0;
+        } else if (strcmp(tok, "gpu") == 0) {
+            d.is_gpu = 1;
+            if (colon && parse_u32("--devices gpu:INDEX", colon + 1, 0, 63, &v))
+                return RS_EXIT_USAGE;
+            d.index = colon ? (int)v : 0;
+        } else {
+            return usage_error("--devices: unknown device '%s' in '%s' (use cpu, cpu:THREADS, "
+                               "gpu or gpu:INDEX)",
+                               tok, text);
+        }
+        for (i = 0; i < o->n_devices; ++i)
+            if (o->devices[i].is_gpu == d.is_gpu && (!d.is_gpu || o->devices[i].index == d.index))
+                return usage_error("--devices: '%s' is listed twice in '%s'", tok, text);
+        if (o->n_devices == RS_MAX_DEVICES)
+            return usage_error("--devices: more than 16 devices in '%s'%s", text, "");
+        o->devices[o->n_devices++] = d;
+    }
+    if (o->n_devices == 0)
+        return usage_error("--devices: empty device list '%s'%s", text, "");
+    return RS_EXIT_OK;
+}
+
+void rs_cli_print_help(const char *command)
+{
+    if (command && strcmp(command, "render") == 0) {
+        printf(
+            "usage: raystream render [SCENE] [options]\n"
+            "\n"
+            "Renders SCENE (default builtin:cornell) to an image.\n"
+            "\n"
+            "  SCENE, --scene builtin:NAME   a built-in scene ('raystream scenes' lists them)\n"
+            "  -o, --output FILE   image to write; the format follows the extension: .png\n"
+            "                      (sRGB, 8-bit), .exr or .hdr (linear float), .jpg, .tif\n"
+            "                      (default: NAME.png)\n"
+            "  --width N, --height N   image size in pixels (default: the scene's, 600x600\n"
+            "                      for the Cornell box; give one to keep the aspect ratio)\n"
+            "  --spp N             samples per pixel (default 64)\n"
+            "  --max-depth N       most ray segments per path, camera ray included (default 50)\n"
+            "  --seed N            random seed; same seed, same image (default 1)\n"
+            "  --threads N         CPU threads (default: every core)\n"
+            "  --devices LIST      comma-separated: cpu, cpu:THREADS, gpu, gpu:INDEX\n"
+            "                      (default cpu).  A gpu without CUDA falls back to the CPU.\n"
+            "  --sampling MODE     mis (default): light + BSDF sampling, power heuristic;\n"
+            "                      mixture: the thesis's light/BSDF mixture pdf;\n"
+            "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
+            "  --chunk-size N      rays per scheduler chunk (default 65536)\n"
+            "  --wave-size N       paths in flight (default 1048576): bounds memory\n"
+            "  -q, --quiet         no progress bar and no summary\n"
+            "  -h, --help          this text\n"
+            "\n"
+            "Ctrl-C writes the samples finished so far and exits with status 130.\n"
+            "Exit status: 0 done, 1 runtime error, 2 usage error, 130 interrupted.\n");
+        return;
+    }
+    printf("usage: raystream COMMAND [options]\n"
+           "\n"
+           "raystream is a heterogeneous CPU+GPU streaming path tracer.\n"
+           "\n"
+           "commands:\n"
+           "  render [SCENE] [options]   render a scene to an image (default builtin:cornell)\n"
+           "  scenes                     list the built-in scenes\n"
+           "  help [COMMAND]             show help (also -h, --help)\n"
+           "  version                    show the version and the build's features (also\n"
+           "                             --version)\n"
+           "\n"
+           "'raystream render --help' lists the render options.\n");
+}
+
+/* Takes the value of option argv[*i] (either "--opt=value" or "--opt value"). */
+static const char *take_value(int argc, char **argv, int *i, const char *eq)
+{
+    if (eq)
+        return eq + 1;
+    if (*i + 1 < argc)
+        return argv[++*i];
+    return NULL;
+}
+
+int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
+{
+    int i = 1;
+    memset(o, 0, sizeof *o);
+    o->command = RS_CMD_RENDER;
+    o->scene = NULL;
+    o->spp = 64;
+    o->max_depth = 50;
+    o->seed = 1;
+    o->sampling = RS_SAMPLING_MIS;
+    o->chunk_size = 65536;
+    o->wave_paths = 1u << 20;
+    o->n_devices = 1;
+    o->devices[0].is_gpu = 0;
+
+    if (argc < 2) {
+        o->command = RS_CMD_HELP;
+        return RS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
+        strcmp(argv[1], "help") == 0) {
+        o->command = RS_CMD_HELP;
+        o->scene = argc > 2 ? argv[2] : NULL; /* the command to explain */
+        return RS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
+        o->command = RS_CMD_VERSION;
+        return RS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "scenes") == 0) {
+        o->command = RS_CMD_SCENES;
+        return RS_EXIT_OK;
+    }
+    if (strcmp(argv[1], "render") != 0)
+        return usage_error("unknown command '%s'%s", argv[1], "");
+
+    for (i = 2; i < argc; ++i) {
+        const char *a = argv[i];
+        const char *eq = (a[0] == '-' && a[1] == '-') ? strchr(a, '=') : NULL;
+        char name[64];
+        const char *v;
+        int rc = RS_EXIT_OK;
+        size_t len = eq ? (size_t)(eq - a) : strlen(a);
+        if (len >= sizeof name)
+            len = sizeof name - 1;
+        memcpy(name, a, len);
+        name[len] = '\0';
+
+        if (a[0] != '-' || a[1] == '\0') {
+            if (o->scene)
+                return usage_error("more than one scene given ('%s' and '%s')", o->scene, a);
+            o->scene = a;
+            continue;
+        }
+        if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
+            o->command = RS_CMD_HELP;
+            o->scene = "render";
+            return RS_EXIT_OK;
+        }
+        if (strcmp(name, "-q") == 0 || strcmp(name, "--quiet") == 0) {
+            o->quiet = 1;
+            continue;
+        }
+#define NEEDS_VALUE()                                                                          \
+    v = take_value(argc, argv, &i, eq);                                                        \
+    if (!v)                                                                                    \
+        return usage_error("%s needs a value%s", name, "");
+        if (strcmp(name, "--scene") == 0) {
+            NEEDS_VALUE();
+            if (o->scene)
+                return usage_error("more than one scene given ('%s' and '%s')", o->scene, v);
+            o->scene = v;
+        } else if (strcmp(name, "-o") == 0 || strcmp(name, "--output") == 0) {
+            NEEDS_VALUE();
+            if (!*v)
+                return usage_error("%s needs a file name%s", name, "");
+            o->output = v;
+        } else if (strcmp(name, "--width") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 32768, &o->width);
+        } else if (strcmp(name, "--height") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 32768, &o->height);
+        } else if (strcmp(name, "--spp") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 1u << 20, &o->spp);
+        } else if (strcmp(name, "--max-depth") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 10000, &o->max_depth);
+        } else if (strcmp(name, "--seed") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u64(name, v, 0, UINT64_MAX, &o->seed);
+        } else if (strcmp(name, "--threads") == 0) {
+            uint32_t t = 0;
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 1024, &t);
+            o->threads = (int)t;
+        } else if (strcmp(name, "--devices") == 0) {
+            NEEDS_VALUE();
+            rc = parse_devices(v, o);
+        } else if (strcmp(name, "--sampling") == 0) {
+            NEEDS_VALUE();
+            if (!rs_sampling_parse(v, &o->sampling))
+                return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
+                                   "uniform)",
+                                   v, "");
+        } else if (strcmp(name, "--chunk-size") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
+        } else if (strcmp(name, "--wave-size") == 0) {
+            NEEDS_VALUE();
+            rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
+        } else {
+            return usage_error("unknown option '%s'%s", a, "");
+        }
+#undef NEEDS_VALUE
+        if (rc != RS_EXIT_OK)
+            return rc;
+    }
+    if (!o->scene)
+        o->scene = "builtin:cornell";
+    return RS_EXIT_OK;
+}

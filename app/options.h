@@ -1,0 +1,51 @@
+/* app/options.h — the command line of `raystream`. */
+#ifndef RS_APP_OPTIONS_H
+#define RS_APP_OPTIONS_H
+
+#include <stdint.h>
+
+#include "shading/integrator.h"
+
+#define RS_EXIT_OK 0
+#define RS_EXIT_RUNTIME 1
+#define RS_EXIT_USAGE 2
+#define RS_EXIT_INTERRUPTED 130
+
+#define RS_MAX_DEVICES 16
+
+typedef enum rs_cli_command {
+    RS_CMD_RENDER,
+    RS_CMD_SCENES,
+    RS_CMD_HELP,
+    RS_CMD_VERSION
+} rs_cli_command;
+
+typedef struct rs_device_spec {
+    int is_gpu;   /* 0: cpu, 1: gpu */
+    int index;    /* gpu: CUDA device index */
+    int threads;  /* cpu: thread count, 0 = the --threads value */
+} rs_device_spec;
+
+typedef struct rs_cli_options {
+    rs_cli_command command;
+    const char *scene;         /* "builtin:NAME" */
+    const char *output;        /* NULL: "<scene name>.png" */
+    uint32_t width, height;    /* 0: the scene's own */
+    uint32_t spp;
+    uint32_t max_depth;
+    uint64_t seed;
+    int threads;               /* 0: every core */
+    rs_sampling sampling;
+    uint32_t chunk_size;
+    uint32_t wave_paths;
+    int quiet;
+    int n_devices;
+    rs_device_spec devices[RS_MAX_DEVICES];
+} rs_cli_options;
+
+/* Parses argv.  Returns RS_EXIT_OK, or RS_EXIT_USAGE after printing one line naming the
+ * problem on stderr. */
+int rs_cli_parse(int argc, char **argv, rs_cli_options *o);
+void rs_cli_print_help(const char *command);
+
+#endif

@@ -1,0 +1,58 @@
+/* core/alloc.c — see alloc.h. */
+#include "core/alloc.h"
+
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+static atomic_long g_fail_after = -1;
+
+int rs_mul_size(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > SIZE_MAX / a)
+        return 0;
+    *out = a * b;
+    return 1;
+}
+
+static int should_fail(void)
+{
+    long left = atomic_load(&g_fail_after);
+    while (left >= 0) {
+        if (atomic_compare_exchange_weak(&g_fail_after, &left, left - 1))
+            return left == 0;
+    }
+    return 0;
+}
+
+void *rs_alloc(size_t n, size_t size)
+{
+    size_t bytes;
+    if (!rs_mul_size(n, size, &bytes) || should_fail())
+        return NULL;
+    return malloc(bytes ? bytes : 1);
+}
+
+void *rs_calloc(size_t n, size_t size)
+{
+    size_t bytes;
+    if (!rs_mul_size(n, size, &bytes) || should_fail())
+        return NULL;
+    return calloc(bytes ? n : 1, bytes ? size : 1);
+}
+
+void *rs_alloc_aligned(size_t n, size_t size)
+{
+    size_t bytes;
+    void *p = NULL;
+    if (!rs_mul_size(n, size, &bytes) || should_fail())
+        return NULL;
+    bytes = (bytes + 63) & ~(size_t)63;
+    if (posix_memalign(&p, 64, bytes ? bytes : 64) != 0)
+        return NULL;
+    return p;
+}
+
+void rs_free(void *p) { free(p); }
+
+void rs_alloc_fail_after(long n) { atomic_store(&g_fail_after, n < 0 ? -1 : n); }

@@ -1,0 +1,27 @@
+/* core/alloc.h — the one allocator hook.  Every allocation of the library goes through here so
+ * that tests can make the n-th allocation fail (rs_alloc_fail_after) and check that each caller
+ * cleans up and reports RS_ERR_NOMEM.  Sizes are overflow-checked. */
+#ifndef RS_CORE_ALLOC_H
+#define RS_CORE_ALLOC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* n * size bytes, uninitialised, or NULL if the product overflows or memory is short. */
+void *rs_alloc(size_t n, size_t size);
+/* n * size zeroed bytes, or NULL. */
+void *rs_calloc(size_t n, size_t size);
+/* 64-byte aligned n * size bytes (for stream arrays), or NULL.  Free with rs_free. */
+void *rs_alloc_aligned(size_t n, size_t size);
+void rs_free(void *p);
+/* Test hook: the allocation after the next `n` ones fails; n < 0 switches failures off. */
+void rs_alloc_fail_after(long n);
+/* Overflow-checked a * b; returns 0 and leaves *out alone on overflow. */
+int rs_mul_size(size_t a, size_t b, size_t *out);
+#ifdef __cplusplus
+}
+#endif
+#endif

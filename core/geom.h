@@ -1,0 +1,39 @@
+/* core/geom.h — the scene's geometry as traversal sees it: flat arrays of each primitive type and
+ * one global primitive numbering over them (spheres first, then quads, then triangles):
+ *
+ *   prim in [0, ns)              sphere  prim
+ *   prim in [ns, ns + nq)        quad    prim - ns
+ *   prim in [ns + nq, ns+nq+nt)  tri     prim - ns - nq
+ *
+ * The same struct holds host pointers on the CPU and device pointers on the GPU. */
+#ifndef RS_CORE_GEOM_H
+#define RS_CORE_GEOM_H
+
+#include "core/intersect.h"
+
+typedef struct rs_geom {
+    const rs_sphere *spheres;
+    const rs_quad *quads;
+    const rs_tri *tris;
+    uint32_t n_spheres, n_quads, n_tris;
+} rs_geom;
+
+RS_HD uint32_t rs_geom_prim_count(const rs_geom *g) { return g->n_spheres + g->n_quads + g->n_tris; }
+
+/* Intersects global primitive `prim`; on a hit writes t, u, v and returns 1. */
+RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, float *t, float *u,
+                            float *v)
+{
+    if (prim < g->n_spheres) {
+        *u = 0.0f;
+        *v = 0.0f;
+        return rs_isect_sphere(&g->spheres[prim], r, t);
+    }
+    prim -= g->n_spheres;
+    if (prim < g->n_quads)
+        return rs_isect_quad(&g->quads[prim], r, t, u, v);
+    prim -= g->n_quads;
+    return rs_isect_tri(&g->tris[prim], r, t, u, v);
+}
+
+#endif

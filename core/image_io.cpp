@@ -1,0 +1,175 @@
+// core/image_io.cpp — the OpenImageIO shim (see image_io.h).  The only C++ file of the project;
+// every entry point catches all exceptions and turns them into rs_status + message.
+#include "core/image_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "core/alloc.h"
+
+namespace {
+
+std::string lower_ext(const char *path)
+{
+    const char *slash = std::strrchr(path, '/');
+    const char *dot = std::strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        return "";
+    std::string e(dot + 1);
+    for (auto &c : e)
+        c = (char)std::tolower((unsigned char)c);
+    return e;
+}
+
+bool is_float_format(const std::string &e) { return e == "exr" || e == "hdr" || e == "pfm"; }
+
+bool is_8bit_format(const std::string &e)
+{
+    return e == "png" || e == "jpg" || e == "jpeg" || e == "tif" || e == "tiff" || e == "bmp" ||
+           e == "tga";
+}
+
+std::string dir_of(const char *path)
+{
+    const char *slash = std::strrchr(path, '/');
+    if (!slash)
+        return ".";
+    if (slash == path)
+        return "/";
+    return std::string(path, (size_t)(slash - path));
+}
+
+std::string temp_name(const char *path)
+{
+    return std::string(path) + ".tmp-" + std::to_string((long)getpid());
+}
+
+} // namespace
+
+extern "C" float rs_srgb_encode(float x)
+{
+    if (!(x > 0.0f))
+        return 0.0f;
+    if (x >= 1.0f)
+        return 1.0f;
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+}
+
+extern "C" rs_status rs_image_check_output(const char *path)
+{
+    try {
+        std::string e = lower_ext(path);
+        if (e.empty())
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: output file has no extension (use .png, .exr or .hdr)", path);
+        if (!is_float_format(e) && !is_8bit_format(e))
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: unsupported output format '.%s' (use .png, .exr, .hdr, .jpg "
+                                "or .tif)",
+                                path, e.c_str());
+        auto out = OIIO::ImageOutput::create(path);
+        if (!out)
+            return rs_error_set(RS_ERR_ARG, "%s: OpenImageIO cannot write '.%s' files", path,
+                                e.c_str());
+        std::string probe = temp_name(path);
+        FILE *f = std::fopen(probe.c_str(), "wx");
+        if (!f)
+            return rs_error_set(RS_ERR_IO, "%s: cannot write to folder '%s': %s", path,
+                                dir_of(path).c_str(), std::strerror(errno));
+        std::fclose(f);
+        std::remove(probe.c_str());
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
+    } catch (...) {
+        return rs_error_set(RS_ERR_IO, "%s: unknown error checking the output", path);
+    }
+}
+
+extern "C" rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, const float *rgb)
+{
+    std::string tmp = temp_name(path);
+    try {
+        std::string e = lower_ext(path);
+        size_t n = (size_t)w * h * 3;
+        auto out = OIIO::ImageOutput::create(path);
+        if (!out)
+            return rs_error_set(RS_ERR_ARG, "%s: OpenImageIO cannot write this format", path);
+        bool ok;
+        if (is_float_format(e)) {
+            OIIO::ImageSpec spec((int)w, (int)h, 3, OIIO::TypeDesc::FLOAT);
+            spec.attribute("oiio:ColorSpace", "Linear");
+            ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb);
+        } else {
+            std::vector<unsigned char> px(n);
+            for (size_t i = 0; i < n; ++i)
+                px[i] = (unsigned char)std::lround(255.0f * rs_srgb_encode(rgb[i]));
+            OIIO::ImageSpec spec((int)w, (int)h, 3, OIIO::TypeDesc::UINT8);
+            spec.attribute("oiio:ColorSpace", "sRGB");
+            ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::UINT8, px.data());
+        }
+        ok = out->close() && ok;
+        if (!ok) {
+            std::string msg = out->geterror();
+            std::remove(tmp.c_str());
+            return rs_error_set(RS_ERR_IO, "%s: write failed: %s", path, msg.c_str());
+        }
+        if (std::rename(tmp.c_str(), path) != 0) {
+            int err = errno;
+            std::remove(tmp.c_str());
+            return rs_error_set(RS_ERR_IO, "%s: cannot rename the finished file into place: %s",
+                                path, std::strerror(err));
+        }
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        std::remove(tmp.c_str());
+        return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
+    } catch (...) {
+        std::remove(tmp.c_str());
+        return rs_error_set(RS_ERR_IO, "%s: unknown error writing the image", path);
+    }
+}
+
+extern "C" rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
+{
+    *rgb = nullptr;
+    try {
+        auto in = OIIO::ImageInput::open(path);
+        if (!in)
+            return rs_error_set(RS_ERR_IO, "%s: cannot open image: %s", path,
+                                OIIO::geterror().c_str());
+        const OIIO::ImageSpec &spec = in->spec();
+        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+            return rs_error_set(RS_ERR_IO, "%s: empty image", path);
+        size_t npix = (size_t)spec.width * (size_t)spec.height;
+        std::vector<float> all(npix * (size_t)spec.nchannels);
+        if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
+        float *o = (float *)rs_alloc(npix * 3, sizeof(float));
+        if (!o)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
+        int nc = spec.nchannels;
+        for (size_t i = 0; i < npix; ++i)
+            for (int c = 0; c < 3; ++c)
+                o[3 * i + c] = all[i * nc + (c < nc ? c : 0)];
+        *w = (uint32_t)spec.width;
+        *h = (uint32_t)spec.height;
+        *rgb = o;
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
+    } catch (...) {
+        return rs_error_set(RS_ERR_IO, "%s: unknown error reading the image", path);
+    }
+}
+
+extern "C" const char *rs_image_library_version(void) { return OIIO_VERSION_STRING; }

@@ -1,0 +1,39 @@
+/* core/image_io.h — image files through OpenImageIO, behind a small C API.
+ *
+ * The format follows the file extension.  Float formats (.exr, .hdr, .pfm) get linear radiance;
+ * 8-bit formats (.png, .jpg, .jpeg, .tif, .tiff, .bmp, .tga) get the sRGB transfer curve after
+ * clamping to [0, 1].  Writes go to a temporary file beside the target that is renamed over it
+ * only once complete, so a failed or interrupted write never leaves a partial file and never
+ * clobbers a good one.  C++ exceptions stop at this API's edge. */
+#ifndef RS_CORE_IMAGE_IO_H
+#define RS_CORE_IMAGE_IO_H
+
+#include <stdint.h>
+
+#include "core/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Checks, before any work, that `path` has a supported extension and that its folder exists
+ * and accepts new files (by creating and removing a probe file). */
+rs_status rs_image_check_output(const char *path);
+
+/* Writes width x height RGB (3 floats a pixel, row-major from the top-left, linear). */
+rs_status rs_image_write(const char *path, uint32_t width, uint32_t height, const float *rgb);
+
+/* Reads any image OpenImageIO knows as RGB floats in the file's own encoding (8-bit files give
+ * their code values / 255, not decoded).  *rgb is allocated with rs_alloc; free with rs_free. */
+rs_status rs_image_read(const char *path, uint32_t *width, uint32_t *height, float **rgb);
+
+/* "2.4.7" */
+const char *rs_image_library_version(void);
+
+/* The sRGB encoding of a linear value, clamped to [0, 1]. */
+float rs_srgb_encode(float linear);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

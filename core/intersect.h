@@ -1,0 +1,136 @@
+/* core/intersect.h — ray/primitive and ray/box tests, shared by host and device.
+ *
+ * Every test takes the ray's open interval (tmin, tmax) and reports a hit only strictly inside
+ * it; a NaN distance is never a hit.  Each function writes its outputs only on a hit.
+ *
+ * Primitive layouts (byte budgets matter: these are what the traversal streams through):
+ *   rs_sphere  16 B  centre + radius
+ *   rs_quad    48 B  corner Q, edges u and v, w = n / (n.n) with n = u x v (Shirley, RTNW §6)
+ *   rs_tri     36 B  three vertices */
+#ifndef RS_CORE_INTERSECT_H
+#define RS_CORE_INTERSECT_H
+
+#include "core/ray.h"
+
+typedef struct rs_sphere {
+    rs_vec3 center;
+    float radius;
+} rs_sphere;
+
+typedef struct rs_quad {
+    rs_vec3 q, u, v, w;
+} rs_quad;
+
+typedef struct rs_tri {
+    rs_vec3 v0, v1, v2;
+} rs_tri;
+
+typedef struct rs_aabb {
+    rs_vec3 lo, hi;
+} rs_aabb;
+
+/* Builds a quad from corner and edges, precomputing w. */
+RS_HD rs_quad rs_quad_make(rs_vec3 q, rs_vec3 u, rs_vec3 v)
+{
+    rs_quad r;
+    rs_vec3 n = rs_v3_cross(u, v);
+    r.q = q;
+    r.u = u;
+    r.v = v;
+    r.w = rs_v3_scale(n, 1.0f / rs_v3_dot(n, n));
+    return r;
+}
+
+/* Ray/sphere, the half-b quadratic (RTIOW §6.2).  On a hit: *t, and u = v = 0 (the shading step
+ * derives the sphere's parameterisation from the hit point).  A ray starting inside the sphere
+ * hits the far side. */
+RS_HD int rs_isect_sphere(const rs_sphere *s, const rs_ray *r, float *t)
+{
+    rs_vec3 oc = rs_v3_sub(s->center, r->o);
+    float a = rs_v3_dot(r->d, r->d);
+    float h = rs_v3_dot(r->d, oc);
+    float c = rs_v3_dot(oc, oc) - s->radius * s->radius;
+    float disc = h * h - a * c;
+    float sq, root;
+    if (!(disc >= 0.0f))
+        return 0;
+    sq = sqrtf(disc);
+    root = (h - sq) / a;
+    if (!(root > r->tmin && root < r->tmax)) {
+        root = (h + sq) / a;
+        if (!(root > r->tmin && root < r->tmax))
+            return 0;
+    }
+    *t = root;
+    return 1;
+}
+
+/* Ray/triangle, Möller & Trumbore 1997.  On a hit: *t and the barycentrics (*u, *v) of v1 and v2.
+ * Both faces are hit; a ray in the triangle's plane misses. */
+RS_HD int rs_isect_tri(const rs_tri *tr, const rs_ray *r, float *t, float *u, float *v)
+{
+    rs_vec3 e1 = rs_v3_sub(tr->v1, tr->v0);
+    rs_vec3 e2 = rs_v3_sub(tr->v2, tr->v0);
+    rs_vec3 p = rs_v3_cross(r->d, e2);
+    float det = rs_v3_dot(e1, p);
+    float inv, bu, bv, tt;
+    rs_vec3 s, q;
+    if (det == 0.0f)
+        return 0;
+    inv = 1.0f / det;
+    s = rs_v3_sub(r->o, tr->v0);
+    bu = rs_v3_dot(s, p) * inv;
+    if (!(bu >= 0.0f && bu <= 1.0f))
+        return 0;
+    q = rs_v3_cross(s, e1);
+    bv = rs_v3_dot(r->d, q) * inv;
+    if (!(bv >= 0.0f && bu + bv <= 1.0f))
+        return 0;
+    tt = rs_v3_dot(e2, q) * inv;
+    if (!(tt > r->tmin && tt < r->tmax))
+        return 0;
+    *t = tt;
+    *u = bu;
+    *v = bv;
+    return 1;
+}
+
+/* Ray/parallelogram Q + a u + b v, 0 <= a, b <= 1 (Shirley, "Ray Tracing: The Next Week" §6).
+ * On a hit: *t and the planar coordinates (*a, *b).  The scale of w cancels in t. */
+RS_HD int rs_isect_quad(const rs_quad *qd, const rs_ray *r, float *t, float *a, float *b)
+{
+    float denom = rs_v3_dot(qd->w, r->d);
+    float tt, alpha, beta;
+    rs_vec3 ph;
+    if (denom == 0.0f)
+        return 0;
+    tt = rs_v3_dot(qd->w, rs_v3_sub(qd->q, r->o)) / denom;
+    if (!(tt > r->tmin && tt < r->tmax))
+        return 0;
+    ph = rs_v3_sub(rs_ray_at(r, tt), qd->q);
+    alpha = rs_v3_dot(qd->w, rs_v3_cross(ph, qd->v));
+    beta = rs_v3_dot(qd->w, rs_v3_cross(qd->u, ph));
+    if (!(alpha >= 0.0f && alpha <= 1.0f && beta >= 0.0f && beta <= 1.0f))
+        return 0;
+    *t = tt;
+    *a = alpha;
+    *b = beta;
+    return 1;
+}
+
+/* Ray/box slab test (Kay & Kajiya 1986) with a precomputed reciprocal direction.  Returns 1 and
+ * the entry distance when the box overlaps (tmin, tmax).  fminf/fmaxf drop the NaN that 0 * inf
+ * makes for a ray lying in a slab plane, so such a ray is conservatively counted as inside. */
+RS_HD int rs_isect_aabb(const rs_aabb *b, rs_vec3 o, rs_vec3 inv_d, float tmin, float tmax,
+                        float *t_entry)
+{
+    float tx0 = (b->lo.x - o.x) * inv_d.x, tx1 = (b->hi.x - o.x) * inv_d.x;
+    float ty0 = (b->lo.y - o.y) * inv_d.y, ty1 = (b->hi.y - o.y) * inv_d.y;
+    float tz0 = (b->lo.z - o.z) * inv_d.z, tz1 = (b->hi.z - o.z) * inv_d.z;
+    float tn = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), tmin));
+    float tf = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)), fminf(fmaxf(tz0, tz1), tmax));
+    *t_entry = tn;
+    return tn <= tf;
+}
+
+#endif

@@ -1,0 +1,61 @@
+/* core/vec3.h — three-float vectors and colours, shared by host and device.
+ * 12 bytes, no padding, so arrays of rs_vec3 have the same bytes on CPU and GPU. */
+#ifndef RS_CORE_VEC3_H
+#define RS_CORE_VEC3_H
+
+#include <math.h>
+#include "core/hd.h"
+
+typedef struct rs_vec3 {
+    float x, y, z;
+} rs_vec3;
+
+RS_HD rs_vec3 rs_v3(float x, float y, float z)
+{
+    rs_vec3 r;
+    r.x = x;
+    r.y = y;
+    r.z = z;
+    return r;
+}
+RS_HD rs_vec3 rs_v3_splat(float s) { return rs_v3(s, s, s); }
+RS_HD rs_vec3 rs_v3_add(rs_vec3 a, rs_vec3 b) { return rs_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+RS_HD rs_vec3 rs_v3_sub(rs_vec3 a, rs_vec3 b) { return rs_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+RS_HD rs_vec3 rs_v3_mul(rs_vec3 a, rs_vec3 b) { return rs_v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+RS_HD rs_vec3 rs_v3_scale(rs_vec3 a, float s) { return rs_v3(a.x * s, a.y * s, a.z * s); }
+RS_HD rs_vec3 rs_v3_neg(rs_vec3 a) { return rs_v3(-a.x, -a.y, -a.z); }
+/* a + b * s */
+RS_HD rs_vec3 rs_v3_madd(rs_vec3 a, rs_vec3 b, float s)
+{
+    return rs_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s);
+}
+RS_HD float rs_v3_dot(rs_vec3 a, rs_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+RS_HD rs_vec3 rs_v3_cross(rs_vec3 a, rs_vec3 b)
+{
+    return rs_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+RS_HD float rs_v3_length2(rs_vec3 a) { return rs_v3_dot(a, a); }
+RS_HD float rs_v3_length(rs_vec3 a) { return sqrtf(rs_v3_dot(a, a)); }
+/* Unit vector along a; a must not be zero. */
+RS_HD rs_vec3 rs_v3_normalize(rs_vec3 a) { return rs_v3_scale(a, 1.0f / rs_v3_length(a)); }
+RS_HD rs_vec3 rs_v3_min(rs_vec3 a, rs_vec3 b)
+{
+    return rs_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z));
+}
+RS_HD rs_vec3 rs_v3_max(rs_vec3 a, rs_vec3 b)
+{
+    return rs_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z));
+}
+RS_HD float rs_v3_max_comp(rs_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+RS_HD float rs_v3_get(rs_vec3 a, int axis) { return axis == 0 ? a.x : (axis == 1 ? a.y : a.z); }
+RS_HD int rs_v3_is_zero(rs_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+
+/* Rotation about the y axis by `deg` degrees (right-handed, as RTIOW's rotate_y). */
+RS_HD rs_vec3 rs_v3_rotate_y(rs_vec3 p, float deg)
+{
+    float r = deg * 0.017453292519943295f;
+    float c = cosf(r), s = sinf(r);
+    return rs_v3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);
+}
+
+#endif

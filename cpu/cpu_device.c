@@ -1,0 +1,64 @@
+/* cpu/cpu_device.c — see cpu_device.h.  Borrows the host scene and BVH arrays (no copy). */
+#include "cpu/cpu_device.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "core/alloc.h"
+
+typedef struct cpu_impl {
+    rs_geom geom;
+    rs_bvh_view bvh;
+    int uploaded;
+} cpu_impl;
+
+static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
+{
+    cpu_impl *c = (cpu_impl *)d->impl;
+    c->geom = *g;
+    c->bvh = rs_bvh_view_of(bvh);
+    c->uploaded = 1;
+    return RS_OK;
+}
+
+static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin,
+                           uint32_t end)
+{
+    const cpu_impl *c = (const cpu_impl *)d->impl;
+    const rs_bvh_view *bv = &c->bvh;
+    const rs_geom *g = &c->geom;
+    long i;
+    if (!c->uploaded)
+        return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
+    /* dynamic schedule: ray costs vary a lot (a miss of the root box vs a deep traversal) */
+#pragma omp parallel for num_threads(d->threads) schedule(dynamic, 256) if (d->threads > 1)
+    for (i = (long)begin; i < (long)end; ++i)
+        rs_trace_one(bv, g, batch, (uint32_t)i);
+    return RS_OK;
+}
+
+static void cpu_destroy(rs_device *d)
+{
+    rs_free(d->impl);
+    rs_free(d);
+}
+
+static const rs_device_ops cpu_ops = {cpu_upload, cpu_trace, cpu_destroy};
+
+rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
+{
+    rs_device *d = (rs_device *)rs_calloc(1, sizeof *d);
+    cpu_impl *c = (cpu_impl *)rs_calloc(1, sizeof *c);
+    *out = NULL;
+    if (!d || !c) {
+        rs_free(d);
+        rs_free(c);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory creating the CPU device");
+    }
+    d->ops = &cpu_ops;
+    d->impl = c;
+    d->threads = threads < 1 ? 1 : threads;
+    snprintf(d->name, sizeof d->name, "%s", name ? name : "cpu");
+    *out = d;
+    return RS_OK;
+}

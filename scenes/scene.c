@@ -1,0 +1,271 @@
+/* scenes/scene.c — see scene.h. */
+#include "scenes/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/alloc.h"
+
+/* Grows *arr (of element size `size`) to hold at least `need` elements. */
+static int grow(void **arr, uint32_t *cap, uint32_t need, size_t size)
+{
+    uint32_t n;
+    void *p;
+    if (need <= *cap)
+        return 1;
+    n = *cap ? *cap : 16;
+    while (n < need) {
+        if (n > UINT32_MAX / 2)
+            return 0;
+        n *= 2;
+    }
+    p = rs_alloc(n, size);
+    if (!p)
+        return 0;
+    if (*arr)
+        memcpy(p, *arr, (size_t)*cap * size);
+    rs_free(*arr);
+    *arr = p;
+    *cap = n;
+    return 1;
+}
+
+/* Grows a primitive array and its parallel material array together. */
+static rs_status grow_prims(void **prims, uint32_t **mats, uint32_t *cap, uint32_t need,
+                            size_t size)
+{
+    uint32_t cap_p = *cap, cap_m = *cap;
+    if (!grow(prims, &cap_p, need, size) || !grow((void **)mats, &cap_m, need, sizeof **mats))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding primitives");
+    /* both grow by the same doubling rule from the same start, so the capacities agree */
+    *cap = cap_p < cap_m ? cap_p : cap_m;
+    return RS_OK;
+}
+
+rs_status rs_scene_create(const char *name, rs_scene **out)
+{
+    rs_scene *s = (rs_scene *)rs_calloc(1, sizeof *s);
+    *out = NULL;
+    if (!s)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory creating a scene");
+    snprintf(s->name, sizeof s->name, "%s", name ? name : "scene");
+    s->camera.from = rs_v3(0, 0, 1);
+    s->camera.at = rs_v3(0, 0, 0);
+    s->camera.up = rs_v3(0, 1, 0);
+    s->camera.vfov_deg = 40.0f;
+    s->width = s->height = 512;
+    *out = s;
+    return RS_OK;
+}
+
+void rs_scene_destroy(rs_scene *s)
+{
+    if (!s)
+        return;
+    rs_free(s->spheres);
+    rs_free(s->sphere_mat);
+    rs_free(s->quads);
+    rs_free(s->quad_mat);
+    rs_free(s->tris);
+    rs_free(s->tri_mat);
+    rs_free(s->materials);
+    rs_free(s->lights);
+    rs_free(s->light_cdf);
+    rs_free(s->prim_light);
+    rs_free(s);
+}
+
+rs_status rs_scene_add_material(rs_scene *s, const rs_material *m, uint32_t *id)
+{
+    if (!grow((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof *m))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding a material");
+    s->materials[s->n_materials] = *m;
+    *id = s->n_materials++;
+    return RS_OK;
+}
+
+static rs_status check_mat(const rs_scene *s, uint32_t mat)
+{
+    if (mat >= s->n_materials)
+        return rs_error_set(RS_ERR_ARG, "material id %u out of range (scene has %u)", mat,
+                            s->n_materials);
+    return RS_OK;
+}
+
+rs_status rs_scene_add_sphere(rs_scene *s, rs_vec3 center, float radius, uint32_t mat)
+{
+    rs_status st = check_mat(s, mat);
+    if (st == RS_OK)
+        st = grow_prims((void **)&s->spheres, &s->sphere_mat, &s->cap_spheres, s->n_spheres + 1,
+                        sizeof *s->spheres);
+    if (st != RS_OK)
+        return st;
+    s->spheres[s->n_spheres].center = center;
+    s->spheres[s->n_spheres].radius = radius;
+    s->sphere_mat[s->n_spheres++] = mat;
+    s->finalized = 0;
+    return RS_OK;
+}
+
+rs_status rs_scene_add_quad(rs_scene *s, rs_vec3 q, rs_vec3 u, rs_vec3 v, uint32_t mat)
+{
+    rs_status st = check_mat(s, mat);
+    if (st == RS_OK)
+        st = grow_prims((void **)&s->quads, &s->quad_mat, &s->cap_quads, s->n_quads + 1,
+                        sizeof *s->quads);
+    if (st != RS_OK)
+        return st;
+    s->quads[s->n_quads] = rs_quad_make(q, u, v);
+    s->quad_mat[s->n_quads++] = mat;
+    s->finalized = 0;
+    return RS_OK;
+}
+
+rs_status rs_scene_add_triangle(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2, uint32_t mat)
+{
+    rs_status st = check_mat(s, mat);
+    if (st == RS_OK)
+        st = grow_prims((void **)&s->tris, &s->tri_mat, &s->cap_tris, s->n_tris + 1,
+                        sizeof *s->tris);
+    if (st != RS_OK)
+        return st;
+    s->tris[s->n_tris].v0 = v0;
+    s->tris[s->n_tris].v1 = v1;
+    s->tris[s->n_tris].v2 = v2;
+    s->tri_mat[s->n_tris++] = mat;
+    s->finalized = 0;
+    return RS_OK;
+}
+
+rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
+                           uint32_t mat)
+{
+    rs_vec3 dx = rs_v3(hi.x - lo.x, 0, 0), dy = rs_v3(0, hi.y - lo.y, 0);
+    rs_vec3 dz = rs_v3(0, 0, hi.z - lo.z);
+    /* the six faces of RTNW v4's box(), each with its normal pointing out */
+    rs_vec3 q[6], u[6], v[6];
+    int i;
+    q[0] = rs_v3(lo.x, lo.y, hi.z), u[0] = dx, v[0] = dy;                  /* front  +z */
+    q[1] = rs_v3(hi.x, lo.y, hi.z), u[1] = rs_v3_neg(dz), v[1] = dy;       /* right  +x */
+    q[2] = rs_v3(hi.x, lo.y, lo.z), u[2] = rs_v3_neg(dx), v[2] = dy;       /* back   -z */
+    q[3] = rs_v3(lo.x, lo.y, lo.z), u[3] = dz, v[3] = dy;                  /* left   -x */
+    q[4] = rs_v3(lo.x, hi.y, hi.z), u[4] = dx, v[4] = rs_v3_neg(dz);       /* top    +y */
+    q[5] = rs_v3(lo.x, lo.y, lo.z), u[5] = dx, v[5] = dz;                  /* bottom -y */
+    for (i = 0; i < 6; ++i) {
+        rs_vec3 qq = rs_v3_add(rs_v3_rotate_y(q[i], rot_y_deg), offset);
+        rs_status st = rs_scene_add_quad(s, qq, rs_v3_rotate_y(u[i], rot_y_deg),
+                                         rs_v3_rotate_y(v[i], rot_y_deg), mat);
+        if (st != RS_OK)
+            return st;
+    }
+    return RS_OK;
+}
+
+static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+static float luminance(rs_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+static float prim_area(const rs_scene *s, uint32_t prim)
+{
+    if (prim < s->n_spheres) {
+        float r = s->spheres[prim].radius;
+        return 4.0f * 3.14159265358979f * r * r;
+    }
+    prim -= s->n_spheres;
+    if (prim < s->n_quads)
+        return rs_v3_length(rs_v3_cross(s->quads[prim].u, s->quads[prim].v));
+    prim -= s->n_quads;
+    {
+        const rs_tri *t = &s->tris[prim];
+        return 0.5f * rs_v3_length(rs_v3_cross(rs_v3_sub(t->v1, t->v0), rs_v3_sub(t->v2, t->v0)));
+    }
+}
+
+rs_status rs_scene_finalize(rs_scene *s)
+{
+    uint32_t i, n = rs_scene_prim_count(s), nl = 0;
+    double total = 0.0, acc = 0.0;
+    for (i = 0; i < s->n_spheres; ++i)
+        if (!finite3(s->spheres[i].center) || !isfinite(s->spheres[i].radius) ||
+            !(s->spheres[i].radius > 0.0f))
+            return rs_error_set(RS_ERR_ARG, "sphere %u: non-finite centre or radius <= 0", i);
+    for (i = 0; i < s->n_quads; ++i)
+        if (!finite3(s->quads[i].q) || !finite3(s->quads[i].w) ||
+            rs_v3_is_zero(rs_v3_cross(s->quads[i].u, s->quads[i].v)))
+            return rs_error_set(RS_ERR_ARG, "quad %u: non-finite or degenerate (zero area)", i);
+    for (i = 0; i < s->n_tris; ++i)
+        if (!finite3(s->tris[i].v0) || !finite3(s->tris[i].v1) || !finite3(s->tris[i].v2))
+            return rs_error_set(RS_ERR_ARG, "triangle %u: non-finite vertex", i);
+
+    rs_free(s->lights);
+    rs_free(s->light_cdf);
+    rs_free(s->prim_light);
+    s->lights = NULL;
+    s->light_cdf = NULL;
+    s->n_lights = 0;
+    s->prim_light = (int32_t *)rs_alloc(n ? n : 1, sizeof *s->prim_light);
+    if (!s->prim_light)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory preparing lights");
+    /* Quads and triangles with an emissive material become samplable lights.  Spheres stay
+     * out of the table until the sphere (cone) sampler lands: BSDF sampling still finds them,
+     * with full weight, so their light is counted exactly once either way. */
+    for (i = 0; i < n; ++i) {
+        const rs_material *m = rs_scene_prim_material(s, i);
+        s->prim_light[i] = -1;
+        if (i >= s->n_spheres && m->type == RS_MAT_DIFFUSE_LIGHT && luminance(m->emission) > 0.0f)
+            s->prim_light[i] = (int32_t)nl++;
+    }
+    if (nl > 0) {
+        s->lights = (rs_light *)rs_alloc(nl, sizeof *s->lights);
+        s->light_cdf = (float *)rs_alloc(nl + 1, sizeof *s->light_cdf);
+        if (!s->lights || !s->light_cdf)
+            return rs_error_set(RS_ERR_NOMEM, "out of memory preparing %u lights", nl);
+        for (i = 0; i < n; ++i) {
+            int32_t l = s->prim_light[i];
+            const rs_material *m;
+            if (l < 0)
+                continue;
+            m = rs_scene_prim_material(s, i);
+            s->lights[l].prim = i;
+            s->lights[l].area = prim_area(s, i);
+            s->lights[l].power = 3.14159265f * s->lights[l].area * luminance(m->emission) *
+                                 ((m->flags & RS_MAT_TWO_SIDED) ? 2.0f : 1.0f);
+            total += s->lights[l].power;
+        }
+        s->light_cdf[0] = 0.0f;
+        for (i = 0; i < nl; ++i) {
+            s->lights[i].pick_pdf = (float)(s->lights[i].power / total);
+            acc += s->lights[i].power;
+            s->light_cdf[i + 1] = (float)(acc / total);
+        }
+        s->light_cdf[nl] = 1.0f;
+    }
+    s->n_lights = nl;
+    s->finalized = 1;
+    return RS_OK;
+}
+
+rs_geom rs_scene_geom(const rs_scene *s)
+{
+    rs_geom g;
+    g.spheres = s->spheres;
+    g.quads = s->quads;
+    g.tris = s->tris;
+    g.n_spheres = s->n_spheres;
+    g.n_quads = s->n_quads;
+    g.n_tris = s->n_tris;
+    return g;
+}
+
+uint32_t rs_scene_prim_count(const rs_scene *s) { return s->n_spheres + s->n_quads + s->n_tris; }
+
+const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim)
+{
+    if (prim < s->n_spheres)
+        return &s->materials[s->sphere_mat[prim]];
+    prim -= s->n_spheres;
+    if (prim < s->n_quads)
+        return &s->materials[s->quad_mat[prim]];
+    return &s->materials[s->tri_mat[prim - s->n_quads]];
+}

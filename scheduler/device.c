@@ -1,0 +1,13 @@
+/* scheduler/device.c — thin wrappers over the device function table. */
+#include "scheduler/device.h"
+
+rs_status rs_device_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
+{
+    return d->ops->upload(d, g, bvh);
+}
+
+void rs_device_destroy(rs_device *d)
+{
+    if (d)
+        d->ops->destroy(d);
+}

@@ -1,0 +1,71 @@
+/* shading/film.c — see film.h. */
+#include "shading/film.h"
+
+#include <math.h>
+
+#include "core/alloc.h"
+
+rs_status rs_film_create(uint32_t width, uint32_t height, rs_film **out)
+{
+    size_t npix;
+    rs_film *f;
+    *out = NULL;
+    if (!rs_mul_size(width, height, &npix) || npix == 0)
+        return rs_error_set(RS_ERR_ARG, "bad image size %ux%u", width, height);
+    f = (rs_film *)rs_calloc(1, sizeof *f);
+    if (!f)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for the film");
+    f->width = width;
+    f->height = height;
+    f->sum = (double *)rs_calloc(npix * 3, sizeof *f->sum);
+    f->count = (uint32_t *)rs_calloc(npix, sizeof *f->count);
+    if (!f->sum || !f->count) {
+        rs_film_destroy(f);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for a %ux%u film", width, height);
+    }
+    *out = f;
+    return RS_OK;
+}
+
+void rs_film_destroy(rs_film *f)
+{
+    if (!f)
+        return;
+    rs_free(f->sum);
+    rs_free(f->count);
+    rs_free(f);
+}
+
+void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
+{
+    double *s = &f->sum[3 * (size_t)pixel];
+    f->count[pixel]++;
+    if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z))) {
+        f->nonfinite++;
+        return;
+    }
+    s[0] += c.x;
+    s[1] += c.y;
+    s[2] += c.z;
+}
+
+void rs_film_resolve(const rs_film *f, float *rgb)
+{
+    size_t i, n = (size_t)f->width * f->height;
+    for (i = 0; i < n; ++i) {
+        double inv = f->count[i] ? 1.0 / f->count[i] : 0.0;
+        rgb[3 * i + 0] = (float)(f->sum[3 * i + 0] * inv);
+        rgb[3 * i + 1] = (float)(f->sum[3 * i + 1] * inv);
+        rgb[3 * i + 2] = (float)(f->sum[3 * i + 2] * inv);
+    }
+}
+
+uint32_t rs_film_min_count(const rs_film *f)
+{
+    size_t i, n = (size_t)f->width * f->height;
+    uint32_t m = UINT32_MAX;
+    for (i = 0; i < n; ++i)
+        if (f->count[i] < m)
+            m = f->count[i];
+    return n ? m : 0;
+}

@@ -1,0 +1,26 @@
+/* shading/film.h — the image being accumulated: per pixel, the sum of sample radiances (double)
+ * and the number of samples.  A pixel's value is the mean (a box filter over the pixel, since
+ * samples are jittered uniformly inside it).  Samples are added in a fixed order by one thread
+ * (the render loop), so the sums are bit-reproducible. */
+#ifndef RS_SHADING_FILM_H
+#define RS_SHADING_FILM_H
+
+#include "core/status.h"
+#include "core/vec3.h"
+
+typedef struct rs_film {
+    uint32_t width, height;
+    double *sum;        /* 3 per pixel, row-major from the top-left */
+    uint32_t *count;    /* samples per pixel */
+    uint64_t nonfinite; /* samples that were NaN or infinite: counted, contributed zero */
+} rs_film;
+
+rs_status rs_film_create(uint32_t width, uint32_t height, rs_film **out);
+void rs_film_destroy(rs_film *f);
+void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 radiance);
+/* Writes width * height * 3 floats of mean radiance (0 where a pixel has no sample yet). */
+void rs_film_resolve(const rs_film *f, float *rgb);
+/* Fewest samples any pixel has. */
+uint32_t rs_film_min_count(const rs_film *f);
+
+#endif

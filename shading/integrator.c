@@ -1,0 +1,292 @@
+/* shading/integrator.c — raygen, shade and shadow-resolve stages (see integrator.h).
+ *
+ * Estimators, per sampling mode, at a diffuse vertex x with albedo a (f = a / pi):
+ *   mis      next-event: light sample y, weight w_l = p_l^2 / (p_l^2 + p_b^2), adds
+ *            beta f cos Le w_l / p_l if the shadow ray is free;  BSDF: cosine sample, beta *= a;
+ *            an emitter hit by that ray adds beta Le w_b, w_b = p_b^2 / (p_b^2 + p_l^2).
+ *   mixture  one direction from p = 1/2 p_light + 1/2 p_cos; beta *= f cos / p; emitters add
+ *            beta Le in full (the thesis's radiance_mixture).
+ *   bsdf     cosine sample; beta *= a; emitters add beta Le.
+ *   uniform  uniform hemisphere; beta *= 2 a cos; emitters add beta Le.
+ * All four estimate the same integral, so they converge to the same image (tested). */
+#include "shading/integrator.h"
+
+#include <float.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/rng.h"
+#include "shading/dims.h"
+#include "shading/lights.h"
+
+const char *rs_sampling_name(rs_sampling s)
+{
+    switch (s) {
+    case RS_SAMPLING_MIS: return "mis";
+    case RS_SAMPLING_MIXTURE: return "mixture";
+    case RS_SAMPLING_BSDF: return "bsdf";
+    case RS_SAMPLING_UNIFORM: return "uniform";
+    }
+    return "?";
+}
+
+int rs_sampling_parse(const char *text, rs_sampling *out)
+{
+    int i;
+    for (i = 0; i <= RS_SAMPLING_UNIFORM; ++i)
+        if (strcmp(text, rs_sampling_name((rs_sampling)i)) == 0) {
+            *out = (rs_sampling)i;
+            return 1;
+        }
+    return 0;
+}
+
+rs_status rs_paths_init(rs_paths *p, uint32_t capacity)
+{
+    memset(p, 0, sizeof *p);
+    p->throughput = (rs_vec3 *)rs_alloc_aligned(capacity, sizeof(rs_vec3));
+    p->radiance = (rs_vec3 *)rs_alloc_aligned(capacity, sizeof(rs_vec3));
+    p->pending = (rs_vec3 *)rs_alloc_aligned(capacity, sizeof(rs_vec3));
+    p->bsdf_pdf = (float *)rs_alloc_aligned(capacity, sizeof(float));
+    p->flags = (uint8_t *)rs_alloc_aligned(capacity, 1);
+    if (!p->throughput || !p->radiance || !p->pending || !p->bsdf_pdf || !p->flags) {
+        rs_paths_free(p);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for %u paths", capacity);
+    }
+    p->capacity = capacity;
+    return RS_OK;
+}
+
+void rs_paths_free(rs_paths *p)
+{
+    rs_free(p->throughput);
+    rs_free(p->radiance);
+    rs_free(p->pending);
+    rs_free(p->bsdf_pdf);
+    rs_free(p->flags);
+    memset(p, 0, sizeof *p);
+}
+
+void rs_integrator_raygen(const rs_integrator *it, uint64_t wave_start, uint32_t count,
+                          rs_paths *paths, rs_ray_soa *out)
+{
+    long i;
+#pragma omp parallel for num_threads(it->threads) schedule(static) if (it->threads > 1)
+    for (i = 0; i < (long)count; ++i) {
+        uint64_t g = wave_start + (uint64_t)i;
+        uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
+        rs_rng_f4 r = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_CAMERA);
+        rs_ray ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, r.v[0],
+                                   r.v[1], r.v[2], r.v[3]);
+        rs_ray_soa_set(out, (uint32_t)i, &ray, (uint32_t)i);
+        paths->throughput[i] = rs_v3_splat(1.0f);
+        paths->radiance[i] = rs_v3_splat(0.0f);
+        paths->pending[i] = rs_v3_splat(0.0f);
+        paths->bsdf_pdf[i] = 0.0f;
+        paths->flags[i] = RS_PATH_SPECULAR;
+    }
+    out->count = count;
+}
+
+/* Moves a ray origin off the surface along the normal on the side the ray leaves from; the
+ * offset scales with the coordinates so that it stays far above float rounding (~1e-7
+ * relative) at any scene scale. */
+static rs_vec3 offset_origin(rs_vec3 x, rs_vec3 n)
+{
+    float scale = fmaxf(fmaxf(fabsf(x.x), fabsf(x.y)), fmaxf(fabsf(x.z), 1e-2f));
+    return rs_v3_madd(x, n, 1e-4f * scale);
+}
+
+static float power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
+                      const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t j,
+                      rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
+                      uint8_t *shadow_valid)
+{
+    const rs_scene *sc = it->scene;
+    uint32_t p = rays->path[j], prim = hits->prim[j];
+    uint64_t g = wave_start + p;
+    uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
+    rs_ray r = rs_ray_soa_get(rays, j);
+    rs_vec3 beta = paths->throughput[p];
+    const rs_material *m;
+    rs_vec3 x, ng, n, xo, wi, albedo;
+    rs_onb frame;
+    rs_rng_f4 rb;
+    float t = hits->t[j], cos_i, pdf;
+
+    next_valid[j] = 0;
+    shadow_valid[j] = 0;
+    if (prim == RS_NO_HIT) {
+        paths->radiance[p] = rs_v3_add(paths->radiance[p], rs_v3_mul(beta, sc->background));
+        return;
+    }
+    m = rs_scene_prim_material(sc, prim);
+    x = rs_ray_at(&r, t);
+    ng = rs_prim_normal(sc, prim, x);
+
+    if (m->type == RS_MAT_DIFFUSE_LIGHT) {
+        rs_vec3 le = rs_emitted(m, ng, r.d);
+        float w = 1.0f;
+        int32_t l = sc->prim_light[prim];
+        if (it->sampling == RS_SAMPLING_MIS && !(paths->flags[p] & RS_PATH_SPECULAR) && l >= 0)
+            w = power_heuristic(paths->bsdf_pdf[p], rs_light_pdf_hit(sc, (uint32_t)l, r.d, t, ng));
+        paths->radiance[p] = rs_v3_add(paths->radiance[p], rs_v3_scale(rs_v3_mul(beta, le), w));
+        return; /* emitters reflect nothing */
+    }
+
+    /* Lambertian from here on.  The segment after this vertex would be number bounce + 1. */
+    if (bounce + 1 >= it->max_depth)
+        return;
+    n = rs_v3_dot(ng, r.d) < 0.0f ? ng : rs_v3_neg(ng); /* two-sided: face the incoming ray */
+    xo = offset_origin(x, n);
+    albedo = m->albedo;
+    frame = rs_onb_from_normal(n);
+
+    if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
+        rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
+        rs_light_sample ls;
+        if (rs_light_sample_at(sc, xo, rl.v[0], rl.v[1], rl.v[2], &ls)) {
+            float c = rs_v3_dot(n, ls.wi);
+            if (c > 0.0f && !rs_v3_is_zero(ls.le)) {
+                float w = power_heuristic(ls.pdf, rs_pdf_cosine_hemisphere(c));
+                rs_vec3 f = rs_v3_scale(albedo, RS_INV_PI);
+                rs_ray sr;
+                paths->pending[p] = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, f), ls.le), c * w / ls.pdf);
+                sr.o = xo;
+                sr.d = rs_v3_sub(ls.point, xo); /* unnormalised: the light is at t = 1 */
+                sr.tmin = 0.0f;
+                sr.tmax = 1.0f - 1e-4f;
+                rs_ray_soa_set(shadow, j, &sr, p);
+                shadow_valid[j] = 1;
+            }
+        }
+    }
+
+    rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
+    switch (it->sampling) {
+    case RS_SAMPLING_UNIFORM:
+        wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
+        cos_i = rs_v3_dot(n, wi);
+        pdf = 0.5f * RS_INV_PI;
+        beta = rs_v3_mul(beta, rs_v3_scale(albedo, 2.0f * cos_i));
+        break;
+    case RS_SAMPLING_MIXTURE:
+        if (sc->n_lights > 0) {
+            if (rb.v[2] < 0.5f) {
+                rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
+                rs_light_sample ls;
+                if (!rs_light_sample_at(sc, xo, rl.v[0], rl.v[1], rl.v[2], &ls))
+                    return;
+                wi = ls.wi;
+            } else {
+                wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(rb.v[0], rb.v[1]));
+            }
+            cos_i = rs_v3_dot(n, wi);
+            if (!(cos_i > 0.0f))
+                return; /* f = 0 below the surface: the path carries nothing further */
+            pdf = 0.5f * rs_lights_pdf_dir(sc, xo, wi) + 0.5f * rs_pdf_cosine_hemisphere(cos_i);
+            if (!(pdf > 0.0f))
+                return;
+            beta = rs_v3_mul(beta, rs_v3_scale(albedo, RS_INV_PI * cos_i / pdf));
+            break;
+        }
+        /* no lights: the mixture is the BSDF pdf alone */
+        /* fall through */
+    case RS_SAMPLING_MIS:
+    case RS_SAMPLING_BSDF:
+    default:
+        wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(rb.v[0], rb.v[1]));
+        cos_i = rs_v3_dot(n, wi);
+        pdf = rs_pdf_cosine_hemisphere(cos_i);
+        beta = rs_v3_mul(beta, albedo);
+        break;
+    }
+    if (!(cos_i > 0.0f))
+        return;
+
+    if (bounce + 1 >= it->rr_depth) {
+        float q = fminf(rs_v3_max_comp(beta), 0.95f);
+        if (!(rb.v[3] < q))
+            return;
+        beta = rs_v3_scale(beta, 1.0f / q);
+    }
+    if (rs_v3_is_zero(beta))
+        return;
+    {
+        rs_ray nr;
+        nr.o = xo;
+        nr.d = wi;
+        nr.tmin = 0.0f;
+        nr.tmax = FLT_MAX;
+        rs_ray_soa_set(next, j, &nr, p);
+        next_valid[j] = 1;
+    }
+    paths->throughput[p] = beta;
+    paths->bsdf_pdf[p] = pdf;
+    paths->flags[p] = 0;
+}
+
+void rs_integrator_shade(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
+                         const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
+                         rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
+                         rs_ray_soa *shadow, uint8_t *shadow_valid)
+{
+    long j;
+#pragma omp parallel for num_threads(it->threads) schedule(dynamic, 512) if (it->threads > 1)
+    for (j = 0; j < (long)count; ++j)
+        shade_one(it, wave_start, bounce, rays, hits, (uint32_t)j, paths, next, next_valid,
+                  shadow, shadow_valid);
+}
+
+void rs_integrator_resolve_shadows(const rs_integrator *it, const rs_ray_soa *shadow,
+                                   const uint8_t *occluded, uint32_t count, rs_paths *paths)
+{
+    long k;
+#pragma omp parallel for num_threads(it->threads) schedule(static) if (it->threads > 1)
+    for (k = 0; k < (long)count; ++k) {
+        uint32_t p = shadow->path[k];
+        if (!occluded[k])
+            paths->radiance[p] = rs_v3_add(paths->radiance[p], paths->pending[p]);
+    }
+}
+
+#define COMPACT_MAX_BLOCKS 64
+
+uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t count,
+                           rs_ray_soa *dst, int threads)
+{
+    uint32_t offsets[COMPACT_MAX_BLOCKS + 1];
+    int nb = threads < 1 ? 1 : (threads > COMPACT_MAX_BLOCKS ? COMPACT_MAX_BLOCKS : threads);
+    int b;
+    if (count < 4096)
+        nb = 1;
+    /* pass 1: count per block */
+#pragma omp parallel for num_threads(nb) schedule(static, 1) if (nb > 1)
+    for (b = 0; b < nb; ++b) {
+        uint32_t lo = (uint32_t)((uint64_t)count * b / nb), hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
+        uint32_t c = 0, i;
+        for (i = lo; i < hi; ++i)
+            c += valid[i] != 0;
+        offsets[b + 1] = c;
+    }
+    offsets[0] = 0;
+    for (b = 0; b < nb; ++b)
+        offsets[b + 1] += offsets[b];
+    /* pass 2: copy, each block from its prefix offset */
+#pragma omp parallel for num_threads(nb) schedule(static, 1) if (nb > 1)
+    for (b = 0; b < nb; ++b) {
+        uint32_t lo = (uint32_t)((uint64_t)count * b / nb), hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
+        uint32_t o = offsets[b], i;
+        for (i = lo; i < hi; ++i)
+            if (valid[i])
+                rs_ray_soa_copy(dst, o++, src, i);
+    }
+    dst->count = offsets[nb];
+    return offsets[nb];
+}

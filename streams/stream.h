@@ -1,0 +1,94 @@
+/* streams/stream.h — ray and hit streams as structures of arrays.
+ *
+ * Each field is declared once in an X-macro list; the struct, the allocation and the copies all
+ * expand from it, so adding a field touches one line.  Byte budgets per entry:
+ *   ray  36 B  ox oy oz dx dy dz tmin tmax (float) + path (uint32: index into the wave's paths)
+ *   hit  16 B  t u v (float) + prim (uint32, RS_NO_HIT for a miss)
+ *   occlusion 1 B per shadow ray (1 = blocked)
+ * A view holds plain pointers (host or device) and is what RS_HD code and devices take. */
+#ifndef RS_STREAMS_STREAM_H
+#define RS_STREAMS_STREAM_H
+
+#include "core/ray.h"
+#include "core/status.h"
+
+#define RS_RAY_FIELDS(X)                                                                       \
+    X(float, ox) X(float, oy) X(float, oz) X(float, dx) X(float, dy) X(float, dz)             \
+    X(float, tmin) X(float, tmax) X(uint32_t, path)
+
+#define RS_HIT_FIELDS(X) X(float, t) X(float, u) X(float, v) X(uint32_t, prim)
+
+#define RS_STREAM_DECLARE_FIELD(type, name) type *name;
+
+typedef struct rs_ray_soa {
+    RS_RAY_FIELDS(RS_STREAM_DECLARE_FIELD)
+    uint32_t count;
+    uint32_t capacity;
+} rs_ray_soa;
+
+typedef struct rs_hit_soa {
+    RS_HIT_FIELDS(RS_STREAM_DECLARE_FIELD)
+    uint32_t capacity;
+} rs_hit_soa;
+
+/* Bytes one entry of each stream takes, summed over its fields. */
+#define RS_STREAM_FIELD_SIZE(type, name) +sizeof(type)
+#define RS_RAY_BYTES (0 RS_RAY_FIELDS(RS_STREAM_FIELD_SIZE))
+#define RS_HIT_BYTES (0 RS_HIT_FIELDS(RS_STREAM_FIELD_SIZE))
+
+RS_HD rs_ray rs_ray_soa_get(const rs_ray_soa *s, uint32_t i)
+{
+    rs_ray r;
+    r.o = rs_v3(s->ox[i], s->oy[i], s->oz[i]);
+    r.d = rs_v3(s->dx[i], s->dy[i], s->dz[i]);
+    r.tmin = s->tmin[i];
+    r.tmax = s->tmax[i];
+    return r;
+}
+
+RS_HD void rs_ray_soa_set(const rs_ray_soa *s, uint32_t i, const rs_ray *r, uint32_t path)
+{
+    s->ox[i] = r->o.x;
+    s->oy[i] = r->o.y;
+    s->oz[i] = r->o.z;
+    s->dx[i] = r->d.x;
+    s->dy[i] = r->d.y;
+    s->dz[i] = r->d.z;
+    s->tmin[i] = r->tmin;
+    s->tmax[i] = r->tmax;
+    s->path[i] = path;
+}
+
+RS_HD void rs_hit_soa_set(const rs_hit_soa *s, uint32_t i, const rs_hit *h)
+{
+    s->t[i] = h->t;
+    s->u[i] = h->u;
+    s->v[i] = h->v;
+    s->prim[i] = h->prim;
+}
+
+RS_HD rs_hit rs_hit_soa_get(const rs_hit_soa *s, uint32_t i)
+{
+    rs_hit h;
+    h.t = s->t[i];
+    h.u = s->u[i];
+    h.v = s->v[i];
+    h.prim = s->prim[i];
+    return h;
+}
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* Allocates every field for `capacity` entries (64-byte aligned); count starts at 0. */
+rs_status rs_ray_soa_init(rs_ray_soa *s, uint32_t capacity);
+void rs_ray_soa_free(rs_ray_soa *s);
+/* Copies entry `from` of `src` to entry `to` of `dst`. */
+void rs_ray_soa_copy(rs_ray_soa *dst, uint32_t to, const rs_ray_soa *src, uint32_t from);
+rs_status rs_hit_soa_init(rs_hit_soa *s, uint32_t capacity);
+void rs_hit_soa_free(rs_hit_soa *s);
+#ifdef __cplusplus
+}
+#endif
+
+#endif
