@@ -118,17 +118,30 @@ RS_HD int rs_isect_quad(const rs_quad *qd, const rs_ray *r, float *t, float *a, 
     return 1;
 }
 
+/* min and max that compile to single instructions (minss/maxss); when a is NaN they return b. */
+RS_HD float rs_minf(float a, float b) { return a < b ? a : b; }
+RS_HD float rs_maxf(float a, float b) { return a > b ? a : b; }
+
+/* One slab of the box test: narrows [*tn, *tf] to the slab's [min(t0, t1), max(t0, t1)].  A ray
+ * lying in the slab's plane makes 0 * inf = NaN for that face; such a slab is skipped, so a ray
+ * running along a face counts as inside it (and primitives lying in that face can be hit). */
+RS_HD void rs_slab(float t0, float t1, float *tn, float *tf)
+{
+    if (t0 == t0 && t1 == t1) {
+        *tn = rs_maxf(rs_minf(t0, t1), *tn);
+        *tf = rs_minf(rs_maxf(t0, t1), *tf);
+    }
+}
+
 /* Ray/box slab test (Kay & Kajiya 1986) with a precomputed reciprocal direction.  Returns 1 and
- * the entry distance when the box overlaps (tmin, tmax).  fminf/fmaxf drop the NaN that 0 * inf
- * makes for a ray lying in a slab plane, so such a ray is conservatively counted as inside. */
+ * the entry distance when the box overlaps [tmin, tmax]. */
 RS_HD int rs_isect_aabb(const rs_aabb *b, rs_vec3 o, rs_vec3 inv_d, float tmin, float tmax,
                         float *t_entry)
 {
-    float tx0 = (b->lo.x - o.x) * inv_d.x, tx1 = (b->hi.x - o.x) * inv_d.x;
-    float ty0 = (b->lo.y - o.y) * inv_d.y, ty1 = (b->hi.y - o.y) * inv_d.y;
-    float tz0 = (b->lo.z - o.z) * inv_d.z, tz1 = (b->hi.z - o.z) * inv_d.z;
-    float tn = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), tmin));
-    float tf = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)), fminf(fmaxf(tz0, tz1), tmax));
+    float tn = tmin, tf = tmax;
+    rs_slab((b->lo.x - o.x) * inv_d.x, (b->hi.x - o.x) * inv_d.x, &tn, &tf);
+    rs_slab((b->lo.y - o.y) * inv_d.y, (b->hi.y - o.y) * inv_d.y, &tn, &tf);
+    rs_slab((b->lo.z - o.z) * inv_d.z, (b->hi.z - o.z) * inv_d.z, &tn, &tf);
     *t_entry = tn;
     return tn <= tf;
 }

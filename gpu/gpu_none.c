@@ -1,6 +1,8 @@
 /* gpu/gpu_none.c — the CUDA device in a build without the CUDA toolkit: never available. */
 #include "gpu/gpu_device.h"
 
+#include <stddef.h>
+
 int rs_gpu_compiled(void) { return 0; }
 
 int rs_gpu_count(const char **why)

@@ -4,7 +4,10 @@
  *   - a chunk is either in the queue, or held by exactly one dispatch thread;
  *   - a held chunk is answered (its batch's `remaining` drops by one) or requeued, never both;
  *   - `alive` counts dispatch threads whose device has not failed; when it reaches 0 every
- *     waiting caller is woken and the batch fails. */
+ *     waiting caller is woken and the batch fails;
+ *   - a failed device's chunk goes to `retry`, never to the bounded queue: the producer may
+ *     have filled the queue since the chunk was popped.  Each device fails at most once, so
+ *     `retry` needs one slot per device.  Dispatch threads take retries first. */
 #include "scheduler/sched.h"
 
 #include <pthread.h>
@@ -40,6 +43,8 @@ struct rs_sched {
     pthread_cond_t done_cv;   /* a chunk was answered, or a device died */
     chunk *queue;
     uint32_t q_cap, q_head, q_len;
+    chunk *retry;
+    uint32_t n_retry;
     uint32_t chunk_size;
     int stop;
     int alive;
@@ -62,13 +67,6 @@ static void queue_push_back(rs_sched *s, chunk c)
     s->q_len++;
 }
 
-static void queue_push_front(rs_sched *s, chunk c)
-{
-    s->q_head = (s->q_head + s->q_cap - 1) % s->q_cap;
-    s->queue[s->q_head] = c;
-    s->q_len++;
-}
-
 static chunk queue_pop(rs_sched *s)
 {
     chunk c = s->queue[s->q_head];
@@ -86,16 +84,20 @@ static void *dispatch_main(void *arg)
         chunk c;
         double t0, t1;
         rs_status st;
-        if (s->q_len == 0 && !s->stop) {
+        if (s->q_len == 0 && s->n_retry == 0 && !s->stop) {
             t0 = now_s();
-            while (s->q_len == 0 && !s->stop)
+            while (s->q_len == 0 && s->n_retry == 0 && !s->stop)
                 pthread_cond_wait(&s->work_cv, &s->lock);
             w->dev->stats.idle_s += now_s() - t0;
         }
-        if (s->q_len == 0 && s->stop)
-            break;
-        c = queue_pop(s);
-        pthread_cond_signal(&s->space_cv);
+        if (s->n_retry > 0) {
+            c = s->retry[--s->n_retry];
+        } else if (s->q_len > 0) {
+            c = queue_pop(s);
+            pthread_cond_signal(&s->space_cv);
+        } else {
+            break; /* stop, and nothing left */
+        }
         pthread_mutex_unlock(&s->lock);
 
         t0 = now_s();
@@ -113,16 +115,13 @@ static void *dispatch_main(void *arg)
             pthread_cond_broadcast(&s->done_cv);
             continue;
         }
-        /* The device failed: give its chunk back and retire it.  The queue cannot be full
-         * here: this chunk's slot was freed when it was popped, and pushes wait for room. */
+        /* The device failed: give its chunk back and retire it. */
         w->dev->stats.failures++;
         snprintf(s->last_error, sizeof s->last_error, "device %s failed: %s", w->dev->name,
                  rs_error_message()[0] ? rs_error_message() : rs_status_name(st));
         rs_error_clear();
-        if (s->q_len < s->q_cap) {
-            queue_push_front(s, c);
-            pthread_cond_signal(&s->work_cv);
-        }
+        s->retry[s->n_retry++] = c;
+        pthread_cond_signal(&s->work_cv);
         w->alive = 0;
         s->alive--;
         pthread_cond_broadcast(&s->done_cv);
@@ -148,8 +147,10 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
     s->q_cap = (cfg && cfg->queue_capacity) ? cfg->queue_capacity : 256;
     s->queue = (chunk *)rs_alloc(s->q_cap, sizeof *s->queue);
     s->workers = (worker *)rs_calloc((size_t)n_devices, sizeof *s->workers);
-    if (!s->queue || !s->workers) {
+    s->retry = (chunk *)rs_alloc((size_t)n_devices, sizeof *s->retry);
+    if (!s->queue || !s->workers || !s->retry) {
         rs_free(s->queue);
+        rs_free(s->retry);
         rs_free(s->workers);
         rs_free(s);
         return rs_error_set(RS_ERR_NOMEM, "out of memory creating the scheduler");
@@ -220,6 +221,10 @@ rs_status rs_sched_trace(rs_sched *s, const rs_trace_batch *batch)
                 keep[(s->q_head + kept++) % s->q_cap] = c;
         }
         s->q_len = kept;
+        for (k = kept = 0; k < s->n_retry; ++k)
+            if (s->retry[k].rec != &rec)
+                s->retry[kept++] = s->retry[k];
+        s->n_retry = kept;
         st = rs_error_set(RS_ERR_DEVICE_LOST, "every device failed; last: %s", s->last_error);
     }
     RS_ASSERT(st != RS_OK || rec.answered == n);
@@ -244,6 +249,7 @@ void rs_sched_destroy(rs_sched *s)
     pthread_cond_destroy(&s->space_cv);
     pthread_cond_destroy(&s->done_cv);
     rs_free(s->queue);
+    rs_free(s->retry);
     rs_free(s->workers);
     rs_free(s);
 }

@@ -1,0 +1,723 @@
+/* tests/accel_bvh_test.c — accel/bvh.h: rs_bvh_build, rs_bvh_closest and rs_bvh_occluded.
+ *
+ * What is checked:
+ *   - traversal equals brute force: over a fixed-seed soup of 2000 triangles, 300 spheres and
+ *     200 quads (global numbering of core/geom.h: spheres, quads, triangles), 10^5 random rays
+ *     (origins inside and outside the soup, random and axis-aligned directions, some with tmin
+ *     or tmax limited) give the same closest prim, t, u and v as looping rs_geom_intersect over
+ *     every primitive, for trees with max_leaf 1, 4 and 8.  t must be bit-identical: the same
+ *     routine computes it.  The prim may differ only when both prims give that identical t.
+ *     rs_bvh_occluded equals "brute force found a hit in (tmin, tmax)";
+ *   - structure: every prim id appears exactly once in prim_ids; the leaves' ranges partition
+ *     prim_ids; every node is reachable exactly once; each node's bounds contain its children's
+ *     and its primitives' bounds (rs_geom_prim_bounds); each interior node separates its
+ *     children's centroids along some axis; leaves hold 1 .. max_leaf prims; depth is the
+ *     recorded depth and at most ceil(log2(n)) + 2; n_nodes = 2 leaves - 1 <= 2n - 1;
+ *   - edge cases: no primitives (no nodes, every ray misses), one primitive of each kind, all
+ *     centroids identical (the build ends and traversal stays exact), rays with NaN or Inf
+ *     components (return within a time limit, with a valid answer), an axis-aligned ray lying
+ *     in the scene's bounding plane, and allocation failure during the build. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <float.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "accel/bvh.h"
+#include "core/alloc.h"
+
+#define T_INF FLT_MAX
+
+/* ---- helpers ------------------------------------------------------------------------------- */
+
+/* splitmix64 (Steele et al. 2014): test inputs from a fixed seed. */
+static uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static double rnd01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
+
+static float rnd_range(uint64_t *s, double lo, double hi)
+{
+    return (float)(lo + (hi - lo) * rnd01(s));
+}
+
+static rs_vec3 rnd_box(uint64_t *s, float h)
+{
+    return rs_v3(rnd_range(s, -h, h), rnd_range(s, -h, h), rnd_range(s, -h, h));
+}
+
+static rs_vec3 rnd_unit(uint64_t *s)
+{
+    double z = 2.0 * rnd01(s) - 1.0, phi = 6.283185307179586 * rnd01(s);
+    double r = sqrt(1.0 - z * z);
+    return rs_v3((float)(r * cos(phi)), (float)(r * sin(phi)), (float)z);
+}
+
+static rs_ray mk_ray(rs_vec3 o, rs_vec3 d, float tmin, float tmax)
+{
+    rs_ray r;
+    r.o = o;
+    r.d = d;
+    r.tmin = tmin;
+    r.tmax = tmax;
+    return r;
+}
+
+/* A scene the tests own: arrays plus the rs_geom view of them. */
+typedef struct soup {
+    rs_sphere *spheres;
+    rs_quad *quads;
+    rs_tri *tris;
+    rs_geom g;
+} soup;
+
+static void soup_alloc(soup *s, uint32_t ns, uint32_t nq, uint32_t nt)
+{
+    s->spheres = (rs_sphere *)calloc(ns ? ns : 1, sizeof *s->spheres);
+    s->quads = (rs_quad *)calloc(nq ? nq : 1, sizeof *s->quads);
+    s->tris = (rs_tri *)calloc(nt ? nt : 1, sizeof *s->tris);
+    assert_non_null(s->spheres);
+    assert_non_null(s->quads);
+    assert_non_null(s->tris);
+    s->g.spheres = s->spheres;
+    s->g.quads = s->quads;
+    s->g.tris = s->tris;
+    s->g.n_spheres = ns;
+    s->g.n_quads = nq;
+    s->g.n_tris = nt;
+}
+
+static void soup_free(soup *s)
+{
+    free(s->spheres);
+    free(s->quads);
+    free(s->tris);
+}
+
+/* Soup extent: centres in [-SOUP, SOUP]^3. */
+#define SOUP 40.0f
+
+/* The random soup: spheres of radius 0.2 .. 3; quads with random edges 0.5 .. 6 long, every
+ * fourth one axis-aligned (zero-thickness bounds); triangles with vertices up to 4 from their
+ * centre, every eighth one in an axis plane. */
+static void soup_random(soup *s, uint64_t seed)
+{
+    uint32_t i;
+    soup_alloc(s, 300, 200, 2000);
+    for (i = 0; i < s->g.n_spheres; ++i) {
+        s->spheres[i].center = rnd_box(&seed, SOUP);
+        s->spheres[i].radius = rnd_range(&seed, 0.2, 3.0);
+    }
+    for (i = 0; i < s->g.n_quads; ++i) {
+        rs_vec3 q = rnd_box(&seed, SOUP), u, v;
+        if (i % 4 == 0) {
+            int axis = (int)(i / 4 % 3);
+            float a = rnd_range(&seed, 0.5, 6.0), b = rnd_range(&seed, 0.5, 6.0);
+            u = axis == 0 ? rs_v3(0, a, 0) : rs_v3(a, 0, 0);
+            v = axis == 2 ? rs_v3(0, b, 0) : rs_v3(0, 0, b);
+        } else {
+            u = rs_v3_scale(rnd_unit(&seed), rnd_range(&seed, 0.5, 6.0));
+            v = rs_v3_scale(rnd_unit(&seed), rnd_range(&seed, 0.5, 6.0));
+        }
+        s->quads[i] = rs_quad_make(q, u, v);
+    }
+    for (i = 0; i < s->g.n_tris; ++i) {
+        rs_vec3 c = rnd_box(&seed, SOUP);
+        rs_tri *t = &s->tris[i];
+        t->v0 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.3, 4.0));
+        t->v1 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.3, 4.0));
+        t->v2 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.3, 4.0));
+        if (i % 8 == 0) {
+            t->v1.y = t->v0.y;
+            t->v2.y = t->v0.y;
+        }
+    }
+}
+
+/* Brute force: every primitive with the full interval; the strictly smallest t wins, so the
+ * lowest-numbered prim wins ties.  Returns 1 on a hit. */
+static int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
+{
+    uint32_t n = rs_geom_prim_count(g), i;
+    hit->prim = RS_NO_HIT;
+    hit->t = r->tmax;
+    hit->u = hit->v = 0.0f;
+    for (i = 0; i < n; ++i) {
+        float t, u, v;
+        if (rs_geom_intersect(g, i, r, &t, &u, &v) && (hit->prim == RS_NO_HIT || t < hit->t)) {
+            hit->t = t;
+            hit->u = u;
+            hit->v = v;
+            hit->prim = i;
+        }
+    }
+    return hit->prim != RS_NO_HIT;
+}
+
+static rs_bvh *build(const rs_geom *g, uint32_t max_leaf)
+{
+    rs_bvh_build_opts o;
+    rs_bvh *b = NULL;
+    rs_status st;
+    o.max_leaf = max_leaf;
+    st = rs_bvh_build(g, max_leaf ? &o : NULL, &b);
+    if (st != RS_OK)
+        fail_msg("rs_bvh_build failed: %d (%s)", (int)st, rs_error_message());
+    assert_non_null(b);
+    return b;
+}
+
+static void describe_ray(char *buf, size_t n, const rs_ray *r)
+{
+    snprintf(buf, n, "o (%.9g %.9g %.9g) d (%.9g %.9g %.9g) t (%.9g, %.9g)", r->o.x, r->o.y,
+             r->o.z, r->d.x, r->d.y, r->d.z, r->tmin, r->tmax);
+}
+
+/* Compares one BVH query against the brute-force answer for ray r. */
+static void expect_same_hit(const rs_bvh *bvh, const rs_geom *g, const rs_ray *r,
+                            const rs_hit *ref, int ref_hit, const char *what, long index)
+{
+    rs_bvh_view view = rs_bvh_view_of(bvh);
+    rs_hit h;
+    int got = rs_bvh_closest(&view, g, *r, &h), occ = rs_bvh_occluded(&view, g, *r);
+    char ray[256];
+    if (got != ref_hit || (got && (h.t != ref->t || (h.prim == ref->prim &&
+                                                     (h.u != ref->u || h.v != ref->v)))) ||
+        (!got && h.prim != RS_NO_HIT) || (got && h.prim >= rs_geom_prim_count(g))) {
+        describe_ray(ray, sizeof ray, r);
+        fail_msg("%s ray %ld: bvh %s prim %u t %.9g (u %.9g v %.9g), brute force %s prim %u t "
+                 "%.9g (u %.9g v %.9g); %s",
+                 what, index, got ? "hit" : "miss", h.prim, h.t, h.u, h.v,
+                 ref_hit ? "hit" : "miss", ref->prim, ref->t, ref->u, ref->v, ray);
+    }
+    if (got && h.prim != ref->prim) {
+        /* a tie: the BVH's prim must give exactly the same t */
+        float t, u, v;
+        if (!(rs_geom_intersect(g, h.prim, r, &t, &u, &v) && t == ref->t)) {
+            describe_ray(ray, sizeof ray, r);
+            fail_msg("%s ray %ld: bvh prim %u, brute force prim %u at the same t %.9g, but prim "
+                     "%u does not hit there; %s",
+                     what, index, h.prim, ref->prim, ref->t, h.prim, ray);
+        }
+    }
+    if (occ != ref_hit) {
+        describe_ray(ray, sizeof ray, r);
+        fail_msg("%s ray %ld: rs_bvh_occluded %d, brute force %s; %s", what, index, occ,
+                 ref_hit ? "hit" : "miss", ray);
+    }
+}
+
+/* ---- structure ----------------------------------------------------------------------------- */
+
+static int box_contains(rs_vec3 olo, rs_vec3 ohi, rs_vec3 ilo, rs_vec3 ihi)
+{
+    return olo.x <= ilo.x && olo.y <= ilo.y && olo.z <= ilo.z && ohi.x >= ihi.x &&
+           ohi.y >= ihi.y && ohi.z >= ihi.z;
+}
+
+static uint32_t ceil_log2(uint32_t n)
+{
+    uint32_t k = 0;
+    while ((1ull << k) < n)
+        ++k;
+    return k;
+}
+
+/* Centroid range of the primitives under `node` (the builder's centroid: the middle of
+ * rs_geom_prim_bounds), and a check that every interior node separates its children's
+ * centroids along some axis: a split by position, whatever the split rule.  Recursion depth is
+ * the tree depth, checked separately. */
+static void centroid_range(const rs_bvh *b, const rs_geom *g, uint32_t node, rs_vec3 *lo,
+                           rs_vec3 *hi)
+{
+    const rs_bvh_node *nd = &b->nodes[node];
+    uint32_t i;
+    if (nd->count > 0) {
+        for (i = nd->left_first; i < nd->left_first + nd->count; ++i) {
+            rs_aabb pb = rs_geom_prim_bounds(g, b->prim_ids[i]);
+            rs_vec3 c = rs_v3_scale(rs_v3_add(pb.lo, pb.hi), 0.5f);
+            *lo = i == nd->left_first ? c : rs_v3_min(*lo, c);
+            *hi = i == nd->left_first ? c : rs_v3_max(*hi, c);
+        }
+        return;
+    }
+    {
+        rs_vec3 llo, lhi, rlo, rhi;
+        int axis, separated = 0;
+        centroid_range(b, g, nd->left_first, &llo, &lhi);
+        centroid_range(b, g, nd->left_first + 1, &rlo, &rhi);
+        for (axis = 0; axis < 3; ++axis)
+            if (rs_v3_get(lhi, axis) <= rs_v3_get(rlo, axis) ||
+                rs_v3_get(rhi, axis) <= rs_v3_get(llo, axis))
+                separated = 1;
+        if (!separated)
+            fail_msg("node %u: its children's centroids overlap on every axis", node);
+        *lo = rs_v3_min(llo, rlo);
+        *hi = rs_v3_max(lhi, rhi);
+    }
+}
+
+/* Walks the tree from the root with an explicit stack and checks every structural invariant. */
+static void check_structure(const rs_bvh *b, const rs_geom *g, uint32_t max_leaf)
+{
+    uint32_t n = rs_geom_prim_count(g), i, max_depth = 0, n_leaves = 0, limit;
+    uint32_t *seen_prim = (uint32_t *)calloc(n ? n : 1, sizeof *seen_prim);
+    uint32_t *seen_slot = (uint32_t *)calloc(n ? n : 1, sizeof *seen_slot);
+    uint32_t *seen_node = (uint32_t *)calloc(b->n_nodes ? b->n_nodes : 1, sizeof *seen_node);
+    uint32_t stack[2 * RS_BVH_STACK], depth_of[2 * RS_BVH_STACK], sp = 0;
+    assert_non_null(seen_prim);
+    assert_non_null(seen_slot);
+    assert_non_null(seen_node);
+    assert_int_equal(b->n_prims, n);
+    if (n == 0) {
+        assert_int_equal(b->n_nodes, 0);
+        goto done;
+    }
+    assert_true(b->n_nodes >= 1 && b->n_nodes <= 2 * n - 1);
+    stack[sp] = 0;
+    depth_of[sp++] = 1;
+    while (sp > 0) {
+        uint32_t node = stack[--sp], depth = depth_of[sp];
+        const rs_bvh_node *nd = &b->nodes[node];
+        assert_true(node < b->n_nodes);
+        if (seen_node[node]++)
+            fail_msg("node %u is reached twice", node);
+        if (depth > max_depth)
+            max_depth = depth;
+        assert_true(nd->lo.x <= nd->hi.x && nd->lo.y <= nd->hi.y && nd->lo.z <= nd->hi.z);
+        if (nd->count == 0) {
+            uint32_t l = nd->left_first;
+            if (!(l > node && l + 1 < b->n_nodes))
+                fail_msg("node %u: children %u, %u out of range (%u nodes)", node, l, l + 1,
+                         b->n_nodes);
+            for (i = 0; i < 2; ++i) {
+                const rs_bvh_node *c = &b->nodes[l + i];
+                if (!box_contains(nd->lo, nd->hi, c->lo, c->hi))
+                    fail_msg("node %u does not contain its child %u", node, l + i);
+                assert_true(sp < 2 * RS_BVH_STACK);
+                stack[sp] = l + i;
+                depth_of[sp++] = depth + 1;
+            }
+        } else {
+            ++n_leaves;
+            if (nd->count > max_leaf)
+                fail_msg("leaf %u holds %u prims, max_leaf %u", node, nd->count, max_leaf);
+            if (!(nd->left_first <= n && nd->count <= n - nd->left_first))
+                fail_msg("leaf %u: range [%u, +%u) outside prim_ids[%u]", node, nd->left_first,
+                         nd->count, n);
+            for (i = nd->left_first; i < nd->left_first + nd->count; ++i) {
+                uint32_t prim = b->prim_ids[i];
+                rs_aabb pb;
+                if (seen_slot[i]++)
+                    fail_msg("prim_ids[%u] belongs to two leaves", i);
+                if (prim >= n)
+                    fail_msg("prim_ids[%u] = %u, only %u prims", i, prim, n);
+                pb = rs_geom_prim_bounds(g, prim);
+                if (!box_contains(nd->lo, nd->hi, pb.lo, pb.hi))
+                    fail_msg("leaf %u does not contain the bounds of prim %u", node, prim);
+            }
+        }
+    }
+    for (i = 0; i < b->n_nodes; ++i)
+        if (seen_node[i] != 1)
+            fail_msg("node %u is reached %u times", i, seen_node[i]);
+    for (i = 0; i < n; ++i) {
+        if (seen_slot[i] != 1)
+            fail_msg("prim_ids[%u] is in %u leaves", i, seen_slot[i]);
+        seen_prim[b->prim_ids[i]]++;
+    }
+    for (i = 0; i < n; ++i)
+        if (seen_prim[i] != 1)
+            fail_msg("prim %u appears %u times in prim_ids", i, seen_prim[i]);
+    /* a binary tree: nodes = 2 leaves - 1 */
+    assert_int_equal(b->n_nodes, 2 * n_leaves - 1);
+    if (max_depth != b->depth)
+        fail_msg("measured depth %u, recorded %u", max_depth, b->depth);
+    {
+        rs_vec3 clo, chi;
+        centroid_range(b, g, 0, &clo, &chi);
+    }
+    limit = ceil_log2(n) + 2;
+    if (max_depth > limit)
+        fail_msg("depth %u over ceil(log2(%u)) + 2 = %u (max_leaf %u)", max_depth, n, limit,
+                 max_leaf);
+done:
+    free(seen_prim);
+    free(seen_slot);
+    free(seen_node);
+}
+
+static void test_structure(void **state)
+{
+    static const uint32_t leaf_sizes[] = {1, 4, 8, 0};
+    soup s;
+    size_t i;
+    (void)state;
+    soup_random(&s, 0x5eed);
+    for (i = 0; i < sizeof leaf_sizes / sizeof leaf_sizes[0]; ++i) {
+        rs_bvh *b = build(&s.g, leaf_sizes[i]);
+        print_message("max_leaf %u: %u nodes, depth %u\n", leaf_sizes[i], b->n_nodes, b->depth);
+        check_structure(b, &s.g, leaf_sizes[i] ? leaf_sizes[i] : 4);
+        rs_bvh_destroy(b);
+    }
+    soup_free(&s);
+    rs_bvh_destroy(NULL);
+}
+
+/* ---- traversal against brute force --------------------------------------------------------- */
+
+/* A random ray for the soup: the origin inside the soup's box half the time, in a box three
+ * times as wide otherwise; the direction random, aimed at a random point of the soup, or (one
+ * in eight) with one or two components exactly zero; tmin > 0 for one in eight and tmax cut
+ * short for one in four. */
+static rs_ray soup_ray(uint64_t *s, long i)
+{
+    rs_vec3 o = (i & 1) ? rnd_box(s, SOUP + 4.0f) : rnd_box(s, 3.0f * SOUP), d;
+    float tmin = 0.0f, tmax = T_INF;
+    if (i % 3 == 0)
+        d = rs_v3_sub(rnd_box(s, SOUP), o);
+    else
+        d = rs_v3_scale(rnd_unit(s), rnd_range(s, 0.5, 2.0));
+    if (i % 8 == 5) {
+        d.x = 0.0f;
+        if (i % 16 == 5)
+            d.z = -0.0f;
+        if (rs_v3_is_zero(d))
+            d.y = 1.0f;
+    }
+    if (i % 8 == 2)
+        tmin = rnd_range(s, 0.0, 20.0);
+    if (i % 4 == 3)
+        tmax = rnd_range(s, 0.0, 40.0);
+    return mk_ray(o, d, tmin, tmax);
+}
+
+static void test_random_rays_vs_brute_force(void **state)
+{
+    enum { N_RAYS = 100000 };
+    static const uint32_t leaf_sizes[] = {1, 4, 8};
+    rs_bvh *trees[3];
+    uint64_t rs = 0xbeef;
+    soup s;
+    long i, hits = 0, ties = 0;
+    size_t k;
+    (void)state;
+    soup_random(&s, 0x5eed);
+    for (k = 0; k < 3; ++k)
+        trees[k] = build(&s.g, leaf_sizes[k]);
+    for (i = 0; i < N_RAYS; ++i) {
+        rs_ray r = soup_ray(&rs, i);
+        rs_hit ref;
+        int ref_hit = brute_closest(&s.g, &r, &ref);
+        hits += ref_hit;
+        for (k = 0; k < 3; ++k) {
+            char what[32];
+            rs_bvh_view v = rs_bvh_view_of(trees[k]);
+            rs_hit h;
+            snprintf(what, sizeof what, "max_leaf %u", leaf_sizes[k]);
+            expect_same_hit(trees[k], &s.g, &r, &ref, ref_hit, what, i);
+            if (k == 0 && rs_bvh_closest(&v, &s.g, r, &h) && h.prim != ref.prim)
+                ++ties;
+        }
+    }
+    print_message("%d rays: %ld hit (%ld ties resolved to another prim)\n", N_RAYS, hits, ties);
+    /* both outcomes well represented, or the comparison says little */
+    assert_true(hits > N_RAYS / 5 && hits < N_RAYS - N_RAYS / 5);
+    for (k = 0; k < 3; ++k)
+        rs_bvh_destroy(trees[k]);
+    soup_free(&s);
+}
+
+/* ---- edge cases ---------------------------------------------------------------------------- */
+
+static void test_empty(void **state)
+{
+    rs_geom g;
+    rs_bvh *b = NULL;
+    rs_bvh_view v;
+    rs_hit h;
+    uint64_t s = 3;
+    int i;
+    (void)state;
+    memset(&g, 0, sizeof g);
+    assert_int_equal(rs_bvh_build(&g, NULL, &b), RS_OK);
+    assert_non_null(b);
+    assert_int_equal(b->n_nodes, 0);
+    assert_int_equal(b->n_prims, 0);
+    v = rs_bvh_view_of(b);
+    assert_int_equal(v.n_nodes, 0);
+    for (i = 0; i < 100; ++i) {
+        rs_ray r = mk_ray(rnd_box(&s, 10.0f), rnd_unit(&s), 0.0f, T_INF);
+        h.prim = 7;
+        assert_int_equal(rs_bvh_closest(&v, &g, r, &h), 0);
+        assert_int_equal(h.prim, RS_NO_HIT);
+        assert_int_equal(rs_bvh_occluded(&v, &g, r), 0);
+    }
+    rs_bvh_destroy(b);
+}
+
+static void test_single_primitive(void **state)
+{
+    int kind;
+    (void)state;
+    for (kind = 0; kind < 3; ++kind) {
+        soup s;
+        rs_bvh *b;
+        rs_bvh_view v;
+        rs_hit h;
+        soup_alloc(&s, kind == 0, kind == 1, kind == 2);
+        s.spheres[0].center = rs_v3(0, 0, -5);
+        s.spheres[0].radius = 1.0f;
+        s.quads[0] = rs_quad_make(rs_v3(-1, -1, -5), rs_v3(2, 0, 0), rs_v3(0, 2, 0));
+        s.tris[0].v0 = rs_v3(-1, -1, -5);
+        s.tris[0].v1 = rs_v3(2, -1, -5);
+        s.tris[0].v2 = rs_v3(-1, 2, -5);
+        b = build(&s.g, 0);
+        check_structure(b, &s.g, 4);
+        assert_int_equal(b->n_nodes, 1);
+        assert_int_equal(b->nodes[0].count, 1);
+        assert_int_equal(b->prim_ids[0], 0);
+        v = rs_bvh_view_of(b);
+        assert_int_equal(rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
+                                                          T_INF), &h), 1);
+        assert_int_equal(h.prim, 0);
+        assert_true(h.t == (kind == 0 ? 4.0f : 5.0f));
+        assert_int_equal(rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
+                                                          T_INF)), 1);
+        /* blocked only inside (tmin, tmax) */
+        assert_int_equal(rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
+                                                          3.5f)), 0);
+        assert_int_equal(rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
+                                                          3.5f), &h), 0);
+        assert_int_equal(h.prim, RS_NO_HIT);
+        /* misses */
+        assert_int_equal(rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f,
+                                                          T_INF), &h), 0);
+        assert_int_equal(rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(5, 0, 0), rs_v3(0, 0, -1), 0.0f,
+                                                          T_INF)), 0);
+        rs_bvh_destroy(b);
+        soup_free(&s);
+    }
+}
+
+static void test_identical_centroids(void **state)
+{
+    /* 400 spheres, 300 quads and 300 triangles all centred on (1, 2, 3): the median split
+     * cannot separate them by position, and the build must still end with a correct tree */
+    soup s;
+    uint64_t seed = 0xce27;
+    rs_vec3 c = rs_v3(1, 2, 3);
+    uint32_t i;
+    long j;
+    size_t k;
+    static const uint32_t leaf_sizes[] = {1, 4, 8};
+    (void)state;
+    soup_alloc(&s, 400, 300, 300);
+    for (i = 0; i < s.g.n_spheres; ++i) {
+        s.spheres[i].center = c;
+        s.spheres[i].radius = (float)(i + 1) / 64.0f; /* c +- r exact: bounds centred on c */
+    }
+    for (i = 0; i < s.g.n_quads; ++i) {
+        /* a square centred on c: q = c - (u + v) / 2, with power-of-two sizes so the
+         * bounds' centre is c exactly */
+        float a = (float)(1u << (i % 4));
+        rs_vec3 u = (i % 3 == 0) ? rs_v3(a, 0, 0) : rs_v3(0, a, 0);
+        rs_vec3 v = (i % 3 == 2) ? rs_v3(a, 0, 0) : rs_v3(0, 0, a);
+        s.quads[i] = rs_quad_make(rs_v3_sub(c, rs_v3_scale(rs_v3_add(u, v), 0.5f)), u, v);
+    }
+    for (i = 0; i < s.g.n_tris; ++i) {
+        /* symmetric bounds about c */
+        float a = 0.5f * (float)(1 + i % 5);
+        s.tris[i].v0 = rs_v3(c.x - a, c.y - a, c.z);
+        s.tris[i].v1 = rs_v3(c.x + a, c.y, c.z - a);
+        s.tris[i].v2 = rs_v3(c.x, c.y + a, c.z + a);
+    }
+    for (i = 0; i < rs_geom_prim_count(&s.g); ++i) {
+        rs_aabb b = rs_geom_prim_bounds(&s.g, i);
+        rs_vec3 m = rs_v3_scale(rs_v3_add(b.lo, b.hi), 0.5f);
+        assert_true(m.x == c.x && m.y == c.y && m.z == c.z);
+    }
+    for (k = 0; k < 3; ++k) {
+        rs_bvh *b = build(&s.g, leaf_sizes[k]);
+        check_structure(b, &s.g, leaf_sizes[k]);
+        for (j = 0; j < 5000; ++j) {
+            rs_ray r = mk_ray(rs_v3_add(c, rnd_box(&seed, 12.0f)), rnd_unit(&seed), 0.0f, T_INF);
+            rs_hit ref;
+            int ref_hit;
+            if (j % 2)
+                r.d = rs_v3_sub(rs_v3_add(c, rnd_box(&seed, 2.0f)), r.o);
+            ref_hit = brute_closest(&s.g, &r, &ref);
+            expect_same_hit(b, &s.g, &r, &ref, ref_hit, "identical centroids", j);
+        }
+        rs_bvh_destroy(b);
+    }
+    soup_free(&s);
+}
+
+static void on_alarm(int sig)
+{
+    (void)sig;
+    /* only async-signal-safe calls here */
+    static const char msg[] = "accel_bvh_test: traversal of a NaN/Inf ray did not return\n";
+    ssize_t w = write(2, msg, sizeof msg - 1);
+    (void)w;
+    _exit(1);
+}
+
+static void test_nan_inf_rays_terminate(void **state)
+{
+    /* Any answer is accepted, but each query must return (an alarm fails the test after 20 s),
+     * and a reported hit must name a real primitive. */
+    static const float specials[] = {NAN, INFINITY, -INFINITY, 0.0f, -0.0f, 1.0f};
+    const int n_special = (int)(sizeof specials / sizeof specials[0]);
+    soup s;
+    rs_bvh *b;
+    rs_bvh_view v;
+    uint64_t seed = 0x7a7;
+    int a, c, e, f, n = 0;
+    (void)state;
+    soup_random(&s, 0x5eed);
+    b = build(&s.g, 0);
+    v = rs_bvh_view_of(b);
+    signal(SIGALRM, on_alarm);
+    alarm(20);
+    for (a = 0; a < n_special; ++a)
+        for (c = 0; c < n_special; ++c)
+            for (e = 0; e < n_special; ++e)
+                for (f = 0; f < 4; ++f) {
+                    rs_vec3 o = f == 3 ? rs_v3(NAN, 0, 0) : rnd_box(&seed, SOUP);
+                    rs_ray r = mk_ray(o, rs_v3(specials[a], specials[c], specials[e]), 0.0f,
+                                      f == 1 ? NAN : (f == 2 ? INFINITY : T_INF));
+                    rs_hit h;
+                    int hit = rs_bvh_closest(&v, &s.g, r, &h);
+                    int occ = rs_bvh_occluded(&v, &s.g, r);
+                    assert_true(hit == 0 || hit == 1);
+                    assert_true(occ == 0 || occ == 1);
+                    if (hit)
+                        assert_true(h.prim < rs_geom_prim_count(&s.g));
+                    else
+                        assert_int_equal(h.prim, RS_NO_HIT);
+                    ++n;
+                }
+    alarm(0);
+    signal(SIGALRM, SIG_DFL);
+    print_message("%d NaN/Inf rays returned\n", n);
+    rs_bvh_destroy(b);
+    soup_free(&s);
+}
+
+/* An axis-aligned ray lying exactly in the scene's bounding plane x = 0 (the root's lo.x) hits a
+ * triangle's edge in that plane, and a Cornell-style floor quad's edge.  Brute force finds both
+ * hits; the BVH must too (its root box is hit with a ray on its face: see core/intersect.h's
+ * promise for rays in a slab plane). */
+static void test_ray_in_bounding_plane(void **state)
+{
+    soup s;
+    rs_bvh *b;
+    rs_bvh_view v;
+    rs_hit h, ref;
+    rs_ray r;
+    int failures = 0;
+    (void)state;
+    soup_alloc(&s, 1, 1, 1);
+    s.spheres[0].center = rs_v3(3, 0, 3);
+    s.spheres[0].radius = 0.5f;
+    /* a floor y = -2 spanning x in [0, 4], z in [0, 4] */
+    s.quads[0] = rs_quad_make(rs_v3(0, -2, 0), rs_v3(4, 0, 0), rs_v3(0, 0, 4));
+    /* edge v0-v1 in the plane x = 0 */
+    s.tris[0].v0 = rs_v3(0, -1, 1);
+    s.tris[0].v1 = rs_v3(0, 1, 1);
+    s.tris[0].v2 = rs_v3(1, 0, 1);
+    b = build(&s.g, 1);
+    v = rs_bvh_view_of(b);
+    assert_true(b->nodes[0].lo.x == 0.0f);
+    /* along +z in the plane x = 0: meets the triangle's edge at (0, 0, 1), t = 6 */
+    r = mk_ray(rs_v3(0, 0, -5), rs_v3(0, 0, 1), 0.0f, T_INF);
+    assert_int_equal(brute_closest(&s.g, &r, &ref), 1);
+    assert_int_equal(ref.prim, 2);
+    assert_true(ref.t == 6.0f);
+    if (!rs_bvh_closest(&v, &s.g, r, &h) || h.prim != ref.prim || h.t != ref.t)
+        ++failures, print_message("ray in the plane x = 0 along +z: bvh prim %u t %g, brute "
+                                  "force prim %u t %g (triangle edge)\n",
+                                  h.prim, h.t, ref.prim, ref.t);
+    if (!rs_bvh_occluded(&v, &s.g, r))
+        ++failures, print_message("ray in the plane x = 0 along +z: not occluded\n");
+    /* down the wall plane x = 0 onto the floor's edge at (0, -2, 2), t = 2 */
+    r = mk_ray(rs_v3(0, 2, 2), rs_v3(0, -2, 0), 0.0f, T_INF);
+    assert_int_equal(brute_closest(&s.g, &r, &ref), 1);
+    assert_int_equal(ref.prim, 1);
+    assert_true(ref.t == 2.0f);
+    if (!rs_bvh_closest(&v, &s.g, r, &h) || h.prim != ref.prim || h.t != ref.t)
+        ++failures, print_message("ray in the plane x = 0 along -y: bvh prim %u t %g, brute "
+                                  "force prim %u t %g (floor edge)\n",
+                                  h.prim, h.t, ref.prim, ref.t);
+    if (!rs_bvh_occluded(&v, &s.g, r))
+        ++failures, print_message("ray in the plane x = 0 along -y: not occluded\n");
+    rs_bvh_destroy(b);
+    soup_free(&s);
+    if (failures)
+        fail_msg("%d of 4 queries along the scene's bounding plane disagree with brute force",
+                 failures);
+}
+
+static void test_build_out_of_memory(void **state)
+{
+    /* Fail each allocation of the build in turn: the build reports RS_ERR_NOMEM, hands back
+     * NULL, and (under the sanitizer build) leaks nothing.  Past the last allocation it
+     * succeeds. */
+    soup s;
+    long k;
+    int succeeded = 0;
+    (void)state;
+    soup_random(&s, 0x5eed);
+    for (k = 0; k < 16 && !succeeded; ++k) {
+        rs_bvh *b = (rs_bvh *)(uintptr_t)1;
+        rs_status st;
+        rs_error_clear();
+        rs_alloc_fail_after(k);
+        st = rs_bvh_build(&s.g, NULL, &b);
+        rs_alloc_fail_after(-1);
+        if (st == RS_OK) {
+            assert_non_null(b);
+            check_structure(b, &s.g, 4);
+            rs_bvh_destroy(b);
+            succeeded = 1;
+        } else {
+            assert_int_equal(st, RS_ERR_NOMEM);
+            assert_null(b);
+            assert_true(rs_error_message()[0] != '\0');
+        }
+    }
+    rs_error_clear();
+    assert_true(succeeded);
+    assert_true(k > 1);
+    soup_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_structure),
+        cmocka_unit_test(test_random_rays_vs_brute_force),
+        cmocka_unit_test(test_empty),
+        cmocka_unit_test(test_single_primitive),
+        cmocka_unit_test(test_identical_centroids),
+        cmocka_unit_test(test_nan_inf_rays_terminate),
+        cmocka_unit_test(test_ray_in_bounding_plane),
+        cmocka_unit_test(test_build_out_of_memory),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

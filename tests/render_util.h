@@ -1,0 +1,109 @@
+/* tests/render_util.h — renders a built-in scene through the public API for tests:
+ * scene -> BVH -> devices -> scheduler -> rs_render -> resolved film.  Test-only helper. */
+#ifndef RS_TESTS_RENDER_UTIL_H
+#define RS_TESTS_RENDER_UTIL_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "cpu/cpu_device.h"
+#include "scenes/builtin.h"
+#include "scheduler/render.h"
+
+typedef struct rt_args {
+    const char *scene;      /* built-in name */
+    uint32_t width, height, spp, max_depth;
+    uint64_t seed;
+    rs_sampling sampling;
+    int threads;            /* CPU device and shading threads */
+    uint32_t chunk_size;    /* 0: default */
+    uint32_t wave_paths;    /* 0: default */
+    int with_fallback;      /* add a second, one-thread "gpu-fallback" CPU device */
+} rt_args;
+
+static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
+{
+    rt_args a;
+    memset(&a, 0, sizeof a);
+    a.scene = scene;
+    a.width = a.height = size;
+    a.spp = spp;
+    a.max_depth = 50;
+    a.seed = 1;
+    a.sampling = RS_SAMPLING_MIS;
+    a.threads = 1;
+    return a;
+}
+
+/* Returns width * height * 3 floats (free with free()), or NULL after printing why. */
+static inline float *rt_render(const rt_args *a, rs_render_stats *stats_out)
+{
+    rs_scene *scene = NULL;
+    rs_bvh *bvh = NULL;
+    rs_device *devs[2] = {NULL, NULL};
+    rs_sched *sched = NULL;
+    rs_film *film = NULL;
+    rs_render_settings st;
+    rs_render_stats stats;
+    rs_sched_config cfg;
+    rs_geom g;
+    float *rgb = NULL;
+    int n = a->with_fallback ? 2 : 1, i, ok = 0;
+
+    if (rs_builtin_create(a->scene, &scene) != RS_OK)
+        goto out;
+    g = rs_scene_geom(scene);
+    if (rs_bvh_build(&g, NULL, &bvh) != RS_OK ||
+        rs_cpu_device_create(a->threads, "cpu", &devs[0]) != RS_OK ||
+        (n == 2 && rs_cpu_device_create(1, "gpu-fallback", &devs[1]) != RS_OK))
+        goto out;
+    for (i = 0; i < n; ++i)
+        if (rs_device_upload(devs[i], &g, bvh) != RS_OK)
+            goto out;
+    cfg.chunk_size = a->chunk_size;
+    cfg.queue_capacity = 0;
+    if (rs_sched_create(devs, n, &cfg, &sched) != RS_OK ||
+        rs_film_create(a->width, a->height, &film) != RS_OK)
+        goto out;
+    memset(&st, 0, sizeof st);
+    st.width = a->width;
+    st.height = a->height;
+    st.spp = a->spp;
+    st.max_depth = a->max_depth;
+    st.seed = a->seed;
+    st.sampling = a->sampling;
+    st.wave_paths = a->wave_paths;
+    st.threads = a->threads;
+    if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK)
+        goto out;
+    rgb = (float *)malloc((size_t)a->width * a->height * 3 * sizeof *rgb);
+    if (!rgb)
+        goto out;
+    rs_film_resolve(film, rgb);
+    if (stats_out)
+        *stats_out = stats;
+    ok = 1;
+out:
+    if (!ok)
+        fprintf(stderr, "rt_render(%s): %s\n", a->scene, rs_error_message());
+    rs_sched_destroy(sched);
+    for (i = 0; i < n; ++i)
+        rs_device_destroy(devs[i]);
+    rs_film_destroy(film);
+    rs_bvh_destroy(bvh);
+    rs_scene_destroy(scene);
+    return rgb;
+}
+
+static inline double rt_mean(const float *rgb, size_t n_floats)
+{
+    double s = 0.0;
+    size_t i;
+    for (i = 0; i < n_floats; ++i)
+        s += rgb[i];
+    return s / (double)n_floats;
+}
+
+#endif
