@@ -1,7 +1,6 @@
 /* app/main.c — the `raystream` command: parses options, builds the scene, BVH, devices and
  * scheduler, runs the render with a progress bar, writes the image and prints a summary.
  * The only place that calls exit() (by returning from main) and that handles signals. */
-#include <omp.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -13,6 +12,7 @@
 #include "app/progress.h"
 #include "core/alloc.h"
 #include "core/image_io.h"
+#include "core/parallel.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
@@ -62,7 +62,10 @@ static int cmd_version(void)
     } else {
         printf("  CUDA:        no (built without the CUDA toolkit)\n");
     }
-    printf("  OpenMP:      yes, %d threads available\n", omp_get_max_threads());
+    if (RS_HAVE_OPENMP)
+        printf("  OpenMP:      yes, %d threads available\n", rs_default_threads());
+    else
+        printf("  OpenMP:      no (compiled out for ThreadSanitizer); %d cores\n", rs_cpu_count());
     printf("  OpenImageIO: %s\n", rs_image_library_version());
     return RS_EXIT_OK;
 }
@@ -176,7 +179,7 @@ static int cmd_render(const rs_cli_options *o)
     st.seed = o->seed;
     st.sampling = o->sampling;
     st.wave_paths = o->wave_paths;
-    threads = o->threads ? o->threads : omp_get_num_procs();
+    threads = o->threads ? o->threads : rs_cpu_count();
     st.threads = threads;
 
     /* ---- the output is checked before any work ---- */

@@ -43,6 +43,7 @@
 
 #include "core/alloc.h"
 #include "core/image_io.h"
+#include "gpu/gpu_device.h"
 
 #ifndef RS_BINARY
 #error "RS_BINARY must name the raystream executable"
@@ -261,10 +262,10 @@ static void report(const proc *p, int line, const char *cond, const char *fmt, .
 }
 
 /* Checks `cond` about run `p`; on failure shows the command, its status and its output. */
-#define EXPECT(p, cond, ...)                                                                   \
-    do {                                                                                       \
-        if (!(cond))                                                                           \
-            report((p), __LINE__, #cond, __VA_ARGS__);                                         \
+#define EXPECT(p, cond, ...)                                                                       \
+    do {                                                                                           \
+        if (!(cond))                                                                               \
+            report((p), __LINE__, #cond, __VA_ARGS__);                                             \
     } while (0)
 
 static int exited_with(const proc *p, int code)
@@ -387,8 +388,7 @@ static int group_setup(void **state)
 {
     (void)state;
     if (access(RS_BINARY, X_OK) != 0) {
-        fprintf(stderr, "app_cli_test: %s is not an executable: %s\n", RS_BINARY,
-                strerror(errno));
+        fprintf(stderr, "app_cli_test: %s is not an executable: %s\n", RS_BINARY, strerror(errno));
         return -1;
     }
     return 0;
@@ -848,6 +848,41 @@ static void test_threads_and_chunks_change_nothing(void **state)
     }
     rs_free(ref.rgb);
 }
+/* Where no CUDA device can be used (CI: the toolkit but no driver), `--devices cpu:1,gpu` still
+ * renders: the gpu becomes the CPU fallback device after one warning line, and the image is the
+ * CPU-only image bit for bit (the fallback runs the very same traversal). */
+static void test_gpu_fallback(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const cpu_args[] = {"render", "--width", "24", "--spp", "4", "-q",
+                                           "--devices", "cpu", "--chunk-size", "100", "-o",
+                                           "cpu.exr", NULL};
+    static const char *const mix_args[] = {"render", "--width", "24", "--spp", "4", "-q",
+                                           "--devices", "cpu:1,gpu", "--chunk-size", "100", "-o",
+                                           "mixed.exr", NULL};
+    const char *why = "";
+    proc p, q;
+    image a, b;
+    if (rs_gpu_count(&why) > 0) {
+        print_message("a CUDA device is present: the fallback path is not exercised here\n");
+        skip();
+    }
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, cpu_args);
+    EXPECT(&p, exited_with(&p, 0), "the cpu render should succeed");
+    run(&q, f->dir, DEFAULT_TIMEOUT_S, mix_args);
+    EXPECT(&q, exited_with(&q, 0), "the cpu+gpu render should fall back and succeed");
+    EXPECT(&q, one_line(&q.err) && contains_ci(q.err.data, "fallback"),
+           "expected one warning line naming the fallback");
+    a = read_image(&p, f, "cpu.exr");
+    b = read_image(&q, f, "mixed.exr");
+    EXPECT(&q, a.w == b.w && a.h == b.h &&
+                   memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
+           "the fallback changed the image");
+    rs_free(a.rgb);
+    rs_free(b.rgb);
+    proc_free(&p);
+    proc_free(&q);
+}
 
 int main(void)
 {
@@ -862,6 +897,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_failed_run_keeps_output, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sigint_writes_partial_image, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }

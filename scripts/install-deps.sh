@@ -1,0 +1,34 @@
+#!/bin/sh
+# scripts/install-deps.sh — installs everything raystream needs to build and test, with apt-get
+# (Debian bookworm).  Idempotent: prints nothing and changes nothing when all is installed.
+# Run as root (or through sudo).  The CUDA toolkit is optional and not installed here: without
+# nvcc the build simply leaves the CUDA device out.
+set -eu
+
+PACKAGES="gcc g++ make cmake pkg-config libc6-dev
+libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev"
+
+missing=""
+for p in $PACKAGES; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        missing="$missing $p"
+    fi
+done
+[ -z "$missing" ] && exit 0
+
+if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then
+        SUDO=sudo
+    else
+        echo "install-deps.sh: missing packages:$missing; run this script as root" >&2
+        exit 1
+    fi
+else
+    SUDO=
+fi
+
+echo "install-deps.sh: installing$missing" >&2
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -qq --no-install-recommends $missing >/dev/null
