@@ -146,11 +146,11 @@ typedef struct rs_bvh {
     uint32_t *prim_ids;
     uint32_t n_nodes;
     uint32_t n_prims;
-    uint32_t depth;   /* longest root-to-leaf path, in nodes */
+    uint32_t depth; /* longest root-to-leaf path, in nodes */
 } rs_bvh;
 
 typedef struct rs_bvh_build_opts {
-    uint32_t max_leaf;  /* most primitives in a leaf (>= 1); 0 means the default, 4 */
+    uint32_t max_leaf; /* most primitives in a leaf (>= 1); 0 means the default, 4 */
 } rs_bvh_build_opts;
 
 /* Builds a BVH over every primitive of `g` by median split on the axis of largest centroid

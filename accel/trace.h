@@ -8,8 +8,8 @@
 #include "streams/stream.h"
 
 typedef enum rs_trace_kind {
-    RS_TRACE_CLOSEST = 0,  /* fill hits[i] */
-    RS_TRACE_OCCLUDED = 1  /* fill occluded[i] */
+    RS_TRACE_CLOSEST = 0, /* fill hits[i] */
+    RS_TRACE_OCCLUDED = 1 /* fill occluded[i] */
 } rs_trace_kind;
 
 /* A batch of rays to trace and where the answers go.  `kind` is stored as uint32_t (fixed width

@@ -19,7 +19,7 @@
 #include "scheduler/render.h"
 
 #ifndef RS_VERSION
-#define RS_VERSION "0.0.0"
+#  define RS_VERSION "0.0.0"
 #endif
 
 static atomic_int g_cancel;
@@ -107,7 +107,8 @@ static int create_devices(const rs_cli_options *o, int threads, rs_device **devs
                 /* alone, the fallback may use every core; beside a cpu device, one of them */
                 int ft = o->n_devices == 1 ? threads : 1;
                 char name[48];
-                fprintf(stderr, "raystream: warning: %s; gpu:%d runs on the CPU fallback (%d thread%s)\n",
+                fprintf(stderr,
+                        "raystream: warning: %s; gpu:%d runs on the CPU fallback (%d thread%s)\n",
                         rs_error_message(), d->index, ft, ft == 1 ? "" : "s");
                 rs_error_clear();
                 snprintf(name, sizeof name, "gpu-fallback:%d", d->index);
@@ -149,12 +150,14 @@ static int cmd_render(const rs_cli_options *o)
     if (strncmp(o->scene, "builtin:", 8) != 0) {
         struct stat sb;
         if (stat(o->scene, &sb) != 0)
-            fprintf(stderr, "raystream: %s: no such scene file (built-in scenes are named "
-                            "builtin:NAME; see 'raystream scenes')\n",
+            fprintf(stderr,
+                    "raystream: %s: no such scene file (built-in scenes are named "
+                    "builtin:NAME; see 'raystream scenes')\n",
                     o->scene);
         else
-            fprintf(stderr, "raystream: %s: scene files are not supported yet; use a built-in "
-                            "scene (see 'raystream scenes')\n",
+            fprintf(stderr,
+                    "raystream: %s: scene files are not supported yet; use a built-in "
+                    "scene (see 'raystream scenes')\n",
                     o->scene);
         return RS_EXIT_USAGE;
     }
@@ -267,8 +270,8 @@ static int cmd_render(const rs_cli_options *o)
                 "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
                 "BVH: %u nodes over %u primitives, built in %.2f ms. ",
                 code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered",
-                o->scene, st.width, st.height, st.spp, rs_sampling_name(st.sampling),
-                st.max_depth, (unsigned long long)st.seed, stats.seconds, sps, rps, rays,
+                o->scene, st.width, st.height, st.spp, rs_sampling_name(st.sampling), st.max_depth,
+                (unsigned long long)st.seed, stats.seconds, sps, rps, rays,
                 (unsigned long long)stats.rays_closest, (unsigned long long)stats.rays_shadow,
                 bvh->n_nodes, bvh->n_prims, bvh_ms);
         for (i = 0; i < n_devs; ++i) {
@@ -293,7 +296,8 @@ static int cmd_render(const rs_cli_options *o)
         else
             fprintf(stderr, "Wrote %s.\n", out);
     } else if (code == RS_EXIT_INTERRUPTED) {
-        fprintf(stderr, "raystream: interrupted; wrote a partial image (%llu of %llu samples) to %s\n",
+        fprintf(stderr,
+                "raystream: interrupted; wrote a partial image (%llu of %llu samples) to %s\n",
                 (unsigned long long)stats.paths_done, (unsigned long long)stats.paths_total, out);
     }
 

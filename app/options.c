@@ -38,8 +38,9 @@ static int parse_u64(const char *opt, const char *text, uint64_t lo, uint64_t hi
     return RS_EXIT_OK;
 bad:
     if (text[0] == '-' && strspn(text + 1, "0123456789") == strlen(text + 1) && text[1]) {
-        fprintf(stderr, "raystream: %s %s: must be a positive whole number (see 'raystream --help')\n",
-                opt, text);
+        fprintf(stderr,
+                "raystream: %s %s: must be a positive whole number (see 'raystream --help')\n", opt,
+                text);
         return RS_EXIT_USAGE;
     }
     return usage_error("%s: '%s' is not a whole number", opt, text);
@@ -214,10 +215,10 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
             o->quiet = 1;
             continue;
         }
-#define NEEDS_VALUE()                                                                          \
-    v = take_value(argc, argv, &i, eq);                                                        \
-    if (!v)                                                                                    \
-        return usage_error("%s needs a value%s", name, "");
+#define NEEDS_VALUE()                                                                              \
+  v = take_value(argc, argv, &i, eq);                                                              \
+  if (!v)                                                                                          \
+    return usage_error("%s needs a value%s", name, "");
         if (strcmp(name, "--scene") == 0) {
             NEEDS_VALUE();
             if (o->scene)

@@ -6,9 +6,9 @@
 
 #include "shading/integrator.h"
 
-#define RS_EXIT_OK 0
-#define RS_EXIT_RUNTIME 1
-#define RS_EXIT_USAGE 2
+#define RS_EXIT_OK          0
+#define RS_EXIT_RUNTIME     1
+#define RS_EXIT_USAGE       2
 #define RS_EXIT_INTERRUPTED 130
 
 #define RS_MAX_DEVICES 16
@@ -21,20 +21,20 @@ typedef enum rs_cli_command {
 } rs_cli_command;
 
 typedef struct rs_device_spec {
-    int is_gpu;   /* 0: cpu, 1: gpu */
-    int index;    /* gpu: CUDA device index */
-    int threads;  /* cpu: thread count, 0 = the --threads value */
+    int is_gpu;  /* 0: cpu, 1: gpu */
+    int index;   /* gpu: CUDA device index */
+    int threads; /* cpu: thread count, 0 = the --threads value */
 } rs_device_spec;
 
 typedef struct rs_cli_options {
     rs_cli_command command;
-    const char *scene;         /* "builtin:NAME" */
-    const char *output;        /* NULL: "<scene name>.png" */
-    uint32_t width, height;    /* 0: the scene's own */
+    const char *scene;      /* "builtin:NAME" */
+    const char *output;     /* NULL: "<scene name>.png" */
+    uint32_t width, height; /* 0: the scene's own */
     uint32_t spp;
     uint32_t max_depth;
     uint64_t seed;
-    int threads;               /* 0: every core */
+    int threads; /* 0: every core */
     rs_sampling sampling;
     uint32_t chunk_size;
     uint32_t wave_paths;

@@ -10,7 +10,7 @@ typedef struct rs_progress {
     int tty;
     double start, last_draw;
     int last_decile;
-    int drawn;   /* a bar is on screen and needs a newline before other output */
+    int drawn; /* a bar is on screen and needs a newline before other output */
 } rs_progress;
 
 void rs_progress_begin(rs_progress *p, int enabled);

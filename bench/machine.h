@@ -10,7 +10,7 @@
 #include "gpu/gpu_device.h"
 
 #ifndef RS_BUILD_FLAGS
-#define RS_BUILD_FLAGS "?"
+#  define RS_BUILD_FLAGS "?"
 #endif
 
 static inline void rs_bench_cpu_model(char *buf, size_t n)

@@ -49,7 +49,8 @@ static int render_once(const rs_scene *scene, const rs_bvh *bvh, uint32_t size, 
     st.sampling = RS_SAMPLING_MIS;
     st.threads = threads;
     if (rs_cpu_device_create(threads, "cpu", &dev) == RS_OK &&
-        rs_device_upload(dev, &g, bvh) == RS_OK && rs_sched_create(&dev, 1, NULL, &sched) == RS_OK &&
+        rs_device_upload(dev, &g, bvh) == RS_OK &&
+        rs_sched_create(&dev, 1, NULL, &sched) == RS_OK &&
         rs_film_create(size, size, &film) == RS_OK &&
         rs_render(scene, sched, &st, NULL, film, &stats) == RS_OK) {
         res->seconds = stats.seconds;
@@ -150,7 +151,8 @@ int main(int argc, char **argv)
         if (csv_f)
             fprintf(csv_f, "scene,size,spp,threads,median_s,samples_per_s,mrays_per_s,speedup\n");
     }
-    for (t = 1; t <= max_threads; t = (t < max_threads && t * 2 > max_threads) ? max_threads : t * 2) {
+    for (t = 1; t <= max_threads;
+         t = (t < max_threads && t * 2 > max_threads) ? max_threads : t * 2) {
         double secs[64];
         result r = {0, 0};
         int k, n = runs > 64 ? 64 : runs;

@@ -18,7 +18,10 @@ typedef struct rs_geom {
     uint32_t n_spheres, n_quads, n_tris;
 } rs_geom;
 
-RS_HD uint32_t rs_geom_prim_count(const rs_geom *g) { return g->n_spheres + g->n_quads + g->n_tris; }
+RS_HD uint32_t rs_geom_prim_count(const rs_geom *g)
+{
+    return g->n_spheres + g->n_quads + g->n_tris;
+}
 
 /* Intersects global primitive `prim`; on a hit writes t, u, v and returns 1. */
 RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, float *t, float *u,

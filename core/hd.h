@@ -8,9 +8,9 @@
 #define RS_CORE_HD_H
 
 #if defined(__CUDACC__)
-#  define RS_HD static inline __host__ __device__
-#  define RS_RESTRICT __restrict__
-#  define RS_ALIGN(n) __align__(n)
+#  define RS_HD          static inline __host__ __device__
+#  define RS_RESTRICT    __restrict__
+#  define RS_ALIGN(n)    __align__(n)
 #  define RS_CONST_TABLE static __device__ const
 #else
 #  define RS_HD static inline
@@ -19,7 +19,7 @@
 #  else
 #    define RS_RESTRICT restrict
 #  endif
-#  define RS_ALIGN(n) _Alignas(n)
+#  define RS_ALIGN(n)    _Alignas(n)
 #  define RS_CONST_TABLE static const
 #endif
 

@@ -16,7 +16,8 @@
 
 #include "core/alloc.h"
 
-namespace {
+namespace
+{
 
 std::string lower_ext(const char *path)
 {

@@ -7,21 +7,21 @@
 #define RS_CORE_PARALLEL_H
 
 #if defined(_OPENMP)
-#include <omp.h>
+#  include <omp.h>
 /* Processors available to this process. */
 static inline int rs_cpu_count(void) { return omp_get_num_procs(); }
 /* Threads an OpenMP region would use by default (OMP_NUM_THREADS or the processors). */
 static inline int rs_default_threads(void) { return omp_get_max_threads(); }
-#define RS_HAVE_OPENMP 1
+#  define RS_HAVE_OPENMP 1
 #else
-#include <unistd.h>
+#  include <unistd.h>
 static inline int rs_cpu_count(void)
 {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n > 0 ? (int)n : 1;
 }
 static inline int rs_default_threads(void) { return rs_cpu_count(); }
-#define RS_HAVE_OPENMP 0
+#  define RS_HAVE_OPENMP 0
 #endif
 
 #endif

@@ -5,9 +5,9 @@
 #include "core/vec3.h"
 
 typedef struct rs_ray {
-    rs_vec3 o;   /* origin */
-    rs_vec3 d;   /* direction; need not be unit length, t is measured in units of |d| */
-    float tmin;  /* the ray is the open segment o + t d, tmin < t < tmax */
+    rs_vec3 o;  /* origin */
+    rs_vec3 d;  /* direction; need not be unit length, t is measured in units of |d| */
+    float tmin; /* the ray is the open segment o + t d, tmin < t < tmax */
     float tmax;
 } rs_ray;
 

@@ -22,8 +22,8 @@ RS_HD uint32_t rs_mulhilo32(uint32_t a, uint32_t b, uint32_t *hi)
 }
 
 /* Philox-4x32 with 10 rounds on counter c and key k. */
-RS_HD rs_rng_out rs_philox4x32_10(uint32_t c0, uint32_t c1, uint32_t c2, uint32_t c3,
-                                  uint32_t k0, uint32_t k1)
+RS_HD rs_rng_out rs_philox4x32_10(uint32_t c0, uint32_t c1, uint32_t c2, uint32_t c3, uint32_t k0,
+                                  uint32_t k1)
 {
     const uint32_t m0 = 0xD2511F53u, m1 = 0xCD9E8D57u;
     const uint32_t w0 = 0x9E3779B9u, w1 = 0xBB67AE85u;

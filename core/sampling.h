@@ -10,7 +10,7 @@
 
 #include "core/vec3.h"
 
-#define RS_PI 3.14159265358979323846f
+#define RS_PI     3.14159265358979323846f
 #define RS_INV_PI 0.31830988618379067154f
 
 typedef struct rs_onb {

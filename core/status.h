@@ -8,12 +8,12 @@
 
 typedef enum rs_status {
     RS_OK = 0,
-    RS_ERR_ARG,          /* bad argument or bad input data */
-    RS_ERR_IO,           /* a file could not be read or written */
-    RS_ERR_NOMEM,        /* out of memory */
-    RS_ERR_CUDA,         /* a CUDA call failed */
-    RS_ERR_DEVICE_LOST,  /* a device failed or is unavailable */
-    RS_ERR_CANCELLED     /* the user interrupted the work */
+    RS_ERR_ARG,         /* bad argument or bad input data */
+    RS_ERR_IO,          /* a file could not be read or written */
+    RS_ERR_NOMEM,       /* out of memory */
+    RS_ERR_CUDA,        /* a CUDA call failed */
+    RS_ERR_DEVICE_LOST, /* a device failed or is unavailable */
+    RS_ERR_CANCELLED    /* the user interrupted the work */
 } rs_status;
 
 #ifdef __cplusplus

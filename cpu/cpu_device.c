@@ -21,8 +21,7 @@ static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     return RS_OK;
 }
 
-static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin,
-                           uint32_t end)
+static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
 {
     const cpu_impl *c = (const cpu_impl *)d->impl;
     const rs_bvh_view *bv = &c->bvh;
@@ -30,11 +29,11 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
     long i;
     if (!c->uploaded)
         return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
-    /* dynamic schedule: ray costs vary a lot (a miss of the root box vs a deep traversal).
-     * A chunk too small to feed every thread runs on the dispatch thread alone: waking a team
-     * costs more than it saves. */
-#pragma omp parallel for num_threads(d->threads) schedule(dynamic, 256) \
-    if (d->threads > 1 && end - begin >= 512u)
+        /* dynamic schedule: ray costs vary a lot (a miss of the root box vs a deep traversal).
+         * A chunk too small to feed every thread runs on the dispatch thread alone: waking a team
+         * costs more than it saves. */
+#pragma omp parallel for num_threads(d->threads)                                                   \
+    schedule(dynamic, 256) if (d->threads > 1 && end - begin >= 512u)
     for (i = (long)begin; i < (long)end; ++i)
         rs_trace_one(bv, g, batch, (uint32_t)i);
     return RS_OK;

@@ -12,13 +12,13 @@
 
 #include "core/alloc.h"
 
-#define CUDA_TRY(call)                                                                         \
-    do {                                                                                       \
-        cudaError_t e_ = (call);                                                               \
-        if (e_ != cudaSuccess)                                                                 \
-            return rs_error_set(RS_ERR_CUDA, "%s failed (%s:%d): %s", #call, __FILE__,        \
-                                __LINE__, cudaGetErrorString(e_));                             \
-    } while (0)
+#define CUDA_TRY(call)                                                                             \
+  do {                                                                                             \
+    cudaError_t e_ = (call);                                                                       \
+    if (e_ != cudaSuccess)                                                                         \
+      return rs_error_set(RS_ERR_CUDA, "%s failed (%s:%d): %s", #call, __FILE__, __LINE__,         \
+                          cudaGetErrorString(e_));                                                 \
+  } while (0)
 
 __global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
 {
@@ -29,13 +29,13 @@ __global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
 
 typedef struct cuda_impl {
     int ordinal;
-    rs_geom geom;           /* device pointers */
-    rs_bvh_view bvh;        /* device pointers */
-    rs_ray_soa rays;        /* device staging, `cap` entries */
+    rs_geom geom;    /* device pointers */
+    rs_bvh_view bvh; /* device pointers */
+    rs_ray_soa rays; /* device staging, `cap` entries */
     rs_hit_soa hits;
     uint8_t *occluded;
     uint32_t cap;
-    int block;              /* threads per block from the occupancy API */
+    int block; /* threads per block from the occupancy API */
 } cuda_impl;
 
 static void free_staging(cuda_impl *c)
@@ -106,8 +106,7 @@ static rs_status cuda_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     return RS_OK;
 }
 
-static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin,
-                            uint32_t end)
+static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
 {
     cuda_impl *c = (cuda_impl *)d->impl;
     uint32_t n = end - begin;
@@ -118,9 +117,9 @@ static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t 
     CUDA_TRY(cudaSetDevice(c->ordinal));
     if ((st = ensure_staging(c, n)) != RS_OK)
         return st;
-#define COPY_IN(type, name)                                                                    \
-    CUDA_TRY(cudaMemcpy(c->rays.name, batch->rays.name + begin, n * sizeof(type),              \
-                        cudaMemcpyHostToDevice));
+#define COPY_IN(type, name)                                                                        \
+  CUDA_TRY(cudaMemcpy(c->rays.name, batch->rays.name + begin, n * sizeof(type),                    \
+                      cudaMemcpyHostToDevice));
     RS_RAY_FIELDS(COPY_IN)
 #undef COPY_IN
     d->stats.bytes_to_device += (uint64_t)n * RS_RAY_BYTES;
@@ -134,9 +133,9 @@ static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t 
     CUDA_TRY(cudaGetLastError());
     CUDA_TRY(cudaDeviceSynchronize());
     if (batch->kind == RS_TRACE_CLOSEST) {
-#define COPY_OUT(type, name)                                                                   \
-    CUDA_TRY(cudaMemcpy(batch->hits.name + begin, c->hits.name, n * sizeof(type),              \
-                        cudaMemcpyDeviceToHost));
+#define COPY_OUT(type, name)                                                                       \
+  CUDA_TRY(cudaMemcpy(batch->hits.name + begin, c->hits.name, n * sizeof(type),                    \
+                      cudaMemcpyDeviceToHost));
         RS_HIT_FIELDS(COPY_OUT)
 #undef COPY_OUT
         d->stats.bytes_from_device += (uint64_t)n * RS_HIT_BYTES;
@@ -174,7 +173,7 @@ extern "C" int rs_gpu_count(const char **why)
     if (e != cudaSuccess) {
         if (why)
             *why = e == cudaErrorInsufficientDriver ? "no NVIDIA driver is loaded"
-                 : e == cudaErrorNoDevice           ? "no CUDA device is present"
+                   : e == cudaErrorNoDevice         ? "no CUDA device is present"
                                                     : "the CUDA runtime could not start";
         return 0;
     }

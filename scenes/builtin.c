@@ -22,12 +22,12 @@ static rs_material light(float r, float g, float b)
     return m;
 }
 
-#define TRY(expr)                                                                              \
-    do {                                                                                       \
-        rs_status st_ = (expr);                                                                \
-        if (st_ != RS_OK)                                                                      \
-            return st_;                                                                        \
-    } while (0)
+#define TRY(expr)                                                                                  \
+  do {                                                                                             \
+    rs_status st_ = (expr);                                                                        \
+    if (st_ != RS_OK)                                                                              \
+      return st_;                                                                                  \
+  } while (0)
 
 /* The two-box Cornell box of Shirley's "Ray Tracing: The Rest of Your Life" (v4), exactly:
  * quads as corner Q and edges u, v; the light emits only downward (its u x v is -y). */

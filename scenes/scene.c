@@ -146,12 +146,12 @@ rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg,
     /* the six faces of RTNW v4's box(), each with its normal pointing out */
     rs_vec3 q[6], u[6], v[6];
     int i;
-    q[0] = rs_v3(lo.x, lo.y, hi.z), u[0] = dx, v[0] = dy;                  /* front  +z */
-    q[1] = rs_v3(hi.x, lo.y, hi.z), u[1] = rs_v3_neg(dz), v[1] = dy;       /* right  +x */
-    q[2] = rs_v3(hi.x, lo.y, lo.z), u[2] = rs_v3_neg(dx), v[2] = dy;       /* back   -z */
-    q[3] = rs_v3(lo.x, lo.y, lo.z), u[3] = dz, v[3] = dy;                  /* left   -x */
-    q[4] = rs_v3(lo.x, hi.y, hi.z), u[4] = dx, v[4] = rs_v3_neg(dz);       /* top    +y */
-    q[5] = rs_v3(lo.x, lo.y, lo.z), u[5] = dx, v[5] = dz;                  /* bottom -y */
+    q[0] = rs_v3(lo.x, lo.y, hi.z), u[0] = dx, v[0] = dy;            /* front  +z */
+    q[1] = rs_v3(hi.x, lo.y, hi.z), u[1] = rs_v3_neg(dz), v[1] = dy; /* right  +x */
+    q[2] = rs_v3(hi.x, lo.y, lo.z), u[2] = rs_v3_neg(dx), v[2] = dy; /* back   -z */
+    q[3] = rs_v3(lo.x, lo.y, lo.z), u[3] = dz, v[3] = dy;            /* left   -x */
+    q[4] = rs_v3(lo.x, hi.y, hi.z), u[4] = dx, v[4] = rs_v3_neg(dz); /* top    +y */
+    q[5] = rs_v3(lo.x, lo.y, lo.z), u[5] = dx, v[5] = dz;            /* bottom -y */
     for (i = 0; i < 6; ++i) {
         rs_vec3 qq = rs_v3_add(rs_v3_rotate_y(q[i], rot_y_deg), offset);
         rs_status st = rs_scene_add_quad(s, qq, rs_v3_rotate_y(u[i], rot_y_deg),

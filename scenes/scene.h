@@ -12,33 +12,33 @@
 #include "core/status.h"
 
 typedef enum rs_material_type {
-    RS_MAT_LAMBERTIAN = 0,     /* ideal diffuse reflector, albedo */
-    RS_MAT_DIFFUSE_LIGHT = 1   /* emitter of constant radiance; reflects nothing */
+    RS_MAT_LAMBERTIAN = 0,   /* ideal diffuse reflector, albedo */
+    RS_MAT_DIFFUSE_LIGHT = 1 /* emitter of constant radiance; reflects nothing */
 } rs_material_type;
 
 /* Material flags. */
-#define RS_MAT_TWO_SIDED 1u  /* a light emits on both sides (else only where its normal points) */
+#define RS_MAT_TWO_SIDED 1u /* a light emits on both sides (else only where its normal points) */
 
 typedef struct rs_material {
-    uint32_t type;      /* rs_material_type, stored fixed-width */
-    uint32_t flags;     /* RS_MAT_* */
-    rs_vec3 albedo;     /* reflectance in [0, 1] per channel */
-    rs_vec3 emission;   /* radiance emitted (W / (m^2 sr)), for lights */
+    uint32_t type;    /* rs_material_type, stored fixed-width */
+    uint32_t flags;   /* RS_MAT_* */
+    rs_vec3 albedo;   /* reflectance in [0, 1] per channel */
+    rs_vec3 emission; /* radiance emitted (W / (m^2 sr)), for lights */
 } rs_material;
 
 /* An emitter that light sampling can pick: a quad or triangle with an emissive material. */
 typedef struct rs_light {
-    uint32_t prim;   /* global primitive index */
-    float area;      /* surface area */
-    float power;     /* pi * area * luminance(emission) * (2 if two-sided): selection weight */
-    float pick_pdf;  /* power / total power: probability that sampling picks this light */
+    uint32_t prim;  /* global primitive index */
+    float area;     /* surface area */
+    float power;    /* pi * area * luminance(emission) * (2 if two-sided): selection weight */
+    float pick_pdf; /* power / total power: probability that sampling picks this light */
 } rs_light;
 
 typedef struct rs_camera_desc {
     rs_vec3 from, at, up;
-    float vfov_deg;    /* vertical field of view, degrees */
-    float aperture;    /* lens diameter; 0 for a pinhole */
-    float focus_dist;  /* distance to the plane in focus; 0 means |at - from| */
+    float vfov_deg;   /* vertical field of view, degrees */
+    float aperture;   /* lens diameter; 0 for a pinhole */
+    float focus_dist; /* distance to the plane in focus; 0 means |at - from| */
 } rs_camera_desc;
 
 typedef struct rs_scene {
@@ -57,14 +57,14 @@ typedef struct rs_scene {
 
     /* built by rs_scene_finalize */
     rs_light *lights;
-    float *light_cdf;     /* n_lights + 1 entries, cdf[0] = 0, cdf[n] = 1 */
+    float *light_cdf; /* n_lights + 1 entries, cdf[0] = 0, cdf[n] = 1 */
     uint32_t n_lights;
-    int32_t *prim_light;  /* per global primitive: index into lights, or -1 */
+    int32_t *prim_light; /* per global primitive: index into lights, or -1 */
     int finalized;
 
     rs_camera_desc camera;
-    rs_vec3 background;   /* radiance of rays that leave the scene */
-    uint32_t width, height;  /* the scene's preferred image size */
+    rs_vec3 background;     /* radiance of rays that leave the scene */
+    uint32_t width, height; /* the scene's preferred image size */
 } rs_scene;
 
 rs_status rs_scene_create(const char *name, rs_scene **out);

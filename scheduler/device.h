@@ -26,18 +26,18 @@ typedef struct rs_device_ops {
 } rs_device_ops;
 
 typedef struct rs_device_stats {
-    uint64_t rays;          /* rays answered by this device */
-    uint64_t chunks;        /* chunks answered */
-    uint64_t failures;      /* failed trace calls (the device is retired after the first) */
-    double busy_s;          /* seconds inside trace() */
-    double idle_s;          /* seconds the dispatch thread waited for work */
-    uint64_t bytes_to_device, bytes_from_device;  /* transfers, for devices with own memory */
+    uint64_t rays;     /* rays answered by this device */
+    uint64_t chunks;   /* chunks answered */
+    uint64_t failures; /* failed trace calls (the device is retired after the first) */
+    double busy_s;     /* seconds inside trace() */
+    double idle_s;     /* seconds the dispatch thread waited for work */
+    uint64_t bytes_to_device, bytes_from_device; /* transfers, for devices with own memory */
 } rs_device_stats;
 
 struct rs_device {
     const rs_device_ops *ops;
-    char name[48];         /* "cpu", "cuda:0 (NVIDIA H100 ...)", "gpu-fallback", ... */
-    int threads;           /* host threads the device uses (0 for a GPU) */
+    char name[48]; /* "cpu", "cuda:0 (NVIDIA H100 ...)", "gpu-fallback", ... */
+    int threads;   /* host threads the device uses (0 for a GPU) */
     rs_device_stats stats;
     void *impl;
 };

@@ -59,10 +59,7 @@ fail:
     return st;
 }
 
-static int cancelled(const rs_render_hooks *h)
-{
-    return h && h->cancel && atomic_load(h->cancel);
-}
+static int cancelled(const rs_render_hooks *h) { return h && h->cancel && atomic_load(h->cancel); }
 
 static void report(const rs_render_hooks *h, uint64_t done, uint64_t total)
 {
@@ -120,8 +117,8 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
     stats->paths_total = total;
 
     for (wave_start = 0; wave_start < total && status == RS_OK; wave_start += st.wave_paths) {
-        uint32_t count = (uint32_t)((total - wave_start < st.wave_paths) ? total - wave_start
-                                                                         : st.wave_paths);
+        uint32_t count =
+            (uint32_t)((total - wave_start < st.wave_paths) ? total - wave_start : st.wave_paths);
         uint32_t alive, bounce, cur = 0, i;
 
         t0 = now_s();
@@ -154,8 +151,8 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
             t0 = now_s();
             rs_integrator_shade(&it, wave_start, bounce, &b.ext[cur], &b.hits, alive, &b.paths,
                                 &b.ext[cur ^ 1], b.next_valid, &b.shadow_raw, b.shadow_valid);
-            n_shadow = rs_stream_compact(&b.shadow_raw, b.shadow_valid, alive, &b.shadow,
-                                         st.threads);
+            n_shadow =
+                rs_stream_compact(&b.shadow_raw, b.shadow_valid, alive, &b.shadow, st.threads);
             stats->shade_s += now_s() - t0;
 
             /* trace the shadow rays, then credit the unoccluded ones */
@@ -178,8 +175,8 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
             /* the surviving paths' next rays, in slot order, become the current stream; they
              * were written in place of the current rays' slots in the other buffer */
             t0 = now_s();
-            alive = rs_stream_compact(&b.ext[cur ^ 1], b.next_valid, alive, &b.ext[cur],
-                                      st.threads);
+            alive =
+                rs_stream_compact(&b.ext[cur ^ 1], b.next_valid, alive, &b.ext[cur], st.threads);
             stats->shade_s += now_s() - t0;
             report(hooks, stats->paths_done + (count - alive), total);
         }

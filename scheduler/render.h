@@ -22,23 +22,23 @@
 
 typedef struct rs_render_settings {
     uint32_t width, height, spp;
-    uint32_t max_depth;    /* most ray segments per path, camera ray included */
-    uint32_t rr_depth;     /* Russian roulette from this segment on; 0 means 3 */
+    uint32_t max_depth; /* most ray segments per path, camera ray included */
+    uint32_t rr_depth;  /* Russian roulette from this segment on; 0 means 3 */
     uint64_t seed;
     rs_sampling sampling;
-    uint32_t wave_paths;   /* paths in flight; 0 means RS_RENDER_DEFAULT_WAVE */
-    int threads;           /* OpenMP threads for the shading stages */
+    uint32_t wave_paths; /* paths in flight; 0 means RS_RENDER_DEFAULT_WAVE */
+    int threads;         /* OpenMP threads for the shading stages */
 } rs_render_settings;
 
 #define RS_RENDER_DEFAULT_WAVE (1u << 20)
 
 typedef struct rs_render_stats {
-    double seconds;            /* wall time of rs_render */
-    double trace_s, shade_s;   /* time in trace calls / in the shading stages (incl. raygen) */
+    double seconds;          /* wall time of rs_render */
+    double trace_s, shade_s; /* time in trace calls / in the shading stages (incl. raygen) */
     uint64_t paths_total, paths_done;
     uint64_t rays_closest, rays_shadow;
     uint32_t waves;
-    uint32_t max_bounce;       /* deepest segment reached */
+    uint32_t max_bounce; /* deepest segment reached */
 } rs_render_stats;
 
 typedef struct rs_render_hooks {

@@ -19,8 +19,8 @@
 
 typedef struct batch_rec {
     const rs_trace_batch *batch;
-    uint32_t remaining;   /* chunks not yet answered */
-    uint64_t answered;    /* rays answered */
+    uint32_t remaining; /* chunks not yet answered */
+    uint64_t answered;  /* rays answered */
 } batch_rec;
 
 typedef struct chunk {
@@ -38,9 +38,9 @@ typedef struct worker {
 
 struct rs_sched {
     pthread_mutex_t lock;
-    pthread_cond_t work_cv;   /* queue became non-empty, or stop */
-    pthread_cond_t space_cv;  /* queue has room */
-    pthread_cond_t done_cv;   /* a chunk was answered, or a device died */
+    pthread_cond_t work_cv;  /* queue became non-empty, or stop */
+    pthread_cond_t space_cv; /* queue has room */
+    pthread_cond_t done_cv;  /* a chunk was answered, or a device died */
     chunk *queue;
     uint32_t q_cap, q_head, q_len;
     chunk *retry;

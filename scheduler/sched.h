@@ -17,8 +17,8 @@
 typedef struct rs_sched rs_sched;
 
 typedef struct rs_sched_config {
-    uint32_t chunk_size;      /* rays per chunk (>= 1); 0 means RS_SCHED_DEFAULT_CHUNK */
-    uint32_t queue_capacity;  /* chunks the queue holds (>= 1); 0 means 256 */
+    uint32_t chunk_size;     /* rays per chunk (>= 1); 0 means RS_SCHED_DEFAULT_CHUNK */
+    uint32_t queue_capacity; /* chunks the queue holds (>= 1); 0 means 256 */
 } rs_sched_config;
 
 #define RS_SCHED_DEFAULT_CHUNK 65536u
@@ -36,7 +36,8 @@ int rs_sched_device_count(const rs_sched *s);
 rs_device *rs_sched_device(const rs_sched *s, int i);
 /* A consistent copy of device i's counters; *alive is 0 once the device has been retired. */
 void rs_sched_device_stats(rs_sched *s, int i, rs_device_stats *out, int *alive);
-/* Totals over every batch so far: rays submitted and rays answered (equal when nothing was lost). */
+/* Totals over every batch so far: rays submitted and rays answered (equal when nothing was lost).
+ */
 void rs_sched_totals(rs_sched *s, uint64_t *submitted, uint64_t *answered);
 
 #endif

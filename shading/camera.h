@@ -9,16 +9,16 @@
 
 typedef struct rs_camera {
     rs_vec3 origin;
-    rs_vec3 corner;  /* top-left corner of the image on the focus plane */
-    rs_vec3 du, dv;  /* one pixel to the right / one pixel down, on the focus plane */
-    rs_vec3 lens_u, lens_v;  /* lens-plane axes scaled by the lens radius */
+    rs_vec3 corner;         /* top-left corner of the image on the focus plane */
+    rs_vec3 du, dv;         /* one pixel to the right / one pixel down, on the focus plane */
+    rs_vec3 lens_u, lens_v; /* lens-plane axes scaled by the lens radius */
     float lens_radius;
 } rs_camera;
 
 /* from/at/up: look-at frame; vfov in degrees; aperture = lens diameter (0: pinhole);
  * focus_dist <= 0 means |at - from|. */
-RS_HD rs_camera rs_camera_make(rs_vec3 from, rs_vec3 at, rs_vec3 up, float vfov_deg,
-                               float aperture, float focus_dist, uint32_t width, uint32_t height)
+RS_HD rs_camera rs_camera_make(rs_vec3 from, rs_vec3 at, rs_vec3 up, float vfov_deg, float aperture,
+                               float focus_dist, uint32_t width, uint32_t height)
 {
     rs_camera c;
     float theta = vfov_deg * (RS_PI / 180.0f);

@@ -4,9 +4,9 @@
 #define RS_SHADING_DIMS_H
 
 enum {
-    RS_DIM_CAMERA = 0,  /* pixel jitter x, y; lens u, v (bounce 0 only) */
-    RS_DIM_BSDF = 1,    /* direction u1, u2; mixture choice; Russian roulette */
-    RS_DIM_LIGHT = 2    /* light pick; point u1, u2; unused */
+    RS_DIM_CAMERA = 0, /* pixel jitter x, y; lens u, v (bounce 0 only) */
+    RS_DIM_BSDF = 1,   /* direction u1, u2; mixture choice; Russian roulette */
+    RS_DIM_LIGHT = 2   /* light pick; point u1, u2; unused */
 };
 
 #endif

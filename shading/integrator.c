@@ -104,8 +104,8 @@ static float power_heuristic(float a, float b)
 }
 
 static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
-                      const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t j,
-                      rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
+                      const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t j, rs_paths *paths,
+                      rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
                       uint8_t *shadow_valid)
 {
     const rs_scene *sc = it->scene;
@@ -157,7 +157,8 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
                 float w = power_heuristic(ls.pdf, rs_pdf_cosine_hemisphere(c));
                 rs_vec3 f = rs_v3_scale(albedo, RS_INV_PI);
                 rs_ray sr;
-                paths->pending[p] = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, f), ls.le), c * w / ls.pdf);
+                paths->pending[p] =
+                    rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, f), ls.le), c * w / ls.pdf);
                 sr.o = xo;
                 sr.d = rs_v3_sub(ls.point, xo); /* unnormalised: the light is at t = 1 */
                 sr.tmin = 0.0f;
@@ -234,14 +235,14 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
 
 void rs_integrator_shade(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
                          const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
-                         rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
-                         rs_ray_soa *shadow, uint8_t *shadow_valid)
+                         rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
+                         uint8_t *shadow_valid)
 {
     long j;
 #pragma omp parallel for num_threads(it->threads) schedule(dynamic, 512) if (it->threads > 1)
     for (j = 0; j < (long)count; ++j)
-        shade_one(it, wave_start, bounce, rays, hits, (uint32_t)j, paths, next, next_valid,
-                  shadow, shadow_valid);
+        shade_one(it, wave_start, bounce, rays, hits, (uint32_t)j, paths, next, next_valid, shadow,
+                  shadow_valid);
 }
 
 void rs_integrator_resolve_shadows(const rs_integrator *it, const rs_ray_soa *shadow,
@@ -266,10 +267,11 @@ uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t
     int b;
     if (count < 4096)
         nb = 1;
-    /* pass 1: count per block */
+        /* pass 1: count per block */
 #pragma omp parallel for num_threads(nb) schedule(static, 1) if (nb > 1)
     for (b = 0; b < nb; ++b) {
-        uint32_t lo = (uint32_t)((uint64_t)count * b / nb), hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
+        uint32_t lo = (uint32_t)((uint64_t)count * b / nb),
+                 hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
         uint32_t c = 0, i;
         for (i = lo; i < hi; ++i)
             c += valid[i] != 0;
@@ -278,10 +280,11 @@ uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t
     offsets[0] = 0;
     for (b = 0; b < nb; ++b)
         offsets[b + 1] += offsets[b];
-    /* pass 2: copy, each block from its prefix offset */
+        /* pass 2: copy, each block from its prefix offset */
 #pragma omp parallel for num_threads(nb) schedule(static, 1) if (nb > 1)
     for (b = 0; b < nb; ++b) {
-        uint32_t lo = (uint32_t)((uint64_t)count * b / nb), hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
+        uint32_t lo = (uint32_t)((uint64_t)count * b / nb),
+                 hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
         uint32_t o = offsets[b], i;
         for (i = lo; i < hi; ++i)
             if (valid[i])

@@ -14,11 +14,11 @@
 #include "streams/stream.h"
 
 typedef enum rs_sampling {
-    RS_SAMPLING_MIS = 0,      /* light sampling + BSDF sampling, power heuristic (Veach 1998) */
-    RS_SAMPLING_MIXTURE = 1,  /* one direction from 1/2 light pdf + 1/2 BSDF pdf (the thesis's
-                                 radiance_mixture, Shirley's "The Rest of Your Life") */
-    RS_SAMPLING_BSDF = 2,     /* BSDF importance sampling only */
-    RS_SAMPLING_UNIFORM = 3   /* uniform hemisphere, no light sampling ("no importance sampling") */
+    RS_SAMPLING_MIS = 0,     /* light sampling + BSDF sampling, power heuristic (Veach 1998) */
+    RS_SAMPLING_MIXTURE = 1, /* one direction from 1/2 light pdf + 1/2 BSDF pdf (the thesis's
+                                radiance_mixture, Shirley's "The Rest of Your Life") */
+    RS_SAMPLING_BSDF = 2,    /* BSDF importance sampling only */
+    RS_SAMPLING_UNIFORM = 3  /* uniform hemisphere, no light sampling ("no importance sampling") */
 } rs_sampling;
 
 const char *rs_sampling_name(rs_sampling s);
@@ -26,15 +26,15 @@ const char *rs_sampling_name(rs_sampling s);
 int rs_sampling_parse(const char *text, rs_sampling *out);
 
 /* Path flags. */
-#define RS_PATH_SPECULAR 1u  /* the current ray left the camera or a delta BSDF: no MIS weight */
+#define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
 
 /* Per-path state of one wave (SoA, indexed by path). */
 typedef struct rs_paths {
-    rs_vec3 *throughput;  /* product of f cos / pdf so far */
-    rs_vec3 *radiance;    /* light gathered so far */
-    rs_vec3 *pending;     /* next-event contribution waiting for its shadow ray */
-    float *bsdf_pdf;      /* solid-angle pdf of the BSDF sample that made the current ray */
-    uint8_t *flags;       /* RS_PATH_* */
+    rs_vec3 *throughput; /* product of f cos / pdf so far */
+    rs_vec3 *radiance;   /* light gathered so far */
+    rs_vec3 *pending;    /* next-event contribution waiting for its shadow ray */
+    float *bsdf_pdf;     /* solid-angle pdf of the BSDF sample that made the current ray */
+    uint8_t *flags;      /* RS_PATH_* */
     uint32_t capacity;
 } rs_paths;
 
@@ -46,10 +46,10 @@ typedef struct rs_integrator {
     rs_camera camera;
     uint64_t seed;
     uint32_t width, height, npix;
-    uint32_t max_depth;   /* most ray segments a path may have, camera ray included (>= 1) */
-    uint32_t rr_depth;    /* Russian roulette from this segment on */
+    uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
+    uint32_t rr_depth;  /* Russian roulette from this segment on */
     rs_sampling sampling;
-    int threads;          /* OpenMP threads for the stages */
+    int threads; /* OpenMP threads for the stages */
 } rs_integrator;
 
 /* Fills `out` with the camera rays of paths [0, count) and resets their state. */
@@ -61,8 +61,8 @@ void rs_integrator_raygen(const rs_integrator *it, uint64_t wave_start, uint32_t
  * `shadow` (shadow_valid[j] = 1, contribution in paths->pending). */
 void rs_integrator_shade(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
                          const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
-                         rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
-                         rs_ray_soa *shadow, uint8_t *shadow_valid);
+                         rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
+                         uint8_t *shadow_valid);
 
 /* Adds each unoccluded shadow ray's pending contribution to its path. */
 void rs_integrator_resolve_shadows(const rs_integrator *it, const rs_ray_soa *shadow,

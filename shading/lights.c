@@ -61,8 +61,9 @@ int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float u_pick, float u1, flo
         /* uniform on a triangle: b0 = 1 - sqrt(u1), b1 = sqrt(u1) (1 - u2), b2 = sqrt(u1) u2 */
         const rs_tri *t = &s->tris[prim - s->n_quads];
         float su = sqrtf(u1);
-        p = rs_v3_add(rs_v3_add(rs_v3_scale(t->v0, 1.0f - su), rs_v3_scale(t->v1, su * (1.0f - u2))),
-                      rs_v3_scale(t->v2, su * u2));
+        p = rs_v3_add(
+            rs_v3_add(rs_v3_scale(t->v0, 1.0f - su), rs_v3_scale(t->v1, su * (1.0f - u2))),
+            rs_v3_scale(t->v2, su * u2));
     }
     n = rs_prim_normal(s, lt->prim, p);
     to = rs_v3_sub(p, x);

@@ -10,11 +10,11 @@
 #include "scenes/scene.h"
 
 typedef struct rs_light_sample {
-    rs_vec3 point;   /* on the light */
-    rs_vec3 wi;      /* unit direction from the shading point toward `point` */
-    float dist;      /* distance to `point` */
-    float pdf;       /* solid-angle pdf, pick probability included */
-    rs_vec3 le;      /* radiance arriving along -wi (zero from the back of a one-sided light) */
+    rs_vec3 point; /* on the light */
+    rs_vec3 wi;    /* unit direction from the shading point toward `point` */
+    float dist;    /* distance to `point` */
+    float pdf;     /* solid-angle pdf, pick probability included */
+    rs_vec3 le;    /* radiance arriving along -wi (zero from the back of a one-sided light) */
 } rs_light_sample;
 
 /* Unit geometric normal of global primitive `prim` at point p on it (spheres: outward; quads:

@@ -9,9 +9,9 @@ rs_status rs_ray_soa_init(rs_ray_soa *s, uint32_t capacity)
 {
     int ok = 1;
     memset(s, 0, sizeof *s);
-#define ALLOC_FIELD(type, name)                                                                \
-    s->name = (type *)rs_alloc_aligned(capacity ? capacity : 1, sizeof(type));                 \
-    ok = ok && s->name != NULL;
+#define ALLOC_FIELD(type, name)                                                                    \
+  s->name = (type *)rs_alloc_aligned(capacity ? capacity : 1, sizeof(type));                       \
+  ok = ok && s->name != NULL;
     RS_RAY_FIELDS(ALLOC_FIELD)
 #undef ALLOC_FIELD
     if (!ok) {
@@ -42,9 +42,9 @@ rs_status rs_hit_soa_init(rs_hit_soa *s, uint32_t capacity)
 {
     int ok = 1;
     memset(s, 0, sizeof *s);
-#define ALLOC_FIELD(type, name)                                                                \
-    s->name = (type *)rs_alloc_aligned(capacity ? capacity : 1, sizeof(type));                 \
-    ok = ok && s->name != NULL;
+#define ALLOC_FIELD(type, name)                                                                    \
+  s->name = (type *)rs_alloc_aligned(capacity ? capacity : 1, sizeof(type));                       \
+  ok = ok && s->name != NULL;
     RS_HIT_FIELDS(ALLOC_FIELD)
 #undef ALLOC_FIELD
     if (!ok) {

@@ -12,9 +12,13 @@
 #include "core/ray.h"
 #include "core/status.h"
 
-#define RS_RAY_FIELDS(X)                                                                       \
-    X(float, ox) X(float, oy) X(float, oz) X(float, dx) X(float, dy) X(float, dz)             \
-    X(float, tmin) X(float, tmax) X(uint32_t, path)
+/* clang-format off */
+#define RS_RAY_FIELDS(X)                                                      \
+    X(float, ox) X(float, oy) X(float, oz)                                    \
+    X(float, dx) X(float, dy) X(float, dz)                                    \
+    X(float, tmin) X(float, tmax)                                             \
+    X(uint32_t, path)
+/* clang-format on */
 
 #define RS_HIT_FIELDS(X) X(float, t) X(float, u) X(float, v) X(uint32_t, prim)
 
@@ -33,8 +37,8 @@ typedef struct rs_hit_soa {
 
 /* Bytes one entry of each stream takes, summed over its fields. */
 #define RS_STREAM_FIELD_SIZE(type, name) +sizeof(type)
-#define RS_RAY_BYTES (0 RS_RAY_FIELDS(RS_STREAM_FIELD_SIZE))
-#define RS_HIT_BYTES (0 RS_HIT_FIELDS(RS_STREAM_FIELD_SIZE))
+#define RS_RAY_BYTES                     (0 RS_RAY_FIELDS(RS_STREAM_FIELD_SIZE))
+#define RS_HIT_BYTES                     (0 RS_HIT_FIELDS(RS_STREAM_FIELD_SIZE))
 
 RS_HD rs_ray rs_ray_soa_get(const rs_ray_soa *s, uint32_t i)
 {

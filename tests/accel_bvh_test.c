@@ -182,26 +182,26 @@ static rs_bvh *build(const rs_geom *g, uint32_t max_leaf)
 
 static void describe_ray(char *buf, size_t n, const rs_ray *r)
 {
-    snprintf(buf, n, "o (%.9g %.9g %.9g) d (%.9g %.9g %.9g) t (%.9g, %.9g)", r->o.x, r->o.y,
-             r->o.z, r->d.x, r->d.y, r->d.z, r->tmin, r->tmax);
+    snprintf(buf, n, "o (%.9g %.9g %.9g) d (%.9g %.9g %.9g) t (%.9g, %.9g)", r->o.x, r->o.y, r->o.z,
+             r->d.x, r->d.y, r->d.z, r->tmin, r->tmax);
 }
 
 /* Compares one BVH query against the brute-force answer for ray r. */
-static void expect_same_hit(const rs_bvh *bvh, const rs_geom *g, const rs_ray *r,
-                            const rs_hit *ref, int ref_hit, const char *what, long index)
+static void expect_same_hit(const rs_bvh *bvh, const rs_geom *g, const rs_ray *r, const rs_hit *ref,
+                            int ref_hit, const char *what, long index)
 {
     rs_bvh_view view = rs_bvh_view_of(bvh);
     rs_hit h;
     int got = rs_bvh_closest(&view, g, *r, &h), occ = rs_bvh_occluded(&view, g, *r);
     char ray[256];
-    if (got != ref_hit || (got && (h.t != ref->t || (h.prim == ref->prim &&
-                                                     (h.u != ref->u || h.v != ref->v)))) ||
+    if (got != ref_hit ||
+        (got && (h.t != ref->t || (h.prim == ref->prim && (h.u != ref->u || h.v != ref->v)))) ||
         (!got && h.prim != RS_NO_HIT) || (got && h.prim >= rs_geom_prim_count(g))) {
         describe_ray(ray, sizeof ray, r);
         fail_msg("%s ray %ld: bvh %s prim %u t %.9g (u %.9g v %.9g), brute force %s prim %u t "
                  "%.9g (u %.9g v %.9g); %s",
-                 what, index, got ? "hit" : "miss", h.prim, h.t, h.u, h.v,
-                 ref_hit ? "hit" : "miss", ref->prim, ref->t, ref->u, ref->v, ray);
+                 what, index, got ? "hit" : "miss", h.prim, h.t, h.u, h.v, ref_hit ? "hit" : "miss",
+                 ref->prim, ref->t, ref->u, ref->v, ray);
     }
     if (got && h.prim != ref->prim) {
         /* a tie: the BVH's prim must give exactly the same t */
@@ -224,8 +224,8 @@ static void expect_same_hit(const rs_bvh *bvh, const rs_geom *g, const rs_ray *r
 
 static int box_contains(rs_vec3 olo, rs_vec3 ohi, rs_vec3 ilo, rs_vec3 ihi)
 {
-    return olo.x <= ilo.x && olo.y <= ilo.y && olo.z <= ilo.z && ohi.x >= ihi.x &&
-           ohi.y >= ihi.y && ohi.z >= ihi.z;
+    return olo.x <= ilo.x && olo.y <= ilo.y && olo.z <= ilo.z && ohi.x >= ihi.x && ohi.y >= ihi.y &&
+           ohi.z >= ihi.z;
 }
 
 static uint32_t ceil_log2(uint32_t n)
@@ -491,23 +491,23 @@ static void test_single_primitive(void **state)
         assert_int_equal(b->nodes[0].count, 1);
         assert_int_equal(b->prim_ids[0], 0);
         v = rs_bvh_view_of(b);
-        assert_int_equal(rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
-                                                          T_INF), &h), 1);
+        assert_int_equal(
+            rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &h), 1);
         assert_int_equal(h.prim, 0);
         assert_true(h.t == (kind == 0 ? 4.0f : 5.0f));
-        assert_int_equal(rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
-                                                          T_INF)), 1);
+        assert_int_equal(
+            rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF)), 1);
         /* blocked only inside (tmin, tmax) */
-        assert_int_equal(rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
-                                                          3.5f)), 0);
-        assert_int_equal(rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f,
-                                                          3.5f), &h), 0);
+        assert_int_equal(
+            rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, 3.5f)), 0);
+        assert_int_equal(
+            rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, 3.5f), &h), 0);
         assert_int_equal(h.prim, RS_NO_HIT);
         /* misses */
-        assert_int_equal(rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f,
-                                                          T_INF), &h), 0);
-        assert_int_equal(rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(5, 0, 0), rs_v3(0, 0, -1), 0.0f,
-                                                          T_INF)), 0);
+        assert_int_equal(
+            rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f, T_INF), &h), 0);
+        assert_int_equal(
+            rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(5, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF)), 0);
         rs_bvh_destroy(b);
         soup_free(&s);
     }

@@ -46,13 +46,13 @@
 #include "gpu/gpu_device.h"
 
 #ifndef RS_BINARY
-#error "RS_BINARY must name the raystream executable"
+#  error "RS_BINARY must name the raystream executable"
 #endif
 
-#define MAX_ARGS 32
+#define MAX_ARGS          32
 #define DEFAULT_TIMEOUT_S 120.0
 /* how long a run that must stop before rendering may take (its --spp would take minutes) */
-#define EARLY_FAIL_LIMIT_S 5.0
+#define EARLY_FAIL_LIMIT_S  5.0
 #define SIGINT_EXIT_LIMIT_S 30.0
 
 /* ---- running the binary ---------------------------------------------------------------------- */
@@ -263,10 +263,10 @@ static void report(const proc *p, int line, const char *cond, const char *fmt, .
 
 /* Checks `cond` about run `p`; on failure shows the command, its status and its output. */
 #define EXPECT(p, cond, ...)                                                                       \
-    do {                                                                                           \
-        if (!(cond))                                                                               \
-            report((p), __LINE__, #cond, __VA_ARGS__);                                             \
-    } while (0)
+  do {                                                                                             \
+    if (!(cond))                                                                                   \
+      report((p), __LINE__, #cond, __VA_ARGS__);                                                   \
+  } while (0)
 
 static int exited_with(const proc *p, int code)
 {
@@ -541,8 +541,8 @@ static void test_usage_errors(void **state)
  * working folder. */
 static void expect_unwritable(const fixture *f, const char *out, int n_files)
 {
-    const char *const args[] = {"render", "--width", "256", "--height", "256", "--spp",
-                                "100000", "-o", out, NULL};
+    const char *const args[] = {"render", "--width", "256", "--height", "256",
+                                "--spp",  "100000",  "-o",  out,        NULL};
     char names[512];
     proc p;
     run(&p, f->dir, 4 * EARLY_FAIL_LIMIT_S, args);
@@ -608,8 +608,8 @@ static void test_help_and_version(void **state)
     static const char *const help[] = {"--help", NULL};
     static const char *const help_words[] = {"usage: raystream", "render", "scenes", NULL};
     static const char *const render_help[] = {"render", "--help", NULL};
-    static const char *const render_help_words[] = {"usage: raystream render", "--spp",
-                                                    "--output", "130", NULL};
+    static const char *const render_help_words[] = {"usage: raystream render", "--spp", "--output",
+                                                    "130", NULL};
     static const char *const render_help2[] = {"render", "--spp", "4", "-h", NULL};
     static const char *const scenes[] = {"scenes", NULL};
     static const char *const scenes_words[] = {"builtin:cornell", NULL};
@@ -649,8 +649,8 @@ static void render_ok(proc *p, const fixture *f, const char *const *args, const 
 static void test_render_png(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const args[] = {"render", "--width", "64", "--height", "48", "--spp",
-                                       "4", "-o", "out.png", NULL};
+    static const char *const args[] = {"render", "--width", "64", "--height", "48",
+                                       "--spp",  "4",       "-o", "out.png",  NULL};
     proc p;
     image im;
     double mean;
@@ -671,10 +671,10 @@ static void test_render_png(void **state)
 static void test_render_float_formats(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const exr[] = {"render", "--width", "64", "--height", "48", "--spp",
-                                      "4", "-o", "out.exr", NULL};
+    static const char *const exr[] = {"render", "--width", "64", "--height", "48",
+                                      "--spp",  "4",       "-o", "out.exr",  NULL};
     static const char *const hdr[] = {"render", "--width", "64", "--height", "48", "--spp",
-                                      "4", "-q", "-o", "out.hdr", NULL};
+                                      "4",      "-q",      "-o", "out.hdr",  NULL};
     char path[256];
     proc p;
     image im;
@@ -724,7 +724,7 @@ static void test_failed_run_keeps_output(void **state)
 {
     const fixture *f = (const fixture *)*state;
     static const char *const good[] = {"render", "--width", "24", "--height", "16", "--spp",
-                                       "2", "-q", "-o", "good.png", NULL};
+                                       "2",      "-q",      "-o", "good.png", NULL};
     static const char *const bad[][12] = {
         {"render", "-o", "good.png", "--width", "24", "--bogus", NULL},
         {"render", "-o", "good.png", "--width", "24", "--spp", "0", NULL},
@@ -762,8 +762,8 @@ static void test_sigint_writes_partial_image(void **state)
 {
     const fixture *f = (const fixture *)*state;
     /* about an hour on 2 cores: it can only end through SIGINT */
-    static const char *const args[] = {"render", "--width", "256", "--height", "256", "--spp",
-                                       "100000", "-o", "partial.png", NULL};
+    static const char *const args[] = {"render", "--width", "256", "--height",    "256",
+                                       "--spp",  "100000",  "-o",  "partial.png", NULL};
     char names[512];
     double sent;
     proc p;
@@ -854,12 +854,12 @@ static void test_threads_and_chunks_change_nothing(void **state)
 static void test_gpu_fallback(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const cpu_args[] = {"render", "--width", "24", "--spp", "4", "-q",
-                                           "--devices", "cpu", "--chunk-size", "100", "-o",
-                                           "cpu.exr", NULL};
-    static const char *const mix_args[] = {"render", "--width", "24", "--spp", "4", "-q",
-                                           "--devices", "cpu:1,gpu", "--chunk-size", "100", "-o",
-                                           "mixed.exr", NULL};
+    static const char *const cpu_args[] = {"render", "--width",   "24",  "--spp",        "4",
+                                           "-q",     "--devices", "cpu", "--chunk-size", "100",
+                                           "-o",     "cpu.exr",   NULL};
+    static const char *const mix_args[] = {
+        "render",    "--width",      "24",  "--spp", "4",         "-q", "--devices",
+        "cpu:1,gpu", "--chunk-size", "100", "-o",    "mixed.exr", NULL};
     const char *why = "";
     proc p, q;
     image a, b;
@@ -875,8 +875,9 @@ static void test_gpu_fallback(void **state)
            "expected one warning line naming the fallback");
     a = read_image(&p, f, "cpu.exr");
     b = read_image(&q, f, "mixed.exr");
-    EXPECT(&q, a.w == b.w && a.h == b.h &&
-                   memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
+    EXPECT(&q,
+           a.w == b.w && a.h == b.h &&
+               memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
            "the fallback changed the image");
     rs_free(a.rgb);
     rs_free(b.rgb);

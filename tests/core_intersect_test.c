@@ -238,13 +238,13 @@ static void test_tri_head_on_and_barycentrics(void **state)
     rs_tri tr = mk_tri(rs_v3(0, 0, -2), rs_v3(1, 0, -2), rs_v3(0, 1, -2));
     float t, u, v;
     (void)state;
-    assert_true(tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u,
-                        &v));
+    assert_true(
+        tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
     assert_true(t == 2.0f);
     assert_true(u == 0.25f && v == 0.25f);
     /* u weights v1 = (1,0,.), v weights v2 = (0,1,.) */
-    assert_true(tri_hit(&tr, mk_ray(rs_v3(0.5f, 0.125f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u,
-                        &v));
+    assert_true(
+        tri_hit(&tr, mk_ray(rs_v3(0.5f, 0.125f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
     assert_true(u == 0.5f && v == 0.125f);
     /* at the vertices and on the edges (closed triangle) */
     assert_true(tri_hit(&tr, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
@@ -253,8 +253,8 @@ static void test_tri_head_on_and_barycentrics(void **state)
     assert_true(u == 1.0f && v == 0.0f);
     assert_true(tri_hit(&tr, mk_ray(rs_v3(0, 1, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
     assert_true(u == 0.0f && v == 1.0f);
-    assert_true(tri_hit(&tr, mk_ray(rs_v3(0.5f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u,
-                        &v));
+    assert_true(
+        tri_hit(&tr, mk_ray(rs_v3(0.5f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
     assert_true(u == 0.5f && v == 0.5f);
     /* the centroid of a general triangle, from an oblique origin, with a non-unit direction */
     {
@@ -274,34 +274,34 @@ static void test_tri_miss_and_both_faces(void **state)
     float t, u, v;
     (void)state;
     /* the back face: from below the plane looking up +z */
-    assert_true(tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, -4), rs_v3(0, 0, 1), 0.0f, T_INF), &t, &u,
-                        &v));
+    assert_true(
+        tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, -4), rs_v3(0, 0, 1), 0.0f, T_INF), &t, &u, &v));
     assert_true(t == 2.0f);
     assert_true(u == 0.25f && v == 0.25f);
     /* the same with the winding reversed (the other face now faces the ray) */
     {
         rs_tri rev = mk_tri(tr.v0, tr.v2, tr.v1);
-        assert_true(tri_hit(&rev, mk_ray(rs_v3(0.25f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t,
-                            &u, &v));
+        assert_true(
+            tri_hit(&rev, mk_ray(rs_v3(0.25f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
         assert_true(t == 2.0f && u == 0.5f && v == 0.25f);
     }
     /* outside each edge */
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.6f, 0.6f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u,
-                         &v));
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(-0.1f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u,
-                         &v));
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.5f, -0.1f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u,
-                         &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(0.6f, 0.6f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(-0.1f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(0.5f, -0.1f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
     /* just outside the hypotenuse and the legs (u + v = 1 + 2^-14, u = -2^-14): exact here */
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.5f + 0x1.0p-14f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f,
-                                     T_INF), &t, &u, &v));
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(-0x1.0p-14f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF),
-                         &t, &u, &v));
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.5f, -0x1.0p-14f, 0), rs_v3(0, 0, -1), 0.0f, T_INF),
-                         &t, &u, &v));
+    assert_false(tri_hit(
+        &tr, mk_ray(rs_v3(0.5f + 0x1.0p-14f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
+    assert_false(tri_hit(&tr, mk_ray(rs_v3(-0x1.0p-14f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t,
+                         &u, &v));
+    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.5f, -0x1.0p-14f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t,
+                         &u, &v));
     /* behind the origin */
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(0, 0, 1), 0.0f, T_INF), &t, &u,
-                         &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(0, 0, 1), 0.0f, T_INF), &t, &u, &v));
     assert_true(t == SENTINEL && u == SENTINEL && v == SENTINEL);
 }
 
@@ -311,25 +311,25 @@ static void test_tri_parallel(void **state)
     float t, u, v;
     (void)state;
     /* in the plane, crossing the triangle */
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(-1, 0.25f, -2), rs_v3(1, 0, 0), 0.0f, T_INF), &t, &u,
-                         &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(-1, 0.25f, -2), rs_v3(1, 0, 0), 0.0f, T_INF), &t, &u, &v));
     assert_false(tri_hit(&tr, mk_ray(rs_v3(-1, -1, -2), rs_v3(1, 1, 0), 0.0f, T_INF), &t, &u, &v));
     /* parallel, above the plane */
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(-1, 0.25f, -1), rs_v3(1, 0, 0), 0.0f, T_INF), &t, &u,
-                         &v));
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(-1, 0.25f, -3), rs_v3(3, 2, 0), 0.0f, T_INF), &t, &u,
-                         &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(-1, 0.25f, -1), rs_v3(1, 0, 0), 0.0f, T_INF), &t, &u, &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(-1, 0.25f, -3), rs_v3(3, 2, 0), 0.0f, T_INF), &t, &u, &v));
     /* a degenerate (zero-area) triangle is never hit */
     {
         rs_tri line = mk_tri(rs_v3(0, 0, -2), rs_v3(1, 1, -2), rs_v3(2, 2, -2));
-        assert_false(tri_hit(&line, mk_ray(rs_v3(0.5f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF),
-                             &t, &u, &v));
+        assert_false(
+            tri_hit(&line, mk_ray(rs_v3(0.5f, 0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &u, &v));
     }
     /* NaN directions never hit */
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(NAN, 0, -1), 0.0f, T_INF), &t,
-                         &u, &v));
-    assert_false(tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(0, 0, 0), 0.0f, T_INF), &t, &u,
-                         &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(NAN, 0, -1), 0.0f, T_INF), &t, &u, &v));
+    assert_false(
+        tri_hit(&tr, mk_ray(rs_v3(0.25f, 0.25f, 0), rs_v3(0, 0, 0), 0.0f, T_INF), &t, &u, &v));
     assert_true(t == SENTINEL);
 }
 
@@ -363,29 +363,29 @@ static void test_quad_analytic(void **state)
     assert_true(a == 0.0f && b == 0.0f);
     assert_true(quad_hit(&q, mk_ray(rs_v3(1, 1, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a, &b));
     assert_true(a == 1.0f && b == 1.0f);
-    assert_true(quad_hit(&q, mk_ray(rs_v3(0.5f, -0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a,
-                         &b));
+    assert_true(
+        quad_hit(&q, mk_ray(rs_v3(0.5f, -0.5f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a, &b));
     assert_true(a == 0.75f && b == 0.25f);
     /* the back face, with a non-unit direction */
-    assert_true(quad_hit(&q, mk_ray(rs_v3(0.5f, -0.5f, -7), rs_v3(0, 0, 2), 0.0f, T_INF), &t, &a,
-                         &b));
+    assert_true(
+        quad_hit(&q, mk_ray(rs_v3(0.5f, -0.5f, -7), rs_v3(0, 0, 2), 0.0f, T_INF), &t, &a, &b));
     assert_true(t == 2.0f && a == 0.75f && b == 0.25f);
     /* just outside the sides: a = 1 + 2^-13, b = -2^-13 (exact here) */
-    assert_false(quad_hit(&q, mk_ray(rs_v3(1.0f + 0x1.0p-12f, 0, 0), rs_v3(0, 0, -1), 0.0f,
-                                     T_INF), &t, &a, &b));
-    assert_false(quad_hit(&q, mk_ray(rs_v3(0, -1.0f - 0x1.0p-12f, 0), rs_v3(0, 0, -1), 0.0f,
-                                     T_INF), &t, &a, &b));
+    assert_false(quad_hit(&q, mk_ray(rs_v3(1.0f + 0x1.0p-12f, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF),
+                          &t, &a, &b));
+    assert_false(quad_hit(&q, mk_ray(rs_v3(0, -1.0f - 0x1.0p-12f, 0), rs_v3(0, 0, -1), 0.0f, T_INF),
+                          &t, &a, &b));
     /* misses: outside each side, behind, parallel in and off the plane */
     assert_false(quad_hit(&q, mk_ray(rs_v3(1.1f, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a, &b));
-    assert_false(quad_hit(&q, mk_ray(rs_v3(-1.1f, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a,
-                          &b));
+    assert_false(
+        quad_hit(&q, mk_ray(rs_v3(-1.1f, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a, &b));
     assert_false(quad_hit(&q, mk_ray(rs_v3(0, 1.1f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a, &b));
-    assert_false(quad_hit(&q, mk_ray(rs_v3(0, -1.1f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a,
-                          &b));
+    assert_false(
+        quad_hit(&q, mk_ray(rs_v3(0, -1.1f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t, &a, &b));
     assert_false(quad_hit(&q, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f, T_INF), &t, &a, &b));
     assert_false(quad_hit(&q, mk_ray(rs_v3(-5, 0, -3), rs_v3(1, 0, 0), 0.0f, T_INF), &t, &a, &b));
-    assert_false(quad_hit(&q, mk_ray(rs_v3(-5, 0, -2), rs_v3(1, 0.5f, 0), 0.0f, T_INF), &t, &a,
-                          &b));
+    assert_false(
+        quad_hit(&q, mk_ray(rs_v3(-5, 0, -2), rs_v3(1, 0.5f, 0), 0.0f, T_INF), &t, &a, &b));
     assert_false(quad_hit(&q, mk_ray(rs_v3(0, 0, 0), rs_v3(NAN, 0, -1), 0.0f, T_INF), &t, &a, &b));
     assert_false(quad_hit(&q, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 0), 0.0f, T_INF), &t, &a, &b));
     assert_true(t == SENTINEL && a == SENTINEL && b == SENTINEL);
@@ -485,7 +485,8 @@ static void test_aabb_in_slab_plane(void **state)
                 d[axis] = zeros[zi];
                 d[along] = 1.0f;
                 ok = box_hit(b, rs_v3(o[0], o[1], o[2]), rs_v3(d[0], d[1], d[2]), 0.0f, T_INF,
-                             &te) && te == 4.0f;
+                             &te) &&
+                     te == 4.0f;
                 if (!ok) {
                     ++n_failed;
                     if (len < sizeof failed - 64)
@@ -651,8 +652,7 @@ static void test_sphere_tangent(void **state)
             assert_true(t == 5.0f);
         /* clearly inside and clearly outside the silhouette */
         assert_true(sphere_hit(&s, mk_ray(rs_v3(0, 0.01f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t));
-        assert_false(sphere_hit(&s, mk_ray(rs_v3(0, -0.01f, 0), rs_v3(0, 0, -1), 0.0f, T_INF),
-                                &t));
+        assert_false(sphere_hit(&s, mk_ray(rs_v3(0, -0.01f, 0), rs_v3(0, 0, -1), 0.0f, T_INF), &t));
     }
     /* Random grazing rays passing at distance r (1 + e) from the centre, |e| <= 2e-3.  e is
      * measured in double on the float ray actually built.  Inside the band where float cannot
@@ -681,9 +681,9 @@ static void test_sphere_tangent(void **state)
         ocz = (double)c.z - o.z;
         along = (ocx * dir.x + ocy * dir.y + ocz * dir.z) /
                 ((double)dir.x * dir.x + (double)dir.y * dir.y + (double)dir.z * dir.z);
-        perp2 = ocx * ocx + ocy * ocy + ocz * ocz -
-                along * along * ((double)dir.x * dir.x + (double)dir.y * dir.y +
-                                 (double)dir.z * dir.z);
+        perp2 =
+            ocx * ocx + ocy * ocy + ocz * ocz -
+            along * along * ((double)dir.x * dir.x + (double)dir.y * dir.y + (double)dir.z * dir.z);
         e_act = sqrt(fmax(perp2, 0.0)) / r - 1.0;
         if (h) {
             double half = r * sqrt(fmax(-2.0 * e_act - e_act * e_act, 0.0));
@@ -701,8 +701,7 @@ static void test_sphere_tangent(void **state)
             ++inside;
         } else {
             if (h)
-                fail_msg("ray %d passing outside the sphere (e = %.3g) hit at t %.7g", i, e_act,
-                         t);
+                fail_msg("ray %d passing outside the sphere (e = %.3g) hit at t %.7g", i, e_act, t);
             ++outside;
         }
     }
@@ -849,8 +848,8 @@ static void compare(cmp_stats *st, const char *what, int i, int got, float t, fl
         if (e > st->max_uv)
             st->max_uv = e;
         if (!(e <= 1e-3))
-            fail_msg("%s ray %d: (u, v) (%.7g, %.7g), reference (%.7g, %.7g)", what, i, u, v,
-                     ref.u, ref.v);
+            fail_msg("%s ray %d: (u, v) (%.7g, %.7g), reference (%.7g, %.7g)", what, i, u, v, ref.u,
+                     ref.v);
     }
 }
 
@@ -992,8 +991,8 @@ static void test_aabb_random_vs_reference(void **state)
         if (got != ref)
             fail_msg("box ray %d: got %s, reference %s (entry %.9g, exit %.9g); o (%.9g %.9g "
                      "%.9g) d (%.9g %.9g %.9g) lo (%.9g %.9g %.9g) hi (%.9g %.9g %.9g)",
-                     i, got ? "hit" : "miss", ref ? "hit" : "miss", tn, tf, o.x, o.y, o.z, d.x,
-                     d.y, d.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+                     i, got ? "hit" : "miss", ref ? "hit" : "miss", tn, tf, o.x, o.y, o.z, d.x, d.y,
+                     d.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
         if (got) {
             ++hits;
             if (!(fabs(te - tn) <= 1e-5 * fmax(fabs(tn), 1e-3 * scale)))

@@ -182,13 +182,25 @@ static void test_uniform_chi_square(void **state)
 
 /* ---- independence --------------------------------------------------------------------------- */
 
-enum { FIELD_PIXEL, FIELD_SAMPLE, FIELD_BOUNCE, FIELD_DIM, FIELD_SEED_LO, FIELD_SEED_HI,
-       FIELD_LANES };
+enum {
+    FIELD_PIXEL,
+    FIELD_SAMPLE,
+    FIELD_BOUNCE,
+    FIELD_DIM,
+    FIELD_SEED_LO,
+    FIELD_SEED_HI,
+    FIELD_LANES
+};
 
 static const char *field_name(int f)
 {
-    static const char *names[] = {"pixel", "sample", "bounce", "dim", "seed (low word)",
-                                  "seed (high word)", "lane 0 vs lane 1..3"};
+    static const char *names[] = {"pixel",
+                                  "sample",
+                                  "bounce",
+                                  "dim",
+                                  "seed (low word)",
+                                  "seed (high word)",
+                                  "lane 0 vs lane 1..3"};
     return names[f];
 }
 
@@ -237,8 +249,8 @@ static void check_pair_independence(int field)
     x2 = chi_square(hist, B * B, (double)N / (B * B));
     cov = sxy / N - (sx / N) * (sy / N);
     r = cov / sqrt((sxx / N - (sx / N) * (sx / N)) * (syy / N - (sy / N) * (sy / N)));
-    print_message("%-20s X^2 = %7.2f (critical %.2f), r = %+.5f (bound %.5f)\n",
-                  field_name(field), x2, CHI2_99DOF_P01, r, bound);
+    print_message("%-20s X^2 = %7.2f (critical %.2f), r = %+.5f (bound %.5f)\n", field_name(field),
+                  x2, CHI2_99DOF_P01, r, bound);
     if (!(x2 < CHI2_99DOF_P01))
         fail_msg("%s neighbours: 2D chi-square %.2f >= %.2f", field_name(field), x2,
                  CHI2_99DOF_P01);
@@ -246,29 +258,51 @@ static void check_pair_independence(int field)
         fail_msg("%s neighbours: correlation %.5f, bound %.5f", field_name(field), r, bound);
 }
 
-static void test_independent_pixel(void **state) { (void)state; check_pair_independence(0); }
-static void test_independent_sample(void **state) { (void)state; check_pair_independence(1); }
-static void test_independent_bounce(void **state) { (void)state; check_pair_independence(2); }
-static void test_independent_dim(void **state) { (void)state; check_pair_independence(3); }
-static void test_independent_seed_lo(void **state) { (void)state; check_pair_independence(4); }
-static void test_independent_seed_hi(void **state) { (void)state; check_pair_independence(5); }
-static void test_independent_lanes(void **state) { (void)state; check_pair_independence(6); }
+static void test_independent_pixel(void **state)
+{
+    (void)state;
+    check_pair_independence(0);
+}
+static void test_independent_sample(void **state)
+{
+    (void)state;
+    check_pair_independence(1);
+}
+static void test_independent_bounce(void **state)
+{
+    (void)state;
+    check_pair_independence(2);
+}
+static void test_independent_dim(void **state)
+{
+    (void)state;
+    check_pair_independence(3);
+}
+static void test_independent_seed_lo(void **state)
+{
+    (void)state;
+    check_pair_independence(4);
+}
+static void test_independent_seed_hi(void **state)
+{
+    (void)state;
+    check_pair_independence(5);
+}
+static void test_independent_lanes(void **state)
+{
+    (void)state;
+    check_pair_independence(6);
+}
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_philox_known_answers),
-        cmocka_unit_test(test_mulhilo),
-        cmocka_unit_test(test_pure_and_keyed),
-        cmocka_unit_test(test_float_range),
-        cmocka_unit_test(test_uniform_chi_square),
-        cmocka_unit_test(test_independent_pixel),
-        cmocka_unit_test(test_independent_sample),
-        cmocka_unit_test(test_independent_bounce),
-        cmocka_unit_test(test_independent_dim),
-        cmocka_unit_test(test_independent_seed_lo),
-        cmocka_unit_test(test_independent_seed_hi),
-        cmocka_unit_test(test_independent_lanes),
+        cmocka_unit_test(test_philox_known_answers), cmocka_unit_test(test_mulhilo),
+        cmocka_unit_test(test_pure_and_keyed),       cmocka_unit_test(test_float_range),
+        cmocka_unit_test(test_uniform_chi_square),   cmocka_unit_test(test_independent_pixel),
+        cmocka_unit_test(test_independent_sample),   cmocka_unit_test(test_independent_bounce),
+        cmocka_unit_test(test_independent_dim),      cmocka_unit_test(test_independent_seed_lo),
+        cmocka_unit_test(test_independent_seed_hi),  cmocka_unit_test(test_independent_lanes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

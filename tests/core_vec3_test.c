@@ -167,8 +167,8 @@ static void test_rotate_y_known(void **state)
                    "rotate_y((0,0,1), 90)");
     expect_v3_near(rs_v3_rotate_y(rs_v3(1.0f, 0.0f, 0.0f), -90.0f), rs_v3(0.0f, 0.0f, 1.0f), 1e-6f,
                    "rotate_y((1,0,0), -90)");
-    expect_v3_near(rs_v3_rotate_y(rs_v3(1.0f, 2.0f, 0.0f), 180.0f), rs_v3(-1.0f, 2.0f, 0.0f),
-                   1e-6f, "rotate_y((1,2,0), 180)");
+    expect_v3_near(rs_v3_rotate_y(rs_v3(1.0f, 2.0f, 0.0f), 180.0f), rs_v3(-1.0f, 2.0f, 0.0f), 1e-6f,
+                   "rotate_y((1,2,0), 180)");
     /* the Cornell box's tall block turns 15°: (1,0,0) goes to (cos 15°, 0, -sin 15°) */
     expect_v3_near(rs_v3_rotate_y(rs_v3(1.0f, 0.0f, 0.0f), 15.0f),
                    rs_v3(0.96592583f, 0.0f, -0.25881905f), 1e-6f, "rotate_y((1,0,0), 15)");
@@ -252,8 +252,8 @@ static void test_onb_near_poles(void **state)
         float tilt = powf(10.0f, rnd_range(&s, -7.0f, -1.0f));
         float phi = rnd_range(&s, 0.0f, 6.2831853f);
         float zs = (i & 1) ? -1.0f : 1.0f;
-        rs_vec3 n = rs_v3_normalize(rs_v3(sinf(tilt) * cosf(phi), sinf(tilt) * sinf(phi),
-                                          zs * cosf(tilt)));
+        rs_vec3 n =
+            rs_v3_normalize(rs_v3(sinf(tilt) * cosf(phi), sinf(tilt) * sinf(phi), zs * cosf(tilt)));
         expect_onb(n, 2e-6f);
     }
 }

@@ -9,8 +9,8 @@
 #include "render_util.h"
 
 #define SIZE 40
-#define SPP 8
-#define NF (SIZE * SIZE * 3)
+#define SPP  8
+#define NF   (SIZE * SIZE * 3)
 
 static float *g_ref;
 
@@ -98,8 +98,8 @@ static void test_seed_matters(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_threads),     cmocka_unit_test(test_chunk_sizes),
-        cmocka_unit_test(test_wave_sizes),  cmocka_unit_test(test_two_devices),
+        cmocka_unit_test(test_threads),      cmocka_unit_test(test_chunk_sizes),
+        cmocka_unit_test(test_wave_sizes),   cmocka_unit_test(test_two_devices),
         cmocka_unit_test(test_seed_matters),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

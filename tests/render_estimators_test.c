@@ -16,10 +16,10 @@
 
 #include "render_util.h"
 
-#define SIZE 32
-#define SPP 64
+#define SIZE  32
+#define SPP   64
 #define SEEDS 16
-#define NF (SIZE * SIZE * 3)
+#define NF    (SIZE * SIZE * 3)
 
 typedef struct estimate {
     double mean, se;

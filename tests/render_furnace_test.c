@@ -13,7 +13,7 @@
 #include "render_util.h"
 
 #define SIZE 64
-#define NF (SIZE * SIZE * 3)
+#define NF   (SIZE * SIZE * 3)
 
 static void furnace(rs_sampling sampling, uint32_t spp, double pixel_tol)
 {

@@ -13,14 +13,14 @@
 #include "scheduler/render.h"
 
 typedef struct rt_args {
-    const char *scene;      /* built-in name */
+    const char *scene; /* built-in name */
     uint32_t width, height, spp, max_depth;
     uint64_t seed;
     rs_sampling sampling;
-    int threads;            /* CPU device and shading threads */
-    uint32_t chunk_size;    /* 0: default */
-    uint32_t wave_paths;    /* 0: default */
-    int with_fallback;      /* add a second, one-thread "gpu-fallback" CPU device */
+    int threads;         /* CPU device and shading threads */
+    uint32_t chunk_size; /* 0: default */
+    uint32_t wave_paths; /* 0: default */
+    int with_fallback;   /* add a second, one-thread "gpu-fallback" CPU device */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)

@@ -21,10 +21,10 @@
 /* ---- a test device: counts how often each ray is answered --------------------------------- */
 
 typedef struct counting {
-    atomic_uint *answers;   /* per ray of the batch */
-    int sleep_us;           /* per chunk, to make devices slow */
-    long fail_on_chunk;     /* fail the n-th trace call (1-based); 0 = never */
-    long calls;             /* only touched by this device's dispatch thread */
+    atomic_uint *answers; /* per ray of the batch */
+    int sleep_us;         /* per chunk, to make devices slow */
+    long fail_on_chunk;   /* fail the n-th trace call (1-based); 0 = never */
+    long calls;           /* only touched by this device's dispatch thread */
 } counting;
 
 static rs_status counting_upload(rs_device *d, const rs_geom *g, const rs_bvh *b)
@@ -355,12 +355,9 @@ static void test_cpu_device_matches_direct(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_chunk_sizes),
-        cmocka_unit_test(test_many_devices_queue_pressure),
-        cmocka_unit_test(test_empty_and_single),
-        cmocka_unit_test(test_device_failure),
-        cmocka_unit_test(test_all_devices_fail),
-        cmocka_unit_test(test_cpu_device_matches_direct),
+        cmocka_unit_test(test_chunk_sizes),      cmocka_unit_test(test_many_devices_queue_pressure),
+        cmocka_unit_test(test_empty_and_single), cmocka_unit_test(test_device_failure),
+        cmocka_unit_test(test_all_devices_fail), cmocka_unit_test(test_cpu_device_matches_direct),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

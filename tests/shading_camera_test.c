@@ -141,8 +141,7 @@ static void expect_points_at(const rs_ray *r, rs_vec3 from, rs_vec3 at, double t
     c = dot3(d, want) / sqrt(dot3(d, d));
     /* 1 - cos(angle) ~ angle^2 / 2 */
     if (!(acos(fmin(c, 1.0)) <= tol))
-        fail_msg("%s: the centre ray is %.3g rad off the view direction", what,
-                 acos(fmin(c, 1.0)));
+        fail_msg("%s: the centre ray is %.3g rad off the view direction", what, acos(fmin(c, 1.0)));
 }
 
 static void test_centre_looks_at_target(void **state)
@@ -172,8 +171,8 @@ static void test_centre_looks_at_target(void **state)
         double half_v = tan(0.5 * k.vfov * PI_D / 180.0), aspect = (double)k.w / k.h;
         double big = fabs(k.from.x) + fabs(k.from.y) + fabs(k.from.z);
         double tol = 1e-6 * (big / focus + 1.0 + half_v * (1.0 + aspect));
-        snprintf(what, sizeof what, "camera %d (%ux%u, vfov %.1f, focus %.2f)", i, k.w, k.h,
-                 k.vfov, fd);
+        snprintf(what, sizeof what, "camera %d (%ux%u, vfov %.1f, focus %.2f)", i, k.w, k.h, k.vfov,
+                 fd);
         /* the centre of the image: pixel w/2 (h/2) with offset 0 when even, 0.5 when odd */
         r = rs_camera_ray(&c, k.w / 2, k.h / 2, (k.w & 1) ? 0.5f : 0.0f, (k.h & 1) ? 0.5f : 0.0f,
                           0.0f, 0.0f);
@@ -223,16 +222,16 @@ static void test_corner_angles(void **state)
         r = rs_camera_ray(&c, k.w - 1, k.h - 1, 1.0f, 1.0f, 0.0f, 0.0f);
         angles(&f, r.d, &h, &v);
         if (!(fabs(v + half_v) <= tol && fabs(h - half_h) <= tol))
-            fail_msg("camera %d: bottom-right corner at (h %.6f, v %.6f) rad, want (%.6f, %.6f)",
-                     i, h, v, half_h, -half_v);
+            fail_msg("camera %d: bottom-right corner at (h %.6f, v %.6f) rad, want (%.6f, %.6f)", i,
+                     h, v, half_h, -half_v);
     }
 }
 
 static void test_cornell_orientation(void **state)
 {
     const uint32_t w = 400, h = 300;
-    rs_camera c = rs_camera_make(cornell_from(), cornell_at(), rs_v3(0, 1, 0), 40.0f, 0.0f, 0.0f,
-                                 w, h);
+    rs_camera c =
+        rs_camera_make(cornell_from(), cornell_at(), rs_v3(0, 1, 0), 40.0f, 0.0f, 0.0f, w, h);
     rs_ray tl = rs_camera_ray(&c, 0, 0, 0.5f, 0.5f, 0.0f, 0.0f);
     rs_ray tr = rs_camera_ray(&c, w - 1, 0, 0.5f, 0.5f, 0.0f, 0.0f);
     rs_ray bl = rs_camera_ray(&c, 0, h - 1, 0.5f, 0.5f, 0.0f, 0.0f);
@@ -390,19 +389,19 @@ static void test_lens_disk_extent(void **state)
 {
     /* The Cornell camera with aperture 10 (lens radius 5): l1 -> 1 reaches the rim, and l2 sweeps
      * the full circle in the (u, v) plane: world (-x, +y) with u = -x. */
-    rs_camera c = rs_camera_make(cornell_from(), cornell_at(), rs_v3(0, 1, 0), 40.0f, 10.0f, 0.0f,
-                                 64, 64);
+    rs_camera c =
+        rs_camera_make(cornell_from(), cornell_at(), rs_v3(0, 1, 0), 40.0f, 10.0f, 0.0f, 64, 64);
     rs_ray r;
     (void)state;
     assert_float_equal(c.lens_radius, 5.0f, 0.0f);
-    r = rs_camera_ray(&c, 32, 32, 0.0f, 0.0f, 0.99999994f, 0.0f);   /* phi = 0: +u = -x */
+    r = rs_camera_ray(&c, 32, 32, 0.0f, 0.0f, 0.99999994f, 0.0f); /* phi = 0: +u = -x */
     assert_float_equal(r.o.x, 278.0f - 5.0f, 1e-3f);
     assert_float_equal(r.o.y, 278.0f, 1e-3f);
     assert_float_equal(r.o.z, -800.0f, 1e-3f);
-    r = rs_camera_ray(&c, 32, 32, 0.0f, 0.0f, 0.99999994f, 0.25f);  /* phi = 90: +v = +y */
+    r = rs_camera_ray(&c, 32, 32, 0.0f, 0.0f, 0.99999994f, 0.25f); /* phi = 90: +v = +y */
     assert_float_equal(r.o.x, 278.0f, 1e-3f);
     assert_float_equal(r.o.y, 278.0f + 5.0f, 1e-3f);
-    r = rs_camera_ray(&c, 32, 32, 0.0f, 0.0f, 0.25f, 0.5f);         /* radius 2.5, phi = 180 */
+    r = rs_camera_ray(&c, 32, 32, 0.0f, 0.0f, 0.25f, 0.5f); /* radius 2.5, phi = 180 */
     assert_float_equal(r.o.x, 278.0f + 2.5f, 1e-3f);
     assert_float_equal(r.o.y, 278.0f, 1e-3f);
     /* and the image centre still lands on `at`, 800 units ahead */
