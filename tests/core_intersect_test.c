@@ -28,47 +28,11 @@
 
 #include "core/intersect.h"
 
+#include "test_rand.h"
+
 #define T_INF FLT_MAX
 
 /* ---- helpers ------------------------------------------------------------------------------- */
-
-/* splitmix64 (Steele et al. 2014): test inputs from a fixed seed. */
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static double rnd01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
-
-static float rnd_range(uint64_t *s, double lo, double hi)
-{
-    return (float)(lo + (hi - lo) * rnd01(s));
-}
-
-static rs_vec3 rnd_box(uint64_t *s, float h)
-{
-    return rs_v3(rnd_range(s, -h, h), rnd_range(s, -h, h), rnd_range(s, -h, h));
-}
-
-static rs_vec3 rnd_unit(uint64_t *s)
-{
-    double z = 2.0 * rnd01(s) - 1.0, phi = 6.283185307179586 * rnd01(s);
-    double r = sqrt(1.0 - z * z);
-    return rs_v3((float)(r * cos(phi)), (float)(r * sin(phi)), (float)z);
-}
-
-static rs_ray mk_ray(rs_vec3 o, rs_vec3 d, float tmin, float tmax)
-{
-    rs_ray r;
-    r.o = o;
-    r.d = d;
-    r.tmin = tmin;
-    r.tmax = tmax;
-    return r;
-}
 
 static rs_tri mk_tri(rs_vec3 a, rs_vec3 b, rs_vec3 c)
 {

@@ -31,14 +31,7 @@
 
 #define TEST_SEED 0x0123456789abcdefull
 
-/* splitmix64 (Steele et al. 2014): picks the base keys of the pair tests. */
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
+#include "test_rand.h"
 
 static int same_words(rs_rng_out a, rs_rng_out b) { return memcmp(a.v, b.v, sizeof a.v) == 0; }
 

@@ -22,32 +22,9 @@
 #include "core/sampling.h"
 #include "core/vec3.h"
 
+#include "test_rand.h"
+
 /* ---- helpers ------------------------------------------------------------------------------- */
-
-/* splitmix64 (Steele et al. 2014): a tiny, well-mixed generator for test inputs. */
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-/* uniform double in [0, 1) from the top 53 bits */
-static double rnd01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
-
-static float rnd_range(uint64_t *s, float lo, float hi)
-{
-    return (float)(lo + (hi - lo) * rnd01(s));
-}
-
-/* a uniformly distributed unit vector (Marsaglia's z / phi form) */
-static rs_vec3 rnd_unit(uint64_t *s)
-{
-    double z = 2.0 * rnd01(s) - 1.0, phi = 2.0 * 3.14159265358979323846 * rnd01(s);
-    double r = sqrt(1.0 - z * z);
-    return rs_v3((float)(r * cos(phi)), (float)(r * sin(phi)), (float)z);
-}
 
 static void expect_v3_near(rs_vec3 got, rs_vec3 want, float tol, const char *what)
 {

@@ -31,30 +31,9 @@
 
 #define PI_D 3.14159265358979323846
 
+#include "test_rand.h"
+
 /* ---- helpers ------------------------------------------------------------------------------- */
-
-/* splitmix64 (Steele et al. 2014): test inputs from a fixed seed. */
-static uint64_t splitmix64(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static double rnd01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
-
-static float rnd_range(uint64_t *s, double lo, double hi)
-{
-    return (float)(lo + (hi - lo) * rnd01(s));
-}
-
-static rs_vec3 rnd_unit(uint64_t *s)
-{
-    double z = 2.0 * rnd01(s) - 1.0, phi = 2.0 * PI_D * rnd01(s);
-    double r = sqrt(1.0 - z * z);
-    return rs_v3((float)(r * cos(phi)), (float)(r * sin(phi)), (float)z);
-}
 
 /* The frame in double, independently of the camera's own arithmetic. */
 typedef struct frame {

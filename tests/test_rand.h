@@ -1,0 +1,52 @@
+/* tests/test_rand.h — random test inputs from a fixed seed (test-only helpers).
+ * splitmix64 (Steele, Lea & Flood 2014): tiny, well mixed, and independent of the renderer's own
+ * generator, so tests of the renderer do not feed it its own numbers. */
+#ifndef RS_TESTS_TEST_RAND_H
+#define RS_TESTS_TEST_RAND_H
+
+#include <math.h>
+#include <stdint.h>
+
+#include "core/ray.h"
+
+static inline uint64_t splitmix64(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* uniform double in [0, 1) from the top 53 bits */
+static inline double rnd01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
+
+static inline float rnd_range(uint64_t *s, double lo, double hi)
+{
+    return (float)(lo + (hi - lo) * rnd01(s));
+}
+
+/* a point uniform in the cube [-h, h]^3 */
+static inline rs_vec3 rnd_box(uint64_t *s, float h)
+{
+    return rs_v3(rnd_range(s, -h, h), rnd_range(s, -h, h), rnd_range(s, -h, h));
+}
+
+/* a uniformly distributed unit vector (z uniform in [-1, 1], phi uniform) */
+static inline rs_vec3 rnd_unit(uint64_t *s)
+{
+    double z = 2.0 * rnd01(s) - 1.0, phi = 6.283185307179586 * rnd01(s);
+    double r = sqrt(1.0 - z * z);
+    return rs_v3((float)(r * cos(phi)), (float)(r * sin(phi)), (float)z);
+}
+
+static inline rs_ray mk_ray(rs_vec3 o, rs_vec3 d, float tmin, float tmax)
+{
+    rs_ray r;
+    r.o = o;
+    r.d = d;
+    r.tmin = tmin;
+    r.tmax = tmax;
+    return r;
+}
+
+#endif
