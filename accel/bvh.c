@@ -26,8 +26,12 @@ rs_aabb rs_geom_prim_bounds(const rs_geom *g, uint32_t prim)
     if (prim < g->n_spheres) {
         const rs_sphere *s = &g->spheres[prim];
         rs_vec3 r = rs_v3_splat(fabsf(s->radius));
-        b.lo = rs_v3_sub(s->center, r);
-        b.hi = rs_v3_add(s->center, r);
+        rs_vec3 c0 = rs_geom_sphere_center(g, prim, g->time0);
+        rs_vec3 c1 = rs_geom_sphere_center(g, prim, g->time1);
+        /* a moving sphere's centre runs along a segment: bound both ends */
+        b.lo = rs_v3_sub(rs_v3_min(c0, c1), r);
+        b.hi = rs_v3_add(rs_v3_max(c0, c1), r);
+        (void)s;
         return b;
     }
     prim -= g->n_spheres;

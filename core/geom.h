@@ -13,10 +13,19 @@
 
 typedef struct rs_geom {
     const rs_sphere *spheres;
+    const rs_vec3 *sphere_motion; /* per sphere: centre displacement per unit time; NULL: none */
+    float time0, time1;           /* the times rays may carry (the shutter); bounds cover it */
     const rs_quad *quads;
     const rs_tri *tris;
     uint32_t n_spheres, n_quads, n_tris;
 } rs_geom;
+
+/* Centre of sphere i at `time`. */
+RS_HD rs_vec3 rs_geom_sphere_center(const rs_geom *g, uint32_t i, float time)
+{
+    return g->sphere_motion ? rs_v3_madd(g->spheres[i].center, g->sphere_motion[i], time)
+                            : g->spheres[i].center;
+}
 
 RS_HD uint32_t rs_geom_prim_count(const rs_geom *g)
 {
@@ -30,6 +39,11 @@ RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, fl
     if (prim < g->n_spheres) {
         *u = 0.0f;
         *v = 0.0f;
+        if (g->sphere_motion) {
+            rs_sphere s = g->spheres[prim];
+            s.center = rs_v3_madd(s.center, g->sphere_motion[prim], r->time);
+            return rs_isect_sphere(&s, r, t);
+        }
         return rs_isect_sphere(&g->spheres[prim], r, t);
     }
     prim -= g->n_spheres;

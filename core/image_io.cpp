@@ -140,7 +140,28 @@ extern "C" rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, co
     }
 }
 
+extern "C" float rs_srgb_decode(float c)
+{
+    if (!(c > 0.0f))
+        return 0.0f;
+    if (c >= 1.0f)
+        return 1.0f;
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **rgb, bool linear);
+
 extern "C" rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
+{
+    return read_image(path, w, h, rgb, false);
+}
+
+extern "C" rs_status rs_image_read_linear(const char *path, uint32_t *w, uint32_t *h, float **rgb)
+{
+    return read_image(path, w, h, rgb, true);
+}
+
+static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **rgb, bool linear)
 {
     *rgb = nullptr;
     try {
@@ -159,9 +180,12 @@ extern "C" rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, f
         if (!o)
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
         int nc = spec.nchannels;
+        bool decode = linear && !spec.format.is_floating_point();
         for (size_t i = 0; i < npix; ++i)
-            for (int c = 0; c < 3; ++c)
-                o[3 * i + c] = all[i * nc + (c < nc ? c : 0)];
+            for (int c = 0; c < 3; ++c) {
+                float v = all[i * nc + (c < nc ? c : 0)];
+                o[3 * i + c] = decode ? rs_srgb_decode(v) : v;
+            }
         *w = (uint32_t)spec.width;
         *h = (uint32_t)spec.height;
         *rgb = o;

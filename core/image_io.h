@@ -27,6 +27,13 @@ rs_status rs_image_write(const char *path, uint32_t width, uint32_t height, cons
  * their code values / 255, not decoded).  *rgb is allocated with rs_alloc; free with rs_free. */
 rs_status rs_image_read(const char *path, uint32_t *width, uint32_t *height, float **rgb);
 
+/* Reads an image as linear RGB: files stored as integers (8/16-bit PNG, JPEG, ...) are taken
+ * as sRGB-encoded and decoded; float files (EXR, HDR) are already linear.  For textures. */
+rs_status rs_image_read_linear(const char *path, uint32_t *width, uint32_t *height, float **rgb);
+
+/* The linear value of an sRGB-encoded one in [0, 1]. */
+float rs_srgb_decode(float encoded);
+
 /* "2.4.7" */
 const char *rs_image_library_version(void);
 

@@ -9,6 +9,7 @@ typedef struct rs_ray {
     rs_vec3 d;  /* direction; need not be unit length, t is measured in units of |d| */
     float tmin; /* the ray is the open segment o + t d, tmin < t < tmax */
     float tmax;
+    float time; /* when the ray exists, in the shutter's units (moving spheres) */
 } rs_ray;
 
 RS_HD rs_vec3 rs_ray_at(const rs_ray *r, float t) { return rs_v3_madd(r->o, r->d, t); }

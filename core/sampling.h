@@ -1,10 +1,15 @@
 /* core/sampling.h — direction sampling routines and orthonormal bases, shared by host and device.
  *
  * Each sampler maps two uniform numbers in [0, 1) to a direction in a local frame whose z axis
- * is the surface normal, and has a matching pdf over solid angle.  Derivations (inversion of the
- * CDF; see the thesis's Table 5.1, whose power-cosine and sphere rows carry typos):
- *   uniform hemisphere  p = 1 / (2 pi):   z = u1,            phi = 2 pi u2
- *   cosine hemisphere   p = cos / pi:     r = sqrt(u1),      phi = 2 pi u2 (Malley's method) */
+ * is the axis of the distribution, and has a matching pdf over solid angle.  Each comes from
+ * inverting the CDF of theta with phi uniform (thesis §A.3.1, whose Table 5.1 has two typos:
+ * the power-cosine z is u^(1/(n+1)), not u^(n+1), and the uniform-sphere z is 1 - 2u):
+ *   uniform sphere      p = 1 / (4 pi)               z = 1 - 2 u1
+ *   uniform hemisphere  p = 1 / (2 pi)               z = u1
+ *   cosine hemisphere   p = cos / pi                 z = sqrt(1 - u1)   (Malley: r = sqrt(u1))
+ *   power cosine        p = (n + 1) cos^n / (2 pi)   z = u1^(1 / (n + 1))
+ *   uniform cone        p = 1 / (2 pi (1 - cmax))    z = 1 - u1 (1 - cmax)
+ * and phi = 2 pi u2 for all of them.  The pdfs are tested (integral = 1, chi-square). */
 #ifndef RS_CORE_SAMPLING_H
 #define RS_CORE_SAMPLING_H
 
@@ -60,6 +65,54 @@ RS_HD rs_vec3 rs_sample_cosine_hemisphere(float u1, float u2)
 RS_HD float rs_pdf_cosine_hemisphere(float cos_theta)
 {
     return cos_theta > 0.0f ? cos_theta * RS_INV_PI : 0.0f;
+}
+
+/* Direction from cos(theta) and phi = 2 pi u2 around the z axis. */
+RS_HD rs_vec3 rs_dir_from_z(float z, float u2)
+{
+    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float phi = 2.0f * RS_PI * u2;
+    return rs_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+RS_HD rs_vec3 rs_sample_uniform_sphere(float u1, float u2)
+{
+    return rs_dir_from_z(1.0f - 2.0f * u1, u2);
+}
+
+RS_HD float rs_pdf_uniform_sphere(void) { return 0.25f * RS_INV_PI; }
+
+/* cos^n lobe around z, normalised over the hemisphere: p = (n + 1) / (2 pi) cos^n(theta). */
+RS_HD rs_vec3 rs_sample_power_cosine(float n, float u1, float u2)
+{
+    return rs_dir_from_z(powf(u1, 1.0f / (n + 1.0f)), u2);
+}
+
+RS_HD float rs_pdf_power_cosine(float n, float cos_theta)
+{
+    return cos_theta > 0.0f ? (n + 1.0f) * 0.5f * RS_INV_PI * powf(cos_theta, n) : 0.0f;
+}
+
+/* Uniform over the cone of directions within angle acos(cos_max) of z. */
+RS_HD rs_vec3 rs_sample_uniform_cone(float cos_max, float u1, float u2)
+{
+    return rs_dir_from_z(1.0f - u1 * (1.0f - cos_max), u2);
+}
+
+RS_HD float rs_pdf_uniform_cone(float cos_max) { return 1.0f / (2.0f * RS_PI * (1.0f - cos_max)); }
+
+/* Uniform point on a triangle as barycentrics (b1, b2) of v1 and v2 (sqrt warp). */
+RS_HD void rs_sample_triangle(float u1, float u2, float *b1, float *b2)
+{
+    float su = sqrtf(u1);
+    *b1 = su * (1.0f - u2);
+    *b2 = su * u2;
+}
+
+/* Mirror direction of w about unit normal n (both pointing away from the surface). */
+RS_HD rs_vec3 rs_reflect(rs_vec3 w, rs_vec3 n)
+{
+    return rs_v3_sub(rs_v3_scale(n, 2.0f * rs_v3_dot(n, w)), w);
 }
 
 #endif

@@ -1,26 +1,16 @@
 /* scenes/builtin.c — the built-in scenes. */
 #include "scenes/builtin.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 static rs_material lambertian(float r, float g, float b)
 {
-    rs_material m;
-    memset(&m, 0, sizeof m);
-    m.type = RS_MAT_LAMBERTIAN;
-    m.albedo = rs_v3(r, g, b);
-    return m;
+    return rs_mat_lambertian(rs_v3(r, g, b));
 }
 
-static rs_material light(float r, float g, float b)
-{
-    rs_material m;
-    memset(&m, 0, sizeof m);
-    m.type = RS_MAT_DIFFUSE_LIGHT;
-    m.emission = rs_v3(r, g, b);
-    return m;
-}
+static rs_material light(float r, float g, float b) { return rs_mat_light(rs_v3(r, g, b), 0); }
 
 #define TRY(expr)                                                                                  \
   do {                                                                                             \
@@ -29,9 +19,10 @@ static rs_material light(float r, float g, float b)
       return st_;                                                                                  \
   } while (0)
 
-/* The two-box Cornell box of Shirley's "Ray Tracing: The Rest of Your Life" (v4), exactly:
- * quads as corner Q and edges u, v; the light emits only downward (its u x v is -y). */
-static rs_status build_cornell(rs_scene *s)
+/* The room of Shirley's Cornell box ("Ray Tracing: The Rest of Your Life" v4), exactly: quads
+ * as corner Q and edges u, v; the light emits only downward (its u x v is -y).  Returns the
+ * white material in *white_out. */
+static rs_status build_cornell_room(rs_scene *s, uint32_t *white_out)
 {
     rs_material m;
     uint32_t red, white, green, lit;
@@ -50,11 +41,7 @@ static rs_status build_cornell(rs_scene *s)
     TRY(rs_scene_add_quad(s, rs_v3(0, 555, 0), rs_v3(555, 0, 0), rs_v3(0, 0, 555), white));
     TRY(rs_scene_add_quad(s, rs_v3(0, 0, 555), rs_v3(555, 0, 0), rs_v3(0, 0, -555), white));
     TRY(rs_scene_add_quad(s, rs_v3(555, 0, 555), rs_v3(-555, 0, 0), rs_v3(0, 555, 0), white));
-
-    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
-                         white));
-    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 165, 165), -18.0f, rs_v3(130, 0, 65),
-                         white));
+    *white_out = white;
 
     s->camera.from = rs_v3(278, 278, -800);
     s->camera.at = rs_v3(278, 278, 0);
@@ -62,6 +49,249 @@ static rs_status build_cornell(rs_scene *s)
     s->camera.vfov_deg = 40.0f;
     s->background = rs_v3(0, 0, 0);
     s->width = s->height = 600;
+    return RS_OK;
+}
+
+static rs_status build_cornell(rs_scene *s)
+{
+    uint32_t white;
+    TRY(build_cornell_room(s, &white));
+    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
+                         white));
+    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 165, 165), -18.0f, rs_v3(130, 0, 65),
+                         white));
+    return RS_OK;
+}
+
+/* The final scene of "The Rest of Your Life": the short box becomes a glass sphere. */
+static rs_status build_cornell_glass(rs_scene *s)
+{
+    uint32_t white, glass;
+    rs_material m = rs_mat_dielectric(1.5f);
+    TRY(build_cornell_room(s, &white));
+    TRY(rs_scene_add_material(s, &m, &glass));
+    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
+                         white));
+    TRY(rs_scene_add_sphere(s, rs_v3(190, 90, 190), 90.0f, glass));
+    return RS_OK;
+}
+
+/* splitmix64: the scene generators' own fixed-seed random numbers. */
+static double scene_rand(uint64_t *st)
+{
+    uint64_t z = (*st += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-53;
+}
+
+static float rand_range(uint64_t *st, float lo, float hi)
+{
+    return lo + (hi - lo) * (float)scene_rand(st);
+}
+
+/* The random spheres of "Ray Tracing in One Weekend" (v4, §14) — the thesis's Fig. 6.9 scene.
+ * With `bouncing`, RTNW's first scene instead: the diffuse spheres move up by up to 0.5 during
+ * the shutter and the ground is a checker.  Same layout rules; our own fixed-seed numbers. */
+static rs_status build_random_spheres(rs_scene *s, int bouncing)
+{
+    uint64_t st = 0x5eedULL;
+    rs_material m;
+    uint32_t id;
+    int a, b;
+    if (bouncing) {
+        rs_texture checker;
+        uint32_t tex;
+        memset(&checker, 0, sizeof checker);
+        checker.type = RS_TEX_CHECKER;
+        checker.a = rs_v3(.2f, .3f, .1f);
+        checker.b = rs_v3(.9f, .9f, .9f);
+        checker.scale = 0.32f;
+        TRY(rs_scene_add_texture(s, &checker, &tex));
+        m = rs_mat_lambertian(rs_v3_splat(1.0f));
+        m.albedo_tex = tex;
+    } else {
+        m = rs_mat_lambertian(rs_v3(.5f, .5f, .5f));
+    }
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(0, -1000, 0), 1000.0f, id));
+    for (a = -11; a < 11; ++a)
+        for (b = -11; b < 11; ++b) {
+            float choose = (float)scene_rand(&st);
+            rs_vec3 c = rs_v3((float)a + 0.9f * (float)scene_rand(&st), 0.2f,
+                              (float)b + 0.9f * (float)scene_rand(&st));
+            if (rs_v3_length(rs_v3_sub(c, rs_v3(4, 0.2f, 0))) <= 0.9f)
+                continue;
+            if (choose < 0.8f) {
+                rs_vec3 c1 =
+                    rs_v3((float)scene_rand(&st), (float)scene_rand(&st), (float)scene_rand(&st));
+                rs_vec3 c2 =
+                    rs_v3((float)scene_rand(&st), (float)scene_rand(&st), (float)scene_rand(&st));
+                m = rs_mat_lambertian(rs_v3_mul(c1, c2));
+                TRY(rs_scene_add_material(s, &m, &id));
+                if (bouncing)
+                    TRY(rs_scene_add_moving_sphere(
+                        s, c, 0.0f, rs_v3_add(c, rs_v3(0, rand_range(&st, 0, 0.5f), 0)), 1.0f, 0.2f,
+                        id));
+                else
+                    TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+            } else if (choose < 0.95f) {
+                m = rs_mat_metal(rs_v3(rand_range(&st, .5f, 1), rand_range(&st, .5f, 1),
+                                       rand_range(&st, .5f, 1)),
+                                 rand_range(&st, 0, .5f));
+                TRY(rs_scene_add_material(s, &m, &id));
+                TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+            } else {
+                m = rs_mat_dielectric(1.5f);
+                TRY(rs_scene_add_material(s, &m, &id));
+                TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+            }
+        }
+    m = rs_mat_dielectric(1.5f);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(0, 1, 0), 1.0f, id));
+    m = rs_mat_lambertian(rs_v3(.4f, .2f, .1f));
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(-4, 1, 0), 1.0f, id));
+    m = rs_mat_metal(rs_v3(.7f, .6f, .5f), 0.0f);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(4, 1, 0), 1.0f, id));
+
+    s->camera.from = rs_v3(13, 2, 3);
+    s->camera.at = rs_v3(0, 0, 0);
+    s->camera.up = rs_v3(0, 1, 0);
+    s->camera.vfov_deg = 20.0f;
+    /* RTIOW v4's defocus angle 0.6 deg at focus distance 10 is a lens of diameter
+     * 2 * 10 * tan(0.3 deg) = 0.105 */
+    s->camera.aperture = 0.105f;
+    s->camera.focus_dist = 10.0f;
+    if (bouncing) {
+        s->camera.shutter_open = 0.0f;
+        s->camera.shutter_close = 1.0f;
+    }
+    s->background = rs_v3(1, 1, 1);
+    s->background_top = rs_v3(.5f, .7f, 1.0f);
+    s->background_sky = 1;
+    s->width = 1200;
+    s->height = 675;
+    return RS_OK;
+}
+
+static rs_status build_rtiow_final(rs_scene *s) { return build_random_spheres(s, 0); }
+
+static rs_status build_bouncing_spheres(rs_scene *s) { return build_random_spheres(s, 1); }
+
+/* A UV grid made in memory: 8 x 4 coloured cells with dark lines, so that the orientation and
+ * filtering of image textures can be seen (and tested) without a file. */
+static rs_status add_uv_grid_image(rs_scene *s, uint32_t *id)
+{
+    enum { W = 256, H = 128 };
+    static float rgb[W * H * 3];
+    int x, y;
+    for (y = 0; y < H; ++y)
+        for (x = 0; x < W; ++x) {
+            float *p = &rgb[3 * (y * W + x)];
+            int cx = x / (W / 8), cy = y / (H / 4);
+            int line = (x % (W / 8)) < 2 || (y % (H / 4)) < 2;
+            p[0] = line ? 0.02f : 0.15f + 0.8f * (float)cx / 7.0f;
+            p[1] = line ? 0.02f : 0.15f + 0.8f * (float)cy / 3.0f;
+            p[2] = line ? 0.02f : ((cx + cy) & 1 ? 0.7f : 0.2f);
+        }
+    return rs_scene_add_image(s, W, H, rgb, id);
+}
+
+/* Every material and texture side by side, on a checker floor under an area light and a sky:
+ *   back row:   Disney diffuse at roughness 0, 0.5, 1; Lambertian; uniform-hemisphere diffuse
+ *   middle row: Phong at exponents 10, 100, 1000; fuzzy metal; mirror
+ *   front row:  glass; 3D checker; stripes; image texture; a sphere light */
+static rs_status build_materials(rs_scene *s)
+{
+    static const float phong_n[3] = {10.0f, 100.0f, 1000.0f};
+    rs_vec3 warm = rs_v3(.8f, .45f, .25f);
+    rs_material m;
+    rs_texture tex;
+    uint32_t id, t_floor, t_checker, t_stripes, t_image, image;
+    int i;
+    memset(&tex, 0, sizeof tex);
+    tex.type = RS_TEX_CHECKER;
+    tex.a = rs_v3(.75f, .75f, .75f);
+    tex.b = rs_v3(.25f, .25f, .28f);
+    tex.scale = 1.0f;
+    TRY(rs_scene_add_texture(s, &tex, &t_floor));
+    tex.a = rs_v3(.9f, .8f, .1f);
+    tex.b = rs_v3(.1f, .2f, .6f);
+    tex.scale = 0.3f;
+    TRY(rs_scene_add_texture(s, &tex, &t_checker));
+    tex.type = RS_TEX_STRIPES;
+    tex.a = rs_v3(.85f, .85f, .85f);
+    tex.b = rs_v3(.7f, .1f, .1f);
+    tex.scale = 12.0f;
+    TRY(rs_scene_add_texture(s, &tex, &t_stripes));
+    TRY(add_uv_grid_image(s, &image));
+    tex.type = RS_TEX_IMAGE;
+    tex.image = image;
+    TRY(rs_scene_add_texture(s, &tex, &t_image));
+
+    m = rs_mat_lambertian(rs_v3_splat(1.0f));
+    m.albedo_tex = t_floor;
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_quad(s, rs_v3(-20, 0, 20), rs_v3(40, 0, 0), rs_v3(0, 0, -40), id));
+
+    for (i = 0; i < 3; ++i) { /* back row */
+        m = rs_mat_disney_diffuse(warm, 0.5f * (float)i);
+        TRY(rs_scene_add_material(s, &m, &id));
+        TRY(rs_scene_add_sphere(s, rs_v3(-4.0f + 2.0f * (float)i, 0.8f, -2.2f), 0.8f, id));
+    }
+    m = rs_mat_lambertian(warm);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, -2.2f), 0.8f, id));
+    m = rs_mat_diffuse_uniform(warm);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, -2.2f), 0.8f, id));
+
+    for (i = 0; i < 3; ++i) { /* middle row */
+        m = rs_mat_phong(rs_v3(.1f, .25f, .6f), rs_v3(.35f, .35f, .35f), phong_n[i]);
+        TRY(rs_scene_add_material(s, &m, &id));
+        TRY(rs_scene_add_sphere(s, rs_v3(-4.0f + 2.0f * (float)i, 0.8f, 0), 0.8f, id));
+    }
+    m = rs_mat_metal(rs_v3(.8f, .8f, .85f), 0.3f);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, 0), 0.8f, id));
+    m = rs_mat_metal(rs_v3(.9f, .9f, .9f), 0.0f);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, 0), 0.8f, id));
+
+    m = rs_mat_dielectric(1.5f); /* front row */
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(-4, 0.8f, 2.2f), 0.8f, id));
+    m = rs_mat_lambertian(rs_v3_splat(1.0f));
+    m.albedo_tex = t_checker;
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(-2, 0.8f, 2.2f), 0.8f, id));
+    m.albedo_tex = t_stripes;
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(0, 0.8f, 2.2f), 0.8f, id));
+    m.albedo_tex = t_image;
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, 2.2f), 0.8f, id));
+    m = rs_mat_light(rs_v3(4, 3.2f, 2), 0);
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, 2.2f), 0.5f, id));
+
+    m = rs_mat_light(rs_v3(6, 6, 6), 0); /* the key light, facing down */
+    TRY(rs_scene_add_material(s, &m, &id));
+    TRY(rs_scene_add_quad(s, rs_v3(-3, 7, -3), rs_v3(6, 0, 0), rs_v3(0, 0, 6), id));
+
+    s->camera.from = rs_v3(0, 6.5f, 11);
+    s->camera.at = rs_v3(0, 0.5f, 0);
+    s->camera.up = rs_v3(0, 1, 0);
+    s->camera.vfov_deg = 38.0f;
+    s->background = rs_v3(.12f, .12f, .12f);
+    s->background_top = rs_v3(.25f, .35f, .5f);
+    s->background_sky = 1;
+    s->width = 960;
+    s->height = 540;
     return RS_OK;
 }
 
@@ -93,6 +323,14 @@ typedef struct builtin {
 static const builtin g_builtins[] = {
     {"cornell", "the two-box Cornell box of Ray Tracing: The Rest of Your Life (default)",
      build_cornell},
+    {"cornell-glass", "the final scene of The Rest of Your Life: a glass sphere for the short box",
+     build_cornell_glass},
+    {"materials", "every material and texture side by side (Disney, Phong, metal, glass, ...)",
+     build_materials},
+    {"rtiow-final", "the random spheres of Ray Tracing in One Weekend (the thesis's Fig. 6.9)",
+     build_rtiow_final},
+    {"bouncing-spheres", "The Next Week's motion-blur scene: moving spheres, checker ground",
+     build_bouncing_spheres},
     {"furnace", "white furnace: an albedo-0.5 diffuse sphere under a white sky (renders 0.5)",
      build_furnace},
 };

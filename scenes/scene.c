@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/image_io.h"
 
 /* Grows *arr (of element size `size`) to hold at least `need` elements. */
 static int grow(void **arr, uint32_t *cap, uint32_t need, size_t size)
@@ -69,7 +70,16 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->quad_mat);
     rs_free(s->tris);
     rs_free(s->tri_mat);
+    rs_free(s->sphere_motion);
+    rs_free(s->tri_uv);
     rs_free(s->materials);
+    rs_free(s->textures);
+    if (s->images) {
+        uint32_t i;
+        for (i = 0; i < s->n_images; ++i)
+            rs_free(s->images[i].rgb);
+    }
+    rs_free(s->images);
     rs_free(s->lights);
     rs_free(s->light_cdf);
     rs_free(s->prim_light);
@@ -78,6 +88,9 @@ void rs_scene_destroy(rs_scene *s)
 
 rs_status rs_scene_add_material(rs_scene *s, const rs_material *m, uint32_t *id)
 {
+    if (m->albedo_tex != RS_NO_TEXTURE && m->albedo_tex >= s->n_textures)
+        return rs_error_set(RS_ERR_ARG, "material names texture %u (scene has %u)", m->albedo_tex,
+                            s->n_textures);
     if (!grow((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof *m))
         return rs_error_set(RS_ERR_NOMEM, "out of memory adding a material");
     s->materials[s->n_materials] = *m;
@@ -101,11 +114,40 @@ rs_status rs_scene_add_sphere(rs_scene *s, rs_vec3 center, float radius, uint32_
                         sizeof *s->spheres);
     if (st != RS_OK)
         return st;
+    if (s->sphere_motion) {
+        if (!grow((void **)&s->sphere_motion, &s->cap_motion, s->n_spheres + 1,
+                  sizeof *s->sphere_motion))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory adding a sphere");
+        s->sphere_motion[s->n_spheres] = rs_v3_splat(0.0f);
+    }
     s->spheres[s->n_spheres].center = center;
     s->spheres[s->n_spheres].radius = radius;
     s->sphere_mat[s->n_spheres++] = mat;
     s->finalized = 0;
     return RS_OK;
+}
+
+rs_status rs_scene_add_moving_sphere(rs_scene *s, rs_vec3 c0, float t0, rs_vec3 c1, float t1,
+                                     float radius, uint32_t mat)
+{
+    rs_vec3 v;
+    rs_status st;
+    if (!(t1 != t0))
+        return rs_error_set(RS_ERR_ARG, "moving sphere: the two times must differ");
+    v = rs_v3_scale(rs_v3_sub(c1, c0), 1.0f / (t1 - t0));
+    if (!s->sphere_motion) {
+        uint32_t i;
+        if (!grow((void **)&s->sphere_motion, &s->cap_motion, s->n_spheres + 1,
+                  sizeof *s->sphere_motion))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory adding a moving sphere");
+        for (i = 0; i < s->n_spheres; ++i)
+            s->sphere_motion[i] = rs_v3_splat(0.0f);
+    }
+    /* stored as the centre at time 0 plus a velocity */
+    st = rs_scene_add_sphere(s, rs_v3_madd(c0, v, -t0), radius, mat);
+    if (st == RS_OK)
+        s->sphere_motion[s->n_spheres - 1] = v;
+    return st;
 }
 
 rs_status rs_scene_add_quad(rs_scene *s, rs_vec3 q, rs_vec3 u, rs_vec3 v, uint32_t mat)
@@ -130,12 +172,85 @@ rs_status rs_scene_add_triangle(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2,
                         sizeof *s->tris);
     if (st != RS_OK)
         return st;
+    if (s->tri_uv) {
+        static const float def[6] = {0, 0, 1, 0, 0, 1};
+        if (!grow((void **)&s->tri_uv, &s->cap_uv, s->n_tris + 1, 6 * sizeof *s->tri_uv))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory adding a triangle");
+        memcpy(&s->tri_uv[6 * (size_t)s->n_tris], def, sizeof def);
+    }
     s->tris[s->n_tris].v0 = v0;
     s->tris[s->n_tris].v1 = v1;
     s->tris[s->n_tris].v2 = v2;
     s->tri_mat[s->n_tris++] = mat;
     s->finalized = 0;
     return RS_OK;
+}
+
+rs_status rs_scene_add_triangle_uv(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2,
+                                   const float uv[6], uint32_t mat)
+{
+    rs_status st;
+    if (!s->tri_uv) {
+        static const float def[6] = {0, 0, 1, 0, 0, 1};
+        uint32_t i;
+        if (!grow((void **)&s->tri_uv, &s->cap_uv, s->n_tris + 1, 6 * sizeof *s->tri_uv))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory adding a triangle");
+        for (i = 0; i < s->n_tris; ++i)
+            memcpy(&s->tri_uv[6 * (size_t)i], def, sizeof def);
+    }
+    st = rs_scene_add_triangle(s, v0, v1, v2, mat);
+    if (st == RS_OK)
+        memcpy(&s->tri_uv[6 * (size_t)(s->n_tris - 1)], uv, 6 * sizeof *uv);
+    return st;
+}
+
+rs_status rs_scene_add_texture(rs_scene *s, const rs_texture *t, uint32_t *id)
+{
+    if (t->type == RS_TEX_IMAGE && t->image >= s->n_images)
+        return rs_error_set(RS_ERR_ARG, "texture names image %u (scene has %u)", t->image,
+                            s->n_images);
+    if (!grow((void **)&s->textures, &s->cap_textures, s->n_textures + 1, sizeof *t))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding a texture");
+    s->textures[s->n_textures] = *t;
+    *id = s->n_textures++;
+    return RS_OK;
+}
+
+static rs_status add_image_owned(rs_scene *s, uint32_t w, uint32_t h, float *rgb, uint32_t *id)
+{
+    if (!grow((void **)&s->images, &s->cap_images, s->n_images + 1, sizeof *s->images)) {
+        rs_free(rgb);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding an image");
+    }
+    s->images[s->n_images].width = w;
+    s->images[s->n_images].height = h;
+    s->images[s->n_images].rgb = rgb;
+    *id = s->n_images++;
+    return RS_OK;
+}
+
+rs_status rs_scene_add_image(rs_scene *s, uint32_t width, uint32_t height, const float *rgb,
+                             uint32_t *id)
+{
+    size_t n;
+    float *copy;
+    if (width == 0 || height == 0 || !rs_mul_size((size_t)width * height, 3, &n))
+        return rs_error_set(RS_ERR_ARG, "bad image size %ux%u", width, height);
+    copy = (float *)rs_alloc(n, sizeof *copy);
+    if (!copy)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for a %ux%u image", width, height);
+    memcpy(copy, rgb, n * sizeof *copy);
+    return add_image_owned(s, width, height, copy, id);
+}
+
+rs_status rs_scene_load_image(rs_scene *s, const char *path, uint32_t *id)
+{
+    uint32_t w, h;
+    float *rgb;
+    rs_status st = rs_image_read_linear(path, &w, &h, &rgb);
+    if (st != RS_OK)
+        return st;
+    return add_image_owned(s, w, h, rgb, id);
 }
 
 rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
@@ -207,13 +322,29 @@ rs_status rs_scene_finalize(rs_scene *s)
     s->prim_light = (int32_t *)rs_alloc(n ? n : 1, sizeof *s->prim_light);
     if (!s->prim_light)
         return rs_error_set(RS_ERR_NOMEM, "out of memory preparing lights");
-    /* Quads and triangles with an emissive material become samplable lights.  Spheres stay
-     * out of the table until the sphere (cone) sampler lands: BSDF sampling still finds them,
-     * with full weight, so their light is counted exactly once either way. */
+    for (i = 0; i < s->n_materials; ++i) {
+        const rs_material *m = &s->materials[i];
+        if (m->type > RS_MAT_DIFFUSE_LIGHT)
+            return rs_error_set(RS_ERR_ARG, "material %u: unknown type %u", i, m->type);
+        if (!finite3(m->albedo) || !finite3(m->emission) || !finite3(m->specular) ||
+            m->albedo.x < 0 || m->albedo.y < 0 || m->albedo.z < 0 || m->emission.x < 0 ||
+            m->emission.y < 0 || m->emission.z < 0)
+            return rs_error_set(RS_ERR_ARG, "material %u: colours must be finite and >= 0", i);
+        if (m->type == RS_MAT_DIELECTRIC && !(m->ior > 0.0f && isfinite(m->ior)))
+            return rs_error_set(RS_ERR_ARG, "material %u: index of refraction must be > 0", i);
+        if (m->type == RS_MAT_PHONG && !(m->exponent >= 0.0f && isfinite(m->exponent)))
+            return rs_error_set(RS_ERR_ARG, "material %u: Phong exponent must be >= 0", i);
+        if (m->type == RS_MAT_METAL && !(m->fuzz >= 0.0f && m->fuzz <= 1.0f))
+            return rs_error_set(RS_ERR_ARG, "material %u: metal fuzz must be in [0, 1]", i);
+        if (m->type == RS_MAT_DISNEY_DIFFUSE && !(m->roughness >= 0.0f && m->roughness <= 1.0f))
+            return rs_error_set(RS_ERR_ARG, "material %u: roughness must be in [0, 1]", i);
+    }
+    /* Every primitive with an emissive material becomes a samplable light: spheres by the cone
+     * they subtend, quads and triangles by area. */
     for (i = 0; i < n; ++i) {
         const rs_material *m = rs_scene_prim_material(s, i);
         s->prim_light[i] = -1;
-        if (i >= s->n_spheres && m->type == RS_MAT_DIFFUSE_LIGHT && luminance(m->emission) > 0.0f)
+        if (m->type == RS_MAT_DIFFUSE_LIGHT && luminance(m->emission) > 0.0f)
             s->prim_light[i] = (int32_t)nl++;
     }
     if (nl > 0) {
@@ -250,6 +381,9 @@ rs_geom rs_scene_geom(const rs_scene *s)
 {
     rs_geom g;
     g.spheres = s->spheres;
+    g.sphere_motion = s->sphere_motion;
+    g.time0 = fminf(s->camera.shutter_open, s->camera.shutter_close);
+    g.time1 = fmaxf(s->camera.shutter_open, s->camera.shutter_close);
     g.quads = s->quads;
     g.tris = s->tris;
     g.n_spheres = s->n_spheres;
@@ -268,4 +402,68 @@ const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim)
     if (prim < s->n_quads)
         return &s->materials[s->quad_mat[prim]];
     return &s->materials[s->tri_mat[prim - s->n_quads]];
+}
+
+rs_vec3 rs_scene_background(const rs_scene *s, rs_vec3 d)
+{
+    if (s->background_sky) {
+        float a = 0.5f * (d.y / rs_v3_length(d) + 1.0f);
+        return rs_v3_add(rs_v3_scale(s->background, 1.0f - a), rs_v3_scale(s->background_top, a));
+    }
+    return s->background;
+}
+
+static rs_material mat_base(uint32_t type, rs_vec3 albedo)
+{
+    rs_material m;
+    memset(&m, 0, sizeof m);
+    m.type = type;
+    m.albedo = albedo;
+    m.albedo_tex = RS_NO_TEXTURE;
+    m.ior = 1.5f;
+    return m;
+}
+
+rs_material rs_mat_lambertian(rs_vec3 albedo) { return mat_base(RS_MAT_LAMBERTIAN, albedo); }
+
+rs_material rs_mat_diffuse_uniform(rs_vec3 albedo)
+{
+    return mat_base(RS_MAT_DIFFUSE_UNIFORM, albedo);
+}
+
+rs_material rs_mat_disney_diffuse(rs_vec3 albedo, float roughness)
+{
+    rs_material m = mat_base(RS_MAT_DISNEY_DIFFUSE, albedo);
+    m.roughness = roughness;
+    return m;
+}
+
+rs_material rs_mat_phong(rs_vec3 kd, rs_vec3 ks, float exponent)
+{
+    rs_material m = mat_base(RS_MAT_PHONG, kd);
+    m.specular = ks;
+    m.exponent = exponent;
+    return m;
+}
+
+rs_material rs_mat_metal(rs_vec3 albedo, float fuzz)
+{
+    rs_material m = mat_base(RS_MAT_METAL, albedo);
+    m.fuzz = fuzz;
+    return m;
+}
+
+rs_material rs_mat_dielectric(float ior)
+{
+    rs_material m = mat_base(RS_MAT_DIELECTRIC, rs_v3_splat(1.0f));
+    m.ior = ior;
+    return m;
+}
+
+rs_material rs_mat_light(rs_vec3 emission, int two_sided)
+{
+    rs_material m = mat_base(RS_MAT_DIFFUSE_LIGHT, rs_v3_splat(0.0f));
+    m.emission = emission;
+    m.flags = two_sided ? RS_MAT_TWO_SIDED : 0u;
+    return m;
 }

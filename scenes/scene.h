@@ -12,19 +12,60 @@
 #include "core/status.h"
 
 typedef enum rs_material_type {
-    RS_MAT_LAMBERTIAN = 0,   /* ideal diffuse reflector, albedo */
-    RS_MAT_DIFFUSE_LIGHT = 1 /* emitter of constant radiance; reflects nothing */
+    RS_MAT_LAMBERTIAN = 0,      /* ideal diffuse: f = albedo / pi, cosine-weighted sampling */
+    RS_MAT_DIFFUSE_UNIFORM = 1, /* the thesis's uniform-hemisphere diffuse: f cos = albedo / 2pi */
+    RS_MAT_DISNEY_DIFFUSE = 2,  /* Burley 2012 diffuse with `roughness` */
+    RS_MAT_PHONG = 3,           /* modified Phong (Lafortune & Willems 1994): albedo = kd,
+                                   `specular` = ks, `exponent` = n */
+    RS_MAT_METAL = 4,           /* mirror reflection perturbed by `fuzz` (RTIOW) */
+    RS_MAT_DIELECTRIC = 5,      /* glass of index `ior`: Schlick Fresnel, total internal
+                                   reflection; albedo tints it */
+    RS_MAT_DIFFUSE_LIGHT = 6    /* emitter of `emission`; reflects nothing */
 } rs_material_type;
 
 /* Material flags. */
-#define RS_MAT_TWO_SIDED 1u /* a light emits on both sides (else only where its normal points) */
+#define RS_MAT_TWO_SIDED                                                                           \
+  1u /* a light emits on both sides (else only where its normal                                    \
+        points) */
+#define RS_MAT_UNIFORM_SAMPLING                                                                    \
+  2u /* not importance-sampled: directions uniform over the                                        \
+        hemisphere (the thesis's "without importance sampling") */
 
+#define RS_NO_TEXTURE 0xffffffffu
+
+/* One material; the fields a type does not use are ignored.  60 bytes, plain data. */
 typedef struct rs_material {
-    uint32_t type;    /* rs_material_type, stored fixed-width */
-    uint32_t flags;   /* RS_MAT_* */
-    rs_vec3 albedo;   /* reflectance in [0, 1] per channel */
-    rs_vec3 emission; /* radiance emitted (W / (m^2 sr)), for lights */
+    uint32_t type;       /* rs_material_type, stored fixed-width */
+    uint32_t flags;      /* RS_MAT_* */
+    rs_vec3 albedo;      /* reflectance in [0, 1] per channel (used when albedo_tex is none) */
+    uint32_t albedo_tex; /* texture index for the albedo, or RS_NO_TEXTURE */
+    rs_vec3 specular;    /* Phong ks */
+    rs_vec3 emission;    /* emitted radiance, for lights */
+    float roughness;     /* Disney diffuse, in [0, 1] */
+    float exponent;      /* Phong n >= 0 */
+    float fuzz;          /* metal, in [0, 1] */
+    float ior;           /* dielectric index of refraction (> 0) */
 } rs_material;
+
+typedef enum rs_texture_type {
+    RS_TEX_SOLID = 0,   /* a */
+    RS_TEX_CHECKER = 1, /* 3D checker of cell size `scale` (RTNW v4): a on even cells, b on odd */
+    RS_TEX_STRIPES = 2, /* `scale` stripes across u: a, b, a, ... */
+    RS_TEX_IMAGE = 3    /* image `image`, bilinear, wrapping, v = 0 at the bottom row */
+} rs_texture_type;
+
+typedef struct rs_texture {
+    uint32_t type;  /* rs_texture_type */
+    uint32_t image; /* index into the scene's images (RS_TEX_IMAGE) */
+    rs_vec3 a, b;
+    float scale;
+} rs_texture;
+
+/* A texture image in linear RGB (8-bit files are sRGB-decoded when loaded). */
+typedef struct rs_image {
+    uint32_t width, height;
+    float *rgb; /* width * height * 3, row-major from the top row */
+} rs_image;
 
 /* An emitter that light sampling can pick: a quad or triangle with an emissive material. */
 typedef struct rs_light {
@@ -36,9 +77,11 @@ typedef struct rs_light {
 
 typedef struct rs_camera_desc {
     rs_vec3 from, at, up;
-    float vfov_deg;   /* vertical field of view, degrees */
-    float aperture;   /* lens diameter; 0 for a pinhole */
-    float focus_dist; /* distance to the plane in focus; 0 means |at - from| */
+    float vfov_deg;      /* vertical field of view, degrees */
+    float aperture;      /* lens diameter; 0 for a pinhole */
+    float focus_dist;    /* distance to the plane in focus; 0 means |at - from| */
+    float shutter_open;  /* each camera ray gets a time uniform in [open, close) */
+    float shutter_close; /* (moving spheres are blurred over it) */
 } rs_camera_desc;
 
 typedef struct rs_scene {
@@ -52,8 +95,16 @@ typedef struct rs_scene {
     rs_tri *tris;
     uint32_t *tri_mat;
     uint32_t n_tris, cap_tris;
+    rs_vec3 *sphere_motion; /* NULL until a moving sphere is added; then one per sphere */
+    uint32_t cap_motion;
+    float *tri_uv; /* NULL until a triangle with UVs is added; then 6 per triangle */
+    uint32_t cap_uv;
     rs_material *materials;
     uint32_t n_materials, cap_materials;
+    rs_texture *textures;
+    uint32_t n_textures, cap_textures;
+    rs_image *images;
+    uint32_t n_images, cap_images;
 
     /* built by rs_scene_finalize */
     rs_light *lights;
@@ -63,19 +114,39 @@ typedef struct rs_scene {
     int finalized;
 
     rs_camera_desc camera;
-    rs_vec3 background;     /* radiance of rays that leave the scene */
+    rs_vec3 background;     /* radiance of rays that leave the scene (the horizon's, when
+                               background_sky is set) */
+    rs_vec3 background_top; /* with background_sky: the radiance straight up */
+    int background_sky;     /* RTIOW sky: lerp(background, background_top, (d.y + 1) / 2) */
     uint32_t width, height; /* the scene's preferred image size */
 } rs_scene;
 
+#ifdef __cplusplus
+extern "C" {
+#endif
 rs_status rs_scene_create(const char *name, rs_scene **out);
 void rs_scene_destroy(rs_scene *s);
 
 /* Each add returns RS_OK or RS_ERR_NOMEM / RS_ERR_ARG (a material id out of range). */
 rs_status rs_scene_add_material(rs_scene *s, const rs_material *m, uint32_t *id);
 rs_status rs_scene_add_sphere(rs_scene *s, rs_vec3 center, float radius, uint32_t mat);
+/* A sphere at c0 at time t0 and at c1 at time t1, moving linearly (RTNW's moving sphere). */
+rs_status rs_scene_add_moving_sphere(rs_scene *s, rs_vec3 c0, float t0, rs_vec3 c1, float t1,
+                                     float radius, uint32_t mat);
 /* Parallelogram Q + a u + b v, a, b in [0, 1]; its normal is u x v. */
 rs_status rs_scene_add_quad(rs_scene *s, rs_vec3 q, rs_vec3 u, rs_vec3 v, uint32_t mat);
 rs_status rs_scene_add_triangle(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2, uint32_t mat);
+/* A triangle with texture coordinates uv[0..5] = (u0, v0, u1, v1, u2, v2).  Triangles added
+ * without UVs get (0,0), (1,0), (0,1). */
+rs_status rs_scene_add_triangle_uv(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2,
+                                   const float uv[6], uint32_t mat);
+rs_status rs_scene_add_texture(rs_scene *s, const rs_texture *t, uint32_t *id);
+/* Copies a width x height linear-RGB image into the scene. */
+rs_status rs_scene_add_image(rs_scene *s, uint32_t width, uint32_t height, const float *rgb,
+                             uint32_t *id);
+/* Reads an image file through OpenImageIO into linear RGB (8- and 16-bit files are decoded from
+ * sRGB, float files are taken as linear). */
+rs_status rs_scene_load_image(rs_scene *s, const char *path, uint32_t *id);
 /* Axis-aligned box [lo, hi] as six outward-facing quads, rotated by `rot_y_deg` about the y axis
  * (through the origin) and then moved by `offset` (RTNW's box + rotate_y + translate). */
 rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
@@ -87,5 +158,19 @@ rs_geom rs_scene_geom(const rs_scene *s);
 uint32_t rs_scene_prim_count(const rs_scene *s);
 /* The material of global primitive `prim`. */
 const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim);
+/* Radiance arriving along direction d (unit) from outside the scene. */
+rs_vec3 rs_scene_background(const rs_scene *s, rs_vec3 d);
+
+/* Material constructors with the RTIOW / thesis defaults for the unused fields. */
+rs_material rs_mat_lambertian(rs_vec3 albedo);
+rs_material rs_mat_diffuse_uniform(rs_vec3 albedo);
+rs_material rs_mat_disney_diffuse(rs_vec3 albedo, float roughness);
+rs_material rs_mat_phong(rs_vec3 kd, rs_vec3 ks, float exponent);
+rs_material rs_mat_metal(rs_vec3 albedo, float fuzz);
+rs_material rs_mat_dielectric(float ior);
+rs_material rs_mat_light(rs_vec3 emission, int two_sided);
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,8 +5,9 @@
 
 enum {
     RS_DIM_CAMERA = 0, /* pixel jitter x, y; lens u, v (bounce 0 only) */
-    RS_DIM_BSDF = 1,   /* direction u1, u2; mixture choice; Russian roulette */
-    RS_DIM_LIGHT = 2   /* light pick; point u1, u2; unused */
+    RS_DIM_BSDF = 1,   /* direction u1, u2; lobe or Fresnel choice; Russian roulette */
+    RS_DIM_LIGHT = 2,  /* light pick; point u1, u2; mixture choice (light or BSDF) */
+    RS_DIM_TIME = 3    /* shutter time; unused x3 (bounce 0 only) */
 };
 
 #endif

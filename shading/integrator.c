@@ -1,14 +1,16 @@
 /* shading/integrator.c — raygen, shade and shadow-resolve stages (see integrator.h).
  *
- * Estimators, per sampling mode, at a diffuse vertex x with albedo a (f = a / pi):
- *   mis      next-event: light sample y, weight w_l = p_l^2 / (p_l^2 + p_b^2), adds
- *            beta f cos Le w_l / p_l if the shadow ray is free;  BSDF: cosine sample, beta *= a;
- *            an emitter hit by that ray adds beta Le w_b, w_b = p_b^2 / (p_b^2 + p_l^2).
- *   mixture  one direction from p = 1/2 p_light + 1/2 p_cos; beta *= f cos / p; emitters add
+ * Estimators, per sampling mode, at a non-delta vertex with BSDF f and its sampling pdf p_b:
+ *   mis      next-event: light sample with pdf p_l, weight w_l = p_l^2 / (p_l^2 + p_b^2),
+ *            adds beta f cos Le w_l / p_l if the shadow ray is free; then a BSDF sample,
+ *            beta *= f cos / p_b; an emitter that ray hits adds beta Le w_b with
+ *            w_b = p_b^2 / (p_b^2 + p_l^2)  (Veach 1998, power heuristic).
+ *   mixture  one direction from p = 1/2 p_light + 1/2 p_b; beta *= f cos / p; emitters add
  *            beta Le in full (the thesis's radiance_mixture).
- *   bsdf     cosine sample; beta *= a; emitters add beta Le.
- *   uniform  uniform hemisphere; beta *= 2 a cos; emitters add beta Le.
- * All four estimate the same integral, so they converge to the same image (tested). */
+ *   bsdf     BSDF sample; emitters add beta Le.
+ *   uniform  uniform hemisphere, p = 1 / 2pi; emitters add beta Le.
+ * Delta materials (mirror, glass) are always sampled by their BSDF, and the emitter their ray
+ * hits counts in full.  All four estimate the same integral (tested). */
 #include "shading/integrator.h"
 
 #include <float.h>
@@ -16,8 +18,10 @@
 
 #include "core/alloc.h"
 #include "core/rng.h"
+#include "shading/bsdf.h"
 #include "shading/dims.h"
 #include "shading/lights.h"
+#include "shading/texture.h"
 
 const char *rs_sampling_name(rs_sampling s)
 {
@@ -48,8 +52,9 @@ rs_status rs_paths_init(rs_paths *p, uint32_t capacity)
     p->radiance = (rs_vec3 *)rs_alloc_aligned(capacity, sizeof(rs_vec3));
     p->pending = (rs_vec3 *)rs_alloc_aligned(capacity, sizeof(rs_vec3));
     p->bsdf_pdf = (float *)rs_alloc_aligned(capacity, sizeof(float));
+    p->time = (float *)rs_alloc_aligned(capacity, sizeof(float));
     p->flags = (uint8_t *)rs_alloc_aligned(capacity, 1);
-    if (!p->throughput || !p->radiance || !p->pending || !p->bsdf_pdf || !p->flags) {
+    if (!p->throughput || !p->radiance || !p->pending || !p->bsdf_pdf || !p->time || !p->flags) {
         rs_paths_free(p);
         return rs_error_set(RS_ERR_NOMEM, "out of memory for %u paths", capacity);
     }
@@ -63,6 +68,7 @@ void rs_paths_free(rs_paths *p)
     rs_free(p->radiance);
     rs_free(p->pending);
     rs_free(p->bsdf_pdf);
+    rs_free(p->time);
     rs_free(p->flags);
     memset(p, 0, sizeof *p);
 }
@@ -70,6 +76,7 @@ void rs_paths_free(rs_paths *p)
 void rs_integrator_raygen(const rs_integrator *it, uint64_t wave_start, uint32_t count,
                           rs_paths *paths, rs_ray_soa *out)
 {
+    const rs_camera_desc *cd = &it->scene->camera;
     long i;
 #pragma omp parallel for num_threads(it->threads) schedule(static) if (it->threads > 1)
     for (i = 0; i < (long)count; ++i) {
@@ -78,19 +85,26 @@ void rs_integrator_raygen(const rs_integrator *it, uint64_t wave_start, uint32_t
         rs_rng_f4 r = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_CAMERA);
         rs_ray ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, r.v[0],
                                    r.v[1], r.v[2], r.v[3]);
+        float time = cd->shutter_open;
+        if (cd->shutter_close != cd->shutter_open) {
+            rs_rng_f4 rt = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_TIME);
+            time += rt.v[0] * (cd->shutter_close - cd->shutter_open);
+        }
+        ray.time = time;
         rs_ray_soa_set(out, (uint32_t)i, &ray, (uint32_t)i);
         paths->throughput[i] = rs_v3_splat(1.0f);
         paths->radiance[i] = rs_v3_splat(0.0f);
         paths->pending[i] = rs_v3_splat(0.0f);
         paths->bsdf_pdf[i] = 0.0f;
+        paths->time[i] = time;
         paths->flags[i] = RS_PATH_SPECULAR;
     }
     out->count = count;
 }
 
-/* Moves a ray origin off the surface along the normal on the side the ray leaves from; the
- * offset scales with the coordinates so that it stays far above float rounding (~1e-7
- * relative) at any scene scale. */
+/* Moves a ray origin off the surface along n (the side the new ray leaves from); the offset
+ * scales with the coordinates so that it stays far above float rounding (~1e-7 relative) at any
+ * scene scale. */
 static rs_vec3 offset_origin(rs_vec3 x, rs_vec3 n)
 {
     float scale = fmaxf(fmaxf(fabsf(x.x), fabsf(x.y)), fmaxf(fabsf(x.z), 1e-2f));
@@ -101,6 +115,42 @@ static float power_heuristic(float a, float b)
 {
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* Surface coordinates at a hit: spheres by longitude/latitude (RTIOW), quads by their planar
+ * coordinates, triangles by interpolating their UVs (or the barycentrics). */
+static void surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, rs_vec3 n_out,
+                       float *u, float *v)
+{
+    if (prim < sc->n_spheres) {
+        float theta = acosf(fminf(1.0f, fmaxf(-1.0f, -n_out.y)));
+        float phi = atan2f(-n_out.z, n_out.x) + RS_PI;
+        *u = phi * (0.5f * RS_INV_PI);
+        *v = theta * RS_INV_PI;
+        return;
+    }
+    prim -= sc->n_spheres;
+    if (prim < sc->n_quads || !sc->tri_uv) {
+        *u = hu;
+        *v = hv;
+        return;
+    }
+    {
+        const float *uv = &sc->tri_uv[6 * (size_t)(prim - sc->n_quads)];
+        float b0 = 1.0f - hu - hv;
+        *u = b0 * uv[0] + hu * uv[2] + hv * uv[4];
+        *v = b0 * uv[1] + hu * uv[3] + hv * uv[5];
+    }
+}
+
+static rs_vec3 surface_albedo(const rs_scene *sc, const rs_material *m, uint32_t prim, float hu,
+                              float hv, rs_vec3 x, rs_vec3 ng)
+{
+    float u, v;
+    if (m->albedo_tex == RS_NO_TEXTURE)
+        return m->albedo;
+    surface_uv(sc, prim, hu, hv, ng, &u, &v);
+    return rs_texture_eval(&sc->textures[m->albedo_tex], sc->images, u, v, x);
 }
 
 static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
@@ -115,101 +165,123 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
     rs_ray r = rs_ray_soa_get(rays, j);
     rs_vec3 beta = paths->throughput[p];
     const rs_material *m;
-    rs_vec3 x, ng, n, xo, wi, albedo;
-    rs_onb frame;
+    rs_vec3 x, ng, n, wo, wi, albedo, origin;
     rs_rng_f4 rb;
-    float t = hits->t[j], cos_i, pdf;
+    float t = hits->t[j], pdf = 0.0f;
+    int front, specular = 0;
 
     next_valid[j] = 0;
     shadow_valid[j] = 0;
     if (prim == RS_NO_HIT) {
-        paths->radiance[p] = rs_v3_add(paths->radiance[p], rs_v3_mul(beta, sc->background));
+        rs_vec3 bg = rs_scene_background(sc, r.d);
+        paths->radiance[p] = rs_v3_add(paths->radiance[p], rs_v3_mul(beta, bg));
         return;
     }
     m = rs_scene_prim_material(sc, prim);
     x = rs_ray_at(&r, t);
-    ng = rs_prim_normal(sc, prim, x);
+    ng = rs_prim_normal(sc, prim, x, r.time);
 
     if (m->type == RS_MAT_DIFFUSE_LIGHT) {
         rs_vec3 le = rs_emitted(m, ng, r.d);
         float w = 1.0f;
         int32_t l = sc->prim_light[prim];
+        /* a light reached by BSDF sampling: MIS against the light sampling that could also
+         * have found it (not after a delta bounce or from the camera, where none could) */
         if (it->sampling == RS_SAMPLING_MIS && !(paths->flags[p] & RS_PATH_SPECULAR) && l >= 0)
-            w = power_heuristic(paths->bsdf_pdf[p], rs_light_pdf_hit(sc, (uint32_t)l, r.d, t, ng));
+            w = power_heuristic(paths->bsdf_pdf[p],
+                                rs_light_pdf_hit(sc, (uint32_t)l, r.o, r.time, r.d, t, ng));
         paths->radiance[p] = rs_v3_add(paths->radiance[p], rs_v3_scale(rs_v3_mul(beta, le), w));
         return; /* emitters reflect nothing */
     }
 
-    /* Lambertian from here on.  The segment after this vertex would be number bounce + 1. */
+    /* The segment after this vertex would be number bounce + 1. */
     if (bounce + 1 >= it->max_depth)
         return;
-    n = rs_v3_dot(ng, r.d) < 0.0f ? ng : rs_v3_neg(ng); /* two-sided: face the incoming ray */
-    xo = offset_origin(x, n);
-    albedo = m->albedo;
-    frame = rs_onb_from_normal(n);
+    front = rs_v3_dot(ng, r.d) < 0.0f;
+    n = front ? ng : rs_v3_neg(ng); /* the normal on the incoming ray's side */
+    wo = rs_v3_neg(r.d);
+    albedo = surface_albedo(sc, m, prim, hits->u[j], hits->v[j], x, ng);
+    rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
 
-    if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
+    if (rs_material_is_delta(m)) {
+        /* mirror or glass: the only direction that carries light is the sampled one */
+        rs_scatter bs;
+        if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+            return;
+        wi = bs.wi;
+        beta = rs_v3_mul(beta, bs.weight);
+        origin = offset_origin(x, bs.transmit ? rs_v3_neg(n) : n);
+        specular = 1;
+    } else {
         rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
-        rs_light_sample ls;
-        if (rs_light_sample_at(sc, xo, rl.v[0], rl.v[1], rl.v[2], &ls)) {
-            float c = rs_v3_dot(n, ls.wi);
-            if (c > 0.0f && !rs_v3_is_zero(ls.le)) {
-                float w = power_heuristic(ls.pdf, rs_pdf_cosine_hemisphere(c));
-                rs_vec3 f = rs_v3_scale(albedo, RS_INV_PI);
-                rs_ray sr;
-                paths->pending[p] =
-                    rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, f), ls.le), c * w / ls.pdf);
-                sr.o = xo;
-                sr.d = rs_v3_sub(ls.point, xo); /* unnormalised: the light is at t = 1 */
-                sr.tmin = 0.0f;
-                sr.tmax = 1.0f - 1e-4f;
-                rs_ray_soa_set(shadow, j, &sr, p);
-                shadow_valid[j] = 1;
+        float ci;
+        rs_vec3 f;
+        origin = offset_origin(x, n);
+
+        if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
+            /* next-event estimation: a shadow ray toward a sampled point on a light */
+            rs_light_sample ls;
+            if (rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls)) {
+                float c = rs_v3_dot(n, ls.wi);
+                rs_vec3 fl = rs_bsdf_eval(m, albedo, n, wo, ls.wi);
+                if (c > 0.0f && !rs_v3_is_zero(ls.le) && !rs_v3_is_zero(fl)) {
+                    float w = power_heuristic(ls.pdf, rs_bsdf_pdf(m, albedo, n, wo, ls.wi));
+                    rs_ray sr;
+                    paths->pending[p] =
+                        rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), c * w / ls.pdf);
+                    sr.o = origin;
+                    sr.d = rs_v3_sub(ls.point, origin); /* unnormalised: the light is at t = 1 */
+                    sr.tmin = 0.0f;
+                    sr.tmax = 1.0f - 1e-4f;
+                    sr.time = r.time;
+                    rs_ray_soa_set(shadow, j, &sr, p);
+                    shadow_valid[j] = 1;
+                }
             }
         }
-    }
 
-    rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
-    switch (it->sampling) {
-    case RS_SAMPLING_UNIFORM:
-        wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
-        cos_i = rs_v3_dot(n, wi);
-        pdf = 0.5f * RS_INV_PI;
-        beta = rs_v3_mul(beta, rs_v3_scale(albedo, 2.0f * cos_i));
-        break;
-    case RS_SAMPLING_MIXTURE:
-        if (sc->n_lights > 0) {
-            if (rb.v[2] < 0.5f) {
-                rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
+        if (it->sampling == RS_SAMPLING_UNIFORM) {
+            /* no importance sampling at all: uniform hemisphere, f cos / (1 / 2pi) */
+            rs_onb frame = rs_onb_from_normal(n);
+            wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
+            ci = rs_v3_dot(n, wi);
+            pdf = rs_pdf_uniform_hemisphere(ci);
+            f = rs_bsdf_eval(m, albedo, n, wo, wi);
+            if (!(pdf > 0.0f))
+                return;
+            beta = rs_v3_mul(beta, rs_v3_scale(f, ci / pdf));
+        } else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > 0) {
+            /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
+            if (rl.v[3] < 0.5f) {
                 rs_light_sample ls;
-                if (!rs_light_sample_at(sc, xo, rl.v[0], rl.v[1], rl.v[2], &ls))
+                if (!rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls))
                     return;
                 wi = ls.wi;
             } else {
-                wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(rb.v[0], rb.v[1]));
+                rs_scatter bs;
+                if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+                    return;
+                wi = bs.wi;
             }
-            cos_i = rs_v3_dot(n, wi);
-            if (!(cos_i > 0.0f))
+            ci = rs_v3_dot(n, wi);
+            if (!(ci > 0.0f))
                 return; /* f = 0 below the surface: the path carries nothing further */
-            pdf = 0.5f * rs_lights_pdf_dir(sc, xo, wi) + 0.5f * rs_pdf_cosine_hemisphere(cos_i);
+            pdf = 0.5f * rs_lights_pdf_dir(sc, origin, r.time, wi) +
+                  0.5f * rs_bsdf_pdf(m, albedo, n, wo, wi);
+            f = rs_bsdf_eval(m, albedo, n, wo, wi);
             if (!(pdf > 0.0f))
                 return;
-            beta = rs_v3_mul(beta, rs_v3_scale(albedo, RS_INV_PI * cos_i / pdf));
-            break;
+            beta = rs_v3_mul(beta, rs_v3_scale(f, ci / pdf));
+        } else {
+            /* mis, bsdf, and mixture without lights: the material's own sampling */
+            rs_scatter bs;
+            if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+                return;
+            wi = bs.wi;
+            pdf = bs.pdf;
+            beta = rs_v3_mul(beta, bs.weight);
         }
-        /* no lights: the mixture is the BSDF pdf alone */
-        /* fall through */
-    case RS_SAMPLING_MIS:
-    case RS_SAMPLING_BSDF:
-    default:
-        wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(rb.v[0], rb.v[1]));
-        cos_i = rs_v3_dot(n, wi);
-        pdf = rs_pdf_cosine_hemisphere(cos_i);
-        beta = rs_v3_mul(beta, albedo);
-        break;
     }
-    if (!(cos_i > 0.0f))
-        return;
 
     if (bounce + 1 >= it->rr_depth) {
         float q = fminf(rs_v3_max_comp(beta), 0.95f);
@@ -217,20 +289,21 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
             return;
         beta = rs_v3_scale(beta, 1.0f / q);
     }
-    if (rs_v3_is_zero(beta))
+    if (rs_v3_is_zero(beta) || !(rs_v3_max_comp(beta) > 0.0f))
         return;
     {
         rs_ray nr;
-        nr.o = xo;
+        nr.o = origin;
         nr.d = wi;
         nr.tmin = 0.0f;
         nr.tmax = FLT_MAX;
+        nr.time = r.time;
         rs_ray_soa_set(next, j, &nr, p);
         next_valid[j] = 1;
     }
     paths->throughput[p] = beta;
     paths->bsdf_pdf[p] = pdf;
-    paths->flags[p] = 0;
+    paths->flags[p] = specular ? RS_PATH_SPECULAR : 0;
 }
 
 void rs_integrator_shade(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,

@@ -34,6 +34,7 @@ typedef struct rs_paths {
     rs_vec3 *radiance;   /* light gathered so far */
     rs_vec3 *pending;    /* next-event contribution waiting for its shadow ray */
     float *bsdf_pdf;     /* solid-angle pdf of the BSDF sample that made the current ray */
+    float *time;         /* the path's time in the shutter interval (its rays share it) */
     uint8_t *flags;      /* RS_PATH_* */
     uint32_t capacity;
 } rs_paths;

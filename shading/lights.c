@@ -3,11 +3,14 @@
 
 #include <float.h>
 
-rs_vec3 rs_prim_normal(const rs_scene *s, uint32_t prim, rs_vec3 p)
+#include "core/sampling.h"
+
+rs_vec3 rs_prim_normal(const rs_scene *s, uint32_t prim, rs_vec3 p, float time)
 {
     if (prim < s->n_spheres) {
-        const rs_sphere *sp = &s->spheres[prim];
-        return rs_v3_scale(rs_v3_sub(p, sp->center), 1.0f / sp->radius);
+        rs_geom g = rs_scene_geom(s);
+        rs_vec3 c = rs_geom_sphere_center(&g, prim, time);
+        return rs_v3_scale(rs_v3_sub(p, c), 1.0f / s->spheres[prim].radius);
     }
     prim -= s->n_spheres;
     if (prim < s->n_quads)
@@ -30,7 +33,7 @@ rs_vec3 rs_emitted(const rs_material *m, rs_vec3 ng, rs_vec3 d)
 
 static uint32_t pick_light(const rs_scene *s, float u)
 {
-    /* the largest l with cdf[l] <= u, skipping zero-probability lights */
+    /* the largest l with cdf[l] <= u, so zero-probability lights are never picked */
     uint32_t lo = 0, hi = s->n_lights;
     while (hi - lo > 1) {
         uint32_t mid = (lo + hi) / 2;
@@ -42,7 +45,15 @@ static uint32_t pick_light(const rs_scene *s, float u)
     return lo;
 }
 
-int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float u_pick, float u1, float u2,
+/* 1 - cos(theta_max) of the cone a sphere of radius r subtends at squared distance d2 > r^2,
+ * written as sin^2 / (1 + cos) so that small, far spheres keep their precision. */
+static float cone_one_minus_cos(float r, float d2)
+{
+    float sin2 = r * r / d2;
+    return sin2 / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - sin2)));
+}
+
+int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_pick, float u1, float u2,
                        rs_light_sample *out)
 {
     uint32_t l, prim;
@@ -53,19 +64,40 @@ int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float u_pick, float u1, flo
         return 0;
     l = pick_light(s, u_pick);
     lt = &s->lights[l];
-    prim = lt->prim - s->n_spheres;
-    if (prim < s->n_quads) {
-        const rs_quad *q = &s->quads[prim];
+    prim = lt->prim;
+    if (prim < s->n_spheres) {
+        rs_geom g = rs_scene_geom(s);
+        rs_vec3 c = rs_geom_sphere_center(&g, prim, time), axis = rs_v3_sub(c, x);
+        float r = s->spheres[prim].radius, dc2 = rs_v3_dot(axis, axis);
+        if (dc2 > r * r * 1.0001f) {
+            /* the cone toward the sphere: every direction in it hits the sphere */
+            float omc = cone_one_minus_cos(r, dc2), dc = sqrtf(dc2);
+            rs_onb f = rs_onb_from_normal(rs_v3_scale(axis, 1.0f / dc));
+            rs_vec3 w = rs_onb_to_world(&f, rs_sample_uniform_cone(1.0f - omc, u1, u2));
+            float ct = rs_v3_dot(w, f.n);
+            float disc = r * r - dc2 * (1.0f - ct * ct);
+            float t = dc * ct - sqrtf(fmaxf(0.0f, disc)); /* the near intersection */
+            out->wi = w;
+            out->dist = t;
+            out->point = rs_v3_madd(x, w, t);
+            out->pdf = lt->pick_pdf / (2.0f * RS_PI * omc);
+            n = rs_v3_scale(rs_v3_sub(out->point, c), 1.0f / r);
+            out->le = rs_emitted(rs_scene_prim_material(s, prim), n, w);
+            return out->pdf > 0.0f && t > 0.0f;
+        }
+        /* inside (or on) the sphere: a point uniform on its surface */
+        p = rs_v3_madd(c, rs_sample_uniform_sphere(u1, u2), r);
+    } else if (prim - s->n_spheres < s->n_quads) {
+        const rs_quad *q = &s->quads[prim - s->n_spheres];
         p = rs_v3_add(q->q, rs_v3_add(rs_v3_scale(q->u, u1), rs_v3_scale(q->v, u2)));
     } else {
-        /* uniform on a triangle: b0 = 1 - sqrt(u1), b1 = sqrt(u1) (1 - u2), b2 = sqrt(u1) u2 */
-        const rs_tri *t = &s->tris[prim - s->n_quads];
-        float su = sqrtf(u1);
-        p = rs_v3_add(
-            rs_v3_add(rs_v3_scale(t->v0, 1.0f - su), rs_v3_scale(t->v1, su * (1.0f - u2))),
-            rs_v3_scale(t->v2, su * u2));
+        const rs_tri *t = &s->tris[prim - s->n_spheres - s->n_quads];
+        float b1, b2;
+        rs_sample_triangle(u1, u2, &b1, &b2);
+        p = rs_v3_add(rs_v3_add(rs_v3_scale(t->v0, 1.0f - b1 - b2), rs_v3_scale(t->v1, b1)),
+                      rs_v3_scale(t->v2, b2));
     }
-    n = rs_prim_normal(s, lt->prim, p);
+    n = rs_prim_normal(s, prim, p, time);
     to = rs_v3_sub(p, x);
     d2 = rs_v3_dot(to, to);
     if (!(d2 > 0.0f))
@@ -77,20 +109,29 @@ int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float u_pick, float u1, flo
         return 0;
     out->point = p;
     out->pdf = lt->pick_pdf * d2 / (lt->area * cos_l);
-    out->le = rs_emitted(rs_scene_prim_material(s, lt->prim), n, out->wi);
+    out->le = rs_emitted(rs_scene_prim_material(s, prim), n, out->wi);
     return 1;
 }
 
-float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 w, float t, rs_vec3 ng)
+float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float time, rs_vec3 w, float t,
+                       rs_vec3 ng)
 {
     const rs_light *lt = &s->lights[light];
-    float cos_l = fabsf(rs_v3_dot(ng, w));
+    float cos_l;
+    if (lt->prim < s->n_spheres) {
+        rs_geom g = rs_scene_geom(s);
+        rs_vec3 axis = rs_v3_sub(rs_geom_sphere_center(&g, lt->prim, time), x);
+        float r = s->spheres[lt->prim].radius, dc2 = rs_v3_dot(axis, axis);
+        if (dc2 > r * r * 1.0001f)
+            return lt->pick_pdf / (2.0f * RS_PI * cone_one_minus_cos(r, dc2));
+    }
+    cos_l = fabsf(rs_v3_dot(ng, w));
     if (!(cos_l > 1e-7f))
         return 0.0f;
     return lt->pick_pdf * t * t / (lt->area * cos_l);
 }
 
-float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, rs_vec3 w)
+float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 w)
 {
     rs_geom g = rs_scene_geom(s);
     rs_ray r;
@@ -100,11 +141,13 @@ float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, rs_vec3 w)
     r.d = w;
     r.tmin = 0.0f;
     r.tmax = FLT_MAX;
+    r.time = time;
     for (l = 0; l < s->n_lights; ++l) {
         float t, u, v;
         uint32_t prim = s->lights[l].prim;
         if (rs_geom_intersect(&g, prim, &r, &t, &u, &v))
-            pdf += rs_light_pdf_hit(s, l, w, t, rs_prim_normal(s, prim, rs_ray_at(&r, t)));
+            pdf += rs_light_pdf_hit(s, l, x, time, w, t,
+                                    rs_prim_normal(s, prim, rs_ray_at(&r, t), time));
     }
     return pdf;
 }

@@ -2,7 +2,8 @@
  *
  * Each field is declared once in an X-macro list; the struct, the allocation and the copies all
  * expand from it, so adding a field touches one line.  Byte budgets per entry:
- *   ray  36 B  ox oy oz dx dy dz tmin tmax (float) + path (uint32: index into the wave's paths)
+ *   ray  40 B  ox oy oz dx dy dz tmin tmax time (float) + path (uint32: index into the wave's
+ *              paths)
  *   hit  16 B  t u v (float) + prim (uint32, RS_NO_HIT for a miss)
  *   occlusion 1 B per shadow ray (1 = blocked)
  * A view holds plain pointers (host or device) and is what RS_HD code and devices take. */
@@ -16,7 +17,7 @@
 #define RS_RAY_FIELDS(X)                                                      \
     X(float, ox) X(float, oy) X(float, oz)                                    \
     X(float, dx) X(float, dy) X(float, dz)                                    \
-    X(float, tmin) X(float, tmax)                                             \
+    X(float, tmin) X(float, tmax) X(float, time)                              \
     X(uint32_t, path)
 /* clang-format on */
 
@@ -47,6 +48,7 @@ RS_HD rs_ray rs_ray_soa_get(const rs_ray_soa *s, uint32_t i)
     r.d = rs_v3(s->dx[i], s->dy[i], s->dz[i]);
     r.tmin = s->tmin[i];
     r.tmax = s->tmax[i];
+    r.time = s->time[i];
     return r;
 }
 
@@ -60,6 +62,7 @@ RS_HD void rs_ray_soa_set(const rs_ray_soa *s, uint32_t i, const rs_ray *r, uint
     s->dz[i] = r->d.z;
     s->tmin[i] = r->tmin;
     s->tmax[i] = r->tmax;
+    s->time[i] = r->time;
     s->path[i] = path;
 }
 

@@ -56,6 +56,7 @@ static void soup_alloc(soup *s, uint32_t ns, uint32_t nq, uint32_t nt)
     assert_non_null(s->spheres);
     assert_non_null(s->quads);
     assert_non_null(s->tris);
+    memset(&s->g, 0, sizeof s->g);
     s->g.spheres = s->spheres;
     s->g.quads = s->quads;
     s->g.tris = s->tris;

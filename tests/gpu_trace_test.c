@@ -54,6 +54,7 @@ static void test_gpu_matches_cpu(void **state)
         ray.o = rs_v3(20.0f + 515.0f * r.v[0], 20.0f + 515.0f * r.v[1], 20.0f + 515.0f * r.v[2]);
         ray.d = rs_v3_normalize(rs_v3(r.v[3] - 0.5f, r.v[2] - 0.5f, r.v[1] - 0.5f));
         ray.tmin = 0.0f;
+        ray.time = 0.0f;
         ray.tmax = 3.4e38f;
         rs_ray_soa_set(&rays, i, &ray, i);
     }

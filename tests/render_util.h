@@ -37,10 +37,11 @@ static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp
     return a;
 }
 
-/* Returns width * height * 3 floats (free with free()), or NULL after printing why. */
-static inline float *rt_render(const rt_args *a, rs_render_stats *stats_out)
+/* Renders a finalized scene the caller owns (a->scene is ignored).  Returns width * height * 3
+ * floats (free with free()), or NULL after printing why. */
+static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
+                                     rs_render_stats *stats_out)
 {
-    rs_scene *scene = NULL;
     rs_bvh *bvh = NULL;
     rs_device *devs[2] = {NULL, NULL};
     rs_sched *sched = NULL;
@@ -52,8 +53,6 @@ static inline float *rt_render(const rt_args *a, rs_render_stats *stats_out)
     float *rgb = NULL;
     int n = a->with_fallback ? 2 : 1, i, ok = 0;
 
-    if (rs_builtin_create(a->scene, &scene) != RS_OK)
-        goto out;
     g = rs_scene_geom(scene);
     if (rs_bvh_build(&g, NULL, &bvh) != RS_OK ||
         rs_cpu_device_create(a->threads, "cpu", &devs[0]) != RS_OK ||
@@ -87,12 +86,25 @@ static inline float *rt_render(const rt_args *a, rs_render_stats *stats_out)
     ok = 1;
 out:
     if (!ok)
-        fprintf(stderr, "rt_render(%s): %s\n", a->scene, rs_error_message());
+        fprintf(stderr, "rt_render(%s): %s\n", scene->name, rs_error_message());
     rs_sched_destroy(sched);
     for (i = 0; i < n; ++i)
         rs_device_destroy(devs[i]);
     rs_film_destroy(film);
     rs_bvh_destroy(bvh);
+    return rgb;
+}
+
+/* Renders built-in scene a->scene.  Returns the image as rt_render_scene does, or NULL. */
+static inline float *rt_render(const rt_args *a, rs_render_stats *stats_out)
+{
+    rs_scene *scene = NULL;
+    float *rgb;
+    if (rs_builtin_create(a->scene, &scene) != RS_OK) {
+        fprintf(stderr, "rt_render(%s): %s\n", a->scene, rs_error_message());
+        return NULL;
+    }
+    rgb = rt_render_scene(scene, a, stats_out);
     rs_scene_destroy(scene);
     return rgb;
 }

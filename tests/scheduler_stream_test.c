@@ -313,6 +313,7 @@ static void test_cpu_device_matches_direct(void **state)
         ray.o = rs_v3(50.0f + 450.0f * r.v[0], 50.0f + 450.0f * r.v[1], -100.0f + 600.0f * r.v[2]);
         ray.d = rs_v3_normalize(rs_v3(r.v[3] - 0.5f, r.v[1] - 0.5f, r.v[0] - 0.3f));
         ray.tmin = 0.0f;
+        ray.time = 0.0f;
         ray.tmax = (i % 3 == 0) ? 200.0f : 3.4e38f;
         rs_ray_soa_set(&f.rays, i, &ray, i);
     }

@@ -46,6 +46,7 @@ static inline rs_ray mk_ray(rs_vec3 o, rs_vec3 d, float tmin, float tmax)
     r.d = d;
     r.tmin = tmin;
     r.tmax = tmax;
+    r.time = 0.0f;
     return r;
 }
 
