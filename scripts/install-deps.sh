@@ -6,7 +6,7 @@
 set -eu
 
 PACKAGES="gcc g++ make cmake pkg-config libc6-dev
-libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev"
+libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev gnuplot-nox"
 
 missing=""
 for p in $PACKAGES; do
