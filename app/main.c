@@ -16,6 +16,7 @@
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
+#include "scenes/scene_json.h"
 #include "scheduler/render.h"
 
 #ifndef RS_VERSION
@@ -135,7 +136,7 @@ static int cmd_render(const rs_cli_options *o)
     rs_film *film = NULL;
     float *rgb = NULL;
     int n_devs = 0, i, code = RS_EXIT_OK, threads;
-    char out_default[96];
+    char out_default[96], scene_stem[64];
     const char *out, *name;
     rs_render_settings st;
     rs_render_stats stats;
@@ -147,23 +148,28 @@ static int cmd_render(const rs_cli_options *o)
     rs_geom geom;
 
     /* ---- the scene ---- */
-    if (strncmp(o->scene, "builtin:", 8) != 0) {
+    if (strncmp(o->scene, "builtin:", 8) == 0) {
+        name = o->scene + 8;
+        if (rs_builtin_create(name, &scene) != RS_OK)
+            return fail(RS_EXIT_USAGE, o->scene);
+    } else {
         struct stat sb;
-        if (stat(o->scene, &sb) != 0)
-            fprintf(stderr,
-                    "raystream: %s: no such scene file (built-in scenes are named "
-                    "builtin:NAME; see 'raystream scenes')\n",
+        const char *slash = strrchr(o->scene, '/'), *dot;
+        if (stat(o->scene, &sb) != 0) {
+            fprintf(stderr, "raystream: %s: no such scene file (built-in scenes are named "
+                            "builtin:NAME; see 'raystream scenes')\n",
                     o->scene);
-        else
-            fprintf(stderr,
-                    "raystream: %s: scene files are not supported yet; use a built-in "
-                    "scene (see 'raystream scenes')\n",
-                    o->scene);
-        return RS_EXIT_USAGE;
+            return RS_EXIT_USAGE;
+        }
+        if (rs_scene_load_json(o->scene, &scene) != RS_OK)
+            return fail(RS_EXIT_RUNTIME, NULL);
+        /* the default output is named after the file: scenes/foo.json -> foo.png */
+        name = slash ? slash + 1 : o->scene;
+        dot = strrchr(name, '.');
+        snprintf(scene_stem, sizeof scene_stem, "%.*s", dot ? (int)(dot - name) : (int)strlen(name),
+                 name);
+        name = scene_stem;
     }
-    name = o->scene + 8;
-    if (rs_builtin_create(name, &scene) != RS_OK)
-        return fail(RS_EXIT_USAGE, o->scene);
 
     /* ---- settings ---- */
     memset(&st, 0, sizeof st);

@@ -1,0 +1,642 @@
+/* scenes/scene_json.c — the JSON scene reader (see scene_json.h and docs/scene-format.md).
+ *
+ * Every object is checked against the keys it may have; every value against its type and range.
+ * Paths in messages are JSON paths: objects[3].radius, materials.glass.ior. */
+#include "scenes/scene_json.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <stdarg.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/alloc.h"
+
+#define MAX_SCENE_BYTES (256u << 20)
+#define MAX_NAMES       4096
+
+typedef struct named {
+    const char *name;
+    uint32_t id;
+} named;
+
+typedef struct ctx {
+    const char *label;
+    const char *base_dir;
+    rs_scene *scene;
+    named textures[MAX_NAMES];
+    uint32_t n_textures;
+    named materials[MAX_NAMES];
+    uint32_t n_materials;
+} ctx;
+
+#define FAIL(c, path, ...) field_error((c), (path), __VA_ARGS__)
+
+static rs_status field_error(const ctx *c, const char *path, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static rs_status field_error(const ctx *c, const char *path, const char *fmt, ...)
+{
+    char msg[384];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return rs_error_set(RS_ERR_ARG, "%s: %s: %s", c->label, path, msg);
+}
+
+/* Fails on any key of `obj` that is not in the NULL-terminated list `keys`. */
+static rs_status check_keys(const ctx *c, const cJSON *obj, const char *path,
+                            const char *const *keys)
+{
+    const cJSON *it;
+    for (it = obj->child; it; it = it->next) {
+        int k, known = 0;
+        for (k = 0; keys[k]; ++k)
+            if (strcmp(it->string, keys[k]) == 0)
+                known = 1;
+        if (!known) {
+            char list[256] = "";
+            for (k = 0; keys[k]; ++k) {
+                strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+                strncat(list, keys[k], sizeof list - strlen(list) - 1);
+            }
+            return FAIL(c, path, "unknown key '%s' (allowed: %s)", it->string, list);
+        }
+    }
+    return RS_OK;
+}
+
+static void subpath(char *out, size_t n, const char *path, const char *key)
+{
+    snprintf(out, n, "%s%s%s", path, *path ? "." : "", key);
+}
+
+/* A number in [lo, hi]; `def` when absent and not required. */
+static rs_status get_num(const ctx *c, const cJSON *obj, const char *path, const char *key,
+                         int required, double def, double lo, double hi, float *out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char p[256];
+    subpath(p, sizeof p, path, key);
+    if (!it) {
+        if (required)
+            return FAIL(c, path, "missing '%s'", key);
+        *out = (float)def;
+        return RS_OK;
+    }
+    if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
+        return FAIL(c, p, "expected a number");
+    if (it->valuedouble < lo || it->valuedouble > hi)
+        return FAIL(c, p, "%g is out of range [%g, %g]", it->valuedouble, lo, hi);
+    *out = (float)it->valuedouble;
+    return RS_OK;
+}
+
+static rs_status vec3_of(const ctx *c, const cJSON *it, const char *p, rs_vec3 *out)
+{
+    float v[3];
+    int i;
+    if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != 3)
+        return FAIL(c, p, "expected an array of 3 numbers");
+    for (i = 0; i < 3; ++i) {
+        const cJSON *e = cJSON_GetArrayItem(it, i);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
+            return FAIL(c, p, "expected an array of 3 finite numbers");
+        v[i] = (float)e->valuedouble;
+    }
+    *out = rs_v3(v[0], v[1], v[2]);
+    return RS_OK;
+}
+
+static rs_status get_vec3(const ctx *c, const cJSON *obj, const char *path, const char *key,
+                          int required, rs_vec3 def, rs_vec3 *out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char p[256];
+    subpath(p, sizeof p, path, key);
+    if (!it) {
+        if (required)
+            return FAIL(c, path, "missing '%s'", key);
+        *out = def;
+        return RS_OK;
+    }
+    return vec3_of(c, it, p, out);
+}
+
+/* A colour: 3 numbers >= 0. */
+static rs_status get_color(const ctx *c, const cJSON *obj, const char *path, const char *key,
+                           int required, rs_vec3 def, rs_vec3 *out)
+{
+    char p[256];
+    rs_status st = get_vec3(c, obj, path, key, required, def, out);
+    subpath(p, sizeof p, path, key);
+    if (st == RS_OK && (out->x < 0 || out->y < 0 || out->z < 0))
+        return FAIL(c, p, "colour components must be >= 0");
+    return st;
+}
+
+static rs_status get_bool(const ctx *c, const cJSON *obj, const char *path, const char *key,
+                          int def, int *out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char p[256];
+    subpath(p, sizeof p, path, key);
+    if (!it) {
+        *out = def;
+        return RS_OK;
+    }
+    if (!cJSON_IsBool(it))
+        return FAIL(c, p, "expected true or false");
+    *out = cJSON_IsTrue(it);
+    return RS_OK;
+}
+
+static rs_status get_string(const ctx *c, const cJSON *obj, const char *path, const char *key,
+                            const char **out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    char p[256];
+    subpath(p, sizeof p, path, key);
+    if (!it)
+        return FAIL(c, path, "missing '%s'", key);
+    if (!cJSON_IsString(it) || !*it->valuestring)
+        return FAIL(c, p, "expected a non-empty string");
+    *out = it->valuestring;
+    return RS_OK;
+}
+
+static int lookup(const named *list, uint32_t n, const char *name, uint32_t *id)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i)
+        if (strcmp(list[i].name, name) == 0) {
+            *id = list[i].id;
+            return 1;
+        }
+    return 0;
+}
+
+#define TRY(expr)                                                                                  \
+  do {                                                                                             \
+    rs_status st_ = (expr);                                                                        \
+    if (st_ != RS_OK)                                                                              \
+      return st_;                                                                                  \
+  } while (0)
+
+static rs_status read_camera(ctx *c, const cJSON *cam)
+{
+    static const char *const keys[] = {"from",           "at",      "up", "vfov", "aperture",
+                                       "focus_distance", "shutter", NULL};
+    rs_camera_desc *d = &c->scene->camera;
+    const cJSON *sh;
+    if (!cJSON_IsObject(cam))
+        return FAIL(c, "camera", "expected an object");
+    TRY(check_keys(c, cam, "camera", keys));
+    TRY(get_vec3(c, cam, "camera", "from", 1, rs_v3(0, 0, 0), &d->from));
+    TRY(get_vec3(c, cam, "camera", "at", 1, rs_v3(0, 0, 0), &d->at));
+    TRY(get_vec3(c, cam, "camera", "up", 0, rs_v3(0, 1, 0), &d->up));
+    TRY(get_num(c, cam, "camera", "vfov", 0, 40.0, 1e-3, 179.0, &d->vfov_deg));
+    TRY(get_num(c, cam, "camera", "aperture", 0, 0.0, 0.0, 1e30, &d->aperture));
+    TRY(get_num(c, cam, "camera", "focus_distance", 0, 0.0, 0.0, 1e30, &d->focus_dist));
+    if (rs_v3_length(rs_v3_sub(d->from, d->at)) == 0.0f)
+        return FAIL(c, "camera", "'from' and 'at' must differ");
+    if (rs_v3_length(rs_v3_cross(d->up, rs_v3_sub(d->from, d->at))) == 0.0f)
+        return FAIL(c, "camera.up", "must not be parallel to the viewing direction");
+    sh = cJSON_GetObjectItemCaseSensitive(cam, "shutter");
+    if (sh) {
+        if (!cJSON_IsArray(sh) || cJSON_GetArraySize(sh) != 2 ||
+            !cJSON_IsNumber(cJSON_GetArrayItem(sh, 0)) ||
+            !cJSON_IsNumber(cJSON_GetArrayItem(sh, 1)))
+            return FAIL(c, "camera.shutter", "expected [open, close]");
+        d->shutter_open = (float)cJSON_GetArrayItem(sh, 0)->valuedouble;
+        d->shutter_close = (float)cJSON_GetArrayItem(sh, 1)->valuedouble;
+        if (!(d->shutter_close >= d->shutter_open))
+            return FAIL(c, "camera.shutter", "close must not be before open");
+    }
+    return RS_OK;
+}
+
+static rs_status read_image_size(ctx *c, const cJSON *img)
+{
+    static const char *const keys[] = {"width", "height", NULL};
+    float w, h;
+    if (!cJSON_IsObject(img))
+        return FAIL(c, "image", "expected an object");
+    TRY(check_keys(c, img, "image", keys));
+    TRY(get_num(c, img, "image", "width", 0, 512, 1, 32768, &w));
+    TRY(get_num(c, img, "image", "height", 0, 512, 1, 32768, &h));
+    if (w != floorf(w) || h != floorf(h))
+        return FAIL(c, "image", "width and height must be whole numbers");
+    c->scene->width = (uint32_t)w;
+    c->scene->height = (uint32_t)h;
+    return RS_OK;
+}
+
+static rs_status read_background(ctx *c, const cJSON *bg)
+{
+    static const char *const keys[] = {"horizon", "zenith", NULL};
+    rs_scene *s = c->scene;
+    if (cJSON_IsArray(bg)) {
+        TRY(vec3_of(c, bg, "background", &s->background));
+        if (s->background.x < 0 || s->background.y < 0 || s->background.z < 0)
+            return FAIL(c, "background", "colour components must be >= 0");
+        return RS_OK;
+    }
+    if (!cJSON_IsObject(bg))
+        return FAIL(c, "background", "expected [r, g, b] or {\"horizon\": .., \"zenith\": ..}");
+    TRY(check_keys(c, bg, "background", keys));
+    TRY(get_color(c, bg, "background", "horizon", 1, rs_v3(0, 0, 0), &s->background));
+    TRY(get_color(c, bg, "background", "zenith", 1, rs_v3(0, 0, 0), &s->background_top));
+    s->background_sky = 1;
+    return RS_OK;
+}
+
+static rs_status resolve_path(const ctx *c, const char *file, char *out, size_t n)
+{
+    if (file[0] == '/' || !c->base_dir || !*c->base_dir)
+        snprintf(out, n, "%s", file);
+    else
+        snprintf(out, n, "%s/%s", c->base_dir, file);
+    return RS_OK;
+}
+
+static rs_status read_texture(ctx *c, const cJSON *t, const char *path, const char *name)
+{
+    static const char *const k_solid[] = {"type", "color", NULL};
+    static const char *const k_two[] = {"type", "a", "b", "scale", NULL};
+    static const char *const k_image[] = {"type", "file", NULL};
+    rs_texture tex;
+    const char *type = "";
+    uint32_t id;
+    memset(&tex, 0, sizeof tex);
+    if (!cJSON_IsObject(t))
+        return FAIL(c, path, "expected an object");
+    TRY(get_string(c, t, path, "type", &type));
+    if (strcmp(type, "solid") == 0) {
+        TRY(check_keys(c, t, path, k_solid));
+        tex.type = RS_TEX_SOLID;
+        TRY(get_color(c, t, path, "color", 1, rs_v3(0, 0, 0), &tex.a));
+    } else if (strcmp(type, "checker") == 0 || strcmp(type, "stripes") == 0) {
+        TRY(check_keys(c, t, path, k_two));
+        tex.type = type[0] == 'c' ? RS_TEX_CHECKER : RS_TEX_STRIPES;
+        TRY(get_color(c, t, path, "a", 1, rs_v3(0, 0, 0), &tex.a));
+        TRY(get_color(c, t, path, "b", 1, rs_v3(0, 0, 0), &tex.b));
+        TRY(get_num(c, t, path, "scale", 0, type[0] == 'c' ? 1.0 : 10.0, 1e-6, 1e6, &tex.scale));
+    } else if (strcmp(type, "image") == 0) {
+        const char *file = "";
+        char full[1024];
+        rs_status st;
+        TRY(check_keys(c, t, path, k_image));
+        TRY(get_string(c, t, path, "file", &file));
+        resolve_path(c, file, full, sizeof full);
+        tex.type = RS_TEX_IMAGE;
+        rs_error_clear();
+        st = rs_scene_load_image(c->scene, full, &tex.image);
+        if (st != RS_OK) {
+            char msg[400];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            return FAIL(c, path, "%s", msg);
+        }
+    } else {
+        return FAIL(c, path, "unknown texture type '%s' (solid, checker, stripes, image)", type);
+    }
+    TRY(rs_scene_add_texture(c->scene, &tex, &id));
+    c->textures[c->n_textures].name = name;
+    c->textures[c->n_textures++].id = id;
+    return RS_OK;
+}
+
+/* "albedo": [r,g,b] or "texture": "name" (exactly one). */
+static rs_status read_albedo(ctx *c, const cJSON *m, const char *path, const char *key,
+                             rs_material *mat)
+{
+    const cJSON *tex = cJSON_GetObjectItemCaseSensitive(m, "texture");
+    if (tex) {
+        char p[256];
+        subpath(p, sizeof p, path, "texture");
+        if (cJSON_GetObjectItemCaseSensitive(m, key))
+            return FAIL(c, path, "give either '%s' or 'texture', not both", key);
+        if (!cJSON_IsString(tex) ||
+            !lookup(c->textures, c->n_textures, tex->valuestring, &mat->albedo_tex))
+            return FAIL(c, p, "no texture named %s%s%s", cJSON_IsString(tex) ? "'" : "",
+                        cJSON_IsString(tex) ? tex->valuestring : "(not a string)",
+                        cJSON_IsString(tex) ? "'" : "");
+        mat->albedo = rs_v3_splat(1.0f);
+        return RS_OK;
+    }
+    TRY(get_color(c, m, path, key, 0, rs_v3(.5f, .5f, .5f), &mat->albedo));
+    if (mat->albedo.x > 1 || mat->albedo.y > 1 || mat->albedo.z > 1) {
+        char p[256];
+        subpath(p, sizeof p, path, key);
+        return FAIL(c, p, "reflectance must be in [0, 1]");
+    }
+    return RS_OK;
+}
+
+static rs_status read_material(ctx *c, const cJSON *m, const char *path, const char *name)
+{
+    static const char *const k_diffuse[] = {"type", "albedo", "texture", "importance_sampling",
+                                            NULL};
+    static const char *const k_disney[] = {
+        "type", "albedo", "texture", "roughness", "importance_sampling", NULL};
+    static const char *const k_phong[] = {
+        "type", "kd", "texture", "ks", "exponent", "importance_sampling", NULL};
+    static const char *const k_metal[] = {"type", "albedo", "fuzz", NULL};
+    static const char *const k_glass[] = {"type", "ior", "tint", NULL};
+    static const char *const k_light[] = {"type", "emission", "two_sided", NULL};
+    rs_material mat;
+    const char *type = "";
+    int is_ok = 1, two = 0;
+    uint32_t id;
+    if (!cJSON_IsObject(m))
+        return FAIL(c, path, "expected an object");
+    TRY(get_string(c, m, path, "type", &type));
+    if (strcmp(type, "lambertian") == 0 || strcmp(type, "diffuse_uniform") == 0) {
+        mat = type[0] == 'l' ? rs_mat_lambertian(rs_v3_splat(.5f))
+                             : rs_mat_diffuse_uniform(rs_v3_splat(.5f));
+        TRY(check_keys(c, m, path, k_diffuse));
+        TRY(read_albedo(c, m, path, "albedo", &mat));
+    } else if (strcmp(type, "disney_diffuse") == 0) {
+        mat = rs_mat_disney_diffuse(rs_v3_splat(.5f), 0.5f);
+        TRY(check_keys(c, m, path, k_disney));
+        TRY(read_albedo(c, m, path, "albedo", &mat));
+        TRY(get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &mat.roughness));
+    } else if (strcmp(type, "phong") == 0) {
+        mat = rs_mat_phong(rs_v3_splat(.5f), rs_v3_splat(.5f), 50.0f);
+        TRY(check_keys(c, m, path, k_phong));
+        TRY(read_albedo(c, m, path, "kd", &mat));
+        TRY(get_color(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat.specular));
+        TRY(get_num(c, m, path, "exponent", 0, 50.0, 0.0, 1e6, &mat.exponent));
+    } else if (strcmp(type, "metal") == 0) {
+        mat = rs_mat_metal(rs_v3_splat(.8f), 0.0f);
+        TRY(check_keys(c, m, path, k_metal));
+        TRY(get_color(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat.albedo));
+        TRY(get_num(c, m, path, "fuzz", 0, 0.0, 0.0, 1.0, &mat.fuzz));
+    } else if (strcmp(type, "dielectric") == 0) {
+        mat = rs_mat_dielectric(1.5f);
+        TRY(check_keys(c, m, path, k_glass));
+        TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat.ior));
+        TRY(get_color(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+    } else if (strcmp(type, "light") == 0) {
+        mat = rs_mat_light(rs_v3_splat(1.0f), 0);
+        TRY(check_keys(c, m, path, k_light));
+        TRY(get_color(c, m, path, "emission", 1, rs_v3(0, 0, 0), &mat.emission));
+        TRY(get_bool(c, m, path, "two_sided", 0, &two));
+        mat.flags = two ? RS_MAT_TWO_SIDED : 0u;
+    } else {
+        return FAIL(c, path,
+                    "unknown material type '%s' (lambertian, diffuse_uniform, disney_diffuse, "
+                    "phong, metal, dielectric, light)",
+                    type);
+    }
+    TRY(get_bool(c, m, path, "importance_sampling", 1, &is_ok));
+    if (!is_ok)
+        mat.flags |= RS_MAT_UNIFORM_SAMPLING;
+    TRY(rs_scene_add_material(c->scene, &mat, &id));
+    c->materials[c->n_materials].name = name;
+    c->materials[c->n_materials++].id = id;
+    return RS_OK;
+}
+
+static rs_status object_material(ctx *c, const cJSON *o, const char *path, uint32_t *id)
+{
+    const char *name = "";
+    char p[256];
+    TRY(get_string(c, o, path, "material", &name));
+    subpath(p, sizeof p, path, "material");
+    if (!lookup(c->materials, c->n_materials, name, id))
+        return FAIL(c, p, "no material named '%s'", name);
+    return RS_OK;
+}
+
+static rs_status read_object(ctx *c, const cJSON *o, const char *path)
+{
+    static const char *const k_sphere[] = {"type",     "center",    "radius",
+                                           "material", "moving_to", NULL};
+    static const char *const k_quad[] = {"type", "q", "u", "v", "material", NULL};
+    static const char *const k_tri[] = {"type", "vertices", "uv", "material", NULL};
+    static const char *const k_box[] = {"type",      "min",      "max", "rotate_y",
+                                        "translate", "material", NULL};
+    rs_scene *s = c->scene;
+    const char *type = "";
+    uint32_t mat;
+    if (!cJSON_IsObject(o))
+        return FAIL(c, path, "expected an object");
+    TRY(get_string(c, o, path, "type", &type));
+    if (strcmp(type, "sphere") == 0) {
+        rs_vec3 center, to;
+        float r;
+        TRY(check_keys(c, o, path, k_sphere));
+        TRY(get_vec3(c, o, path, "center", 1, rs_v3(0, 0, 0), &center));
+        TRY(get_num(c, o, path, "radius", 1, 0, 1e-30, 1e30, &r));
+        TRY(object_material(c, o, path, &mat));
+        if (cJSON_GetObjectItemCaseSensitive(o, "moving_to")) {
+            /* the centre moves linearly from `center` at time 0 to `moving_to` at time 1 */
+            TRY(get_vec3(c, o, path, "moving_to", 1, center, &to));
+            return rs_scene_add_moving_sphere(s, center, 0.0f, to, 1.0f, r, mat);
+        }
+        return rs_scene_add_sphere(s, center, r, mat);
+    }
+    if (strcmp(type, "quad") == 0) {
+        rs_vec3 q, u, v;
+        TRY(check_keys(c, o, path, k_quad));
+        TRY(get_vec3(c, o, path, "q", 1, rs_v3(0, 0, 0), &q));
+        TRY(get_vec3(c, o, path, "u", 1, rs_v3(0, 0, 0), &u));
+        TRY(get_vec3(c, o, path, "v", 1, rs_v3(0, 0, 0), &v));
+        if (rs_v3_is_zero(rs_v3_cross(u, v)))
+            return FAIL(c, path, "u and v must span a parallelogram (u x v = 0)");
+        TRY(object_material(c, o, path, &mat));
+        return rs_scene_add_quad(s, q, u, v, mat);
+    }
+    if (strcmp(type, "triangle") == 0) {
+        const cJSON *vs = cJSON_GetObjectItemCaseSensitive(o, "vertices");
+        const cJSON *uv = cJSON_GetObjectItemCaseSensitive(o, "uv");
+        rs_vec3 p[3];
+        float uvs[6];
+        char sp[256];
+        int i;
+        TRY(check_keys(c, o, path, k_tri));
+        subpath(sp, sizeof sp, path, "vertices");
+        if (!cJSON_IsArray(vs) || cJSON_GetArraySize(vs) != 3)
+            return FAIL(c, vs ? sp : path, vs ? "expected 3 vertices" : "missing 'vertices'");
+        for (i = 0; i < 3; ++i)
+            TRY(vec3_of(c, cJSON_GetArrayItem(vs, i), sp, &p[i]));
+        TRY(object_material(c, o, path, &mat));
+        if (!uv)
+            return rs_scene_add_triangle(s, p[0], p[1], p[2], mat);
+        subpath(sp, sizeof sp, path, "uv");
+        if (!cJSON_IsArray(uv) || cJSON_GetArraySize(uv) != 6)
+            return FAIL(c, sp, "expected 6 numbers (u0, v0, u1, v1, u2, v2)");
+        for (i = 0; i < 6; ++i) {
+            const cJSON *e = cJSON_GetArrayItem(uv, i);
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+                return FAIL(c, sp, "expected 6 numbers (u0, v0, u1, v1, u2, v2)");
+            uvs[i] = (float)e->valuedouble;
+        }
+        return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
+    }
+    if (strcmp(type, "box") == 0) {
+        rs_vec3 lo, hi, t;
+        float rot;
+        TRY(check_keys(c, o, path, k_box));
+        TRY(get_vec3(c, o, path, "min", 1, rs_v3(0, 0, 0), &lo));
+        TRY(get_vec3(c, o, path, "max", 1, rs_v3(0, 0, 0), &hi));
+        if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+            return FAIL(c, path, "'max' must exceed 'min' on every axis");
+        TRY(get_num(c, o, path, "rotate_y", 0, 0.0, -1e6, 1e6, &rot));
+        TRY(get_vec3(c, o, path, "translate", 0, rs_v3(0, 0, 0), &t));
+        TRY(object_material(c, o, path, &mat));
+        return rs_scene_add_box(s, lo, hi, rot, t, mat);
+    }
+    return FAIL(c, path, "unknown object type '%s' (sphere, quad, triangle, box)", type);
+}
+
+/* Reads a name -> definition map (textures, materials) in file order. */
+static rs_status read_map(ctx *c, const cJSON *root, const char *key,
+                          rs_status (*read)(ctx *, const cJSON *, const char *, const char *),
+                          uint32_t *count)
+{
+    const cJSON *map = cJSON_GetObjectItemCaseSensitive(root, key), *it;
+    if (!map)
+        return RS_OK;
+    if (!cJSON_IsObject(map))
+        return FAIL(c, key, "expected an object of named definitions");
+    for (it = map->child; it; it = it->next) {
+        char p[256];
+        uint32_t dummy;
+        snprintf(p, sizeof p, "%s.%s", key, it->string);
+        if (!*it->string)
+            return FAIL(c, key, "names must not be empty");
+        if (*count >= MAX_NAMES)
+            return FAIL(c, key, "more than %d definitions", MAX_NAMES);
+        if ((read == read_material && lookup(c->materials, c->n_materials, it->string, &dummy)) ||
+            (read == read_texture && lookup(c->textures, c->n_textures, it->string, &dummy)))
+            return FAIL(c, p, "defined twice");
+        TRY(read(c, it, p, it->string));
+    }
+    return RS_OK;
+}
+
+static rs_status build(ctx *c, const cJSON *root)
+{
+    static const char *const keys[] = {"camera",    "image",   "background", "textures",
+                                       "materials", "objects", NULL};
+    const cJSON *objs, *it;
+    int i = 0;
+    if (!cJSON_IsObject(root))
+        return rs_error_set(RS_ERR_ARG, "%s: the scene must be a JSON object", c->label);
+    TRY(check_keys(c, root, "(top level)", keys));
+    if (!cJSON_GetObjectItemCaseSensitive(root, "camera"))
+        return FAIL(c, "(top level)", "missing 'camera'");
+    TRY(read_camera(c, cJSON_GetObjectItemCaseSensitive(root, "camera")));
+    if (cJSON_GetObjectItemCaseSensitive(root, "image"))
+        TRY(read_image_size(c, cJSON_GetObjectItemCaseSensitive(root, "image")));
+    if (cJSON_GetObjectItemCaseSensitive(root, "background"))
+        TRY(read_background(c, cJSON_GetObjectItemCaseSensitive(root, "background")));
+    TRY(read_map(c, root, "textures", read_texture, &c->n_textures));
+    TRY(read_map(c, root, "materials", read_material, &c->n_materials));
+    objs = cJSON_GetObjectItemCaseSensitive(root, "objects");
+    if (!objs)
+        return FAIL(c, "(top level)", "missing 'objects'");
+    if (!cJSON_IsArray(objs))
+        return FAIL(c, "objects", "expected an array");
+    for (it = objs->child; it; it = it->next, ++i) {
+        char p[64];
+        snprintf(p, sizeof p, "objects[%d]", i);
+        TRY(read_object(c, it, p));
+    }
+    return RS_OK;
+}
+
+rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, const char *base_dir,
+                              rs_scene **out)
+{
+    const char *end = NULL;
+    cJSON *root;
+    ctx *c;
+    rs_status st;
+    *out = NULL;
+    root = cJSON_ParseWithLengthOpts(text, len, &end, 0);
+    if (!root) {
+        /* the line of the syntax error: count newlines up to where parsing stopped */
+        size_t line = 1, i,
+               stop = end && end >= text && end <= text + len ? (size_t)(end - text) : len;
+        for (i = 0; i < stop; ++i)
+            line += text[i] == '\n';
+        return rs_error_set(RS_ERR_ARG, "%s:%zu: JSON syntax error", label, line);
+    }
+    c = (ctx *)rs_calloc(1, sizeof *c);
+    if (!c) {
+        cJSON_Delete(root);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", label);
+    }
+    c->label = label;
+    c->base_dir = base_dir;
+    st = rs_scene_create(label, &c->scene);
+    if (st == RS_OK)
+        st = build(c, root);
+    if (st == RS_OK) {
+        st = rs_scene_finalize(c->scene);
+        if (st != RS_OK) {
+            /* finalize names the primitive or material; prefix the file */
+            char msg[400];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            st = rs_error_set(st, "%s: %s", label, msg);
+        }
+    }
+    if (st == RS_OK)
+        *out = c->scene;
+    else
+        rs_scene_destroy(c->scene);
+    cJSON_Delete(root);
+    rs_free(c);
+    return st;
+}
+
+rs_status rs_scene_load_json(const char *path, rs_scene **out)
+{
+    FILE *f = fopen(path, "rb");
+    char *text, dir[1024];
+    const char *slash;
+    long n;
+    size_t got;
+    rs_status st;
+    *out = NULL;
+    if (!f)
+        return rs_error_set(RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return rs_error_set(RS_ERR_IO, "%s: cannot read (not a regular file?)", path);
+    }
+    if ((unsigned long)n > MAX_SCENE_BYTES) {
+        fclose(f);
+        return rs_error_set(RS_ERR_ARG, "%s: larger than %u MiB", path, MAX_SCENE_BYTES >> 20);
+    }
+    text = (char *)rs_alloc((size_t)n + 1, 1);
+    if (!text) {
+        fclose(f);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    }
+    got = fread(text, 1, (size_t)n, f);
+    fclose(f);
+    if (got != (size_t)n) {
+        rs_free(text);
+        return rs_error_set(RS_ERR_IO, "%s: read error", path);
+    }
+    text[n] = '\0';
+    slash = strrchr(path, '/');
+    if (slash)
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    else
+        snprintf(dir, sizeof dir, ".");
+    st = rs_scene_parse_json(text, (size_t)n, path, dir, out);
+    rs_free(text);
+    return st;
+}

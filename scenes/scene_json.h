@@ -1,0 +1,27 @@
+/* scenes/scene_json.h — scene files in JSON (the format is documented in docs/scene-format.md).
+ *
+ * The reader is strict, like pbrt's: an unknown key, a wrong type, a value out of range or a
+ * name that is not defined is an error, reported in one line naming the file and the JSON path
+ * of the offending field ("scene.json: materials.red.albedo: expected 3 numbers"), or the line
+ * for a syntax error.  Relative file names (image textures) are relative to the scene file. */
+#ifndef RS_SCENES_SCENE_JSON_H
+#define RS_SCENES_SCENE_JSON_H
+
+#include <stddef.h>
+
+#include "scenes/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* Reads and finalizes the scene in file `path`.  RS_ERR_IO if it cannot be read, RS_ERR_ARG for
+ * bad content. */
+rs_status rs_scene_load_json(const char *path, rs_scene **out);
+/* The same from text in memory; `label` names it in messages, `base_dir` resolves relative
+ * file names (NULL: the working directory). */
+rs_status rs_scene_parse_json(const char *text, size_t len, const char *label,
+                              const char *base_dir, rs_scene **out);
+#ifdef __cplusplus
+}
+#endif
+#endif
