@@ -41,16 +41,18 @@ RS_HD rs_quad rs_quad_make(rs_vec3 q, rs_vec3 u, rs_vec3 v)
     return r;
 }
 
-/* Ray/sphere, the half-b quadratic (RTIOW §6.2).  On a hit: *t, and u = v = 0 (the shading step
- * derives the sphere's parameterisation from the hit point).  A ray starting inside the sphere
- * hits the far side. */
+/* Ray/sphere, the half-b quadratic (RTIOW §6.2) with the discriminant taken from the
+ * perpendicular distance l from the centre to the line (Haines et al., Ray Tracing Gems ch. 7):
+ * h^2 - a c = a (r^2 - |l|^2), l = oc - (h / a) d, which does not cancel for small or far
+ * spheres the way |oc|^2 - r^2 does.  On a hit: *t, and u = v = 0 (the shading step derives
+ * the sphere's parameterisation from the hit point).  A ray starting inside hits the far side. */
 RS_HD int rs_isect_sphere(const rs_sphere *s, const rs_ray *r, float *t)
 {
     rs_vec3 oc = rs_v3_sub(s->center, r->o);
     float a = rs_v3_dot(r->d, r->d);
     float h = rs_v3_dot(r->d, oc);
-    float c = rs_v3_dot(oc, oc) - s->radius * s->radius;
-    float disc = h * h - a * c;
+    rs_vec3 l = rs_v3_sub(oc, rs_v3_scale(r->d, h / a));
+    float disc = a * (s->radius * s->radius - rs_v3_dot(l, l));
     float sq, root;
     if (!(disc >= 0.0f))
         return 0;

@@ -8,7 +8,7 @@
  *   uniform hemisphere  p = 1 / (2 pi)               z = u1
  *   cosine hemisphere   p = cos / pi                 z = sqrt(1 - u1)   (Malley: r = sqrt(u1))
  *   power cosine        p = (n + 1) cos^n / (2 pi)   z = u1^(1 / (n + 1))
- *   uniform cone        p = 1 / (2 pi (1 - cmax))    z = 1 - u1 (1 - cmax)
+ *   uniform cone        p = 1 / (2 pi (1 - cmax))    1 - z = u1 (1 - cmax)
  * and phi = 2 pi u2 for all of them.  The pdfs are tested (integral = 1, chi-square). */
 #ifndef RS_CORE_SAMPLING_H
 #define RS_CORE_SAMPLING_H
@@ -93,13 +93,18 @@ RS_HD float rs_pdf_power_cosine(float n, float cos_theta)
     return cos_theta > 0.0f ? (n + 1.0f) * 0.5f * RS_INV_PI * powf(cos_theta, n) : 0.0f;
 }
 
-/* Uniform over the cone of directions within angle acos(cos_max) of z. */
-RS_HD rs_vec3 rs_sample_uniform_cone(float cos_max, float u1, float u2)
+/* Uniform over the cone of directions within angle theta_max of z, given omc = 1 - cos(theta_max).
+ * Sampled in 1 - cos(theta) = u1 omc and sin(theta) = sqrt(s (2 - s)) (as pbrt-v4), never via a
+ * float cos(theta) near 1: a small cone (a far sphere light) keeps every polar angle it has. */
+RS_HD rs_vec3 rs_sample_uniform_cone(float omc, float u1, float u2)
 {
-    return rs_dir_from_z(1.0f - u1 * (1.0f - cos_max), u2);
+    float s = u1 * omc;
+    float r = sqrtf(fmaxf(0.0f, s * (2.0f - s)));
+    float phi = 2.0f * RS_PI * u2;
+    return rs_v3(r * cosf(phi), r * sinf(phi), 1.0f - s);
 }
 
-RS_HD float rs_pdf_uniform_cone(float cos_max) { return 1.0f / (2.0f * RS_PI * (1.0f - cos_max)); }
+RS_HD float rs_pdf_uniform_cone(float omc) { return 1.0f / (2.0f * RS_PI * omc); }
 
 /* Uniform point on a triangle as barycentrics (b1, b2) of v1 and v2 (sqrt warp). */
 RS_HD void rs_sample_triangle(float u1, float u2, float *b1, float *b2)

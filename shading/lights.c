@@ -73,14 +73,17 @@ int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_pick, f
             /* the cone toward the sphere: every direction in it hits the sphere */
             float omc = cone_one_minus_cos(r, dc2), dc = sqrtf(dc2);
             rs_onb f = rs_onb_from_normal(rs_v3_scale(axis, 1.0f / dc));
-            rs_vec3 w = rs_onb_to_world(&f, rs_sample_uniform_cone(1.0f - omc, u1, u2));
+            rs_vec3 w = rs_onb_to_world(&f, rs_sample_uniform_cone(omc, u1, u2));
             float ct = rs_v3_dot(w, f.n);
-            float disc = r * r - dc2 * (1.0f - ct * ct);
-            float t = dc * ct - sqrtf(fmaxf(0.0f, disc)); /* the near intersection */
+            /* the near intersection, from the perpendicular distance to the centre (no
+             * cancellation in dc^2 - r^2 for far spheres) */
+            rs_vec3 perp = rs_v3_sub(rs_v3_scale(w, dc * ct), axis);
+            float disc = r * r - rs_v3_dot(perp, perp);
+            float t = dc * ct - sqrtf(fmaxf(0.0f, disc));
             out->wi = w;
             out->dist = t;
             out->point = rs_v3_madd(x, w, t);
-            out->pdf = lt->pick_pdf / (2.0f * RS_PI * omc);
+            out->pdf = lt->pick_pdf * rs_pdf_uniform_cone(omc);
             n = rs_v3_scale(rs_v3_sub(out->point, c), 1.0f / r);
             out->le = rs_emitted(rs_scene_prim_material(s, prim), n, w);
             return out->pdf > 0.0f && t > 0.0f;
@@ -123,7 +126,7 @@ float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float time,
         rs_vec3 axis = rs_v3_sub(rs_geom_sphere_center(&g, lt->prim, time), x);
         float r = s->spheres[lt->prim].radius, dc2 = rs_v3_dot(axis, axis);
         if (dc2 > r * r * 1.0001f)
-            return lt->pick_pdf / (2.0f * RS_PI * cone_one_minus_cos(r, dc2));
+            return lt->pick_pdf * rs_pdf_uniform_cone(cone_one_minus_cos(r, dc2));
     }
     cos_l = fabsf(rs_v3_dot(ng, w));
     if (!(cos_l > 1e-7f))
