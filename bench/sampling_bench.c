@@ -5,11 +5,12 @@
  * Validates first: the reference is finite and not black, and at the highest spp every
  * strategy's image mean agrees with the reference's within 3%.  Then prints, per scene, the
  * machine, the settings, the RMSE table, and time-to-RMSE with the ratio to the BSDF-only
- * baseline measured in the same run.  RMSE falls as spp^(-1/2), so the spp a strategy needs
- * for a target RMSE is extrapolated from its highest-spp point: spp * (rmse / target)^2.
+ * baseline measured in the same run.  RMSE falls as spp^(-1/2): each strategy's constant
+ * C = RMSE sqrt(spp) is the geometric mean over the levels from 4 spp up (robust to one
+ * firefly-struck level), and the spp it needs for the target RMSE is (C / target)^2.
  * The reference's own noise (1/16 of the 256-spp variance) is included in the RMSE.
  *
- *   sampling_bench [--quick] [--ref-spp N] [--max-spp N] [--runs N] [--out DIR]
+ *   sampling_bench [--quick] [--ref-spp N] [--max-spp N] [--runs N] [--target RMSE] [--out DIR]
  *   --out DIR writes DIR/sampling_<scene>.dat (for scripts/plot-sampling.sh) and .csv. */
 #include <math.h>
 #include <stdio.h>
@@ -69,10 +70,10 @@ static float *render(const scene_cfg *sc, rs_sampling sampling, uint32_t spp, ui
 }
 
 static int bench_scene(const scene_cfg *sc, uint32_t ref_spp, uint32_t max_spp, int runs,
-                       const char *out_dir)
+                       double target, const char *out_dir)
 {
     size_t nf = (size_t)sc->width * sc->height * 3;
-    double ref_s, ref_mean, err[N_STRATEGIES][MAX_LEVELS], per_spp[N_STRATEGIES], target;
+    double ref_s, ref_mean, err[N_STRATEGIES][MAX_LEVELS], per_spp[N_STRATEGIES], cst[N_STRATEGIES];
     uint32_t levels[MAX_LEVELS], n_levels = 0, spp;
     float *ref;
     int k, l;
@@ -125,29 +126,34 @@ static int bench_scene(const scene_cfg *sc, uint32_t ref_spp, uint32_t max_spp, 
         qsort(secs, (size_t)n, sizeof secs[0], cmp_double);
         per_spp[k] = (n % 2 ? secs[n / 2] : 0.5 * (secs[n / 2 - 1] + secs[n / 2])) / 4.0;
     }
-    /* the target: what MIS reaches at the second-highest level */
-    target = err[RS_SAMPLING_MIS][n_levels > 1 ? n_levels - 2 : 0];
+    for (k = 0; k < N_STRATEGIES; ++k) {
+        double acc = 0.0;
+        int m = 0;
+        for (l = 0; l < (int)n_levels; ++l)
+            if (levels[l] >= 4 || n_levels == 1) {
+                acc += log(err[k][l] * sqrt((double)levels[l]));
+                m++;
+            }
+        if (m == 0)
+            acc = log(err[k][0]), m = 1;
+        cst[k] = exp(acc / m);
+    }
 
     printf("\n### builtin:%s, %ux%u; reference %u spp MIS (%.1f s, mean %.5f)\n\n", sc->name,
            sc->width, sc->height, ref_spp, ref_s, ref_mean);
     printf("| strategy |");
     for (l = 0; l < (int)n_levels; ++l)
         printf(" RMSE %u spp |", levels[l]);
-    printf(" s per spp | spp for RMSE %.4f | time for it | vs bsdf |\n|---|", target);
+    printf(" s per spp | spp for RMSE %.3g | time for it | vs bsdf |\n|---|", target);
     for (l = 0; l < (int)n_levels; ++l)
         printf("---:|");
     printf("---:|---:|---:|---:|\n");
     {
-        double base_time = 0.0;
+        double base_time = (cst[RS_SAMPLING_BSDF] / target) * (cst[RS_SAMPLING_BSDF] / target) *
+                           per_spp[RS_SAMPLING_BSDF];
         for (k = 0; k < N_STRATEGIES; ++k) {
-            double last = err[k][n_levels - 1];
-            double need = levels[n_levels - 1] * (last / target) * (last / target);
+            double need = (cst[k] / target) * (cst[k] / target);
             double t = need * per_spp[k];
-            if (k == RS_SAMPLING_BSDF || base_time == 0.0) {
-                double lb = err[RS_SAMPLING_BSDF][n_levels - 1];
-                base_time = levels[n_levels - 1] * (lb / target) * (lb / target) *
-                            per_spp[RS_SAMPLING_BSDF];
-            }
             printf("| %s |", rs_sampling_name((rs_sampling)k));
             for (l = 0; l < (int)n_levels; ++l)
                 printf(" %.5f |", err[k][l]);
@@ -186,6 +192,7 @@ int main(int argc, char **argv)
 {
     scene_cfg scenes[2] = {{"cornell", 96, 96}, {"materials", 128, 72}};
     uint32_t ref_spp = 4096, max_spp = 256;
+    double target = 0.05;
     int runs = 3, n_scenes = 2, i;
     const char *out_dir = NULL;
     for (i = 1; i < argc; ++i) {
@@ -201,15 +208,17 @@ int main(int argc, char **argv)
             max_spp = (uint32_t)atoi(argv[++i]);
         } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
             runs = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--target") == 0 && i + 1 < argc) {
+            target = atof(argv[++i]);
         } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
             out_dir = argv[++i];
         } else {
             fprintf(stderr, "usage: sampling_bench [--quick] [--ref-spp N] [--max-spp N] "
-                            "[--runs N] [--out DIR]\n");
+                            "[--runs N] [--target RMSE] [--out DIR]\n");
             return 2;
         }
     }
-    if (ref_spp < 1 || max_spp < 1 || runs < 1) {
+    if (ref_spp < 1 || max_spp < 1 || runs < 1 || !(target > 0.0)) {
         fprintf(stderr, "sampling_bench: spp and runs must be >= 1\n");
         return 2;
     }
@@ -218,7 +227,7 @@ int main(int argc, char **argv)
            "4-spp renders / 4\n",
            rs_cpu_count(), runs);
     for (i = 0; i < n_scenes; ++i)
-        if (bench_scene(&scenes[i], ref_spp, max_spp, runs, out_dir) != 0)
+        if (bench_scene(&scenes[i], ref_spp, max_spp, runs, target, out_dir) != 0)
             return 1;
     return 0;
 }
