@@ -149,15 +149,31 @@ static int cmd_render(const rs_cli_options *o)
 
     /* ---- the scene ---- */
     if (strncmp(o->scene, "builtin:", 8) == 0) {
+        rs_builtin_opts bo;
+        rs_status bst;
+        const char *slash, *dot;
+        bo.models_dir = o->models;
+        bo.mesh_file = o->mesh;
         name = o->scene + 8;
-        if (rs_builtin_create(name, &scene) != RS_OK)
-            return fail(RS_EXIT_USAGE, o->scene);
+        bst = rs_builtin_create_ex(name, &bo, &scene);
+        if (bst != RS_OK)
+            return fail(bst == RS_ERR_ARG && !o->mesh ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
+        if (o->mesh) {
+            /* the default output is named after the mesh: bunny.ply -> bunny.png */
+            slash = strrchr(o->mesh, '/');
+            name = slash ? slash + 1 : o->mesh;
+            dot = strrchr(name, '.');
+            snprintf(scene_stem, sizeof scene_stem, "%.*s",
+                     dot ? (int)(dot - name) : (int)strlen(name), name);
+            name = scene_stem;
+        }
     } else {
         struct stat sb;
         const char *slash = strrchr(o->scene, '/'), *dot;
         if (stat(o->scene, &sb) != 0) {
-            fprintf(stderr, "raystream: %s: no such scene file (built-in scenes are named "
-                            "builtin:NAME; see 'raystream scenes')\n",
+            fprintf(stderr,
+                    "raystream: %s: no such scene file (built-in scenes are named "
+                    "builtin:NAME; see 'raystream scenes')\n",
                     o->scene);
             return RS_EXIT_USAGE;
         }

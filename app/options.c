@@ -104,7 +104,11 @@ void rs_cli_print_help(const char *command)
             "\n"
             "Renders SCENE (default builtin:cornell) to an image.\n"
             "\n"
-            "  SCENE, --scene builtin:NAME   a built-in scene ('raystream scenes' lists them)\n"
+            "  SCENE, --scene S    builtin:NAME ('raystream scenes' lists them) or FILE.json\n"
+            "  --mesh FILE         drop a mesh (OBJ, PLY, glTF, FBX, ...) into the Cornell box,\n"
+            "                      scaled to fit, with its own materials\n"
+            "  --models DIR        the test models folder for builtin scenes with meshes\n"
+            "                      (default ../shared/models beside the source tree)\n"
             "  -o, --output FILE   image to write; the format follows the extension: .png\n"
             "                      (sRGB, 8-bit), .exr or .hdr (linear float), .jpg, .tif\n"
             "                      (default: NAME.png)\n"
@@ -258,6 +262,16 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
                 return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
                                    "uniform)",
                                    v, "");
+        } else if (strcmp(name, "--mesh") == 0) {
+            NEEDS_VALUE();
+            if (!*v)
+                return usage_error("%s needs a file name%s", name, "");
+            o->mesh = v;
+        } else if (strcmp(name, "--models") == 0) {
+            NEEDS_VALUE();
+            if (!*v)
+                return usage_error("%s needs a folder%s", name, "");
+            o->models = v;
         } else if (strcmp(name, "--chunk-size") == 0) {
             NEEDS_VALUE();
             rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
@@ -270,6 +284,13 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
 #undef NEEDS_VALUE
         if (rc != RS_EXIT_OK)
             return rc;
+    }
+    if (o->mesh) {
+        if (o->scene && strcmp(o->scene, "builtin:cornell") != 0)
+            return usage_error("--mesh puts a mesh into the Cornell box; it cannot be combined "
+                               "with the scene '%s'%s",
+                               o->scene, "");
+        o->scene = "builtin:cornell-mesh";
     }
     if (!o->scene)
         o->scene = "builtin:cornell";

@@ -39,6 +39,8 @@ typedef struct rs_cli_options {
     uint32_t chunk_size;
     uint32_t wave_paths;
     int quiet;
+    const char *mesh;          /* --mesh FILE: into the Cornell box */
+    const char *models;        /* --models DIR */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
 } rs_cli_options;

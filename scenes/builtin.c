@@ -1,6 +1,11 @@
 /* scenes/builtin.c — the built-in scenes. */
 #include "scenes/builtin.h"
 
+#include <stdlib.h>
+#include <sys/stat.h>
+
+#include "scenes/mesh.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -295,6 +300,87 @@ static rs_status build_materials(rs_scene *s)
     return RS_OK;
 }
 
+#ifndef RS_DEFAULT_MODELS_DIR
+#  define RS_DEFAULT_MODELS_DIR "../shared/models"
+#endif
+
+const char *rs_builtin_models_dir(const char *dir)
+{
+    const char *env = getenv("RS_MODELS_DIR");
+    if (dir && *dir)
+        return dir;
+    if (env && *env)
+        return env;
+    return RS_DEFAULT_MODELS_DIR;
+}
+
+/* Adds model `rel` (under the models folder) fitted to `size` with its base at `base`. */
+static rs_status add_model(rs_scene *s, const rs_builtin_opts *o, const char *rel, float size,
+                           rs_vec3 base, float rot_y, uint32_t mat)
+{
+    char path[1024];
+    struct stat sb;
+    rs_mesh_opts mo = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    const char *dir = rs_builtin_models_dir(o ? o->models_dir : NULL);
+    snprintf(path, sizeof path, "%s/%s", dir, rel);
+    if (stat(path, &sb) != 0)
+        return rs_error_set(RS_ERR_IO,
+                            "builtin:%s needs %s from the test models, not found in '%s' (use "
+                            "--models DIR)",
+                            s->name, rel, dir);
+    mo.rotate_deg = rs_v3(0, rot_y, 0);
+    mo.fit = 1;
+    mo.fit_size = size;
+    mo.fit_base = base;
+    return rs_scene_add_mesh(s, path, &mo, &info);
+}
+
+/* The thesis's Fig. 6.8: a Phong teapot in the Cornell box (the boxes removed). */
+static rs_status build_cornell_teapot(rs_scene *s, const rs_builtin_opts *o)
+{
+    uint32_t white, teapot;
+    rs_material m = rs_mat_phong(rs_v3(.15f, .3f, .55f), rs_v3(.35f, .35f, .35f), 60.0f);
+    TRY(build_cornell_room(s, &white));
+    TRY(rs_scene_add_material(s, &m, &teapot));
+    return add_model(s, o, "teapot/teapot.obj", 330.0f, rs_v3(278, 0, 260), 25.0f, teapot);
+}
+
+/* The thesis's Figs. 6.2 and 6.4: the Stanford bunny and the teapot in the Cornell box. */
+static rs_status build_cornell_bunny_teapot(rs_scene *s, const rs_builtin_opts *o)
+{
+    uint32_t white, teapot, bunny;
+    rs_material m = rs_mat_metal(rs_v3(.85f, .75f, .55f), 0.15f);
+    TRY(build_cornell_room(s, &white));
+    TRY(rs_scene_add_material(s, &m, &teapot));
+    m = rs_mat_lambertian(rs_v3(.75f, .72f, .68f));
+    TRY(rs_scene_add_material(s, &m, &bunny));
+    TRY(add_model(s, o, "bunny/bun_zipper.ply", 290.0f, rs_v3(375, 0, 345), -20.0f, bunny));
+    return add_model(s, o, "teapot/teapot.obj", 270.0f, rs_v3(185, 0, 185), 30.0f, teapot);
+}
+
+/* `--mesh FILE`: any mesh, scaled to fit and centred on the Cornell box's floor, with its own
+ * materials (a file without any gets a light grey). */
+static rs_status build_cornell_mesh(rs_scene *s, const rs_builtin_opts *o)
+{
+    uint32_t white;
+    rs_mesh_opts mo = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
+    rs_mesh_info info;
+    if (!o || !o->mesh_file)
+        return rs_error_set(RS_ERR_ARG, "builtin:cornell-mesh needs a mesh file (--mesh FILE)");
+    TRY(build_cornell_room(s, &white));
+    mo.fit = 1;
+    mo.fit_size = 330.0f;
+    mo.fit_base = rs_v3(278, 0, 278);
+    TRY(rs_scene_add_mesh(s, o->mesh_file, &mo, &info));
+    if (info.dropped)
+        fprintf(stderr,
+                "raystream: warning: %s: %u faces dropped (non-finite, out of range or "
+                "zero area)\n",
+                o->mesh_file, info.dropped);
+    return RS_OK;
+}
+
 /* White furnace: a diffuse sphere of albedo 0.5 filling the whole view, under a uniform white
  * background of radiance 1.  Every pixel's expected value is exactly 0.5 (the sphere is convex,
  * so each bounce leaves it and sees the background). */
@@ -318,21 +404,27 @@ typedef struct builtin {
     const char *name;
     const char *description;
     rs_status (*build)(rs_scene *s);
+    rs_status (*build_ex)(rs_scene *s, const rs_builtin_opts *o); /* scenes that read files */
 } builtin;
 
 static const builtin g_builtins[] = {
     {"cornell", "the two-box Cornell box of Ray Tracing: The Rest of Your Life (default)",
-     build_cornell},
+     build_cornell, NULL},
     {"cornell-glass", "the final scene of The Rest of Your Life: a glass sphere for the short box",
-     build_cornell_glass},
+     build_cornell_glass, NULL},
     {"materials", "every material and texture side by side (Disney, Phong, metal, glass, ...)",
-     build_materials},
+     build_materials, NULL},
     {"rtiow-final", "the random spheres of Ray Tracing in One Weekend (the thesis's Fig. 6.9)",
-     build_rtiow_final},
+     build_rtiow_final, NULL},
     {"bouncing-spheres", "The Next Week's motion-blur scene: moving spheres, checker ground",
-     build_bouncing_spheres},
+     build_bouncing_spheres, NULL},
+    {"cornell-teapot", "a Phong Utah teapot in the Cornell box (thesis Fig. 6.8; needs the models)",
+     NULL, build_cornell_teapot},
+    {"cornell-bunny-teapot",
+     "the Stanford bunny and a metal teapot in the Cornell box (thesis Figs. 6.2, 6.4)", NULL,
+     build_cornell_bunny_teapot},
     {"furnace", "white furnace: an albedo-0.5 diffuse sphere under a white sky (renders 0.5)",
-     build_furnace},
+     build_furnace, NULL},
 };
 
 #define N_BUILTINS ((int)(sizeof g_builtins / sizeof g_builtins[0]))
@@ -348,8 +440,27 @@ const char *rs_builtin_name(int i, const char **description)
 
 rs_status rs_builtin_create(const char *name, rs_scene **out)
 {
+    return rs_builtin_create_ex(name, NULL, out);
+}
+
+rs_status rs_builtin_create_ex(const char *name, const rs_builtin_opts *opts, rs_scene **out)
+{
     int i;
     *out = NULL;
+    if (strcmp(name, "cornell-mesh") == 0) {
+        rs_scene *s;
+        rs_status st = rs_scene_create(name, &s);
+        if (st == RS_OK)
+            st = build_cornell_mesh(s, opts);
+        if (st == RS_OK)
+            st = rs_scene_finalize(s);
+        if (st != RS_OK) {
+            rs_scene_destroy(s);
+            return st;
+        }
+        *out = s;
+        return RS_OK;
+    }
     for (i = 0; i < N_BUILTINS; ++i) {
         rs_scene *s;
         rs_status st;
@@ -357,7 +468,7 @@ rs_status rs_builtin_create(const char *name, rs_scene **out)
             continue;
         st = rs_scene_create(name, &s);
         if (st == RS_OK)
-            st = g_builtins[i].build(s);
+            st = g_builtins[i].build ? g_builtins[i].build(s) : g_builtins[i].build_ex(s, opts);
         if (st == RS_OK)
             st = rs_scene_finalize(s);
         if (st != RS_OK) {

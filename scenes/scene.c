@@ -72,6 +72,7 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->tri_mat);
     rs_free(s->sphere_motion);
     rs_free(s->tri_uv);
+    rs_free(s->tri_normal);
     rs_free(s->materials);
     rs_free(s->textures);
     if (s->images) {
@@ -178,6 +179,12 @@ rs_status rs_scene_add_triangle(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2,
             return rs_error_set(RS_ERR_NOMEM, "out of memory adding a triangle");
         memcpy(&s->tri_uv[6 * (size_t)s->n_tris], def, sizeof def);
     }
+    if (s->tri_normal) {
+        if (!grow((void **)&s->tri_normal, &s->cap_normal, s->n_tris + 1,
+                  9 * sizeof *s->tri_normal))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory adding a triangle");
+        memset(&s->tri_normal[9 * (size_t)s->n_tris], 0, 9 * sizeof *s->tri_normal);
+    }
     s->tris[s->n_tris].v0 = v0;
     s->tris[s->n_tris].v1 = v1;
     s->tris[s->n_tris].v2 = v2;
@@ -201,6 +208,24 @@ rs_status rs_scene_add_triangle_uv(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 
     st = rs_scene_add_triangle(s, v0, v1, v2, mat);
     if (st == RS_OK)
         memcpy(&s->tri_uv[6 * (size_t)(s->n_tris - 1)], uv, 6 * sizeof *uv);
+    return st;
+}
+
+rs_status rs_scene_add_triangle_full(rs_scene *s, const rs_vec3 v[3], const float *uv,
+                                     const float *normals, uint32_t mat)
+{
+    rs_status st;
+    if (normals && !s->tri_normal) {
+        if (!grow((void **)&s->tri_normal, &s->cap_normal, s->n_tris + 1,
+                  9 * sizeof *s->tri_normal))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory adding a triangle");
+        /* earlier triangles: zero normals mean "use the face normal" */
+        memset(s->tri_normal, 0, 9 * sizeof *s->tri_normal * (size_t)s->n_tris);
+    }
+    st = uv ? rs_scene_add_triangle_uv(s, v[0], v[1], v[2], uv, mat)
+            : rs_scene_add_triangle(s, v[0], v[1], v[2], mat);
+    if (st == RS_OK && normals)
+        memcpy(&s->tri_normal[9 * (size_t)(s->n_tris - 1)], normals, 9 * sizeof *normals);
     return st;
 }
 

@@ -99,6 +99,9 @@ typedef struct rs_scene {
     uint32_t cap_motion;
     float *tri_uv; /* NULL until a triangle with UVs is added; then 6 per triangle */
     uint32_t cap_uv;
+    float *tri_normal; /* NULL until a triangle with vertex normals is added; then 9 per
+                          triangle (unit shading normals at v0, v1, v2; zeros: use the face's) */
+    uint32_t cap_normal;
     rs_material *materials;
     uint32_t n_materials, cap_materials;
     rs_texture *textures;
@@ -140,6 +143,10 @@ rs_status rs_scene_add_triangle(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2,
  * without UVs get (0,0), (1,0), (0,1). */
 rs_status rs_scene_add_triangle_uv(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2,
                                    const float uv[6], uint32_t mat);
+/* A triangle with optional UVs (6 floats, or NULL) and optional unit vertex normals (9 floats,
+ * or NULL: shading uses the face normal). */
+rs_status rs_scene_add_triangle_full(rs_scene *s, const rs_vec3 v[3], const float *uv,
+                                     const float *normals, uint32_t mat);
 rs_status rs_scene_add_texture(rs_scene *s, const rs_texture *t, uint32_t *id);
 /* Copies a width x height linear-RGB image into the scene. */
 rs_status rs_scene_add_image(rs_scene *s, uint32_t width, uint32_t height, const float *rgb,

@@ -153,6 +153,31 @@ static rs_vec3 surface_albedo(const rs_scene *sc, const rs_material *m, uint32_t
     return rs_texture_eval(&sc->textures[m->albedo_tex], sc->images, u, v, x);
 }
 
+/* The shading normal at a hit: the interpolated vertex normal of a triangle that has them,
+ * turned to the side of n_geo (the geometric normal on the incoming side); n_geo otherwise, or
+ * where the vertex normal would face away from wo. */
+static rs_vec3 shading_normal(const rs_scene *sc, uint32_t prim, float hu, float hv, rs_vec3 n_geo,
+                              rs_vec3 wo)
+{
+    uint32_t t = prim - sc->n_spheres - sc->n_quads;
+    const float *vn;
+    rs_vec3 ns;
+    float len;
+    if (!sc->tri_normal || prim < sc->n_spheres + sc->n_quads)
+        return n_geo;
+    vn = &sc->tri_normal[9 * (size_t)t];
+    ns = rs_v3_add(rs_v3_add(rs_v3_scale(rs_v3(vn[0], vn[1], vn[2]), 1.0f - hu - hv),
+                             rs_v3_scale(rs_v3(vn[3], vn[4], vn[5]), hu)),
+                   rs_v3_scale(rs_v3(vn[6], vn[7], vn[8]), hv));
+    len = rs_v3_length(ns);
+    if (!(len > 1e-6f))
+        return n_geo;
+    ns = rs_v3_scale(ns, 1.0f / len);
+    if (rs_v3_dot(ns, n_geo) < 0.0f)
+        ns = rs_v3_neg(ns);
+    return rs_v3_dot(ns, wo) > 0.0f ? ns : n_geo;
+}
+
 static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
                       const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t j, rs_paths *paths,
                       rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
@@ -165,7 +190,7 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
     rs_ray r = rs_ray_soa_get(rays, j);
     rs_vec3 beta = paths->throughput[p];
     const rs_material *m;
-    rs_vec3 x, ng, n, wo, wi, albedo, origin;
+    rs_vec3 x, ng, n, n_geo, wo, wi, albedo, origin;
     rs_rng_f4 rb;
     float t = hits->t[j], pdf = 0.0f;
     int front, specular = 0;
@@ -198,8 +223,9 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
     if (bounce + 1 >= it->max_depth)
         return;
     front = rs_v3_dot(ng, r.d) < 0.0f;
-    n = front ? ng : rs_v3_neg(ng); /* the normal on the incoming ray's side */
+    n_geo = front ? ng : rs_v3_neg(ng); /* the geometric normal on the incoming ray's side */
     wo = rs_v3_neg(r.d);
+    n = shading_normal(sc, prim, hits->u[j], hits->v[j], n_geo, wo);
     albedo = surface_albedo(sc, m, prim, hits->u[j], hits->v[j], x, ng);
     rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
 
@@ -209,14 +235,17 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
         if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
             return;
         wi = bs.wi;
+        /* with a shading normal, a direction can land on the wrong side of the real surface */
+        if ((rs_v3_dot(wi, n_geo) > 0.0f) == (bs.transmit != 0))
+            return;
         beta = rs_v3_mul(beta, bs.weight);
-        origin = offset_origin(x, bs.transmit ? rs_v3_neg(n) : n);
+        origin = offset_origin(x, bs.transmit ? rs_v3_neg(n_geo) : n_geo);
         specular = 1;
     } else {
         rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
         float ci;
         rs_vec3 f;
-        origin = offset_origin(x, n);
+        origin = offset_origin(x, n_geo);
 
         if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
             /* next-event estimation: a shadow ray toward a sampled point on a light */
@@ -224,7 +253,8 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
             if (rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls)) {
                 float c = rs_v3_dot(n, ls.wi);
                 rs_vec3 fl = rs_bsdf_eval(m, albedo, n, wo, ls.wi);
-                if (c > 0.0f && !rs_v3_is_zero(ls.le) && !rs_v3_is_zero(fl)) {
+                if (c > 0.0f && rs_v3_dot(n_geo, ls.wi) > 0.0f && !rs_v3_is_zero(ls.le) &&
+                    !rs_v3_is_zero(fl)) {
                     float w = power_heuristic(ls.pdf, rs_bsdf_pdf(m, albedo, n, wo, ls.wi));
                     rs_ray sr;
                     paths->pending[p] =
@@ -283,6 +313,8 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
         }
     }
 
+    if (!specular && !(rs_v3_dot(wi, n_geo) > 0.0f))
+        return; /* below the real surface (a shading-normal artefact): nothing comes back */
     if (bounce + 1 >= it->rr_depth) {
         float q = fminf(rs_v3_max_comp(beta), 0.95f);
         if (!(rb.v[3] < q))

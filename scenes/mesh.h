@@ -1,0 +1,45 @@
+/* scenes/mesh.h — triangle meshes from files through Assimp's C API: OBJ (+MTL), PLY, glTF 2.0,
+ * FBX, ...  Faces are triangulated; vertex normals and UVs are kept where the file has them
+ * (smooth normals are generated where it has none); the mesh is placed by scale, rotations about
+ * x, y, z, and a translation, in that order (the thesis's transforms), or fitted into a box.
+ *
+ * Bad data never crashes the import: a file Assimp cannot read is an RS_ERR_ARG naming it; faces
+ * with non-finite or out-of-range vertices, or of zero area, are dropped and counted. */
+#ifndef RS_SCENES_MESH_H
+#define RS_SCENES_MESH_H
+
+#include "scenes/scene.h"
+
+/* Use the materials the file defines (MTL, glTF) instead of one given material. */
+#define RS_MESH_FILE_MATERIALS 0xffffffffu
+
+typedef struct rs_mesh_opts {
+    rs_vec3 scale;      /* per axis (1, 1, 1 for none) */
+    rs_vec3 rotate_deg; /* about x, then y, then z, in degrees */
+    rs_vec3 translate;
+    uint32_t material;  /* a scene material id, or RS_MESH_FILE_MATERIALS */
+    int fit;            /* ignore scale/translate: scale uniformly so the largest extent is
+                           fit_size, and stand the mesh on fit_base (its bottom centre) */
+    float fit_size;
+    rs_vec3 fit_base;
+} rs_mesh_opts;
+
+typedef struct rs_mesh_info {
+    uint32_t triangles;  /* added to the scene */
+    uint32_t dropped;    /* faces dropped: non-finite, out-of-range indices, zero area */
+    uint32_t materials;  /* materials added from the file */
+    rs_aabb bounds;      /* of the placed mesh */
+} rs_mesh_info;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* Identity placement with material `mat`. */
+rs_mesh_opts rs_mesh_opts_default(uint32_t mat);
+/* Imports every mesh of the file into the scene (not finalized). */
+rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *opts,
+                            rs_mesh_info *info);
+#ifdef __cplusplus
+}
+#endif
+#endif

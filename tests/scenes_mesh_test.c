@@ -1,0 +1,292 @@
+/* tests/scenes_mesh_test.c — mesh import through Assimp: placement (scale, rotations, translation,
+ * fit), UVs and normals kept, OBJ / PLY / glTF read; malformed files (truncated, out-of-range
+ * indices, NaN coordinates, empty, not a mesh) give an error naming the file or drop and count
+ * the bad faces — never a crash; the shared test models load with their known triangle counts,
+ * and the BVH over each gives brute force's closest hits.  The models are read from
+ * ../shared/models (or $RS_MODELS_DIR); without them those cases skip with a printed reason. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "accel/bvh.h"
+#include "scenes/builtin.h"
+#include "scenes/mesh.h"
+#include "test_rand.h"
+
+#ifndef RS_SOURCE_DIR
+#  define RS_SOURCE_DIR "."
+#endif
+#define DATA RS_SOURCE_DIR "/tests/data/"
+
+static rs_scene *new_scene(uint32_t *mat)
+{
+    rs_scene *s;
+    rs_material m = rs_mat_lambertian(rs_v3(.5f, .5f, .5f));
+    assert_int_equal(rs_scene_create("mesh", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &m, mat), RS_OK);
+    return s;
+}
+
+static int near(float a, float b) { return fabsf(a - b) <= 1e-5f * (1.0f + fabsf(b)); }
+
+static void test_obj_placement_uv_normals(void **state)
+{
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    const rs_tri *t;
+    (void)state;
+    /* (x, y, z) -> scale (2, 3, 4) -> rotate 90 deg about y: (x, y, z) -> (z, y, -x) -> +10 x */
+    o.scale = rs_v3(2, 3, 4);
+    o.rotate_deg = rs_v3(0, 90, 0);
+    o.translate = rs_v3(10, 0, 0);
+    assert_int_equal(rs_scene_add_mesh(s, DATA "tri.obj", &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    assert_int_equal(info.dropped, 0u);
+    t = &s->tris[0];
+    /* v1 = (1,0,0) -> (2,0,0) -> (0,0,-2) -> (10,0,-2); v2 = (0,1,0) -> (0,3,0) -> (10,3,0) */
+    assert_true(near(t->v0.x, 10) && near(t->v0.y, 0) && near(t->v0.z, 0));
+    assert_true(near(t->v1.x, 10) && near(t->v1.y, 0) && near(t->v1.z, -2));
+    assert_true(near(t->v2.x, 10) && near(t->v2.y, 3) && near(t->v2.z, 0));
+    assert_non_null(s->tri_uv);
+    assert_true(near(s->tri_uv[2], 1) && near(s->tri_uv[3], 0) && near(s->tri_uv[5], 1));
+    /* the normal (0,0,1) scales by 1/4 and rotates to (1,0,0) (then renormalised) */
+    assert_non_null(s->tri_normal);
+    assert_true(near(s->tri_normal[0], 1) && near(s->tri_normal[1], 0) &&
+                near(s->tri_normal[2], 0));
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    rs_scene_destroy(s);
+}
+
+static void test_ply_and_gltf(void **state)
+{
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    (void)state;
+    assert_int_equal(rs_scene_add_mesh(s, DATA "cube.ply", &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 12u); /* 6 quads, triangulated */
+    assert_true(near(info.bounds.lo.x, 0) && near(info.bounds.hi.y, 1) &&
+                near(info.bounds.hi.z, 1));
+    /* glTF: the node's translation (0, 0, 2) is baked into the vertices */
+    assert_int_equal(rs_scene_add_mesh(s, DATA "tri.gltf", &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    assert_true(near(info.bounds.lo.z, 2) && near(info.bounds.hi.z, 2));
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    rs_scene_destroy(s);
+}
+
+static void test_fit(void **state)
+{
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    (void)state;
+    o.fit = 1;
+    o.fit_size = 300.0f;
+    o.fit_base = rs_v3(278, 0, 278);
+    assert_int_equal(rs_scene_add_mesh(s, DATA "cube.ply", &o, &info), RS_OK);
+    assert_true(near(info.bounds.hi.x - info.bounds.lo.x, 300));
+    assert_true(near(info.bounds.lo.y, 0));
+    assert_true(near(0.5f * (info.bounds.lo.x + info.bounds.hi.x), 278));
+    assert_true(near(0.5f * (info.bounds.lo.z + info.bounds.hi.z), 278));
+    rs_scene_destroy(s);
+}
+
+/* Bad files: an error whose one-line message names the file, or dropped faces counted. */
+static void test_malformed(void **state)
+{
+    static const char *const errors[] = {"truncated.ply", "bad_index.obj", "empty.obj",
+                                         "garbage.obj",   "missing.obj",   ""};
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    size_t k;
+    (void)state;
+    for (k = 0; k < sizeof errors / sizeof errors[0]; ++k) {
+        char path[512];
+        rs_status st;
+        snprintf(path, sizeof path, DATA "%s", errors[k]);
+        rs_error_clear();
+        st = rs_scene_add_mesh(s, path, &o, &info);
+        if (st == RS_OK)
+            fail_msg("%s imported without an error", path);
+        assert_true(st == RS_ERR_ARG || st == RS_ERR_IO);
+        assert_non_null(strstr(rs_error_message(), path));
+        assert_null(strchr(rs_error_message(), '\n'));
+        print_message("%s -> %s\n", errors[k][0] ? errors[k] : "(a folder)", rs_error_message());
+    }
+    rs_error_clear();
+    /* a NaN vertex: its face is dropped and counted, the good one kept */
+    assert_int_equal(rs_scene_add_mesh(s, DATA "nan.obj", &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    assert_int_equal(info.dropped, 1u);
+    /* a truncated OBJ: either its good face survives or the file is refused; never a crash */
+    if (rs_scene_add_mesh(s, DATA "truncated.obj", &o, &info) == RS_OK)
+        assert_int_equal(info.triangles, 1u);
+    else
+        assert_non_null(strstr(rs_error_message(), "truncated.obj"));
+    rs_error_clear();
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    rs_scene_destroy(s);
+}
+
+static const char *models_dir(void)
+{
+    static char dir[1024];
+    const char *env = getenv("RS_MODELS_DIR");
+    struct stat sb;
+    snprintf(dir, sizeof dir, "%s", env && *env ? env : RS_SOURCE_DIR "/../shared/models");
+    return stat(dir, &sb) == 0 ? dir : NULL;
+}
+
+/* Closest hits through the BVH equal brute force for rays aimed at the model. */
+static void check_bvh(const rs_scene *s, uint32_t nrays)
+{
+    rs_geom g = rs_scene_geom(s);
+    rs_bvh *b;
+    rs_bvh_view v;
+    rs_aabb box = {{1e30f, 1e30f, 1e30f}, {-1e30f, -1e30f, -1e30f}};
+    uint64_t st = 11;
+    uint32_t i, k, n = rs_geom_prim_count(&g), hits = 0;
+    assert_int_equal(rs_bvh_build(&g, NULL, &b), RS_OK);
+    v = rs_bvh_view_of(b);
+    for (i = 0; i < n; ++i) {
+        rs_aabb pb = rs_geom_prim_bounds(&g, i);
+        box.lo = rs_v3_min(box.lo, pb.lo);
+        box.hi = rs_v3_max(box.hi, pb.hi);
+    }
+    for (k = 0; k < nrays; ++k) {
+        rs_vec3 c = rs_v3_scale(rs_v3_add(box.lo, box.hi), 0.5f);
+        rs_vec3 ext = rs_v3_sub(box.hi, box.lo);
+        rs_vec3 target = rs_v3_add(c, rs_v3_mul(rnd_box(&st, 0.5f), ext));
+        rs_vec3 o = rs_v3_add(c, rs_v3_scale(rnd_unit(&st), 2.0f * rs_v3_max_comp(ext)));
+        rs_ray r = mk_ray(o, rs_v3_sub(target, o), 0.0f, 1e30f);
+        rs_hit h;
+        float best = 1e30f, t, u, w;
+        uint32_t best_prim = RS_NO_HIT;
+        for (i = 0; i < n; ++i)
+            if (rs_geom_intersect(&g, i, &r, &t, &u, &w) && t < best) {
+                best = t;
+                best_prim = i;
+            }
+        rs_bvh_closest(&v, &g, r, &h);
+        if (h.prim != best_prim)
+            assert_true(best_prim != RS_NO_HIT && h.t == best); /* a tie at equal t */
+        hits += best_prim != RS_NO_HIT;
+    }
+    print_message("  BVH: %u nodes, depth %u; %u of %u rays hit, all as brute force\n", b->n_nodes,
+                  b->depth, hits, nrays);
+    assert_true(hits > nrays / 4);
+    rs_bvh_destroy(b);
+}
+
+static void test_shared_models(void **state)
+{
+    static const struct {
+        const char *file;
+        uint32_t min_tris, max_tris;
+        int has_uv;
+    } models[] = {
+        {"teapot/teapot.obj", 6320, 6320, 0},          {"bunny/bun_zipper.ply", 69000, 69451, 0},
+        {"bunny/stanford-bunny.obj", 69000, 69451, 0}, {"dragon/dragon_100k.ply", 99000, 100000, 0},
+        {"spot/spot_triangulated.obj", 5856, 5856, 1},
+    };
+    const char *dir = models_dir();
+    size_t k;
+    (void)state;
+    if (!dir) {
+        print_message("SKIP: no test models (../shared/models or $RS_MODELS_DIR)\n");
+        skip();
+    }
+    for (k = 0; k < sizeof models / sizeof models[0]; ++k) {
+        uint32_t mat;
+        rs_scene *s = new_scene(&mat);
+        rs_mesh_opts o = rs_mesh_opts_default(mat);
+        rs_mesh_info info;
+        char path[1100];
+        snprintf(path, sizeof path, "%s/%s", dir, models[k].file);
+        assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_OK);
+        print_message("%s: %u triangles, %u dropped\n", models[k].file, info.triangles,
+                      info.dropped);
+        assert_true(info.triangles >= models[k].min_tris && info.triangles <= models[k].max_tris);
+        assert_int_equal(info.triangles + info.dropped >= models[k].min_tris, 1);
+        if (models[k].has_uv)
+            assert_non_null(s->tri_uv);
+        assert_int_equal(rs_scene_finalize(s), RS_OK);
+        check_bvh(s, info.triangles > 50000 ? 1500 : 4000);
+        rs_scene_destroy(s);
+    }
+}
+
+/* The Cornell box OBJ + MTL: its materials come along, the light (Ke) becomes an emitter. */
+static void test_obj_mtl_materials(void **state)
+{
+    const char *dir = models_dir();
+    rs_scene *s;
+    rs_mesh_opts o;
+    rs_mesh_info info;
+    char path[1100];
+    (void)state;
+    if (!dir) {
+        print_message("SKIP: no test models\n");
+        skip();
+    }
+    assert_int_equal(rs_scene_create("cornell-obj", &s), RS_OK);
+    o = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
+    snprintf(path, sizeof path, "%s/cornell-box/cornell_box.obj", dir);
+    assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 32u);
+    assert_true(info.materials >= 4u);
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    assert_true(s->n_lights >= 1u);
+    rs_scene_destroy(s);
+}
+
+static void test_builtin_mesh_scenes(void **state)
+{
+    rs_scene *s;
+    rs_builtin_opts bo = {"/nonexistent-models", NULL};
+    (void)state;
+    rs_error_clear();
+    assert_int_equal(rs_builtin_create_ex("cornell-teapot", &bo, &s), RS_ERR_IO);
+    assert_non_null(strstr(rs_error_message(), "--models"));
+    rs_error_clear();
+    if (!models_dir()) {
+        print_message("SKIP: no test models\n");
+        skip();
+    }
+    bo.models_dir = models_dir();
+    assert_int_equal(rs_builtin_create_ex("cornell-teapot", &bo, &s), RS_OK);
+    assert_int_equal(s->n_tris, 6320u);
+    rs_scene_destroy(s);
+    assert_int_equal(rs_builtin_create_ex("cornell-bunny-teapot", &bo, &s), RS_OK);
+    assert_true(s->n_tris > 75000u);
+    rs_scene_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_obj_placement_uv_normals),
+        cmocka_unit_test(test_ply_and_gltf),
+        cmocka_unit_test(test_fit),
+        cmocka_unit_test(test_malformed),
+        cmocka_unit_test(test_shared_models),
+        cmocka_unit_test(test_obj_mtl_materials),
+        cmocka_unit_test(test_builtin_mesh_scenes),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
