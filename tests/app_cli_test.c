@@ -41,6 +41,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#ifndef RS_SOURCE_DIR
+#  define RS_SOURCE_DIR "."
+#endif
+
 #include "core/alloc.h"
 #include "core/image_io.h"
 #include "gpu/gpu_device.h"
@@ -884,6 +888,67 @@ static void test_gpu_fallback(void **state)
     proc_free(&p);
     proc_free(&q);
 }
+/* Scene files and meshes from the command line: a good JSON scene and a mesh render; a bad
+ * JSON scene and an unreadable mesh give one line naming the file and exit 1; a mesh with bad
+ * faces renders with one warning line counting them. */
+static void test_scene_files_and_meshes(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const json_ok[] = {"render",  RS_SOURCE_DIR "/scenes/examples/cornell.json",
+                                          "--width", "16",
+                                          "--spp",   "1",
+                                          "-q",      "-o",
+                                          "j.png",   NULL};
+    static const char *const mesh_ok[] = {"render",  "--mesh", RS_SOURCE_DIR "/tests/data/cube.ply",
+                                          "--width", "16",     "--spp",
+                                          "1",       "-q",     NULL};
+    static const char *const mesh_bad[] = {
+        "render",  "--mesh", RS_SOURCE_DIR "/tests/data/garbage.obj",
+        "--width", "16",     "--spp",
+        "1",       "-q",     "-o",
+        "x.png",   NULL};
+    static const char *const mesh_nan[] = {"render",  "--mesh", RS_SOURCE_DIR "/tests/data/nan.obj",
+                                           "--width", "16",     "--spp",
+                                           "1",       "-q",     "-o",
+                                           "n.png",   NULL};
+    static const char *const json_bad[] = {"render", "bad.json", "-q", "-o", "y.png", NULL};
+    char path[512];
+    FILE *fp;
+    proc p;
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, json_ok);
+    EXPECT(&p, exited_with(&p, 0), "the example scene file should render");
+    path_in(f, "j.png", path, sizeof path);
+    EXPECT(&p, file_exists(path), "j.png was not written");
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, mesh_ok);
+    EXPECT(&p, exited_with(&p, 0), "--mesh cube.ply should render");
+    path_in(f, "cube.png", path, sizeof path);
+    EXPECT(&p, file_exists(path), "--mesh cube.ply should write cube.png by default");
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, mesh_bad);
+    EXPECT(&p, exited_with(&p, 1) && one_line(&p.err) && strstr(p.err.data, "garbage.obj"),
+           "an unreadable mesh: exit 1, one line naming it");
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, mesh_nan);
+    EXPECT(&p, exited_with(&p, 0) && one_line(&p.err) && strstr(p.err.data, "1 faces dropped"),
+           "a mesh with a NaN face: rendered, one warning counting the dropped face");
+    proc_free(&p);
+    path_in(f, "bad.json", path, sizeof path);
+    fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs("{\"camera\": {\"from\": [0,0,1], \"at\": [0,0,0]},\n \"objects\": [{\"type\": "
+          "\"sphere\", \"center\": [0,0,0], \"radius\": 1, \"material\": \"nope\"}]}\n",
+          fp);
+    fclose(fp);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, json_bad);
+    EXPECT(&p,
+           exited_with(&p, 1) && one_line(&p.err) && strstr(p.err.data, "bad.json") &&
+               strstr(p.err.data, "objects[0].material"),
+           "a bad scene file: exit 1, one line naming the file and the field");
+    path_in(f, "y.png", path, sizeof path);
+    EXPECT(&p, !file_exists(path), "no image for a bad scene");
+    proc_free(&p);
+}
 
 int main(void)
 {
@@ -899,6 +964,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_sigint_writes_partial_image, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_scene_files_and_meshes, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
