@@ -32,6 +32,15 @@
 
 #include <stdint.h>
 
+/* a * b rounded on its own, never contracted with a following add into a fused multiply-add.
+ * Host C11 code is not contracted (ISO C mode); nvcc contracts by default, so device code says
+ * so explicitly.  Used where exact cancellation matters (the watertight triangle test). */
+#if defined(__CUDA_ARCH__)
+#  define RS_MUL_EXACT(a, b) __fmul_rn((a), (b))
+#else
+#  define RS_MUL_EXACT(a, b) ((a) * (b))
+#endif
+
 /* A primitive index meaning "no hit". */
 #define RS_NO_HIT 0xffffffffu
 
