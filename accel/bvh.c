@@ -1,24 +1,57 @@
-/* accel/bvh.c — the host BVH builder: median split on the axis of largest centroid extent.
+/* accel/bvh.c — the frame every BVH builder runs in: per-primitive boxes, the top-down recursion
+ * (with OpenMP tasks for large subtrees), the depth bound, the node boxes, the final node order,
+ * and the SAH cost of a finished tree.  The split rules live in bvh_grid.c (median and the thesis
+ * grid), bvh_sah.c (binned SAH) and bvh_lbvh.c (Morton codes); names in bvh_builder.c.
  *
- * Invariants of the finished tree:
- *   - node 0 is the root; children of an interior node are adjacent (left, left + 1);
+ * Invariants of the finished tree, for every builder:
+ *   - node 0 is the root; children of an interior node are adjacent (left, left + 1) and come
+ *     after their parent; nodes are numbered in the order of a depth-first walk that numbers a
+ *     node's two children together when it visits the node (the order the original median
+ *     builder produced, so its trees are unchanged bit for bit);
  *   - every primitive appears exactly once in prim_ids, and each leaf's range lies inside it;
- *   - each node's bounds contain the bounds of everything below it.
- * The split halves the primitive range with a quickselect on centroids (an nth_element), so the
- * depth is at most ceil(log2(n)) + 1 and the build is O(n log n). */
+ *     leaves hold 1 .. max_leaf primitives;
+ *   - each node's bounds are the union of its children's (a leaf's: of its primitives' boxes,
+ *     rs_geom_prim_bounds, which cover a moving sphere's whole sweep);
+ *   - depth <= RS_BVH_MAX_DEPTH (63 nodes), so traversal's RS_BVH_STACK-entry stacks never
+ *     overflow.  The frame keeps the invariant  depth(node) + ceil(log2(count(node))) <= 63:  it
+ *     holds at the root for any 32-bit count, a median split (children of at most ceil(count/2)
+ *     primitives) preserves it, and a heuristic split that would break it is replaced by a
+ *     median split (counted in rs_bvh.n_fallback);
+ *   - the tree is a function of the geometry and the options only, never of the thread count.
+ *
+ * Where nodes go while building.  Subtrees are built concurrently, so a node's index cannot come
+ * from a shared counter.  Instead a node with c primitives owns a block of 2c - 2 slots for its
+ * descendants (a binary tree over c primitives has at most 2c - 1 nodes): its two children at the
+ * block's start, then the left child's block (2 c_left - 2 slots), then the right child's.  Leaves
+ * with more than one primitive leave holes; a sequential depth-first pass then copies the reached
+ * slots into the final, hole-free array in the order stated above. */
 #include "accel/bvh.h"
 
+#include "accel/internal.h"
 #include "core/alloc.h"
+#include "core/parallel.h"
 
-typedef struct build_ctx {
-    const rs_aabb *bounds;   /* per primitive */
-    const rs_vec3 *centroid; /* per primitive */
-    uint32_t *ids;
-    rs_bvh_node *nodes;
-    uint32_t n_nodes;
-    uint32_t max_leaf;
-    uint32_t depth;
-} build_ctx;
+#include <string.h>
+
+/* Subtrees over at least this many primitives are built as OpenMP tasks. */
+#define TASK_RANGE 4096u
+/* Below this many primitives the whole build runs on the calling thread. */
+#define PAR_BUILD 8192u
+
+typedef uint32_t (*split_fn)(const rs_bvh_ctx *c, uint32_t first, uint32_t count, uint32_t depth,
+                             int *fallback);
+
+typedef struct frame {
+    const rs_bvh_ctx *c;
+    rs_bvh_node *slots; /* 2n - 1 build slots */
+    split_fn split;
+    int keep_order; /* LBVH: the fallback splits the sorted range at its middle, no reordering */
+} frame;
+
+/* What a subtree reports back: its depth, leaves and fallback splits. */
+typedef struct rec_out {
+    uint32_t depth, leaves, fallback;
+} rec_out;
 
 rs_aabb rs_geom_prim_bounds(const rs_geom *g, uint32_t prim)
 {
@@ -52,91 +85,167 @@ rs_aabb rs_geom_prim_bounds(const rs_geom *g, uint32_t prim)
     return b;
 }
 
-static float centroid_on(const build_ctx *c, uint32_t id, int axis)
+static rs_aabb aabb_empty(void)
 {
-    return rs_v3_get(c->centroid[id], axis);
+    rs_aabb b;
+    b.lo = rs_v3_splat(INFINITY);
+    b.hi = rs_v3_splat(-INFINITY);
+    return b;
 }
 
-/* Quickselect with a three-way partition: reorders ids[lo, hi) so that ids[k] holds the element
- * of rank k by centroid on `axis`, nothing larger before it and nothing smaller after it.
- * Elements that compare neither less nor greater (equal, or NaN) stay in the middle block, so
- * every round shrinks the range and the loop ends. */
-static void select_kth(const build_ctx *c, uint32_t *ids, uint32_t lo, uint32_t hi, uint32_t k,
-                       int axis)
+static rs_aabb centroid_bounds_serial(const rs_bvh_ctx *c, uint32_t first, uint32_t count)
 {
-    while (hi - lo > 1) {
-        float pivot = centroid_on(c, ids[lo + (hi - lo) / 2], axis);
-        uint32_t lt = lo, i = lo, gt = hi, t;
-        while (i < gt) {
-            float x = centroid_on(c, ids[i], axis);
-            if (x < pivot) {
-                t = ids[lt];
-                ids[lt++] = ids[i];
-                ids[i++] = t;
-            } else if (x > pivot) {
-                t = ids[--gt];
-                ids[gt] = ids[i];
-                ids[i] = t;
-            } else {
-                ++i;
-            }
-        }
-        if (k < lt)
-            hi = lt;
-        else if (k >= gt)
-            lo = gt;
-        else
-            return;
-    }
-}
-
-static void build_node(build_ctx *c, uint32_t node, uint32_t first, uint32_t count, uint32_t depth)
-{
-    rs_bvh_node *n = &c->nodes[node];
-    rs_aabb b = c->bounds[c->ids[first]];
-    rs_vec3 clo = c->centroid[c->ids[first]], chi = clo, ext;
+    rs_aabb b = aabb_empty();
     uint32_t i;
-    int axis;
-    if (depth > c->depth)
-        c->depth = depth;
-    for (i = first + 1; i < first + count; ++i) {
-        uint32_t id = c->ids[i];
-        b.lo = rs_v3_min(b.lo, c->bounds[id].lo);
-        b.hi = rs_v3_max(b.hi, c->bounds[id].hi);
-        clo = rs_v3_min(clo, c->centroid[id]);
-        chi = rs_v3_max(chi, c->centroid[id]);
+    for (i = first; i < first + count; ++i) {
+        rs_vec3 p = c->centroid[c->ids[i]];
+        b.lo = rs_v3_min(b.lo, p);
+        b.hi = rs_v3_max(b.hi, p);
     }
-    n->lo = b.lo;
-    n->hi = b.hi;
-    if (count <= c->max_leaf) {
+    return b;
+}
+
+rs_aabb rs_bvh_centroid_bounds(const rs_bvh_ctx *c, uint32_t first, uint32_t count)
+{
+    rs_aabb part[RS_BVH_PAR_CHUNKS], b;
+    uint32_t chunk = (count + RS_BVH_PAR_CHUNKS - 1) / RS_BVH_PAR_CHUNKS;
+    int k;
+    if (count < RS_BVH_PAR_RANGE)
+        return centroid_bounds_serial(c, first, count);
+        /* fixed chunks merged in order; min and max are exact, so this equals the serial pass */
+#pragma omp taskloop grainsize(1) shared(part)
+    for (k = 0; k < (int)RS_BVH_PAR_CHUNKS; ++k) {
+        uint32_t lo = (uint32_t)k * chunk, hi = lo + chunk < count ? lo + chunk : count;
+        part[k] = centroid_bounds_serial(c, first + lo, hi - lo);
+    }
+    b = part[0];
+    for (k = 1; k < (int)RS_BVH_PAR_CHUNKS; ++k) {
+        b.lo = rs_v3_min(b.lo, part[k].lo);
+        b.hi = rs_v3_max(b.hi, part[k].hi);
+    }
+    return b;
+}
+
+/* Smallest k with 2^k >= n. */
+static uint32_t ceil_log2(uint32_t n)
+{
+    uint32_t k = 0;
+    while (k < 32 && (1ull << k) < n)
+        ++k;
+    return k;
+}
+
+static rec_out build_rec(const frame *f, uint32_t slot, uint32_t block, uint32_t first,
+                         uint32_t count, uint32_t depth)
+{
+    const rs_bvh_ctx *c = f->c;
+    rs_bvh_node *n = &f->slots[slot];
+    rec_out o, ol, orr;
+    int fallback = 0;
+    uint32_t mid = count > 1 ? f->split(c, first, count, depth, &fallback) : 0, big;
+    if (mid >= count || (mid == 0 && count > c->max_leaf)) {
+        RS_ASSERT(0); /* a split function broke its contract: split at the middle instead */
+        mid = count / 2;
+        fallback = 1;
+    }
+    big = mid > count - mid ? mid : count - mid;
+    if (mid > 0 && depth + 1 + ceil_log2(big) > RS_BVH_MAX_DEPTH) {
+        /* the heuristic's split could push a leaf past the traversal stack: halve instead */
+        mid = f->keep_order ? count / 2 : rs_bvh_split_median(c, first, count);
+        fallback = 1;
+    }
+    if (mid == 0) {
+        rs_aabb b = c->bounds[c->ids[first]];
+        uint32_t i;
+        for (i = first + 1; i < first + count; ++i) {
+            b.lo = rs_v3_min(b.lo, c->bounds[c->ids[i]].lo);
+            b.hi = rs_v3_max(b.hi, c->bounds[c->ids[i]].hi);
+        }
+        n->lo = b.lo;
+        n->hi = b.hi;
         n->left_first = first;
         n->count = count;
+        o.depth = depth;
+        o.leaves = 1;
+        o.fallback = 0;
+        return o;
+    }
+    /* children at block, block + 1; the left child's block of 2 mid - 2 slots follows them, then
+     * the right child's 2 (count - mid) - 2: together exactly this node's 2 count - 2 */
+#pragma omp task shared(ol) if (count >= TASK_RANGE)
+    ol = build_rec(f, block, block + 2, first, mid, depth + 1);
+    orr = build_rec(f, block + 1, block + 2 * mid, first + mid, count - mid, depth + 1);
+#pragma omp taskwait
+    n->lo = rs_v3_min(f->slots[block].lo, f->slots[block + 1].lo);
+    n->hi = rs_v3_max(f->slots[block].hi, f->slots[block + 1].hi);
+    n->left_first = block;
+    n->count = 0;
+    o.depth = ol.depth > orr.depth ? ol.depth : orr.depth;
+    o.leaves = ol.leaves + orr.leaves;
+    o.fallback = ol.fallback + orr.fallback + (uint32_t)fallback;
+    return o;
+}
+
+/* Copies the subtree at build slot `from` to out[to], numbering children in depth-first order. */
+static void compact(const rs_bvh_node *slots, uint32_t from, rs_bvh_node *out, uint32_t to,
+                    uint32_t *next, uint32_t *max_count)
+{
+    rs_bvh_node n = slots[from];
+    if (n.count > 0) {
+        out[to] = n;
+        if (n.count > *max_count)
+            *max_count = n.count;
         return;
     }
-    ext = rs_v3_sub(chi, clo);
-    axis = (ext.x >= ext.y && ext.x >= ext.z) ? 0 : (ext.y >= ext.z ? 1 : 2);
-    {
-        uint32_t half = count / 2, left = c->n_nodes;
-        select_kth(c, c->ids, first, first + count, first + half, axis);
-        c->n_nodes += 2;
-        n->left_first = left;
-        n->count = 0;
-        build_node(c, left, first, half, depth + 1);
-        build_node(c, left + 1, first + half, count - half, depth + 1);
-    }
+    out[to] = n;
+    out[to].left_first = *next;
+    *next += 2;
+    compact(slots, n.left_first, out, out[to].left_first, next, max_count);
+    compact(slots, n.left_first + 1, out, out[to].left_first + 1, next, max_count);
 }
 
 rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out)
 {
-    uint32_t n = rs_geom_prim_count(g), i;
-    build_ctx c = {0};
-    rs_bvh *b = (rs_bvh *)rs_calloc(1, sizeof *b);
+    uint32_t n = rs_geom_prim_count(g), max_leaf = (opts && opts->max_leaf) ? opts->max_leaf : 4;
+    int threads = (opts && opts->threads) ? (int)opts->threads : rs_default_threads();
+    rs_bvh_builder builder;
+    rs_bvh_ctx c;
+    frame f;
+    rec_out res;
+    rs_bvh *b = NULL;
     rs_aabb *bounds = NULL;
     rs_vec3 *centroid = NULL;
+    rs_bvh_node *slots = NULL;
+    rs_bvh_key_id *pairs = NULL, *pairs2 = NULL;
+    uint32_t *codes = NULL, *codes_tmp = NULL, *ids_tmp = NULL, next = 1, max_count = 0;
+    int need_pairs, need_pairs2, lbvh;
+    long i;
     *out = NULL;
+    memset(&builder, 0, sizeof builder);
+    if (opts) {
+        if (rs_bvh_builder_check(&opts->builder) != RS_OK)
+            return RS_ERR_ARG;
+        /* keep only the fields the method reads, so that rs_bvh.builder names the tree */
+        builder.method = opts->builder.method;
+        if (builder.method == RS_BVH_GRID) {
+            builder.axis = opts->builder.axis;
+            builder.partition = opts->builder.partition;
+            builder.key = opts->builder.key;
+        } else if (builder.method == RS_BVH_SAH) {
+            builder.bins = opts->builder.bins ? opts->builder.bins : RS_BVH_SAH_BINS_DEFAULT;
+        }
+    }
+    if (n > 0x7fffffffu)
+        return rs_error_set(RS_ERR_ARG, "BVH: %u primitives, at most 2^31 - 1 supported", n);
+    lbvh = builder.method == RS_BVH_LBVH;
+    need_pairs = !lbvh;
+    need_pairs2 = builder.method == RS_BVH_GRID && builder.partition == RS_BVH_PART_SORT;
+
+    b = (rs_bvh *)rs_calloc(1, sizeof *b);
     if (!b)
         return rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH");
     b->n_prims = n;
+    b->builder = builder;
     if (n == 0) {
         *out = b;
         return RS_OK;
@@ -144,32 +253,103 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
     bounds = (rs_aabb *)rs_alloc(n, sizeof *bounds);
     centroid = (rs_vec3 *)rs_alloc(n, sizeof *centroid);
     b->prim_ids = (uint32_t *)rs_alloc(n, sizeof *b->prim_ids);
-    /* a binary tree with n leaves of >= 1 primitive has at most 2n - 1 nodes */
-    b->nodes = (rs_bvh_node *)rs_alloc(2 * (size_t)n, sizeof *b->nodes);
-    if (!bounds || !centroid || !b->prim_ids || !b->nodes) {
-        rs_free(bounds);
-        rs_free(centroid);
-        rs_bvh_destroy(b);
-        return rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH over %u primitives", n);
+    slots = (rs_bvh_node *)rs_alloc(2 * (size_t)n - 1, sizeof *slots);
+    if (need_pairs)
+        pairs = (rs_bvh_key_id *)rs_alloc(n, sizeof *pairs);
+    if (need_pairs2)
+        pairs2 = (rs_bvh_key_id *)rs_alloc(n, sizeof *pairs2);
+    if (lbvh) {
+        codes = (uint32_t *)rs_alloc(n, sizeof *codes);
+        codes_tmp = (uint32_t *)rs_alloc(n, sizeof *codes_tmp);
+        ids_tmp = (uint32_t *)rs_alloc(n, sizeof *ids_tmp);
     }
-    for (i = 0; i < n; ++i) {
-        bounds[i] = rs_geom_prim_bounds(g, i);
+    if (!bounds || !centroid || !b->prim_ids || !slots || (need_pairs && !pairs) ||
+        (need_pairs2 && !pairs2) || (lbvh && (!codes || !codes_tmp || !ids_tmp)))
+        goto nomem;
+
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= PAR_BUILD)
+    for (i = 0; i < (long)n; ++i) {
+        bounds[i] = rs_geom_prim_bounds(g, (uint32_t)i);
         centroid[i] = rs_v3_scale(rs_v3_add(bounds[i].lo, bounds[i].hi), 0.5f);
-        b->prim_ids[i] = i;
+        b->prim_ids[i] = (uint32_t)i;
     }
+    if (lbvh)
+        rs_bvh_lbvh_sort(centroid, n, b->prim_ids, codes, codes_tmp, ids_tmp, threads);
+
+    memset(&c, 0, sizeof c);
     c.bounds = bounds;
     c.centroid = centroid;
     c.ids = b->prim_ids;
-    c.nodes = b->nodes;
-    c.n_nodes = 1;
-    c.max_leaf = (opts && opts->max_leaf > 0) ? opts->max_leaf : 4;
-    build_node(&c, 0, 0, n, 1);
-    b->n_nodes = c.n_nodes;
-    b->depth = c.depth;
+    c.max_leaf = max_leaf;
+    c.builder = builder;
+    c.pairs = pairs;
+    c.pairs2 = pairs2;
+    c.codes = codes;
+    f.c = &c;
+    f.slots = slots;
+    f.keep_order = lbvh;
+    switch (builder.method) {
+    case RS_BVH_SAH: f.split = rs_bvh_split_sah; break;
+    case RS_BVH_LBVH: f.split = rs_bvh_split_lbvh; break;
+    default: f.split = rs_bvh_split_grid; break;
+    }
+#pragma omp parallel num_threads(threads) if (n >= PAR_BUILD && threads > 1)
+#pragma omp single
+    res = build_rec(&f, 0, 1, 0, n, 1);
+
+    b->n_nodes = 2 * res.leaves - 1;
+    b->n_leaves = res.leaves;
+    b->depth = res.depth;
+    b->n_fallback = res.fallback;
+    b->nodes = (rs_bvh_node *)rs_alloc(b->n_nodes, sizeof *b->nodes);
+    if (!b->nodes)
+        goto nomem;
+    compact(slots, 0, b->nodes, 0, &next, &max_count);
+    RS_ASSERT(next == b->n_nodes);
+    b->max_leaf_count = max_count;
     rs_free(bounds);
     rs_free(centroid);
+    rs_free(slots);
+    rs_free(pairs);
+    rs_free(pairs2);
+    rs_free(codes);
+    rs_free(codes_tmp);
+    rs_free(ids_tmp);
     *out = b;
     return RS_OK;
+
+nomem:
+    rs_free(bounds);
+    rs_free(centroid);
+    rs_free(slots);
+    rs_free(pairs);
+    rs_free(pairs2);
+    rs_free(codes);
+    rs_free(codes_tmp);
+    rs_free(ids_tmp);
+    rs_bvh_destroy(b);
+    return rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH over %u primitives", n);
+}
+
+static double box_area(rs_vec3 lo, rs_vec3 hi)
+{
+    double x = (double)hi.x - lo.x, y = (double)hi.y - lo.y, z = (double)hi.z - lo.z;
+    return 2.0 * (x * y + y * z + z * x);
+}
+
+double rs_bvh_sah_cost(const rs_bvh *b)
+{
+    double root, sum = 0.0;
+    uint32_t i;
+    if (!b || b->n_nodes == 0)
+        return 0.0;
+    root = box_area(b->nodes[0].lo, b->nodes[0].hi);
+    for (i = 0; i < b->n_nodes; ++i) {
+        const rs_bvh_node *nd = &b->nodes[i];
+        double w = root > 0.0 ? box_area(nd->lo, nd->hi) / root : 1.0;
+        sum += w * (nd->count > 0 ? RS_BVH_COST_ISECT * nd->count : RS_BVH_COST_TRAV);
+    }
+    return sum;
 }
 
 void rs_bvh_destroy(rs_bvh *b)

@@ -146,6 +146,8 @@ static int cmd_render(const rs_cli_options *o)
     rs_status rst;
     double t0, bvh_ms;
     rs_geom geom;
+    rs_bvh_build_opts bvh_opts;
+    char bvh_name[64];
 
     /* ---- the scene ---- */
     if (strncmp(o->scene, "builtin:", 8) == 0) {
@@ -222,8 +224,14 @@ static int cmd_render(const rs_cli_options *o)
 
     /* ---- BVH, devices, scheduler, film ---- */
     geom = rs_scene_geom(scene);
+    geom.sphere_algo = o->isect_sphere;
+    geom.tri_algo = o->isect_tri;
+    geom.aabb_algo = o->isect_aabb;
+    memset(&bvh_opts, 0, sizeof bvh_opts);
+    bvh_opts.builder = o->bvh;
+    bvh_opts.threads = (uint32_t)threads;
     t0 = rs_now_s();
-    if (rs_bvh_build(&geom, NULL, &bvh) != RS_OK) {
+    if (rs_bvh_build(&geom, &bvh_opts, &bvh) != RS_OK) {
         code = fail(RS_EXIT_RUNTIME, "building the BVH");
         goto done;
     }
@@ -290,11 +298,12 @@ static int cmd_render(const rs_cli_options *o)
         fprintf(stderr,
                 "%s %s at %ux%u, %u spp (%s sampling, max depth %u, seed %llu) in %.2f s: "
                 "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
-                "BVH: %u nodes over %u primitives, built in %.2f ms. ",
+                "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
                 code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered",
                 o->scene, st.width, st.height, st.spp, rs_sampling_name(st.sampling), st.max_depth,
                 (unsigned long long)st.seed, stats.seconds, sps, rps, rays,
                 (unsigned long long)stats.rays_closest, (unsigned long long)stats.rays_shadow,
+                rs_bvh_builder_name(&bvh->builder, bvh_name, sizeof bvh_name), rs_bvh_sah_cost(bvh),
                 bvh->n_nodes, bvh->n_prims, bvh_ms);
         for (i = 0; i < n_devs; ++i) {
             rs_device_stats ds;

@@ -123,6 +123,12 @@ void rs_cli_print_help(const char *command)
             "  --sampling MODE     mis (default): light + BSDF sampling, power heuristic;\n"
             "                      mixture: the thesis's light/BSDF mixture pdf;\n"
             "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
+            "  --bvh NAME          BVH builder: median (default), sah or sah:BINS, lbvh, or the\n"
+            "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
+            "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
+            "  --isect-sphere A    algebraic (default) or geometric\n"
+            "  --isect-tri A       moller (default), snyder-barr or watertight\n"
+            "  --isect-aabb A      slab (default), branchless, williams, kensler or swap\n"
             "  --chunk-size N      rays per scheduler chunk (default 65536)\n"
             "  --wave-size N       paths in flight (default 1048576): bounds memory\n"
             "  -q, --quiet         no progress bar and no summary\n"
@@ -272,6 +278,32 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
             if (!*v)
                 return usage_error("%s needs a folder%s", name, "");
             o->models = v;
+        } else if (strcmp(name, "--bvh") == 0) {
+            NEEDS_VALUE();
+            if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
+                fprintf(stderr, "raystream: --bvh: %s (see 'raystream render --help')\n",
+                        rs_error_message());
+                rs_error_clear();
+                return RS_EXIT_USAGE;
+            }
+        } else if (strcmp(name, "--isect-sphere") == 0) {
+            NEEDS_VALUE();
+            if (!rs_isect_sphere_algo_parse(v, &o->isect_sphere))
+                return usage_error("--isect-sphere: unknown algorithm '%s'%s (use algebraic or "
+                                   "geometric)",
+                                   v, "");
+        } else if (strcmp(name, "--isect-tri") == 0) {
+            NEEDS_VALUE();
+            if (!rs_isect_tri_algo_parse(v, &o->isect_tri))
+                return usage_error("--isect-tri: unknown algorithm '%s'%s (use moller, snyder-barr "
+                                   "or watertight)",
+                                   v, "");
+        } else if (strcmp(name, "--isect-aabb") == 0) {
+            NEEDS_VALUE();
+            if (!rs_isect_aabb_algo_parse(v, &o->isect_aabb))
+                return usage_error("--isect-aabb: unknown algorithm '%s'%s (use slab, branchless, "
+                                   "williams, kensler or swap)",
+                                   v, "");
         } else if (strcmp(name, "--chunk-size") == 0) {
             NEEDS_VALUE();
             rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);

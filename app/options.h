@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 
+#include "accel/bvh.h"
 #include "shading/integrator.h"
 
 #define RS_EXIT_OK          0
@@ -41,6 +42,10 @@ typedef struct rs_cli_options {
     int quiet;
     const char *mesh;          /* --mesh FILE: into the Cornell box */
     const char *models;        /* --models DIR */
+    rs_bvh_builder bvh;        /* --bvh NAME */
+    uint32_t isect_sphere;     /* --isect-sphere: rs_isect_sphere_algo */
+    uint32_t isect_tri;        /* --isect-tri: rs_isect_tri_algo */
+    uint32_t isect_aabb;       /* --isect-aabb: rs_isect_aabb_algo */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
 } rs_cli_options;

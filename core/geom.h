@@ -15,6 +15,9 @@ typedef struct rs_geom {
     const rs_sphere *spheres;
     const rs_vec3 *sphere_motion; /* per sphere: centre displacement per unit time; NULL: none */
     float time0, time1;           /* the times rays may carry (the shutter); bounds cover it */
+    uint32_t sphere_algo;         /* rs_isect_sphere_algo (0: algebraic, the default) */
+    uint32_t tri_algo;            /* rs_isect_tri_algo (0: Moller-Trumbore, the default) */
+    uint32_t aabb_algo;           /* rs_isect_aabb_algo for BVH nodes (0: slab, the default) */
     const rs_quad *quads;
     const rs_tri *tris;
     uint32_t n_spheres, n_quads, n_tris;
@@ -42,15 +45,15 @@ RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, fl
         if (g->sphere_motion) {
             rs_sphere s = g->spheres[prim];
             s.center = rs_v3_madd(s.center, g->sphere_motion[prim], r->time);
-            return rs_isect_sphere(&s, r, t);
+            return rs_isect_sphere_by(g->sphere_algo, &s, r, t);
         }
-        return rs_isect_sphere(&g->spheres[prim], r, t);
+        return rs_isect_sphere_by(g->sphere_algo, &g->spheres[prim], r, t);
     }
     prim -= g->n_spheres;
     if (prim < g->n_quads)
         return rs_isect_quad(&g->quads[prim], r, t, u, v);
     prim -= g->n_quads;
-    return rs_isect_tri(&g->tris[prim], r, t, u, v);
+    return rs_isect_tri_by(g->tri_algo, &g->tris[prim], r, t, u, v);
 }
 
 #endif

@@ -409,6 +409,9 @@ rs_geom rs_scene_geom(const rs_scene *s)
     g.sphere_motion = s->sphere_motion;
     g.time0 = fminf(s->camera.shutter_open, s->camera.shutter_close);
     g.time1 = fmaxf(s->camera.shutter_open, s->camera.shutter_close);
+    g.sphere_algo = 0; /* the default intersection tests; the CLI may choose others */
+    g.tri_algo = 0;
+    g.aabb_algo = 0;
     g.quads = s->quads;
     g.tris = s->tris;
     g.n_spheres = s->n_spheres;

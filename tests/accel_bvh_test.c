@@ -134,7 +134,7 @@ static int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
 
 static rs_bvh *build(const rs_geom *g, uint32_t max_leaf)
 {
-    rs_bvh_build_opts o;
+    rs_bvh_build_opts o = {0};
     rs_bvh *b = NULL;
     rs_status st;
     o.max_leaf = max_leaf;

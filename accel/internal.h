@@ -1,0 +1,66 @@
+/* accel/internal.h — what the BVH builders share; for accel/ only.
+ *
+ * rs_bvh_build (accel/bvh.c) owns the frame every builder runs in: it computes each primitive's
+ * box and centroid, then recurses top-down over ranges of `ids`.  At each node it asks the
+ * builder's split function for a split of ids[first, first + count):
+ *
+ *   returns 0          make a leaf of the whole range (only allowed when count <= max_leaf);
+ *   returns m          0 < m < count: the function has reordered the range so that its first m
+ *                      ids form the left child and the rest the right child.
+ *
+ * A split function may reorder only its own range and write only its own range of the scratch
+ * arrays, so subtrees can be built by concurrent OpenMP tasks; it must be a pure function of the
+ * range's contents and (first, count, depth), so the tree does not depend on the thread count.
+ * It never allocates: every buffer is allocated before the recursion starts, so out-of-memory can
+ * only happen up front.  The frame enforces the depth bound and computes the node boxes
+ * (bottom-up: a leaf's from its primitives, an interior node's as the union of its children). */
+#ifndef RS_ACCEL_INTERNAL_H
+#define RS_ACCEL_INTERNAL_H
+
+#include "accel/bvh.h"
+
+/* A sort key and the primitive it belongs to (8 bytes). */
+typedef struct rs_bvh_key_id {
+    float key;
+    uint32_t id;
+} rs_bvh_key_id;
+
+typedef struct rs_bvh_ctx {
+    const rs_aabb *bounds;   /* per primitive: rs_geom_prim_bounds */
+    const rs_vec3 *centroid; /* per primitive: the centre of its box */
+    uint32_t *ids;           /* the permutation under construction; becomes prim_ids */
+    uint32_t max_leaf;
+    rs_bvh_builder builder; /* validated, bins filled in */
+    rs_bvh_key_id *pairs;   /* n scratch pairs (grid builders and the median fallback) */
+    rs_bvh_key_id *pairs2;  /* n more for the merge sort (RS_BVH_PART_SORT only) */
+    const uint32_t *codes;  /* LBVH: Morton code of ids[i], sorted ascending */
+} rs_bvh_ctx;
+
+/* Ranges at least this long get their linear passes (bounds, binning) split over OpenMP tasks in
+ * a fixed number of chunks, merged in chunk order (so the result is the same for any number of
+ * threads). */
+#define RS_BVH_PAR_RANGE  65536u
+#define RS_BVH_PAR_CHUNKS 8u
+
+/* Bounds of the centroids of ids[first, first + count), count >= 1. */
+rs_aabb rs_bvh_centroid_bounds(const rs_bvh_ctx *c, uint32_t first, uint32_t count);
+
+/* The split functions (see the contract above).  *fallback is set to 1 when the builder had to
+ * split at the middle because its heuristic could not separate the range. */
+uint32_t rs_bvh_split_grid(const rs_bvh_ctx *c, uint32_t first, uint32_t count, uint32_t depth,
+                           int *fallback);
+uint32_t rs_bvh_split_sah(const rs_bvh_ctx *c, uint32_t first, uint32_t count, uint32_t depth,
+                          int *fallback);
+uint32_t rs_bvh_split_lbvh(const rs_bvh_ctx *c, uint32_t first, uint32_t count, uint32_t depth,
+                           int *fallback);
+/* The median split (largest centroid extent, quickselect by centroid at count / 2), used by
+ * RS_BVH_MEDIAN and as the depth-bound fallback of the SAH builder; count >= 2. */
+uint32_t rs_bvh_split_median(const rs_bvh_ctx *c, uint32_t first, uint32_t count);
+
+/* LBVH preparation (accel/bvh_lbvh.c): Morton codes of the centroids, radix-sorted together with
+ * ids.  `codes`, `codes_tmp` and `ids_tmp` hold n entries each; on return ids[] is sorted by code
+ * (ties in ascending primitive order) and codes[i] is the code of ids[i]. */
+void rs_bvh_lbvh_sort(const rs_vec3 *centroid, uint32_t n, uint32_t *ids, uint32_t *codes,
+                      uint32_t *codes_tmp, uint32_t *ids_tmp, int threads);
+
+#endif

@@ -1,0 +1,538 @@
+/* bench/bvh_bench.c — the BVH builders compared (the thesis's §6.4 and Table 6.5, plus binned SAH
+ * and LBVH): build time, tree quality (SAH cost, nodes, depth) and closest-hit traversal speed.
+ *
+ * Scenes: a random soup of triangles (100000 by default) and, when the shared models exist, the
+ * Stanford bunny (69451 triangles, read by the small reader in tests/test_mesh.h).  Two ray sets
+ * per scene, the same for every builder:
+ *   primary  one camera ray per pixel of a W x W pinhole image framing the scene's bounding
+ *            sphere from outside, in scanline order (coherent);
+ *   diffuse  from random points on random triangles, cosine-distributed about the normal on a
+ *            random side of the surface, in random order (incoherent), tmin = 1e-4 of the
+ *            scene's size so the ray does not hit its own triangle.
+ *
+ * Validates first: the median builder's closest hits equal brute force on a subset of each ray
+ * set, and then every builder's hits equal the median builder's (same t, bit for bit, and the
+ * same triangle or an exact tie) on every 8th ray.  Then prints the machine, the settings and per
+ * scene one table: build time (median of the runs, with 1 thread and with all threads), SAH cost
+ * (C_trav = C_isect = 1, rs_bvh_sah_cost), nodes, depth, and Mrays/s of closest-hit queries (the
+ * median of the runs, 1 thread and all threads; all threads use an OpenMP loop with dynamic
+ * chunks of 256 rays), with the ratios to the median builder measured in the same run.
+ *
+ *   bvh_bench [--quick] [--tris N] [--size W] [--diffuse N] [--runs N] [--max-leaf N]
+ *             [--bvh NAME,NAME,...] [--model FILE|none] [--csv FILE]
+ *   --quick: a 3000-triangle soup, 64x64 primary rays, one run, no bunny (the test suite's smoke
+ *   test). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "accel/bvh.h"
+#include "core/parallel.h"
+#include "machine.h"
+#include "test_mesh.h"
+#include "test_rand.h"
+
+#define MAX_VARIANTS 64
+#define MAX_RUNS     15
+
+typedef struct ray_set {
+    const char *name;
+    rs_ray *rays;
+    rs_hit *hits; /* scratch answers */
+    uint32_t n;
+} ray_set;
+
+typedef struct row {
+    rs_bvh_builder b;
+    double build1, buildn, sah;
+    uint32_t nodes, depth, leaves, fallback;
+    double mrays[2][2]; /* [primary, diffuse][1 thread, all threads] */
+} row;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median_of(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof v[0], cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* ---- scenes and rays ----------------------------------------------------------------------- */
+
+/* n triangles with edges up to ~2 units, centres uniform in a cube whose size grows with the
+ * cube root of n (half-size 30 for 100000), so every n sees about the same density. */
+static rs_tri *soup_make(uint32_t n, uint64_t seed)
+{
+    rs_tri *t = (rs_tri *)malloc((size_t)n * sizeof *t);
+    float h = 30.0f * cbrtf((float)n / 100000.0f);
+    uint32_t i;
+    if (!t)
+        return NULL;
+    for (i = 0; i < n; ++i) {
+        rs_vec3 c = rnd_box(&seed, h);
+        t[i].v0 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.1, 1.0));
+        t[i].v1 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.1, 1.0));
+        t[i].v2 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.1, 1.0));
+    }
+    return t;
+}
+
+static rs_aabb scene_box(const rs_tri *t, uint32_t n)
+{
+    rs_aabb b;
+    uint32_t i;
+    b.lo = rs_v3_splat(INFINITY);
+    b.hi = rs_v3_splat(-INFINITY);
+    for (i = 0; i < n; ++i) {
+        b.lo = rs_v3_min(b.lo, rs_v3_min(t[i].v0, rs_v3_min(t[i].v1, t[i].v2)));
+        b.hi = rs_v3_max(b.hi, rs_v3_max(t[i].v0, rs_v3_max(t[i].v1, t[i].v2)));
+    }
+    return b;
+}
+
+static int rays_alloc(ray_set *s, const char *name, uint32_t n)
+{
+    s->name = name;
+    s->n = n;
+    s->rays = (rs_ray *)malloc((size_t)n * sizeof *s->rays);
+    s->hits = (rs_hit *)malloc((size_t)n * sizeof *s->hits);
+    return s->rays && s->hits;
+}
+
+static void rays_free(ray_set *s)
+{
+    free(s->rays);
+    free(s->hits);
+}
+
+/* A W x W pinhole camera on the diagonal (1, 0.6, 1.4) of the box, looking at its centre, with a
+ * field of view that just holds the bounding sphere. */
+static int rays_primary(ray_set *s, rs_aabb box, uint32_t w)
+{
+    rs_vec3 c = rs_v3_scale(rs_v3_add(box.lo, box.hi), 0.5f);
+    float r = 0.5f * rs_v3_length(rs_v3_sub(box.hi, box.lo));
+    rs_vec3 dir = rs_v3_normalize(rs_v3(1.0f, 0.6f, 1.4f));
+    rs_vec3 eye = rs_v3_madd(c, dir, 2.5f * r), fwd = rs_v3_neg(dir);
+    rs_vec3 right = rs_v3_normalize(rs_v3_cross(fwd, rs_v3(0, 1, 0)));
+    rs_vec3 up = rs_v3_cross(right, fwd);
+    /* the sphere fills the view: sin(half angle) = r / (2.5 r) */
+    float tan_half = 1.0f / sqrtf(2.5f * 2.5f - 1.0f);
+    uint32_t x, y;
+    if (!rays_alloc(s, "primary", w * w))
+        return 0;
+    for (y = 0; y < w; ++y)
+        for (x = 0; x < w; ++x) {
+            float px = (2.0f * ((float)x + 0.5f) / (float)w - 1.0f) * tan_half;
+            float py = (1.0f - 2.0f * ((float)y + 0.5f) / (float)w) * tan_half;
+            rs_vec3 d = rs_v3_add(fwd, rs_v3_add(rs_v3_scale(right, px), rs_v3_scale(up, py)));
+            s->rays[y * w + x] = mk_ray(eye, rs_v3_normalize(d), 0.0f, INFINITY);
+        }
+    return 1;
+}
+
+static int rays_diffuse(ray_set *s, const rs_tri *t, uint32_t nt, rs_aabb box, uint32_t n,
+                        uint64_t seed)
+{
+    float eps = 1e-4f * rs_v3_length(rs_v3_sub(box.hi, box.lo));
+    uint32_t i;
+    if (!rays_alloc(s, "diffuse", n))
+        return 0;
+    for (i = 0; i < n; ++i) {
+        const rs_tri *tr = &t[(uint32_t)(rnd01(&seed) * nt)];
+        double a = rnd01(&seed), b = rnd01(&seed);
+        rs_vec3 nrm = rs_v3_cross(rs_v3_sub(tr->v1, tr->v0), rs_v3_sub(tr->v2, tr->v0)), p, d;
+        if (a + b > 1.0)
+            a = 1.0 - a, b = 1.0 - b;
+        p = rs_v3_madd(rs_v3_madd(tr->v0, rs_v3_sub(tr->v1, tr->v0), (float)a),
+                       rs_v3_sub(tr->v2, tr->v0), (float)b);
+        if (rs_v3_length2(nrm) > 0.0f)
+            nrm = rs_v3_normalize(nrm);
+        else
+            nrm = rs_v3(0, 1, 0);
+        if (rnd01(&seed) < 0.5)
+            nrm = rs_v3_neg(nrm);
+        /* cosine-distributed: normal plus a uniform unit vector (Shirley, RTIOW §9.4) */
+        d = rs_v3_add(nrm, rnd_unit(&seed));
+        if (rs_v3_length2(d) < 1e-12f)
+            d = nrm;
+        s->rays[i] = mk_ray(p, rs_v3_normalize(d), eps, INFINITY);
+    }
+    return 1;
+}
+
+/* ---- measuring ----------------------------------------------------------------------------- */
+
+static rs_bvh *build_timed(const rs_geom *g, const rs_bvh_builder *b, uint32_t max_leaf,
+                           int threads, int runs, double *median_s)
+{
+    double t[MAX_RUNS];
+    rs_bvh *bvh = NULL;
+    int k;
+    for (k = 0; k < runs; ++k) {
+        rs_bvh_build_opts o;
+        double t0;
+        memset(&o, 0, sizeof o);
+        o.max_leaf = max_leaf;
+        o.builder = *b;
+        o.threads = (uint32_t)threads;
+        rs_bvh_destroy(bvh);
+        bvh = NULL;
+        t0 = now_s();
+        if (rs_bvh_build(g, &o, &bvh) != RS_OK) {
+            fprintf(stderr, "bvh_bench: %s\n", rs_error_message());
+            return NULL;
+        }
+        t[k] = now_s() - t0;
+    }
+    *median_s = median_of(t, runs);
+    return bvh;
+}
+
+/* Closest hits of every ray into s->hits; returns the seconds taken. */
+static double trace(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads)
+{
+    rs_bvh_view v = rs_bvh_view_of(bvh);
+    double t0 = now_s();
+    long i, n = (long)s->n;
+    if (threads == 1) {
+        for (i = 0; i < n; ++i)
+            rs_bvh_closest(&v, g, s->rays[i], &s->hits[i]);
+    } else {
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+        for (i = 0; i < n; ++i)
+            rs_bvh_closest(&v, g, s->rays[i], &s->hits[i]);
+    }
+    return now_s() - t0;
+}
+
+static double mrays(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads, int runs)
+{
+    double t[MAX_RUNS];
+    int k;
+    for (k = 0; k < runs; ++k)
+        t[k] = trace(bvh, g, s, threads);
+    return (double)s->n / median_of(t, runs) / 1e6;
+}
+
+/* Same answer: the same t bit for bit, and the same prim or an exact tie. */
+static int same_hit(const rs_geom *g, const rs_ray *r, const rs_hit *a, const rs_hit *b)
+{
+    float t, u, v;
+    if (a->prim == RS_NO_HIT || b->prim == RS_NO_HIT)
+        return a->prim == b->prim;
+    if (a->t != b->t)
+        return 0;
+    return a->prim == b->prim || (rs_geom_intersect(g, a->prim, r, &t, &u, &v) && t == b->t);
+}
+
+static int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
+{
+    uint32_t n = rs_geom_prim_count(g), i;
+    hit->prim = RS_NO_HIT;
+    hit->t = r->tmax;
+    for (i = 0; i < n; ++i) {
+        float t, u, v;
+        if (rs_geom_intersect(g, i, r, &t, &u, &v) && (hit->prim == RS_NO_HIT || t < hit->t)) {
+            hit->t = t;
+            hit->prim = i;
+        }
+    }
+    return hit->prim != RS_NO_HIT;
+}
+
+/* ---- one scene ----------------------------------------------------------------------------- */
+
+typedef struct settings {
+    const rs_bvh_builder *variants;
+    int n_variants, runs, threads;
+    uint32_t max_leaf, size, n_diffuse, brute_rays;
+    int progress; /* a line on stderr per builder */
+    FILE *csv;
+} settings;
+
+static int bench_scene(const char *scene, const rs_tri *tris, uint32_t nt, const settings *st)
+{
+    rs_geom g;
+    rs_aabb box = scene_box(tris, nt);
+    ray_set sets[2];
+    rs_hit *ref[2] = {NULL, NULL};
+    row rows[MAX_VARIANTS];
+    rs_bvh *median_bvh = NULL;
+    int v, k, ok = 0, median_row = -1;
+    uint32_t i;
+    long hits[2] = {0, 0};
+    char name[64];
+    memset(&g, 0, sizeof g);
+    g.tris = tris;
+    g.n_tris = nt;
+    memset(sets, 0, sizeof sets);
+    if (!rays_primary(&sets[0], box, st->size) ||
+        !rays_diffuse(&sets[1], tris, nt, box, st->n_diffuse, 0xd1ffu)) {
+        fprintf(stderr, "bvh_bench: out of memory for rays\n");
+        goto out;
+    }
+    /* the reference: the median builder, checked against brute force on a subset */
+    {
+        rs_bvh_builder med;
+        double dummy;
+        memset(&med, 0, sizeof med);
+        median_bvh = build_timed(&g, &med, st->max_leaf, 1, 1, &dummy);
+        if (!median_bvh)
+            goto out;
+    }
+    for (k = 0; k < 2; ++k) {
+        uint32_t step = sets[k].n / st->brute_rays ? sets[k].n / st->brute_rays : 1;
+        ref[k] = (rs_hit *)malloc((size_t)sets[k].n * sizeof *ref[k]);
+        if (!ref[k])
+            goto out;
+        trace(median_bvh, &g, &sets[k], st->threads);
+        memcpy(ref[k], sets[k].hits, (size_t)sets[k].n * sizeof *ref[k]);
+        for (i = 0; i < sets[k].n; ++i)
+            hits[k] += ref[k][i].prim != RS_NO_HIT;
+        for (i = 0; i < sets[k].n; i += step) {
+            rs_hit h;
+            brute_closest(&g, &sets[k].rays[i], &h);
+            if (!same_hit(&g, &sets[k].rays[i], &h, &ref[k][i])) {
+                fprintf(stderr,
+                        "bvh_bench: %s: median BVH disagrees with brute force on %s ray %u\n",
+                        scene, sets[k].name, i);
+                goto out;
+            }
+        }
+    }
+
+    for (v = 0; v < st->n_variants; ++v) {
+        row *r = &rows[v];
+        rs_bvh *bvh, *b1;
+        r->b = st->variants[v];
+        rs_bvh_builder_name(&r->b, name, sizeof name);
+        if (r->b.method == RS_BVH_MEDIAN)
+            median_row = v;
+        b1 = build_timed(&g, &r->b, st->max_leaf, 1, st->runs, &r->build1);
+        bvh = build_timed(&g, &r->b, st->max_leaf, st->threads, st->runs, &r->buildn);
+        if (!b1 || !bvh)
+            goto out;
+        if (b1->n_nodes != bvh->n_nodes ||
+            memcmp(b1->nodes, bvh->nodes, (size_t)b1->n_nodes * sizeof *b1->nodes) != 0) {
+            fprintf(stderr, "bvh_bench: %s: %s builds another tree with %d threads\n", scene, name,
+                    st->threads);
+            goto out;
+        }
+        rs_bvh_destroy(b1);
+        r->sah = rs_bvh_sah_cost(bvh);
+        r->nodes = bvh->n_nodes;
+        r->depth = bvh->depth;
+        r->leaves = bvh->n_leaves;
+        r->fallback = bvh->n_fallback;
+        /* validate against the median builder before timing */
+        for (k = 0; k < 2; ++k) {
+            trace(bvh, &g, &sets[k], st->threads);
+            for (i = 0; i < sets[k].n; i += 8)
+                if (!same_hit(&g, &sets[k].rays[i], &sets[k].hits[i], &ref[k][i])) {
+                    fprintf(stderr,
+                            "bvh_bench: %s: %s disagrees with the median BVH on %s ray %u\n", scene,
+                            name, sets[k].name, i);
+                    rs_bvh_destroy(bvh);
+                    goto out;
+                }
+            r->mrays[k][0] = mrays(bvh, &g, &sets[k], 1, st->runs);
+            r->mrays[k][1] = mrays(bvh, &g, &sets[k], st->threads, st->runs);
+        }
+        rs_bvh_destroy(bvh);
+        if (st->progress)
+            fprintf(stderr, "  %s: %s done\n", scene, name);
+    }
+
+    printf("\n### %s: %u triangles; %u primary rays (%ux%u), %u diffuse rays; %.1f%% / %.1f%% "
+           "hit\n\n",
+           scene, nt, sets[0].n, st->size, st->size, sets[1].n, 100.0 * hits[0] / sets[0].n,
+           100.0 * hits[1] / sets[1].n);
+    printf("| builder | build ms 1 thr | build ms %d thr | build vs median | SAH cost | SAH vs "
+           "median | nodes | depth | primary Mrays/s 1 thr | primary %d thr | diffuse 1 thr | "
+           "diffuse %d thr | primary vs median | diffuse vs median |\n",
+           st->threads, st->threads, st->threads);
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (v = 0; v < st->n_variants; ++v) {
+        const row *r = &rows[v], *m = median_row >= 0 ? &rows[median_row] : &rows[0];
+        rs_bvh_builder_name(&r->b, name, sizeof name);
+        printf("| %s | %.2f | %.2f | %.2fx | %.2f | %.3f | %u | %u | %.2f | %.2f | %.2f | %.2f | "
+               "%.2fx | %.2fx |\n",
+               name, 1e3 * r->build1, 1e3 * r->buildn, r->build1 / m->build1, r->sah,
+               r->sah / m->sah, r->nodes, r->depth, r->mrays[0][0], r->mrays[0][1], r->mrays[1][0],
+               r->mrays[1][1], r->mrays[0][1] / m->mrays[0][1], r->mrays[1][1] / m->mrays[1][1]);
+        if (st->csv)
+            fprintf(st->csv, "%s,%u,%s,%u,%.6f,%.6f,%.4f,%u,%u,%u,%u,%.4f,%.4f,%.4f,%.4f\n", scene,
+                    nt, name, st->max_leaf, r->build1, r->buildn, r->sah, r->nodes, r->depth,
+                    r->leaves, r->fallback, r->mrays[0][0], r->mrays[0][1], r->mrays[1][0],
+                    r->mrays[1][1]);
+    }
+    ok = 1;
+out:
+    rs_bvh_destroy(median_bvh);
+    free(ref[0]);
+    free(ref[1]);
+    rays_free(&sets[0]);
+    rays_free(&sets[1]);
+    return ok;
+}
+
+/* ---- main ---------------------------------------------------------------------------------- */
+
+static int parse_list(const char *list, rs_bvh_builder *out, int cap)
+{
+    char buf[1024], *tok;
+    int n = 0;
+    snprintf(buf, sizeof buf, "%s", list);
+    for (tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        if (n == cap || rs_bvh_builder_parse(tok, &out[n]) != RS_OK) {
+            fprintf(stderr, "bvh_bench: %s\n", rs_error_message());
+            return -1;
+        }
+        ++n;
+    }
+    return n;
+}
+
+int main(int argc, char **argv)
+{
+    rs_bvh_builder variants[MAX_VARIANTS];
+    settings st;
+    const char *model = NULL, *csv = NULL, *list = NULL;
+    uint32_t n_tris = 100000;
+    int quick = 0, i, ok = 1, have_median = 0;
+    rs_tri *soup;
+    char label[64];
+
+    memset(&st, 0, sizeof st);
+    st.runs = 3;
+    st.threads = rs_default_threads();
+    st.max_leaf = 4;
+    st.size = 512;
+    st.n_diffuse = 262144;
+    st.brute_rays = 256;
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--quick") == 0) {
+            quick = 1;
+        } else if (strcmp(argv[i], "--tris") == 0 && i + 1 < argc) {
+            n_tris = (uint32_t)atol(argv[++i]);
+        } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
+            st.size = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--diffuse") == 0 && i + 1 < argc) {
+            st.n_diffuse = (uint32_t)atol(argv[++i]);
+        } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
+            st.runs = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--max-leaf") == 0 && i + 1 < argc) {
+            st.max_leaf = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--bvh") == 0 && i + 1 < argc) {
+            list = argv[++i];
+        } else if (strcmp(argv[i], "--model") == 0 && i + 1 < argc) {
+            model = argv[++i];
+        } else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
+            csv = argv[++i];
+        } else {
+            fprintf(stderr, "usage: bvh_bench [--quick] [--tris N] [--size W] [--diffuse N] "
+                            "[--runs N] [--max-leaf N] [--bvh NAME,...] [--model FILE|none] "
+                            "[--csv FILE]\n");
+            return 2;
+        }
+    }
+    st.progress = !quick;
+    if (quick) {
+        n_tris = 3000;
+        st.size = 64;
+        st.n_diffuse = 4096;
+        st.runs = 1;
+        st.brute_rays = 64;
+        if (!model)
+            model = "none";
+    }
+    if (n_tris < 1 || st.size < 1 || st.n_diffuse < 1 || st.runs < 1 || st.runs > MAX_RUNS ||
+        st.max_leaf < 1) {
+        fprintf(stderr, "bvh_bench: tris, size, diffuse, max-leaf must be >= 1, runs 1..%d\n",
+                MAX_RUNS);
+        return 2;
+    }
+    /* the builders: the given list, or every standard variant plus SAH with 8 and 32 bins; the
+     * median builder is always measured (it is the baseline of the ratios) */
+    if (list) {
+        st.n_variants = parse_list(list, variants, MAX_VARIANTS - 1);
+        if (st.n_variants < 0)
+            return 2;
+    } else {
+        st.n_variants = (int)rs_bvh_builder_variants(variants, MAX_VARIANTS);
+        rs_bvh_builder_parse("sah:8", &variants[st.n_variants++]);
+        rs_bvh_builder_parse("sah:32", &variants[st.n_variants++]);
+    }
+    for (i = 0; i < st.n_variants; ++i)
+        have_median |= variants[i].method == RS_BVH_MEDIAN;
+    if (!have_median) {
+        memmove(&variants[1], &variants[0], (size_t)st.n_variants * sizeof variants[0]);
+        memset(&variants[0], 0, sizeof variants[0]);
+        st.n_variants++;
+    }
+    st.variants = variants;
+    if (csv) {
+        st.csv = fopen(csv, "w");
+        if (!st.csv) {
+            fprintf(stderr, "bvh_bench: cannot write %s\n", csv);
+            return 1;
+        }
+        fprintf(st.csv, "scene,triangles,builder,max_leaf,build_s_1thr,build_s_nthr,sah_cost,"
+                        "nodes,depth,leaves,fallback,primary_mrays_1thr,primary_mrays_nthr,"
+                        "diffuse_mrays_1thr,diffuse_mrays_nthr\n");
+    }
+
+    rs_bench_print_machine(stdout);
+    printf("settings: max_leaf %u; %d builders; median of %d run%s; %d threads for the "
+           "\"all threads\" columns; SAH cost with C_trav = C_isect = 1 normalised by the root's "
+           "area\n",
+           st.max_leaf, st.n_variants, st.runs, st.runs == 1 ? "" : "s", st.threads);
+
+    soup = soup_make(n_tris, 0x50u);
+    if (!soup) {
+        fprintf(stderr, "bvh_bench: out of memory\n");
+        return 1;
+    }
+    snprintf(label, sizeof label, "soup of %u random triangles", n_tris);
+    ok = bench_scene(label, soup, n_tris, &st);
+    free(soup);
+
+    if (ok && !(model && strcmp(model, "none") == 0)) {
+        test_mesh m;
+        char path[4200];
+        const char *why = "";
+        if (!model) {
+            const char *dir = test_models_dir(&why);
+            if (dir) {
+                snprintf(path, sizeof path, "%s/bunny/bun_zipper.ply", dir);
+                model = path;
+            }
+        }
+        if (!model) {
+            printf("\n(bunny skipped: %s)\n", why);
+        } else if (!test_mesh_load(model, &m)) {
+            fprintf(stderr, "bvh_bench: cannot read %s (ascii PLY or OBJ)\n", model);
+            ok = 0;
+        } else {
+            const char *base = strrchr(model, '/');
+            ok = bench_scene(base ? base + 1 : model, m.tris, m.n_tris, &st);
+            test_mesh_free(&m);
+        }
+    }
+    if (st.csv)
+        fclose(st.csv);
+    return ok ? 0 : 1;
+}
