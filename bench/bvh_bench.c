@@ -238,21 +238,6 @@ static int same_hit(const rs_geom *g, const rs_ray *r, const rs_hit *a, const rs
     return a->prim == b->prim || (rs_geom_intersect(g, a->prim, r, &t, &u, &v) && t == b->t);
 }
 
-static int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
-{
-    uint32_t n = rs_geom_prim_count(g), i;
-    hit->prim = RS_NO_HIT;
-    hit->t = r->tmax;
-    for (i = 0; i < n; ++i) {
-        float t, u, v;
-        if (rs_geom_intersect(g, i, r, &t, &u, &v) && (hit->prim == RS_NO_HIT || t < hit->t)) {
-            hit->t = t;
-            hit->prim = i;
-        }
-    }
-    return hit->prim != RS_NO_HIT;
-}
-
 /* ---- one scene ----------------------------------------------------------------------------- */
 
 typedef struct settings {

@@ -443,41 +443,34 @@ rs_status rs_builtin_create(const char *name, rs_scene **out)
     return rs_builtin_create_ex(name, NULL, out);
 }
 
+/* Creates scene `name` with one of the two builder forms, then finalizes it. */
+static rs_status make_scene(const char *name, rs_status (*build)(rs_scene *),
+                            rs_status (*build_ex)(rs_scene *, const rs_builtin_opts *),
+                            const rs_builtin_opts *opts, rs_scene **out)
+{
+    rs_scene *s;
+    rs_status st = rs_scene_create(name, &s);
+    if (st == RS_OK)
+        st = build ? build(s) : build_ex(s, opts);
+    if (st == RS_OK)
+        st = rs_scene_finalize(s);
+    if (st != RS_OK) {
+        rs_scene_destroy(s);
+        return st;
+    }
+    *out = s;
+    return RS_OK;
+}
+
 rs_status rs_builtin_create_ex(const char *name, const rs_builtin_opts *opts, rs_scene **out)
 {
     int i;
     *out = NULL;
-    if (strcmp(name, "cornell-mesh") == 0) {
-        rs_scene *s;
-        rs_status st = rs_scene_create(name, &s);
-        if (st == RS_OK)
-            st = build_cornell_mesh(s, opts);
-        if (st == RS_OK)
-            st = rs_scene_finalize(s);
-        if (st != RS_OK) {
-            rs_scene_destroy(s);
-            return st;
-        }
-        *out = s;
-        return RS_OK;
-    }
-    for (i = 0; i < N_BUILTINS; ++i) {
-        rs_scene *s;
-        rs_status st;
-        if (strcmp(name, g_builtins[i].name) != 0)
-            continue;
-        st = rs_scene_create(name, &s);
-        if (st == RS_OK)
-            st = g_builtins[i].build ? g_builtins[i].build(s) : g_builtins[i].build_ex(s, opts);
-        if (st == RS_OK)
-            st = rs_scene_finalize(s);
-        if (st != RS_OK) {
-            rs_scene_destroy(s);
-            return st;
-        }
-        *out = s;
-        return RS_OK;
-    }
+    if (strcmp(name, "cornell-mesh") == 0)
+        return make_scene(name, NULL, build_cornell_mesh, opts, out);
+    for (i = 0; i < N_BUILTINS; ++i)
+        if (strcmp(name, g_builtins[i].name) == 0)
+            return make_scene(name, g_builtins[i].build, g_builtins[i].build_ex, opts, out);
     {
         char known[256] = "";
         for (i = 0; i < N_BUILTINS; ++i) {

@@ -189,24 +189,6 @@ static void soup_tris(soup *s, uint32_t n, uint64_t seed)
 
 /* ---- rays and brute force ------------------------------------------------------------------ */
 
-static int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
-{
-    uint32_t n = rs_geom_prim_count(g), i;
-    hit->prim = RS_NO_HIT;
-    hit->t = r->tmax;
-    hit->u = hit->v = 0.0f;
-    for (i = 0; i < n; ++i) {
-        float t, u, v;
-        if (rs_geom_intersect(g, i, r, &t, &u, &v) && (hit->prim == RS_NO_HIT || t < hit->t)) {
-            hit->t = t;
-            hit->u = u;
-            hit->v = v;
-            hit->prim = i;
-        }
-    }
-    return hit->prim != RS_NO_HIT;
-}
-
 /* A random ray around a scene of half-size `h`: the origin inside the box or in one three times
  * as wide; the direction random or aimed at a point of the box, one in eight with zero
  * components; tmin > 0 for one in eight, tmax cut short for one in four; a random time. */

@@ -114,24 +114,6 @@ static void soup_random(soup *s, uint64_t seed)
 
 /* Brute force: every primitive with the full interval; the strictly smallest t wins, so the
  * lowest-numbered prim wins ties.  Returns 1 on a hit. */
-static int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
-{
-    uint32_t n = rs_geom_prim_count(g), i;
-    hit->prim = RS_NO_HIT;
-    hit->t = r->tmax;
-    hit->u = hit->v = 0.0f;
-    for (i = 0; i < n; ++i) {
-        float t, u, v;
-        if (rs_geom_intersect(g, i, r, &t, &u, &v) && (hit->prim == RS_NO_HIT || t < hit->t)) {
-            hit->t = t;
-            hit->u = u;
-            hit->v = v;
-            hit->prim = i;
-        }
-    }
-    return hit->prim != RS_NO_HIT;
-}
-
 static rs_bvh *build(const rs_geom *g, uint32_t max_leaf)
 {
     rs_bvh_build_opts o = {0};

@@ -7,7 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "core/ray.h"
+#include "core/geom.h"
 
 static inline uint64_t splitmix64(uint64_t *s)
 {
@@ -48,6 +48,25 @@ static inline rs_ray mk_ray(rs_vec3 o, rs_vec3 d, float tmin, float tmax)
     r.tmax = tmax;
     r.time = 0.0f;
     return r;
+}
+
+/* Closest hit by testing every primitive: the reference BVH tests compare against. */
+static inline int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
+{
+    uint32_t n = rs_geom_prim_count(g), i;
+    hit->prim = RS_NO_HIT;
+    hit->t = r->tmax;
+    hit->u = hit->v = 0.0f;
+    for (i = 0; i < n; ++i) {
+        float t, u, v;
+        if (rs_geom_intersect(g, i, r, &t, &u, &v) && (hit->prim == RS_NO_HIT || t < hit->t)) {
+            hit->t = t;
+            hit->u = u;
+            hit->v = v;
+            hit->prim = i;
+        }
+    }
+    return hit->prim != RS_NO_HIT;
 }
 
 #endif
