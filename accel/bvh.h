@@ -35,6 +35,20 @@ typedef struct rs_bvh_view {
  * closest-hit stack then holds at most depth - 1 entries and the any-hit stack depth + 1. */
 #define RS_BVH_STACK 64
 
+/* Traversal counters (the thesis's "ray-object intersection tests" metric): compiled in only in
+ * a translation unit that defines RS_COUNTERS before including this header (a benchmark's
+ * counting pass), as that unit's thread-local tallies.  Everywhere else RS_COUNT is empty, so
+ * the traversal the devices run pays nothing. */
+#if defined(RS_COUNTERS) && !defined(__CUDACC__)
+typedef struct rs_trace_counters {
+    uint64_t rays, nodes, box_tests, prim_tests;
+} rs_trace_counters;
+static _Thread_local rs_trace_counters rs_counters;
+#  define RS_COUNT(field, n) (rs_counters.field += (uint64_t)(n))
+#else
+#  define RS_COUNT(field, n) ((void)0)
+#endif
+
 RS_HD rs_vec3 rs_bvh_inv_dir(rs_vec3 d) { return rs_v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z); }
 
 /* The node's box test, with the ray/box algorithm the geometry names (g->aabb_algo; the slab
@@ -61,13 +75,17 @@ RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_
     hit->prim = RS_NO_HIT;
     hit->t = ray.tmax;
     hit->u = hit->v = 0.0f;
+    RS_COUNT(rays, 1);
+    RS_COUNT(box_tests, b->n_nodes > 0);
     if (b->n_nodes == 0 ||
         !rs_bvh_node_hit(&b->nodes[0], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &te))
         return 0;
     for (;;) {
         const rs_bvh_node *n = &b->nodes[node];
+        RS_COUNT(nodes, 1);
         if (n->count > 0) {
             uint32_t i;
+            RS_COUNT(prim_tests, n->count);
             for (i = 0; i < n->count; ++i) {
                 uint32_t prim = b->prim_ids[n->left_first + i];
                 float t, u, v;
@@ -82,8 +100,9 @@ RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_
         } else {
             uint32_t l = n->left_first, r = l + 1;
             float tl = 0.0f, tr = 0.0f;
-            int hl =
-                rs_bvh_node_hit(&b->nodes[l], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tl);
+            int hl;
+            RS_COUNT(box_tests, 2);
+            hl = rs_bvh_node_hit(&b->nodes[l], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tl);
             int hr =
                 rs_bvh_node_hit(&b->nodes[r], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tr);
             if (hl && hr) {
@@ -111,6 +130,7 @@ RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_
             if (sp == 0)
                 return hit->prim != RS_NO_HIT;
             node = stack[--sp];
+            RS_COUNT(box_tests, 1);
             if (rs_bvh_node_hit(&b->nodes[node], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax,
                                 &te))
                 break;
@@ -125,6 +145,7 @@ RS_HD int rs_bvh_occluded(const rs_bvh_view *b, const rs_geom *g, rs_ray ray)
     uint32_t sp = 0, node = 0;
     rs_vec3 inv_d = rs_bvh_inv_dir(ray.d);
     float te;
+    RS_COUNT(rays, 1);
     if (b->n_nodes == 0)
         return 0;
     stack[sp++] = 0;
@@ -132,12 +153,15 @@ RS_HD int rs_bvh_occluded(const rs_bvh_view *b, const rs_geom *g, rs_ray ray)
         const rs_bvh_node *n;
         node = stack[--sp];
         n = &b->nodes[node];
+        RS_COUNT(box_tests, 1);
         if (!rs_bvh_node_hit(n, g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &te))
             continue;
+        RS_COUNT(nodes, 1);
         if (n->count > 0) {
             uint32_t i;
             for (i = 0; i < n->count; ++i) {
                 float t, u, v;
+                RS_COUNT(prim_tests, 1);
                 if (rs_geom_intersect(g, b->prim_ids[n->left_first + i], &ray, &t, &u, &v))
                     return 1;
             }

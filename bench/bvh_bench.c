@@ -31,6 +31,7 @@
 #include "accel/bvh.h"
 #include "core/parallel.h"
 #include "machine.h"
+#include "bvh_count.h"
 #include "test_mesh.h"
 #include "test_rand.h"
 
@@ -48,7 +49,8 @@ typedef struct row {
     rs_bvh_builder b;
     double build1, buildn, sah;
     uint32_t nodes, depth, leaves, fallback;
-    double mrays[2][2]; /* [primary, diffuse][1 thread, all threads] */
+    double mrays[2][2];                 /* [primary, diffuse][1 thread, all threads] */
+    double box_tests[2], prim_tests[2]; /* per ray, primary / diffuse (counting pass) */
 } row;
 
 static double now_s(void)
@@ -333,6 +335,8 @@ static int bench_scene(const char *scene, const rs_tri *tris, uint32_t nt, const
                     rs_bvh_destroy(bvh);
                     goto out;
                 }
+            rs_bench_count_closest(bvh, &g, sets[k].rays, sets[k].n, &r->box_tests[k],
+                                   &r->prim_tests[k]);
             r->mrays[k][0] = mrays(bvh, &g, &sets[k], 1, st->runs);
             r->mrays[k][1] = mrays(bvh, &g, &sets[k], st->threads, st->runs);
         }
@@ -347,17 +351,19 @@ static int bench_scene(const char *scene, const rs_tri *tris, uint32_t nt, const
            100.0 * hits[1] / sets[1].n);
     printf("| builder | build ms 1 thr | build ms %d thr | build vs median | SAH cost | SAH vs "
            "median | nodes | depth | primary Mrays/s 1 thr | primary %d thr | diffuse 1 thr | "
-           "diffuse %d thr | primary vs median | diffuse vs median |\n",
+           "diffuse %d thr | primary vs median | diffuse vs median | box+prim tests/ray primary | "
+           "diffuse |\n",
            st->threads, st->threads, st->threads);
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (v = 0; v < st->n_variants; ++v) {
         const row *r = &rows[v], *m = median_row >= 0 ? &rows[median_row] : &rows[0];
         rs_bvh_builder_name(&r->b, name, sizeof name);
         printf("| %s | %.2f | %.2f | %.2fx | %.2f | %.3f | %u | %u | %.2f | %.2f | %.2f | %.2f | "
-               "%.2fx | %.2fx |\n",
+               "%.2fx | %.2fx | %.1f + %.1f | %.1f + %.1f |\n",
                name, 1e3 * r->build1, 1e3 * r->buildn, r->build1 / m->build1, r->sah,
                r->sah / m->sah, r->nodes, r->depth, r->mrays[0][0], r->mrays[0][1], r->mrays[1][0],
-               r->mrays[1][1], r->mrays[0][1] / m->mrays[0][1], r->mrays[1][1] / m->mrays[1][1]);
+               r->mrays[1][1], r->mrays[0][1] / m->mrays[0][1], r->mrays[1][1] / m->mrays[1][1],
+               r->box_tests[0], r->prim_tests[0], r->box_tests[1], r->prim_tests[1]);
         if (st->csv)
             fprintf(st->csv, "%s,%u,%s,%u,%.6f,%.6f,%.4f,%u,%u,%u,%u,%.4f,%.4f,%.4f,%.4f\n", scene,
                     nt, name, st->max_leaf, r->build1, r->buildn, r->sah, r->nodes, r->depth,
