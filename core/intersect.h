@@ -540,39 +540,33 @@ static inline const char *rs_isect_aabb_algo_name(uint32_t algo)
     return algo < RS_ISECT_AABB_COUNT ? names[algo] : "?";
 }
 
-/* Parse a name as printed by the *_name functions (exact, case-sensitive).  Returns 1 and
- * stores the id, or 0 and leaves *out alone when the name is unknown or text is NULL. */
-static inline int rs_isect_sphere_algo_parse(const char *text, uint32_t *out)
+/* The id whose name (by `name_of`) is `text`, exact and case-sensitive: returns 1 and stores it,
+ * or 0 and leaves *out alone when the name is unknown or text is NULL. */
+static inline int rs_isect_algo_parse(const char *text, uint32_t count,
+                                      const char *(*name_of)(uint32_t), uint32_t *out)
 {
     uint32_t a;
-    for (a = 0; text && a < RS_ISECT_SPHERE_COUNT; ++a)
-        if (strcmp(text, rs_isect_sphere_algo_name(a)) == 0) {
+    for (a = 0; text && a < count; ++a)
+        if (strcmp(text, name_of(a)) == 0) {
             *out = a;
             return 1;
         }
     return 0;
+}
+
+static inline int rs_isect_sphere_algo_parse(const char *text, uint32_t *out)
+{
+    return rs_isect_algo_parse(text, RS_ISECT_SPHERE_COUNT, rs_isect_sphere_algo_name, out);
 }
 
 static inline int rs_isect_tri_algo_parse(const char *text, uint32_t *out)
 {
-    uint32_t a;
-    for (a = 0; text && a < RS_ISECT_TRI_COUNT; ++a)
-        if (strcmp(text, rs_isect_tri_algo_name(a)) == 0) {
-            *out = a;
-            return 1;
-        }
-    return 0;
+    return rs_isect_algo_parse(text, RS_ISECT_TRI_COUNT, rs_isect_tri_algo_name, out);
 }
 
 static inline int rs_isect_aabb_algo_parse(const char *text, uint32_t *out)
 {
-    uint32_t a;
-    for (a = 0; text && a < RS_ISECT_AABB_COUNT; ++a)
-        if (strcmp(text, rs_isect_aabb_algo_name(a)) == 0) {
-            *out = a;
-            return 1;
-        }
-    return 0;
+    return rs_isect_algo_parse(text, RS_ISECT_AABB_COUNT, rs_isect_aabb_algo_name, out);
 }
 
 #endif

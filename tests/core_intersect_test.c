@@ -28,38 +28,12 @@
 
 #include "core/intersect.h"
 
+#include "test_isect_ref.h"
 #include "test_rand.h"
 
 #define T_INF FLT_MAX
 
 /* ---- helpers ------------------------------------------------------------------------------- */
-
-static rs_tri mk_tri(rs_vec3 a, rs_vec3 b, rs_vec3 c)
-{
-    rs_tri t;
-    t.v0 = a;
-    t.v1 = b;
-    t.v2 = c;
-    return t;
-}
-
-static rs_sphere mk_sphere(rs_vec3 c, float r)
-{
-    rs_sphere s;
-    s.center = c;
-    s.radius = r;
-    return s;
-}
-
-static rs_aabb mk_box(rs_vec3 lo, rs_vec3 hi)
-{
-    rs_aabb b;
-    b.lo = lo;
-    b.hi = hi;
-    return b;
-}
-
-static rs_vec3 inv_dir(rs_vec3 d) { return rs_v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z); }
 
 /* Sentinels: intersection routines write their outputs only on a hit. */
 #define SENTINEL (-12345.0f)
@@ -524,84 +498,6 @@ static void test_aabb_bounds_primitive_edge_on_face(void **state)
 
 /* ---- randomized comparison with double-precision references -------------------------------- */
 
-typedef struct ref_result {
-    int hit;       /* the exact answer for the float inputs */
-    int ambiguous; /* within the stated band: either answer is accepted, t is not compared */
-    double t;      /* on a hit */
-    double u, v;   /* on a hit: barycentrics (triangles) or planar coordinates (quads) */
-} ref_result;
-
-typedef struct dv3 {
-    double x, y, z;
-} dv3;
-
-static dv3 dv(rs_vec3 a)
-{
-    dv3 r;
-    r.x = a.x;
-    r.y = a.y;
-    r.z = a.z;
-    return r;
-}
-static dv3 dsub(dv3 a, dv3 b)
-{
-    dv3 r;
-    r.x = a.x - b.x;
-    r.y = a.y - b.y;
-    r.z = a.z - b.z;
-    return r;
-}
-static double ddot(dv3 a, dv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static dv3 dcross(dv3 a, dv3 b)
-{
-    dv3 r;
-    r.x = a.y * b.z - a.z * b.y;
-    r.y = a.z * b.x - a.x * b.z;
-    r.z = a.x * b.y - a.y * b.x;
-    return r;
-}
-
-/* Relative band around tmin and tmax in which either answer is accepted: a root that close to
- * an end of the interval is decided by float rounding of t itself. */
-#define T_BAND 1e-4
-
-static int near_bound(double t, double tmin, double tmax, double scale)
-{
-    double band = T_BAND * scale;
-    return fabs(t - tmin) <= band || (tmax < T_INF && fabs(t - tmax) <= band);
-}
-
-/* Sphere.  Reference: the same quadratic in double.  Ambiguous when the discriminant is within
- * 1e-5 of the size of its terms (|disc| < 1e-5 * a * (|oc|^2 + r^2)): float evaluates
- * h^2 - a c with an error of a few ulps of h^2, so closer to the silhouette than that float
- * cannot decide; the square root then amplifies that error, and this band keeps the t error of
- * a hit below 1e-4 relative. */
-static ref_result ref_sphere(const rs_sphere *s, const rs_ray *r)
-{
-    ref_result out = {0, 0, 0.0, 0.0, 0.0};
-    dv3 oc = dsub(dv(s->center), dv(r->o)), d = dv(r->d);
-    double a = ddot(d, d), h = ddot(d, oc), rad = s->radius;
-    double c = ddot(oc, oc) - rad * rad, disc = h * h - a * c;
-    double size = ddot(oc, oc) + rad * rad, scale = sqrt(size / a);
-    double sq, t0, t1;
-    out.ambiguous = fabs(disc) < 1e-5 * a * size;
-    if (disc < 0.0)
-        return out;
-    sq = sqrt(disc);
-    t0 = (h - sq) / a;
-    t1 = (h + sq) / a;
-    if (near_bound(t0, r->tmin, r->tmax, scale) || near_bound(t1, r->tmin, r->tmax, scale))
-        out.ambiguous = 1;
-    if (t0 > r->tmin && t0 < r->tmax) {
-        out.hit = 1;
-        out.t = t0;
-    } else if (t1 > r->tmin && t1 < r->tmax) {
-        out.hit = 1;
-        out.t = t1;
-    }
-    return out;
-}
-
 static void test_sphere_tangent(void **state)
 {
     uint64_t seed = 11;
@@ -673,62 +569,11 @@ static void test_sphere_tangent(void **state)
     assert_true(inside > 30000 && outside > 30000);
 }
 
-/* Edge band for triangles and quads, in barycentric units.  Float Moller-Trumbore computes
- * u = (s . p) / det with s = o - v0, p = d x e2, det = d . (e1 x e2); the numerator's rounding
- * error is a few ulps of |s||p|, so u is off by about eps |s| |e2| / (|e1 x e2| cos), i.e.
- * eps * (distance / edge length) * aspect / cos, where aspect = |e1||e2| / |e1 x e2| and cos is
- * that of the angle between the ray and the plane's normal.  The band is 16 times that
- * (eps = 2^-24 ~ 6e-8).  Closer to an edge than the band, either answer is accepted. */
-static double edge_band(dv3 e1, dv3 e2, dv3 o_minus_v0, dv3 d)
-{
-    dv3 n = dcross(e1, e2);
-    double nn = sqrt(ddot(n, n)), cosang = fabs(ddot(n, d)) / (nn * sqrt(ddot(d, d)));
-    double aspect = sqrt(ddot(e1, e1) * ddot(e2, e2)) / nn;
-    double edge = sqrt(fmin(ddot(e1, e1), ddot(e2, e2)));
-    double dist = sqrt(ddot(o_minus_v0, o_minus_v0));
-    return 16.0 * 0x1.0p-24 * (1.0 + dist / edge) * aspect / fmax(cosang, 1e-30);
-}
-
-/* Triangle.  Reference: plane intersection, then barycentrics by Cramer's rule, in double. */
-static ref_result ref_tri(const rs_tri *tr, const rs_ray *r)
-{
-    ref_result out = {0, 0, 0.0, 0.0, 0.0};
-    dv3 v0 = dv(tr->v0), e1 = dsub(dv(tr->v1), v0), e2 = dsub(dv(tr->v2), v0);
-    dv3 o = dv(r->o), d = dv(r->d), n = dcross(e1, e2), p, w;
-    double denom = ddot(n, d), t, u, v, band, m;
-    double scale = (sqrt(ddot(dsub(v0, o), dsub(v0, o))) + sqrt(ddot(e1, e1) + ddot(e2, e2))) /
-                   sqrt(ddot(d, d));
-    band = edge_band(e1, e2, dsub(o, v0), d);
-    if (band > 1e-3) {
-        /* grazing or sliver: the float answer is not meaningful to compare */
-        out.ambiguous = 1;
-    }
-    if (denom == 0.0)
-        return out;
-    t = ddot(n, dsub(v0, o)) / denom;
-    p.x = o.x + t * d.x - v0.x;
-    p.y = o.y + t * d.y - v0.y;
-    p.z = o.z + t * d.z - v0.z;
-    w = n;
-    u = ddot(w, dcross(p, e2)) / ddot(n, n);
-    v = ddot(w, dcross(e1, p)) / ddot(n, n);
-    m = fmin(fmin(u, v), 1.0 - u - v);
-    if (fabs(m) <= band || near_bound(t, r->tmin, r->tmax, scale))
-        out.ambiguous = 1;
-    if (m >= 0.0 && t > r->tmin && t < r->tmax) {
-        out.hit = 1;
-        out.t = t;
-        out.u = u;
-        out.v = v;
-    }
-    return out;
-}
-
 /* Quad.  Reference: the same plane and planar coordinates, in double from q, u, v (not from the
  * stored float w). */
 static ref_result ref_quad(const rs_quad *q, const rs_ray *r)
 {
-    ref_result out = {0, 0, 0.0, 0.0, 0.0};
+    ref_result out = {0, 0, 0.0, 0.0, 0.0, 0.0};
     dv3 q0 = dv(q->q), eu = dv(q->u), ev = dv(q->v), o = dv(r->o), d = dv(r->d);
     dv3 n = dcross(eu, ev), p;
     double denom = ddot(n, d), t, a, b, band, m;
