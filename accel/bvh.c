@@ -219,6 +219,7 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
     rs_bvh_key_id *pairs = NULL, *pairs2 = NULL;
     uint32_t *codes = NULL, *codes_tmp = NULL, *ids_tmp = NULL, next = 1, max_count = 0;
     int need_pairs, need_pairs2, lbvh;
+    rs_status st = RS_ERR_NOMEM; /* until the tree is complete */
     long i;
     *out = NULL;
     memset(&builder, 0, sizeof builder);
@@ -307,6 +308,9 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
     compact(slots, 0, b->nodes, 0, &next, &max_count);
     RS_ASSERT(next == b->n_nodes);
     b->max_leaf_count = max_count;
+    st = RS_OK;
+
+nomem: /* success falls through here too: the scratch buffers go either way */
     rs_free(bounds);
     rs_free(centroid);
     rs_free(slots);
@@ -315,20 +319,12 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
     rs_free(codes);
     rs_free(codes_tmp);
     rs_free(ids_tmp);
+    if (st != RS_OK) {
+        rs_bvh_destroy(b);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH over %u primitives", n);
+    }
     *out = b;
     return RS_OK;
-
-nomem:
-    rs_free(bounds);
-    rs_free(centroid);
-    rs_free(slots);
-    rs_free(pairs);
-    rs_free(pairs2);
-    rs_free(codes);
-    rs_free(codes_tmp);
-    rs_free(ids_tmp);
-    rs_bvh_destroy(b);
-    return rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH over %u primitives", n);
 }
 
 static double box_area(rs_vec3 lo, rs_vec3 hi)

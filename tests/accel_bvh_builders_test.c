@@ -689,22 +689,7 @@ static void test_identical_centroids(void **state)
     size_t v;
     (void)state;
     soup_alloc(&s, 400, 300, 300);
-    for (i = 0; i < s.g.n_spheres; ++i) {
-        s.spheres[i].center = c;
-        s.spheres[i].radius = (float)(i + 1) / 64.0f;
-    }
-    for (i = 0; i < s.g.n_quads; ++i) {
-        float a = (float)(1u << (i % 4));
-        rs_vec3 u = (i % 3 == 0) ? rs_v3(a, 0, 0) : rs_v3(0, a, 0);
-        rs_vec3 w = (i % 3 == 2) ? rs_v3(a, 0, 0) : rs_v3(0, 0, a);
-        s.quads[i] = rs_quad_make(rs_v3_sub(c, rs_v3_scale(rs_v3_add(u, w), 0.5f)), u, w);
-    }
-    for (i = 0; i < s.g.n_tris; ++i) {
-        float a = 0.5f * (float)(1 + i % 5);
-        s.tris[i].v0 = rs_v3(c.x - a, c.y - a, c.z);
-        s.tris[i].v1 = rs_v3(c.x + a, c.y, c.z - a);
-        s.tris[i].v2 = rs_v3(c.x, c.y + a, c.z + a);
-    }
+    fill_identical_centroids(s.spheres, s.g.n_spheres, s.quads, s.g.n_quads, s.tris, s.g.n_tris, c);
     for (i = 0; i < rs_geom_prim_count(&s.g); ++i) {
         rs_aabb b = rs_geom_prim_bounds(&s.g, i);
         rs_vec3 m = rs_v3_scale(rs_v3_add(b.lo, b.hi), 0.5f);

@@ -473,25 +473,7 @@ static void test_identical_centroids(void **state)
     static const uint32_t leaf_sizes[] = {1, 4, 8};
     (void)state;
     soup_alloc(&s, 400, 300, 300);
-    for (i = 0; i < s.g.n_spheres; ++i) {
-        s.spheres[i].center = c;
-        s.spheres[i].radius = (float)(i + 1) / 64.0f; /* c +- r exact: bounds centred on c */
-    }
-    for (i = 0; i < s.g.n_quads; ++i) {
-        /* a square centred on c: q = c - (u + v) / 2, with power-of-two sizes so the
-         * bounds' centre is c exactly */
-        float a = (float)(1u << (i % 4));
-        rs_vec3 u = (i % 3 == 0) ? rs_v3(a, 0, 0) : rs_v3(0, a, 0);
-        rs_vec3 v = (i % 3 == 2) ? rs_v3(a, 0, 0) : rs_v3(0, 0, a);
-        s.quads[i] = rs_quad_make(rs_v3_sub(c, rs_v3_scale(rs_v3_add(u, v), 0.5f)), u, v);
-    }
-    for (i = 0; i < s.g.n_tris; ++i) {
-        /* symmetric bounds about c */
-        float a = 0.5f * (float)(1 + i % 5);
-        s.tris[i].v0 = rs_v3(c.x - a, c.y - a, c.z);
-        s.tris[i].v1 = rs_v3(c.x + a, c.y, c.z - a);
-        s.tris[i].v2 = rs_v3(c.x, c.y + a, c.z + a);
-    }
+    fill_identical_centroids(s.spheres, s.g.n_spheres, s.quads, s.g.n_quads, s.tris, s.g.n_tris, c);
     for (i = 0; i < rs_geom_prim_count(&s.g); ++i) {
         rs_aabb b = rs_geom_prim_bounds(&s.g, i);
         rs_vec3 m = rs_v3_scale(rs_v3_add(b.lo, b.hi), 0.5f);

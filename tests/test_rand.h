@@ -69,4 +69,29 @@ static inline int brute_closest(const rs_geom *g, const rs_ray *r, rs_hit *hit)
     return hit->prim != RS_NO_HIT;
 }
 
+/* Fills the arrays so that every primitive's bounds are centred exactly on c (spheres c +- r;
+ * squares q = c - (u + v) / 2 with power-of-two sizes; triangles with bounds symmetric about c):
+ * the identical-centroids case every builder must survive. */
+static inline void fill_identical_centroids(rs_sphere *sp, uint32_t ns, rs_quad *qd, uint32_t nq,
+                                            rs_tri *tr, uint32_t nt, rs_vec3 c)
+{
+    uint32_t i;
+    for (i = 0; i < ns; ++i) {
+        sp[i].center = c;
+        sp[i].radius = (float)(i + 1) / 64.0f;
+    }
+    for (i = 0; i < nq; ++i) {
+        float a = (float)(1u << (i % 4));
+        rs_vec3 u = (i % 3 == 0) ? rs_v3(a, 0, 0) : rs_v3(0, a, 0);
+        rs_vec3 v = (i % 3 == 2) ? rs_v3(a, 0, 0) : rs_v3(0, 0, a);
+        qd[i] = rs_quad_make(rs_v3_sub(c, rs_v3_scale(rs_v3_add(u, v), 0.5f)), u, v);
+    }
+    for (i = 0; i < nt; ++i) {
+        float a = 0.5f * (float)(1 + i % 5);
+        tr[i].v0 = rs_v3(c.x - a, c.y - a, c.z);
+        tr[i].v1 = rs_v3(c.x + a, c.y, c.z - a);
+        tr[i].v2 = rs_v3(c.x, c.y + a, c.z + a);
+    }
+}
+
 #endif
