@@ -264,19 +264,6 @@ static const algo ALGOS[] = {
 
 /* ---- measuring ----------------------------------------------------------------------------- */
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 typedef struct result {
     double median_s;
     loop_out out;
@@ -404,13 +391,11 @@ int main(int argc, char **argv)
         for (a = 0; a < N_ALGOS; ++a) {
             double secs[64];
             for (k = 0; k < runs; ++k) {
-                double t0 = now_s();
+                double t0 = rs_bench_now();
                 res[o][a].out = order_fn(&ALGOS[a], o)(&in, passes[o], NULL, NULL);
-                secs[k] = now_s() - t0;
+                secs[k] = rs_bench_now() - t0;
             }
-            qsort(secs, (size_t)runs, sizeof secs[0], cmp_double);
-            res[o][a].median_s =
-                runs % 2 ? secs[runs / 2] : 0.5 * (secs[runs / 2 - 1] + secs[runs / 2]);
+            res[o][a].median_s = rs_bench_median(secs, runs);
         }
         /* the timed runs' hit counts against the baseline's (same inputs) */
         for (a = 0; a < N_ALGOS; ++a) {

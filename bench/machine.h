@@ -1,10 +1,13 @@
-/* bench/machine.h — the machine line every benchmark table starts with: CPU model, cores,
- * GPU, compiler and build flags.  Benchmark-only helper. */
+/* bench/machine.h — what every benchmark shares: the machine line its tables start with (CPU
+ * model, cores, GPU, compiler and build flags), a monotonic clock and the median of runs.
+ * Benchmark-only helper. */
 #ifndef RS_BENCH_MACHINE_H
 #define RS_BENCH_MACHINE_H
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/parallel.h"
 #include "gpu/gpu_device.h"
@@ -12,6 +15,27 @@
 #ifndef RS_BUILD_FLAGS
 #  define RS_BUILD_FLAGS "?"
 #endif
+
+/* Seconds on the monotonic clock. */
+static inline double rs_bench_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static inline int rs_bench_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The median of v[n] (sorts v). */
+static inline double rs_bench_median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof v[0], rs_bench_cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
 
 static inline void rs_bench_cpu_model(char *buf, size_t n)
 {

@@ -24,12 +24,6 @@ typedef struct result {
     uint64_t rays;
 } result;
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* One render; returns 0 on failure.  `rgb` (optional) receives the image. */
 static int render_once(const rs_scene *scene, const rs_bvh *bvh, uint32_t size, uint32_t spp,
                        int threads, float *rgb, result *res)
@@ -166,8 +160,7 @@ int main(int argc, char **argv)
             }
             secs[k] = r.seconds;
         }
-        qsort(secs, (size_t)n, sizeof secs[0], cmp_double);
-        med = n % 2 ? secs[n / 2] : 0.5 * (secs[n / 2 - 1] + secs[n / 2]);
+        med = rs_bench_median(secs, n);
         if (t == 1)
             base = med;
         sps = (double)size * size * spp / med;

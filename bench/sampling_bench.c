@@ -29,12 +29,6 @@ typedef struct scene_cfg {
 #define MAX_LEVELS   16
 #define N_STRATEGIES 4
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double rmse(const float *a, const float *b, size_t n)
 {
     double s = 0.0;
@@ -123,8 +117,7 @@ static int bench_scene(const scene_cfg *sc, uint32_t ref_spp, uint32_t max_spp, 
                 return 1;
             free(img);
         }
-        qsort(secs, (size_t)n, sizeof secs[0], cmp_double);
-        per_spp[k] = (n % 2 ? secs[n / 2] : 0.5 * (secs[n / 2 - 1] + secs[n / 2])) / 4.0;
+        per_spp[k] = rs_bench_median(secs, n) / 4.0;
     }
     for (k = 0; k < N_STRATEGIES; ++k) {
         double acc = 0.0;
