@@ -51,8 +51,29 @@ static _Thread_local rs_trace_counters rs_counters;
 
 RS_HD rs_vec3 rs_bvh_inv_dir(rs_vec3 d) { return rs_v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z); }
 
+/* Traversal's box tests are conservative by a relative margin: a box passes when the ray's
+ * interval [tn, tf] inside it, clipped to [tmin, tmax], satisfies tn <= tf * RS_BVH_SLACK.  The
+ * slab distances (bound - o) / d and a primitive test's t each carry rounding errors of a few
+ * ulps; without the margin a primitive hit exactly on its box's face (a ray through a mesh
+ * vertex, a point on an axis-aligned wall) could be culled by one ancestor box and found through
+ * another, so that the answer would depend on the order of the visit. */
+#define RS_BVH_SLACK (1.0f + 0x1.0p-16f)
+
+/* The slab test (rs_isect_aabb) with the margin. */
+RS_HD int rs_bvh_slab(const rs_aabb *b, rs_vec3 o, rs_vec3 inv_d, float tmin, float tmax,
+                      float *t_entry)
+{
+    float tn = tmin, tf = tmax;
+    rs_slab((b->lo.x - o.x) * inv_d.x, (b->hi.x - o.x) * inv_d.x, &tn, &tf);
+    rs_slab((b->lo.y - o.y) * inv_d.y, (b->hi.y - o.y) * inv_d.y, &tn, &tf);
+    rs_slab((b->lo.z - o.z) * inv_d.z, (b->hi.z - o.z) * inv_d.z, &tn, &tf);
+    *t_entry = tn;
+    return tn <= tf * RS_BVH_SLACK;
+}
+
 /* The node's box test, with the ray/box algorithm the geometry names (g->aabb_algo; the slab
- * test by default).  The id is loop-invariant, so the branch is predicted perfectly. */
+ * test with the margin by default; the other algorithms, benchmark options, get the margin on
+ * tmax only).  The id is loop-invariant, so the branch is predicted perfectly. */
 RS_HD int rs_bvh_node_hit(const rs_bvh_node *n, uint32_t algo, rs_vec3 o, rs_vec3 inv_d, float tmin,
                           float tmax, float *t_entry)
 {
@@ -60,12 +81,42 @@ RS_HD int rs_bvh_node_hit(const rs_bvh_node *n, uint32_t algo, rs_vec3 o, rs_vec
     b.lo = n->lo;
     b.hi = n->hi;
     if (algo == 0)
-        return rs_isect_aabb(&b, o, inv_d, tmin, tmax, t_entry);
-    return rs_isect_aabb_by(algo, &b, o, inv_d, tmin, tmax, t_entry);
+        return rs_bvh_slab(&b, o, inv_d, tmin, tmax, t_entry);
+    return rs_isect_aabb_by(algo, &b, o, inv_d, tmin, tmax * RS_BVH_SLACK, t_entry);
+}
+
+/* The next float above t (for t >= 0, the common case, the next bit pattern): a bound that lets
+ * a primitive hit at exactly t through the primitive tests' strict t < tmax. */
+RS_HD float rs_float_next_up(float t)
+{
+    union {
+        float f;
+        uint32_t u;
+    } x;
+    x.f = t;
+    if (t == 0.0f)
+        x.u = 1u; /* the smallest denormal, also above -0 */
+    else if (t > 0.0f && x.u < 0x7f800000u)
+        x.u++;
+    else if (t < 0.0f)
+        x.u--;
+    return x.f;
+}
+
+/* Which closest hit a traversal reports, whatever order it visits the primitives in: the smallest
+ * t, and of primitives hit at exactly that t the lowest-numbered (what a brute-force loop over
+ * the primitives in order keeps).  After a hit at t, a traversal keeps searching up to
+ * rs_float_next_up(t) so that ties are seen, and takes a candidate (t', prim') when this says so
+ * (before any hit, best->t is the ray's tmax and best->prim RS_NO_HIT).  So the binary and the 4-wide traversals (accel/bvh4.h), on any device, agree
+ * bit for bit. */
+RS_HD int rs_hit_better(float t, uint32_t prim, const rs_hit *best)
+{
+    return t < best->t || (t == best->t && prim < best->prim);
 }
 
 /* Closest hit along `ray` (ordered, stack-based traversal: the nearer child first, the other
- * pushed).  Returns 1 and fills *hit on a hit; on a miss sets hit->prim = RS_NO_HIT, returns 0. */
+ * pushed).  Returns 1 and fills *hit on a hit; on a miss sets hit->prim = RS_NO_HIT, returns 0.
+ * Ties go to the lowest primitive number (rs_hit_better). */
 RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
 {
     uint32_t stack[RS_BVH_STACK];
@@ -89,8 +140,8 @@ RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_
             for (i = 0; i < n->count; ++i) {
                 uint32_t prim = b->prim_ids[n->left_first + i];
                 float t, u, v;
-                if (rs_geom_intersect(g, prim, &ray, &t, &u, &v)) {
-                    ray.tmax = t;
+                if (rs_geom_intersect(g, prim, &ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
+                    ray.tmax = rs_float_next_up(t);
                     hit->t = t;
                     hit->u = u;
                     hit->v = v;

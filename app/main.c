@@ -101,19 +101,22 @@ static int create_devices(const rs_cli_options *o, int threads, rs_device **devs
         const rs_device_spec *d = &o->devices[i];
         rs_status st;
         if (!d->is_gpu) {
-            st = rs_cpu_device_create(d->threads ? d->threads : threads, "cpu", &devs[n]);
+            rs_cpu_device_opts co;
+            memset(&co, 0, sizeof co);
+            co.threads = d->threads ? d->threads : threads;
+            co.name = "cpu";
+            co.bvh_width = o->bvh_width;
+            st = rs_cpu_device_create_opts(&co, &devs[n]);
         } else {
             st = rs_gpu_device_create(d->index, &devs[n]);
             if (st != RS_OK) {
                 /* alone, the fallback may use every core; beside a cpu device, one of them */
                 int ft = o->n_devices == 1 ? threads : 1;
-                char name[48];
                 fprintf(stderr,
                         "raystream: warning: %s; gpu:%d runs on the CPU fallback (%d thread%s)\n",
                         rs_error_message(), d->index, ft, ft == 1 ? "" : "s");
                 rs_error_clear();
-                snprintf(name, sizeof name, "gpu-fallback:%d", d->index);
-                st = rs_cpu_device_create(ft, name, &devs[n]);
+                st = rs_cpu_fallback_device_create(ft, d->index, &devs[n]);
             }
         }
         if (st != RS_OK) {

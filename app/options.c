@@ -126,6 +126,9 @@ void rs_cli_print_help(const char *command)
             "  --bvh NAME          BVH builder: median (default), sah or sah:BINS, lbvh, or the\n"
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
+            "  --bvh-width W       the CPU's traversal: 4 (default; the binary BVH collapsed to\n"
+            "                      4-wide nodes, SSE box tests) or 2 (the binary BVH, as on\n"
+            "                      the GPU).  Same image either way.\n"
             "  --isect-sphere A    algebraic (default) or geometric\n"
             "  --isect-tri A       moller (default), snyder-barr or watertight\n"
             "  --isect-aabb A      slab (default), branchless, williams, kensler or swap\n"
@@ -286,6 +289,11 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
                 rs_error_clear();
                 return RS_EXIT_USAGE;
             }
+        } else if (strcmp(name, "--bvh-width") == 0) {
+            NEEDS_VALUE();
+            if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0)
+                return usage_error("--bvh-width must be 2 or 4, not '%s'%s", v, "");
+            o->bvh_width = (uint32_t)(v[0] - '0');
         } else if (strcmp(name, "--isect-sphere") == 0) {
             NEEDS_VALUE();
             if (!rs_isect_sphere_algo_parse(v, &o->isect_sphere))

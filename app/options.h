@@ -46,6 +46,7 @@ typedef struct rs_cli_options {
     uint32_t isect_sphere;     /* --isect-sphere: rs_isect_sphere_algo */
     uint32_t isect_tri;        /* --isect-tri: rs_isect_tri_algo */
     uint32_t isect_aabb;       /* --isect-aabb: rs_isect_aabb_algo */
+    uint32_t bvh_width;        /* --bvh-width 2|4: the CPU device's traversal (default 4) */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
 } rs_cli_options;

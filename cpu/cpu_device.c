@@ -1,14 +1,18 @@
-/* cpu/cpu_device.c — see cpu_device.h.  Borrows the host scene and BVH arrays (no copy). */
+/* cpu/cpu_device.c — see cpu_device.h.  Borrows the host scene and BVH arrays (no copy); owns
+ * only the 4-wide tree it collapses from the BVH. */
 #include "cpu/cpu_device.h"
 
 #include <stdio.h>
 #include <string.h>
 
+#include "accel/bvh4.h"
 #include "core/alloc.h"
 
 typedef struct cpu_impl {
     rs_geom geom;
     rs_bvh_view bvh;
+    rs_bvh4 *bvh4; /* NULL: the binary kernel */
+    uint32_t width;
     int uploaded;
 } cpu_impl;
 
@@ -17,6 +21,13 @@ static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     cpu_impl *c = (cpu_impl *)d->impl;
     c->geom = *g;
     c->bvh = rs_bvh_view_of(bvh);
+    rs_bvh4_destroy(c->bvh4);
+    c->bvh4 = NULL;
+    if (c->width == 4 && g->aabb_algo == RS_ISECT_AABB_SLAB) {
+        rs_status st = rs_bvh4_build(bvh, g, &c->bvh4);
+        if (st != RS_OK)
+            return st;
+    }
     c->uploaded = 1;
     return RS_OK;
 }
@@ -34,20 +45,48 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
          * costs more than it saves. */
 #pragma omp parallel for num_threads(d->threads)                                                   \
     schedule(dynamic, 256) if (d->threads > 1 && end - begin >= 512u)
-    for (i = (long)begin; i < (long)end; ++i)
-        rs_trace_one(bv, g, batch, (uint32_t)i);
+    for (i = (long)begin; i < (long)end; ++i) {
+        if (c->bvh4)
+            rs_bvh4_trace_one(c->bvh4, g, batch, (uint32_t)i);
+        else
+            rs_trace_one(bv, g, batch, (uint32_t)i);
+    }
     return RS_OK;
 }
 
 static void cpu_destroy(rs_device *d)
 {
-    rs_free(d->impl);
+    cpu_impl *c = (cpu_impl *)d->impl;
+    if (c)
+        rs_bvh4_destroy(c->bvh4);
+    rs_free(c);
     rs_free(d);
 }
 
 static const rs_device_ops cpu_ops = {cpu_upload, cpu_trace, cpu_destroy};
 
 rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
+{
+    rs_cpu_device_opts o;
+    memset(&o, 0, sizeof o);
+    o.threads = threads;
+    o.name = name;
+    return rs_cpu_device_create_opts(&o, out);
+}
+
+rs_status rs_cpu_fallback_device_create(int threads, int gpu_index, rs_device **out)
+{
+    rs_cpu_device_opts o;
+    char name[48];
+    snprintf(name, sizeof name, "gpu-fallback:%d", gpu_index);
+    memset(&o, 0, sizeof o);
+    o.threads = threads;
+    o.name = name;
+    o.bvh_width = 2;
+    return rs_cpu_device_create_opts(&o, out);
+}
+
+rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out)
 {
     rs_device *d = (rs_device *)rs_calloc(1, sizeof *d);
     cpu_impl *c = (cpu_impl *)rs_calloc(1, sizeof *c);
@@ -57,10 +96,16 @@ rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
         rs_free(c);
         return rs_error_set(RS_ERR_NOMEM, "out of memory creating the CPU device");
     }
+    if (o->bvh_width != 0 && o->bvh_width != 2 && o->bvh_width != 4) {
+        rs_free(d);
+        rs_free(c);
+        return rs_error_set(RS_ERR_ARG, "BVH width %u: 2 or 4", o->bvh_width);
+    }
+    c->width = o->bvh_width ? o->bvh_width : 4;
     d->ops = &cpu_ops;
     d->impl = c;
-    d->threads = threads < 1 ? 1 : threads;
-    snprintf(d->name, sizeof d->name, "%s", name ? name : "cpu");
+    d->threads = o->threads < 1 ? 1 : o->threads;
+    snprintf(d->name, sizeof d->name, "%s", o->name ? o->name : "cpu");
     *out = d;
     return RS_OK;
 }

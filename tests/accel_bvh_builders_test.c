@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "accel/bvh.h"
+#include "accel/bvh4.h"
 #include "core/alloc.h"
 
 #include "test_mesh.h"
@@ -247,39 +248,41 @@ static void ray_set_free(ray_set *rs)
     free(rs->ref_hit);
 }
 
-/* Checks the first n rays of `rs` against the tree; returns the hit count.  t must be bit-equal
- * (the same routine computes it); the prim may differ only on an exact tie. */
+/* Checks the first n rays of `rs` against the tree and its 4-wide collapse (the CPU device's
+ * kernel); returns the hit count.  The answer must be brute force's bit for bit: the same
+ * routines compute t, u, v, and every kernel breaks ties by the lowest prim (rs_hit_better). */
 static long check_rays(const rs_bvh *bvh, const rs_geom *g, const ray_set *rs, long n,
                        const char *what)
 {
     rs_bvh_view view = rs_bvh_view_of(bvh);
+    rs_bvh4 *b4 = NULL;
     long i, hits = 0;
+    if (rs_bvh4_build(bvh, g, &b4) != RS_OK)
+        fail_msg("%s: rs_bvh4_build: %s", what, rs_error_message());
     if (n > rs->n)
         n = rs->n;
     for (i = 0; i < n; ++i) {
         const rs_ray *r = &rs->rays[i];
         const rs_hit *ref = &rs->ref[i];
-        rs_hit h;
-        int got = rs_bvh_closest(&view, g, *r, &h), occ = rs_bvh_occluded(&view, g, *r);
-        int want = rs->ref_hit[i];
+        int want = rs->ref_hit[i], k;
         hits += want;
-        if (got != want || (got && h.t != ref->t) || (!got && h.prim != RS_NO_HIT) ||
-            (got && h.prim == ref->prim && (h.u != ref->u || h.v != ref->v)))
-            fail_msg("%s ray %ld: bvh %s prim %u t %.9g, brute force %s prim %u t %.9g "
-                     "(o %g %g %g d %g %g %g t %g..%g time %g)",
-                     what, i, got ? "hit" : "miss", h.prim, h.t, want ? "hit" : "miss", ref->prim,
-                     ref->t, r->o.x, r->o.y, r->o.z, r->d.x, r->d.y, r->d.z, r->tmin, r->tmax,
-                     r->time);
-        if (got && h.prim != ref->prim) {
-            float t, u, v;
-            if (!(h.prim < rs_geom_prim_count(g) && rs_geom_intersect(g, h.prim, r, &t, &u, &v) &&
-                  t == ref->t))
-                fail_msg("%s ray %ld: bvh prim %u is not a tie with prim %u at t %.9g", what, i,
-                         h.prim, ref->prim, ref->t);
+        for (k = 0; k < 2; ++k) {
+            rs_hit h;
+            int got = k ? rs_bvh4_closest(b4, g, *r, &h) : rs_bvh_closest(&view, g, *r, &h);
+            int occ = k ? rs_bvh4_occluded(b4, g, *r) : rs_bvh_occluded(&view, g, *r);
+            if (got != want || h.prim != ref->prim ||
+                (got && (h.t != ref->t || h.u != ref->u || h.v != ref->v)))
+                fail_msg("%s ray %ld (%s kernel): bvh %s prim %u t %.9g, brute force %s prim %u "
+                         "t %.9g (o %g %g %g d %g %g %g t %g..%g time %g)",
+                         what, i, k ? "4-wide" : "binary", got ? "hit" : "miss", h.prim, h.t,
+                         want ? "hit" : "miss", ref->prim, ref->t, r->o.x, r->o.y, r->o.z, r->d.x,
+                         r->d.y, r->d.z, r->tmin, r->tmax, r->time);
+            if (occ != want)
+                fail_msg("%s ray %ld (%s kernel): occluded %d, brute force %d", what, i,
+                         k ? "4-wide" : "binary", occ, want);
         }
-        if (occ != want)
-            fail_msg("%s ray %ld: occluded %d, brute force %d", what, i, occ, want);
     }
+    rs_bvh4_destroy(b4);
     return hits;
 }
 

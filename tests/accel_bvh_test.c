@@ -1,13 +1,17 @@
-/* tests/accel_bvh_test.c — accel/bvh.h: rs_bvh_build, rs_bvh_closest and rs_bvh_occluded.
+/* tests/accel_bvh_test.c — accel/bvh.h and accel/bvh4.h: rs_bvh_build, the binary traversal
+ * (rs_bvh_closest, rs_bvh_occluded) and the 4-wide one the CPU device runs (rs_bvh4_*).
  *
  * What is checked:
  *   - traversal equals brute force: over a fixed-seed soup of 2000 triangles, 300 spheres and
  *     200 quads (global numbering of core/geom.h: spheres, quads, triangles), 10^5 random rays
  *     (origins inside and outside the soup, random and axis-aligned directions, some with tmin
  *     or tmax limited) give the same closest prim, t, u and v as looping rs_geom_intersect over
- *     every primitive, for trees with max_leaf 1, 4 and 8.  t must be bit-identical: the same
- *     routine computes it.  The prim may differ only when both prims give that identical t.
- *     rs_bvh_occluded equals "brute force found a hit in (tmin, tmax)";
+ *     every primitive, for trees with max_leaf 1, 4 and 8, with both kernels, bit for bit: the
+ *     same routines compute t, and ties go to the lowest prim number in every kernel as in the
+ *     brute-force loop (rs_hit_better).  The 4-wide kernel packs leaves of triangles and tests
+ *     four at once; a soup of triangles alone (every leaf packed) and one with the watertight
+ *     test (none packed) are checked too.  Occlusion equals "brute force found a hit in
+ *     (tmin, tmax)";
  *   - structure: every prim id appears exactly once in prim_ids; the leaves' ranges partition
  *     prim_ids; every node is reachable exactly once; each node's bounds contain its children's
  *     and its primitives' bounds (rs_geom_prim_bounds); each interior node separates its
@@ -16,7 +20,8 @@
  *   - edge cases: no primitives (no nodes, every ray misses), one primitive of each kind, all
  *     centroids identical (the build ends and traversal stays exact), rays with NaN or Inf
  *     components (return within a time limit, with a valid answer), an axis-aligned ray lying
- *     in the scene's bounding plane, and allocation failure during the build. */
+ *     in the scene's bounding plane, and allocation failure during the build and the collapse
+ *     to 4-wide nodes. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -32,6 +37,7 @@
 #include <unistd.h>
 
 #include "accel/bvh.h"
+#include "accel/bvh4.h"
 #include "core/alloc.h"
 
 #include "test_rand.h"
@@ -133,37 +139,44 @@ static void describe_ray(char *buf, size_t n, const rs_ray *r)
              r->d.x, r->d.y, r->d.z, r->tmin, r->tmax);
 }
 
-/* Compares one BVH query against the brute-force answer for ray r. */
-static void expect_same_hit(const rs_bvh *bvh, const rs_geom *g, const rs_ray *r, const rs_hit *ref,
-                            int ref_hit, const char *what, long index)
+/* The 4-wide tree of `b`, or a test failure. */
+static rs_bvh4 *collapse4(const rs_bvh *b, const rs_geom *g)
 {
+    rs_bvh4 *b4 = NULL;
+    rs_status st = rs_bvh4_build(b, g, &b4);
+    if (st != RS_OK)
+        fail_msg("rs_bvh4_build failed: %d (%s)", (int)st, rs_error_message());
+    assert_non_null(b4);
+    return b4;
+}
+
+/* Compares the queries of the binary tree and, if b4 is not NULL, of the 4-wide one against the
+ * brute-force answer for ray r: the same hit bit for bit, and the same occlusion. */
+static void expect_same_hit(const rs_bvh *bvh, const rs_bvh4 *b4, const rs_geom *g,
+                            const rs_ray *r, const rs_hit *ref, int ref_hit, const char *what,
+                            long index)
+{
+    static const char *const kernel[2] = {"binary", "4-wide"};
     rs_bvh_view view = rs_bvh_view_of(bvh);
-    rs_hit h;
-    int got = rs_bvh_closest(&view, g, *r, &h), occ = rs_bvh_occluded(&view, g, *r);
-    char ray[256];
-    if (got != ref_hit ||
-        (got && (h.t != ref->t || (h.prim == ref->prim && (h.u != ref->u || h.v != ref->v)))) ||
-        (!got && h.prim != RS_NO_HIT) || (got && h.prim >= rs_geom_prim_count(g))) {
-        describe_ray(ray, sizeof ray, r);
-        fail_msg("%s ray %ld: bvh %s prim %u t %.9g (u %.9g v %.9g), brute force %s prim %u t "
-                 "%.9g (u %.9g v %.9g); %s",
-                 what, index, got ? "hit" : "miss", h.prim, h.t, h.u, h.v, ref_hit ? "hit" : "miss",
-                 ref->prim, ref->t, ref->u, ref->v, ray);
-    }
-    if (got && h.prim != ref->prim) {
-        /* a tie: the BVH's prim must give exactly the same t */
-        float t, u, v;
-        if (!(rs_geom_intersect(g, h.prim, r, &t, &u, &v) && t == ref->t)) {
+    int k;
+    for (k = 0; k < (b4 ? 2 : 1); ++k) {
+        rs_hit h;
+        int got = k ? rs_bvh4_closest(b4, g, *r, &h) : rs_bvh_closest(&view, g, *r, &h);
+        int occ = k ? rs_bvh4_occluded(b4, g, *r) : rs_bvh_occluded(&view, g, *r);
+        char ray[256];
+        if (got != ref_hit || h.prim != ref->prim ||
+            (got && (h.t != ref->t || h.u != ref->u || h.v != ref->v))) {
             describe_ray(ray, sizeof ray, r);
-            fail_msg("%s ray %ld: bvh prim %u, brute force prim %u at the same t %.9g, but prim "
-                     "%u does not hit there; %s",
-                     what, index, h.prim, ref->prim, ref->t, h.prim, ray);
+            fail_msg("%s ray %ld: %s bvh %s prim %u t %.9g (u %.9g v %.9g), brute force %s prim "
+                     "%u t %.9g (u %.9g v %.9g); %s",
+                     what, index, kernel[k], got ? "hit" : "miss", h.prim, h.t, h.u, h.v,
+                     ref_hit ? "hit" : "miss", ref->prim, ref->t, ref->u, ref->v, ray);
         }
-    }
-    if (occ != ref_hit) {
-        describe_ray(ray, sizeof ray, r);
-        fail_msg("%s ray %ld: rs_bvh_occluded %d, brute force %s; %s", what, index, occ,
-                 ref_hit ? "hit" : "miss", ray);
+        if (occ != ref_hit) {
+            describe_ray(ray, sizeof ray, r);
+            fail_msg("%s ray %ld: %s occluded %d, brute force %s; %s", what, index, kernel[k],
+                     occ, ref_hit ? "hit" : "miss", ray);
+        }
     }
 }
 
@@ -352,39 +365,136 @@ static rs_ray soup_ray(uint64_t *s, long i)
     return mk_ray(o, d, tmin, tmax);
 }
 
+/* A height field of triangles on an n x n grid of cells, two per cell, sharing their edges and
+ * vertices exactly: rays aimed at its vertices cross several triangles at one point, where
+ * two of them can report the very same t (a tie the kernels must break the same way). */
+static void soup_grid(soup *s, uint32_t n, uint64_t seed)
+{
+    uint32_t x, y;
+    float *h = (float *)malloc((size_t)(n + 1) * (n + 1) * sizeof *h);
+    assert_non_null(h);
+    for (x = 0; x < (n + 1) * (n + 1); ++x)
+        h[x] = rnd_range(&seed, -2.0, 2.0);
+    soup_alloc(s, 0, 0, 2 * n * n);
+    for (y = 0; y < n; ++y)
+        for (x = 0; x < n; ++x) {
+            rs_vec3 a = rs_v3((float)x, h[y * (n + 1) + x], (float)y);
+            rs_vec3 b = rs_v3((float)x + 1, h[y * (n + 1) + x + 1], (float)y);
+            rs_vec3 c = rs_v3((float)x, h[(y + 1) * (n + 1) + x], (float)y + 1);
+            rs_vec3 d = rs_v3((float)x + 1, h[(y + 1) * (n + 1) + x + 1], (float)y + 1);
+            rs_tri *t = &s->tris[2 * (y * n + x)];
+            t[0].v0 = a, t[0].v1 = b, t[0].v2 = c;
+            t[1].v0 = b, t[1].v1 = d, t[1].v2 = c;
+        }
+    free(h);
+}
+
+/* Rays from above the grid aimed at one of its vertices, or at a random point. */
+static rs_ray grid_ray(uint64_t *s, long i, uint32_t n, const soup *g)
+{
+    rs_vec3 o = rs_v3(rnd_range(s, -5.0, n + 5.0), rnd_range(s, 5.0, 30.0),
+                      rnd_range(s, -5.0, n + 5.0));
+    rs_vec3 target;
+    if (i % 4 != 3) {
+        const rs_tri *t = &g->tris[(uint32_t)(rnd01(s) * g->g.n_tris)];
+        target = i % 4 == 0 ? t->v0 : (i % 4 == 1 ? t->v1 : t->v2);
+    } else {
+        target = rs_v3(rnd_range(s, 0.0, n), 0.0f, rnd_range(s, 0.0, n));
+    }
+    return mk_ray(o, rs_v3_sub(target, o), 0.0f, T_INF);
+}
+
+/* How many primitives other than ref->prim hit r at exactly ref->t. */
+static int brute_ties(const rs_geom *g, const rs_ray *r, const rs_hit *ref)
+{
+    uint32_t i, n = rs_geom_prim_count(g);
+    int ties = 0;
+    for (i = 0; i < n; ++i) {
+        float t, u, v;
+        ties += i != ref->prim && rs_geom_intersect(g, i, r, &t, &u, &v) && t == ref->t;
+    }
+    return ties;
+}
+
+/* n rays (from the soup's generator, or the grid's when grid > 0) against brute force, for trees
+ * with max_leaf 1, 4 and 8 and both kernels.  Returns the hits; *ties counts the rays whose
+ * closest t several primitives share. */
+static long check_vs_brute_force(const soup *s, const char *name, long n, uint32_t grid,
+                                 long *ties)
+{
+    static const uint32_t leaf_sizes[] = {1, 4, 8};
+    rs_bvh *trees[3];
+    rs_bvh4 *wide[3];
+    uint64_t rs = 0xbeef;
+    long i, hits = 0;
+    size_t k;
+    *ties = 0;
+    for (k = 0; k < 3; ++k) {
+        trees[k] = build(&s->g, leaf_sizes[k]);
+        wide[k] = collapse4(trees[k], &s->g);
+    }
+    for (i = 0; i < n; ++i) {
+        rs_ray r = grid ? grid_ray(&rs, i, grid, s) : soup_ray(&rs, i);
+        rs_hit ref;
+        int ref_hit = brute_closest(&s->g, &r, &ref);
+        hits += ref_hit;
+        if (ref_hit && grid)
+            *ties += brute_ties(&s->g, &r, &ref) > 0;
+        for (k = 0; k < 3; ++k) {
+            char what[64];
+            snprintf(what, sizeof what, "%s, max_leaf %u", name, leaf_sizes[k]);
+            expect_same_hit(trees[k], wide[k], &s->g, &r, &ref, ref_hit, what, i);
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        rs_bvh4_destroy(wide[k]);
+        rs_bvh_destroy(trees[k]);
+    }
+    return hits;
+}
+
 static void test_random_rays_vs_brute_force(void **state)
 {
     enum { N_RAYS = 100000 };
-    static const uint32_t leaf_sizes[] = {1, 4, 8};
-    rs_bvh *trees[3];
-    uint64_t rs = 0xbeef;
     soup s;
-    long i, hits = 0, ties = 0;
-    size_t k;
+    long hits, ties;
     (void)state;
     soup_random(&s, 0x5eed);
-    for (k = 0; k < 3; ++k)
-        trees[k] = build(&s.g, leaf_sizes[k]);
-    for (i = 0; i < N_RAYS; ++i) {
-        rs_ray r = soup_ray(&rs, i);
-        rs_hit ref;
-        int ref_hit = brute_closest(&s.g, &r, &ref);
-        hits += ref_hit;
-        for (k = 0; k < 3; ++k) {
-            char what[32];
-            rs_bvh_view v = rs_bvh_view_of(trees[k]);
-            rs_hit h;
-            snprintf(what, sizeof what, "max_leaf %u", leaf_sizes[k]);
-            expect_same_hit(trees[k], &s.g, &r, &ref, ref_hit, what, i);
-            if (k == 0 && rs_bvh_closest(&v, &s.g, r, &h) && h.prim != ref.prim)
-                ++ties;
-        }
-    }
-    print_message("%d rays: %ld hit (%ld ties resolved to another prim)\n", N_RAYS, hits, ties);
+    hits = check_vs_brute_force(&s, "soup", N_RAYS, 0, &ties);
+    print_message("soup: %d rays, %ld hit\n", N_RAYS, hits);
     /* both outcomes well represented, or the comparison says little */
     assert_true(hits > N_RAYS / 5 && hits < N_RAYS - N_RAYS / 5);
-    for (k = 0; k < 3; ++k)
-        rs_bvh_destroy(trees[k]);
+    /* the same soup with the watertight triangle test: the 4-wide tree packs no leaves then */
+    s.g.tri_algo = RS_ISECT_TRI_WATERTIGHT;
+    hits = check_vs_brute_force(&s, "soup, watertight", N_RAYS / 4, 0, &ties);
+    assert_true(hits > N_RAYS / 20);
+    soup_free(&s);
+}
+
+static void test_shared_vertices_vs_brute_force(void **state)
+{
+    enum { N_RAYS = 40000, GRID = 24 };
+    soup s;
+    long hits, ties;
+    rs_bvh *b;
+    rs_bvh4 *b4;
+    (void)state;
+    soup_grid(&s, GRID, 0x9e1d);
+    /* a triangles-only scene: with Möller-Trumbore every 4-wide leaf is packed */
+    b = build(&s.g, 4);
+    b4 = collapse4(b, &s.g);
+#ifdef RS_BVH4_SSE
+    assert_true(b4->n_packed > 0);
+    assert_true(b4->n_tri4 >= (s.g.n_tris + 3) / 4);
+#endif
+    rs_bvh4_destroy(b4);
+    rs_bvh_destroy(b);
+    hits = check_vs_brute_force(&s, "grid", N_RAYS, GRID, &ties);
+    print_message("grid: %d rays, %ld hit, %ld at a t that several triangles share\n", N_RAYS,
+                  hits, ties);
+    assert_true(hits > N_RAYS * 3 / 4);
+    /* the tie rule was exercised */
+    assert_true(ties > 100);
     soup_free(&s);
 }
 
@@ -412,6 +522,15 @@ static void test_empty(void **state)
         assert_int_equal(rs_bvh_closest(&v, &g, r, &h), 0);
         assert_int_equal(h.prim, RS_NO_HIT);
         assert_int_equal(rs_bvh_occluded(&v, &g, r), 0);
+    }
+    {
+        rs_bvh4 *b4 = collapse4(b, &g);
+        rs_ray r = mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f, T_INF);
+        assert_int_equal(b4->n_nodes, 0);
+        assert_int_equal(rs_bvh4_closest(b4, &g, r, &h), 0);
+        assert_int_equal(h.prim, RS_NO_HIT);
+        assert_int_equal(rs_bvh4_occluded(b4, &g, r), 0);
+        rs_bvh4_destroy(b4);
     }
     rs_bvh_destroy(b);
 }
@@ -455,6 +574,21 @@ static void test_single_primitive(void **state)
             rs_bvh_closest(&v, &s.g, mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f, T_INF), &h), 0);
         assert_int_equal(
             rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(5, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF)), 0);
+        {
+            /* a tree that is one leaf: a 4-wide root with one leaf lane */
+            rs_bvh4 *b4 = collapse4(b, &s.g);
+            rs_ray down = mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF);
+            assert_int_equal(b4->n_nodes, 1);
+            assert_int_equal(b4->nodes[0].n_lanes, 1);
+            assert_int_equal(rs_bvh4_closest(b4, &s.g, down, &h), 1);
+            assert_int_equal(h.prim, 0);
+            assert_true(h.t == (kind == 0 ? 4.0f : 5.0f));
+            assert_int_equal(rs_bvh4_occluded(b4, &s.g, down), 1);
+            down.tmax = 3.5f;
+            assert_int_equal(rs_bvh4_closest(b4, &s.g, down, &h), 0);
+            assert_int_equal(rs_bvh4_occluded(b4, &s.g, down), 0);
+            rs_bvh4_destroy(b4);
+        }
         rs_bvh_destroy(b);
         soup_free(&s);
     }
@@ -481,6 +615,7 @@ static void test_identical_centroids(void **state)
     }
     for (k = 0; k < 3; ++k) {
         rs_bvh *b = build(&s.g, leaf_sizes[k]);
+        rs_bvh4 *b4 = collapse4(b, &s.g);
         check_structure(b, &s.g, leaf_sizes[k]);
         for (j = 0; j < 5000; ++j) {
             rs_ray r = mk_ray(rs_v3_add(c, rnd_box(&seed, 12.0f)), rnd_unit(&seed), 0.0f, T_INF);
@@ -489,8 +624,9 @@ static void test_identical_centroids(void **state)
             if (j % 2)
                 r.d = rs_v3_sub(rs_v3_add(c, rnd_box(&seed, 2.0f)), r.o);
             ref_hit = brute_closest(&s.g, &r, &ref);
-            expect_same_hit(b, &s.g, &r, &ref, ref_hit, "identical centroids", j);
+            expect_same_hit(b, b4, &s.g, &r, &ref, ref_hit, "identical centroids", j);
         }
+        rs_bvh4_destroy(b4);
         rs_bvh_destroy(b);
     }
     soup_free(&s);
@@ -514,12 +650,14 @@ static void test_nan_inf_rays_terminate(void **state)
     const int n_special = (int)(sizeof specials / sizeof specials[0]);
     soup s;
     rs_bvh *b;
+    rs_bvh4 *b4;
     rs_bvh_view v;
     uint64_t seed = 0x7a7;
     int a, c, e, f, n = 0;
     (void)state;
     soup_random(&s, 0x5eed);
     b = build(&s.g, 0);
+    b4 = collapse4(b, &s.g);
     v = rs_bvh_view_of(b);
     signal(SIGALRM, on_alarm);
     alarm(20);
@@ -533,17 +671,25 @@ static void test_nan_inf_rays_terminate(void **state)
                     rs_hit h;
                     int hit = rs_bvh_closest(&v, &s.g, r, &h);
                     int occ = rs_bvh_occluded(&v, &s.g, r);
+                    rs_hit h4;
+                    int hit4 = rs_bvh4_closest(b4, &s.g, r, &h4);
+                    int occ4 = rs_bvh4_occluded(b4, &s.g, r);
                     assert_true(hit == 0 || hit == 1);
                     assert_true(occ == 0 || occ == 1);
                     if (hit)
                         assert_true(h.prim < rs_geom_prim_count(&s.g));
                     else
                         assert_int_equal(h.prim, RS_NO_HIT);
+                    /* the 4-wide kernel: the same answer, whatever it is */
+                    assert_int_equal(hit4, hit);
+                    assert_int_equal(occ4, occ);
+                    assert_int_equal(h4.prim, h.prim);
                     ++n;
                 }
     alarm(0);
     signal(SIGALRM, SIG_DFL);
     print_message("%d NaN/Inf rays returned\n", n);
+    rs_bvh4_destroy(b4);
     rs_bvh_destroy(b);
     soup_free(&s);
 }
@@ -595,10 +741,28 @@ static void test_ray_in_bounding_plane(void **state)
                                   h.prim, h.t, ref.prim, ref.t);
     if (!rs_bvh_occluded(&v, &s.g, r))
         ++failures, print_message("ray in the plane x = 0 along -y: not occluded\n");
+    {
+        /* the 4-wide kernel on both rays */
+        rs_bvh4 *b4 = collapse4(b, &s.g);
+        rs_ray rays[2];
+        int k;
+        rays[0] = mk_ray(rs_v3(0, 0, -5), rs_v3(0, 0, 1), 0.0f, T_INF);
+        rays[1] = mk_ray(rs_v3(0, 2, 2), rs_v3(0, -2, 0), 0.0f, T_INF);
+        for (k = 0; k < 2; ++k) {
+            brute_closest(&s.g, &rays[k], &ref);
+            if (!rs_bvh4_closest(b4, &s.g, rays[k], &h) || h.prim != ref.prim || h.t != ref.t)
+                ++failures, print_message("4-wide, ray %d in the plane x = 0: prim %u t %g, "
+                                          "brute force prim %u t %g\n",
+                                          k, h.prim, h.t, ref.prim, ref.t);
+            if (!rs_bvh4_occluded(b4, &s.g, rays[k]))
+                ++failures, print_message("4-wide, ray %d in the plane x = 0: not occluded\n", k);
+        }
+        rs_bvh4_destroy(b4);
+    }
     rs_bvh_destroy(b);
     soup_free(&s);
     if (failures)
-        fail_msg("%d of 4 queries along the scene's bounding plane disagree with brute force",
+        fail_msg("%d of 8 queries along the scene's bounding plane disagree with brute force",
                  failures);
 }
 
@@ -633,6 +797,30 @@ static void test_build_out_of_memory(void **state)
     rs_error_clear();
     assert_true(succeeded);
     assert_true(k > 1);
+    /* the same for the collapse to 4-wide nodes */
+    {
+        rs_bvh *b = build(&s.g, 4);
+        for (succeeded = 0, k = 0; k < 8 && !succeeded; ++k) {
+            rs_bvh4 *b4 = (rs_bvh4 *)(uintptr_t)1;
+            rs_status st;
+            rs_alloc_fail_after(k);
+            st = rs_bvh4_build(b, &s.g, &b4);
+            rs_alloc_fail_after(-1);
+            if (st == RS_OK) {
+                assert_non_null(b4);
+                assert_true(b4->n_nodes >= 1 && b4->depth <= b->depth);
+                rs_bvh4_destroy(b4);
+                succeeded = 1;
+            } else {
+                assert_int_equal(st, RS_ERR_NOMEM);
+                assert_null(b4);
+            }
+        }
+        rs_error_clear();
+        assert_true(succeeded);
+        assert_true(k > 1);
+        rs_bvh_destroy(b);
+    }
     soup_free(&s);
 }
 
@@ -641,6 +829,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_structure),
         cmocka_unit_test(test_random_rays_vs_brute_force),
+        cmocka_unit_test(test_shared_vertices_vs_brute_force),
         cmocka_unit_test(test_empty),
         cmocka_unit_test(test_single_primitive),
         cmocka_unit_test(test_identical_centroids),

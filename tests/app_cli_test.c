@@ -505,6 +505,8 @@ static void test_usage_errors(void **state)
          {"--sampling", "sobol"}},
         {{"render", "-o", "out.png", "--spp", "1", "--devices", "cpu,tpu", NULL},
          {"--devices", "tpu"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--bvh-width", "8", NULL},
+         {"--bvh-width", "8"}},
         {{"render", "--width", "8", "--spp", "1", "-o", "out.xyz", NULL}, {"out.xyz"}},
         {{"render", "no-such-scene.rss", "-o", "out.png", "--spp", "1", NULL},
          {"no-such-scene.rss"}},
@@ -814,6 +816,9 @@ static void test_threads_and_chunks_change_nothing(void **state)
          "--chunk-size", "7", "-o", "c7.exr", NULL},
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
          "--wave-size", "1000", "-o", "w1000.exr", NULL},
+        /* the binary BVH kernel instead of the 4-wide one: the same hits, the same image */
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
+         "--bvh-width", "2", "-o", "b2.exr", NULL},
     };
     image ref = {0, 0, NULL};
     size_t r;

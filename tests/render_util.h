@@ -56,7 +56,7 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     g = rs_scene_geom(scene);
     if (rs_bvh_build(&g, NULL, &bvh) != RS_OK ||
         rs_cpu_device_create(a->threads, "cpu", &devs[0]) != RS_OK ||
-        (n == 2 && rs_cpu_device_create(1, "gpu-fallback", &devs[1]) != RS_OK))
+        (n == 2 && rs_cpu_fallback_device_create(1, 0, &devs[1]) != RS_OK))
         goto out;
     for (i = 0; i < n; ++i)
         if (rs_device_upload(devs[i], &g, bvh) != RS_OK)

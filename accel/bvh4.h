@@ -1,0 +1,369 @@
+/* accel/bvh4.h — the CPU's 4-wide BVH: the binary tree collapsed so that each node holds up to
+ * four children's boxes side by side, tested against one ray with SSE (Wald et al. 2008, "Getting
+ * rid of packets"; Dammertz et al. 2008; Embree's BVH4).  Host only: the CUDA kernels and the GPU
+ * fallback keep the binary tree (accel/bvh.h), whose 32-byte nodes suit one ray per GPU thread.
+ *
+ * Same answers as the binary traversal, bit for bit: the 4-wide tree holds the binary tree's own
+ * boxes (a subset of them) and its leaves' primitive ranges, each box test is the scalar slab
+ * test's arithmetic lane by lane (rs_bvh_slab: (bound - o) * inv_d, NaN slabs skipped, the same
+ * conservative margin RS_BVH_SLACK), and the
+ * closest hit follows the same rule (rs_hit_better: smallest t, then lowest primitive number),
+ * whatever order the children are visited in.
+ *
+ * Node layout (128 bytes, two cache lines, 64-byte aligned):
+ *   lo[3][4], hi[3][4]  the children's boxes, axis-major (x of all four lanes, then y, then z)
+ *   child[4]            interior lane: index of the child node; leaf lane: first prim_ids entry,
+ *                       or for a packed leaf the first of its tri4 blocks
+ *   count[4]            0 for an interior lane, else the leaf's primitive count, or for a packed
+ *                       leaf RS_BVH4_PACKED | its number of tri4 blocks
+ *   n_lanes             lanes in use (1 to 4), packed from lane 0
+ *
+ * Packed leaves (SSE builds, Möller-Trumbore geometry): a leaf of triangles only keeps copies of
+ * them, four to a block, as v0 and the edges e1 = v1 - v0, e2 = v2 - v0 side by side, and tests
+ * the four at once with the scalar rs_isect_tri's operations in its order (unused lanes are all
+ * zero: det = 0, never a hit), so that t, u and v come out the same bit for bit. */
+#ifndef RS_ACCEL_BVH4_H
+#define RS_ACCEL_BVH4_H
+
+#include "accel/bvh.h"
+#include "accel/trace.h"
+
+#if defined(__SSE2__) || defined(_M_X64)
+#  include <emmintrin.h>
+#  define RS_BVH4_SSE 1
+#endif
+
+typedef struct rs_bvh4_node {
+    float lo[3][4];
+    float hi[3][4];
+    uint32_t child[4];
+    uint16_t count[4];
+    uint32_t n_lanes;
+    uint32_t pad_;
+} rs_bvh4_node;
+
+typedef struct rs_bvh4_tri4 {
+    float v0[3][4], e1[3][4], e2[3][4];
+    uint32_t prim[4]; /* global primitive numbers; RS_NO_HIT in unused lanes */
+} rs_bvh4_tri4;
+
+typedef struct rs_bvh4 {
+    rs_bvh4_node *nodes;      /* node 0 is the root; none for an empty scene */
+    rs_bvh4_tri4 *tri4;       /* the packed leaves' triangles */
+    const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
+    uint32_t n_nodes, n_tri4;
+    uint32_t depth;    /* in nodes; at most the binary tree's */
+    uint32_t n_packed; /* leaves packed as tri4 blocks */
+} rs_bvh4;
+
+/* A traversal stack entry refers to an interior node (its index) or to one leaf lane of a node
+ * (RS_BVH4_LEAF | node << 2 | lane). */
+#define RS_BVH4_LEAF      0x80000000u
+#define RS_BVH4_PACKED    0x8000u
+#define RS_BVH4_MAX_NODES (1u << 29)
+/* Each level of the tree pushes at most 3 entries (closest) or 4 (any hit), and the tree is at
+ * most RS_BVH_MAX_DEPTH deep. */
+#define RS_BVH4_STACK (4 * RS_BVH_STACK)
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* Collapses `b`, built over `g`, into a 4-wide tree: each node takes its binary node's two
+ * children and then keeps opening the interior child of largest surface area until it has four;
+ * leaves of triangles are packed when g->tri_algo is Möller-Trumbore.  RS_ERR_ARG for a leaf of
+ * more than 32767 primitives or a tree of more than 2^29 nodes, RS_ERR_NOMEM when memory runs out
+ * (*out is NULL then). */
+rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out);
+void rs_bvh4_destroy(rs_bvh4 *b);
+#ifdef __cplusplus
+}
+#endif
+
+/* The slab test of the four lanes of `n` against one ray: returns the mask of lanes hit (bit i for
+ * lane i) and their entry distances in tn[4].  o and inv_d are the ray's, broadcast. */
+#ifdef RS_BVH4_SSE
+typedef struct rs_bvh4_ray {
+    __m128 o[3], d[3], inv[3];
+    int axis_parallel; /* a direction component is 0 (or NaN): slabs may give NaN */
+} rs_bvh4_ray;
+
+static inline rs_bvh4_ray rs_bvh4_ray_of(rs_vec3 o, rs_vec3 d)
+{
+    rs_bvh4_ray r;
+    rs_vec3 inv_d = rs_bvh_inv_dir(d);
+    r.o[0] = _mm_set1_ps(o.x);
+    r.o[1] = _mm_set1_ps(o.y);
+    r.o[2] = _mm_set1_ps(o.z);
+    r.d[0] = _mm_set1_ps(d.x);
+    r.d[1] = _mm_set1_ps(d.y);
+    r.d[2] = _mm_set1_ps(d.z);
+    r.inv[0] = _mm_set1_ps(inv_d.x);
+    r.inv[1] = _mm_set1_ps(inv_d.y);
+    r.inv[2] = _mm_set1_ps(inv_d.z);
+    r.axis_parallel = !(d.x != 0.0f && d.y != 0.0f && d.z != 0.0f);
+    return r;
+}
+
+static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, float tmin,
+                                     float tmax, float tn_out[4])
+{
+    __m128 tn = _mm_set1_ps(tmin), tf = _mm_set1_ps(tmax);
+    int a;
+    for (a = 0; a < 3; ++a) {
+        __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n->lo[a]), r->o[a]), r->inv[a]);
+        __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n->hi[a]), r->o[a]), r->inv[a]);
+        /* _mm_min_ps(a, b) is a < b ? a : b, exactly rs_minf */
+        __m128 n_tn = _mm_max_ps(_mm_min_ps(t0, t1), tn);
+        __m128 n_tf = _mm_min_ps(_mm_max_ps(t0, t1), tf);
+        if (r->axis_parallel) {
+            /* (bound - o) * inf = NaN for a ray in a slab's plane: that slab is skipped */
+            __m128 ok = _mm_cmpord_ps(t0, t1);
+            tn = _mm_or_ps(_mm_and_ps(ok, n_tn), _mm_andnot_ps(ok, tn));
+            tf = _mm_or_ps(_mm_and_ps(ok, n_tf), _mm_andnot_ps(ok, tf));
+        } else {
+            /* both NaN only for a NaN direction, when min / max keep tn, tf as the skip does */
+            tn = n_tn;
+            tf = n_tf;
+        }
+    }
+    _mm_storeu_ps(tn_out, tn);
+    tf = _mm_mul_ps(tf, _mm_set1_ps(RS_BVH_SLACK));
+    return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(tn, tf)) & ((1u << n->n_lanes) - 1u);
+}
+#else
+typedef struct rs_bvh4_ray {
+    rs_vec3 o, inv;
+} rs_bvh4_ray;
+
+static inline rs_bvh4_ray rs_bvh4_ray_of(rs_vec3 o, rs_vec3 d)
+{
+    rs_bvh4_ray r;
+    r.o = o;
+    r.inv = rs_bvh_inv_dir(d);
+    return r;
+}
+
+static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, float tmin,
+                                     float tmax, float tn_out[4])
+{
+    uint32_t i, mask = 0;
+    for (i = 0; i < n->n_lanes; ++i) {
+        float tn = tmin, tf = tmax;
+        rs_slab((n->lo[0][i] - r->o.x) * r->inv.x, (n->hi[0][i] - r->o.x) * r->inv.x, &tn, &tf);
+        rs_slab((n->lo[1][i] - r->o.y) * r->inv.y, (n->hi[1][i] - r->o.y) * r->inv.y, &tn, &tf);
+        rs_slab((n->lo[2][i] - r->o.z) * r->inv.z, (n->hi[2][i] - r->o.z) * r->inv.z, &tn, &tf);
+        tn_out[i] = tn;
+        mask |= (uint32_t)(tn <= tf * RS_BVH_SLACK) << i;
+    }
+    return mask;
+}
+#endif
+
+#ifdef RS_BVH4_SSE
+/* rs_isect_tri on the four triangles of a block: the mask of lanes hit inside (tmin, tmax), and
+ * their t, u, v. */
+static inline uint32_t rs_bvh4_tri4_hit(const rs_bvh4_tri4 *b, const rs_bvh4_ray *r, float tmin,
+                                        float tmax, float t[4], float u[4], float v[4])
+{
+#  define RS_LD(a) _mm_load_ps(a)
+    __m128 e1x = RS_LD(b->e1[0]), e1y = RS_LD(b->e1[1]), e1z = RS_LD(b->e1[2]);
+    __m128 e2x = RS_LD(b->e2[0]), e2y = RS_LD(b->e2[1]), e2z = RS_LD(b->e2[2]);
+    __m128 dx = r->d[0], dy = r->d[1], dz = r->d[2];
+    /* p = d x e2, det = e1 . p */
+    __m128 px = _mm_sub_ps(_mm_mul_ps(dy, e2z), _mm_mul_ps(dz, e2y));
+    __m128 py = _mm_sub_ps(_mm_mul_ps(dz, e2x), _mm_mul_ps(dx, e2z));
+    __m128 pz = _mm_sub_ps(_mm_mul_ps(dx, e2y), _mm_mul_ps(dy, e2x));
+    __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)),
+                            _mm_mul_ps(e1z, pz));
+    __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
+    /* s = o - v0, u = (s . p) inv */
+    __m128 sx = _mm_sub_ps(r->o[0], RS_LD(b->v0[0]));
+    __m128 sy = _mm_sub_ps(r->o[1], RS_LD(b->v0[1]));
+    __m128 sz = _mm_sub_ps(r->o[2], RS_LD(b->v0[2]));
+    __m128 bu = _mm_mul_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz)), inv);
+    /* q = s x e1, v = (d . q) inv, t = (e2 . q) inv */
+    __m128 qx = _mm_sub_ps(_mm_mul_ps(sy, e1z), _mm_mul_ps(sz, e1y));
+    __m128 qy = _mm_sub_ps(_mm_mul_ps(sz, e1x), _mm_mul_ps(sx, e1z));
+    __m128 qz = _mm_sub_ps(_mm_mul_ps(sx, e1y), _mm_mul_ps(sy, e1x));
+    __m128 bv = _mm_mul_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, qx), _mm_mul_ps(dy, qy)), _mm_mul_ps(dz, qz)), inv);
+    __m128 tt = _mm_mul_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)),
+        inv);
+    __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    __m128 ok = _mm_cmpneq_ps(det, zero);
+    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(bu, zero), _mm_cmple_ps(bu, one)));
+    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(bv, zero), _mm_cmple_ps(_mm_add_ps(bu, bv), one)));
+    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(tt, _mm_set1_ps(tmin)),
+                                   _mm_cmplt_ps(tt, _mm_set1_ps(tmax))));
+#  undef RS_LD
+    _mm_storeu_ps(t, tt);
+    _mm_storeu_ps(u, bu);
+    _mm_storeu_ps(v, bv);
+    return (uint32_t)_mm_movemask_ps(ok);
+}
+#endif
+
+/* The stack entry for lane `lane` of node `node`. */
+static inline uint32_t rs_bvh4_ref(const rs_bvh4_node *n, uint32_t node, uint32_t lane)
+{
+    return n->count[lane] ? RS_BVH4_LEAF | node << 2 | lane : n->child[lane];
+}
+
+static inline int rs_bvh4_lowest_bit(uint32_t m) { return __builtin_ctz(m); }
+
+/* Closest hit, as rs_bvh_closest: 1 and *hit on a hit, else hit->prim = RS_NO_HIT and 0.
+ * Ordered: the hit lanes are sorted by entry distance, the nearest is visited next and the others
+ * pushed far to near with their entry distances; a popped entry that starts beyond the closest
+ * hit so far is dropped without touching its node. */
+static inline int rs_bvh4_closest(const rs_bvh4 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
+{
+    uint32_t stack[RS_BVH4_STACK];
+    float stack_t[RS_BVH4_STACK];
+    uint32_t sp = 0, ref = 0;
+    rs_bvh4_ray r = rs_bvh4_ray_of(ray.o, ray.d);
+    hit->prim = RS_NO_HIT;
+    hit->t = ray.tmax;
+    hit->u = hit->v = 0.0f;
+    if (b->n_nodes == 0)
+        return 0;
+    for (;;) {
+        if (!(ref & RS_BVH4_LEAF)) {
+            const rs_bvh4_node *n = &b->nodes[ref];
+            float tn[4];
+            uint32_t mask = rs_bvh4_lanes(n, &r, ray.tmin, ray.tmax, tn);
+            if (mask != 0) {
+                int first = rs_bvh4_lowest_bit(mask);
+                mask &= mask - 1;
+                if (mask == 0) {
+                    ref = rs_bvh4_ref(n, ref, (uint32_t)first);
+                    continue;
+                } else {
+                    /* two to four lanes: insertion sort by entry distance, nearest first */
+                    uint32_t lanes[4], k = 1, i, j;
+                    lanes[0] = (uint32_t)first;
+                    while (mask) {
+                        uint32_t l = (uint32_t)rs_bvh4_lowest_bit(mask);
+                        mask &= mask - 1;
+                        for (j = k; j > 0 && tn[lanes[j - 1]] > tn[l]; --j)
+                            lanes[j] = lanes[j - 1];
+                        lanes[j] = l;
+                        ++k;
+                    }
+                    for (i = k - 1; i > 0; --i) {
+                        RS_ASSERT(sp < RS_BVH4_STACK);
+                        stack[sp] = rs_bvh4_ref(n, ref, lanes[i]);
+                        stack_t[sp++] = tn[lanes[i]];
+                    }
+                    ref = rs_bvh4_ref(n, ref, lanes[0]);
+                    continue;
+                }
+            }
+        } else {
+            const rs_bvh4_node *n = &b->nodes[(ref & ~RS_BVH4_LEAF) >> 2];
+            uint32_t lane = ref & 3u, first = n->child[lane], count = n->count[lane], i;
+#ifdef RS_BVH4_SSE
+            if (count & RS_BVH4_PACKED) {
+                for (i = 0; i < (count & ~RS_BVH4_PACKED); ++i) {
+                    const rs_bvh4_tri4 *blk = &b->tri4[first + i];
+                    float t[4], u[4], v[4];
+                    uint32_t m = rs_bvh4_tri4_hit(blk, &r, ray.tmin, ray.tmax, t, u, v);
+                    while (m) {
+                        uint32_t l = (uint32_t)rs_bvh4_lowest_bit(m);
+                        m &= m - 1;
+                        if (rs_hit_better(t[l], blk->prim[l], hit)) {
+                            ray.tmax = rs_float_next_up(t[l]);
+                            hit->t = t[l];
+                            hit->u = u[l];
+                            hit->v = v[l];
+                            hit->prim = blk->prim[l];
+                        }
+                    }
+                }
+                count = 0;
+            }
+#endif
+            for (i = 0; i < count; ++i) {
+                uint32_t prim = b->prim_ids[first + i];
+                float t, u, v;
+                if (rs_geom_intersect(g, prim, &ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
+                    ray.tmax = rs_float_next_up(t);
+                    hit->t = t;
+                    hit->u = u;
+                    hit->v = v;
+                    hit->prim = prim;
+                }
+            }
+        }
+        /* pop the next entry that can still hold a hit no farther than the best so far */
+        for (;;) {
+            if (sp == 0)
+                return hit->prim != RS_NO_HIT;
+            --sp;
+            if (stack_t[sp] <= ray.tmax * RS_BVH_SLACK)
+                break;
+        }
+        ref = stack[sp];
+    }
+}
+
+/* Any hit inside (tmin, tmax), as rs_bvh_occluded. */
+static inline int rs_bvh4_occluded(const rs_bvh4 *b, const rs_geom *g, rs_ray ray)
+{
+    uint32_t stack[RS_BVH4_STACK];
+    uint32_t sp = 0;
+    rs_bvh4_ray r = rs_bvh4_ray_of(ray.o, ray.d);
+    if (b->n_nodes == 0)
+        return 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        uint32_t ref = stack[--sp];
+        if (!(ref & RS_BVH4_LEAF)) {
+            const rs_bvh4_node *n = &b->nodes[ref];
+            float tn[4];
+            uint32_t mask = rs_bvh4_lanes(n, &r, ray.tmin, ray.tmax, tn);
+            while (mask) {
+                uint32_t l = (uint32_t)rs_bvh4_lowest_bit(mask);
+                mask &= mask - 1;
+                RS_ASSERT(sp < RS_BVH4_STACK);
+                stack[sp++] = rs_bvh4_ref(n, ref, l);
+            }
+        } else {
+            const rs_bvh4_node *n = &b->nodes[(ref & ~RS_BVH4_LEAF) >> 2];
+            uint32_t lane = ref & 3u, first = n->child[lane], count = n->count[lane], i;
+#ifdef RS_BVH4_SSE
+            if (count & RS_BVH4_PACKED) {
+                for (i = 0; i < (count & ~RS_BVH4_PACKED); ++i) {
+                    float t[4], u[4], v[4];
+                    if (rs_bvh4_tri4_hit(&b->tri4[first + i], &r, ray.tmin, ray.tmax, t, u, v))
+                        return 1;
+                }
+                continue;
+            }
+#endif
+            for (i = 0; i < count; ++i) {
+                float t, u, v;
+                if (rs_geom_intersect(g, b->prim_ids[first + i], &ray, &t, &u, &v))
+                    return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* rs_trace_one (accel/trace.h) on the 4-wide tree. */
+static inline void rs_bvh4_trace_one(const rs_bvh4 *b, const rs_geom *g,
+                                     const rs_trace_batch *batch, uint32_t i)
+{
+    rs_ray r = rs_ray_soa_get(&batch->rays, i);
+    if (batch->kind == RS_TRACE_CLOSEST) {
+        rs_hit h;
+        rs_bvh4_closest(b, g, r, &h);
+        rs_hit_soa_set(&batch->hits, i, &h);
+    } else {
+        batch->occluded[i] = (uint8_t)rs_bvh4_occluded(b, g, r);
+    }
+}
+
+#endif
