@@ -1,14 +1,11 @@
 /* bench/bvh_bench.c — the BVH builders compared (the thesis's §6.4 and Table 6.5, plus binned SAH
  * and LBVH): build time, tree quality (SAH cost, nodes, depth) and closest-hit traversal speed.
  *
- * Scenes: a random soup of triangles (100000 by default) and, when the shared models exist, the
- * Stanford bunny (69451 triangles, read by the small reader in tests/test_mesh.h).  Two ray sets
- * per scene, the same for every builder:
- *   primary  one camera ray per pixel of a W x W pinhole image framing the scene's bounding
- *            sphere from outside, in scanline order (coherent);
- *   diffuse  from random points on random triangles, cosine-distributed about the normal on a
- *            random side of the surface, in random order (incoherent), tmin = 1e-4 of the
- *            scene's size so the ray does not hit its own triangle.
+ * Scenes (bench/bench_scene.h; --scene SPEC, repeatable): by default a soup of 100000 random
+ * triangles and, when the shared models exist, the teapot+bunny Cornell box of the thesis
+ * (builtin:cornell-bunny-teapot) and the largest model, the dragon (dragon/dragon_100k.ply, read
+ * by the real mesh importer).  Two ray sets per scene, the same for every builder: primary
+ * (camera rays, scanline order) and diffuse (cosine bounce rays from the primary hits).
  *
  * Validates first: the median builder's closest hits equal brute force on a subset of each ray
  * set, and then every builder's hits equal the median builder's (same t, bit for bit, and the
@@ -18,22 +15,19 @@
  * median of the runs, 1 thread and all threads; all threads use an OpenMP loop with dynamic
  * chunks of 256 rays), with the ratios to the median builder measured in the same run.
  *
- *   bvh_bench [--quick] [--tris N] [--size W] [--diffuse N] [--runs N] [--max-leaf N]
- *             [--bvh NAME,NAME,...] [--model FILE|none] [--csv FILE]
- *   --quick: a 3000-triangle soup, 64x64 primary rays, one run, no bunny (the test suite's smoke
- *   test). */
+ *   bvh_bench [--quick] [--scene SPEC]... [--models DIR] [--size W] [--diffuse N] [--runs N]
+ *             [--max-leaf N] [--bvh NAME,NAME,...] [--csv FILE]
+ *   --quick: a 3000-triangle soup, 64x64 primary rays, one run (the test suite's smoke test). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "accel/bvh.h"
 #include "core/parallel.h"
 #include "machine.h"
 #include "bvh_count.h"
-#include "test_mesh.h"
-#include "test_rand.h"
+#include "bench_scene.h"
 
 #define MAX_VARIANTS 64
 #define MAX_RUNS     15
@@ -53,128 +47,6 @@ typedef struct row {
     double box_tests[2], prim_tests[2]; /* per ray, primary / diffuse (counting pass) */
 } row;
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median_of(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof v[0], cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-/* ---- scenes and rays ----------------------------------------------------------------------- */
-
-/* n triangles with edges up to ~2 units, centres uniform in a cube whose size grows with the
- * cube root of n (half-size 30 for 100000), so every n sees about the same density. */
-static rs_tri *soup_make(uint32_t n, uint64_t seed)
-{
-    rs_tri *t = (rs_tri *)malloc((size_t)n * sizeof *t);
-    float h = 30.0f * cbrtf((float)n / 100000.0f);
-    uint32_t i;
-    if (!t)
-        return NULL;
-    for (i = 0; i < n; ++i) {
-        rs_vec3 c = rnd_box(&seed, h);
-        t[i].v0 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.1, 1.0));
-        t[i].v1 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.1, 1.0));
-        t[i].v2 = rs_v3_madd(c, rnd_unit(&seed), rnd_range(&seed, 0.1, 1.0));
-    }
-    return t;
-}
-
-static rs_aabb scene_box(const rs_tri *t, uint32_t n)
-{
-    rs_aabb b;
-    uint32_t i;
-    b.lo = rs_v3_splat(INFINITY);
-    b.hi = rs_v3_splat(-INFINITY);
-    for (i = 0; i < n; ++i) {
-        b.lo = rs_v3_min(b.lo, rs_v3_min(t[i].v0, rs_v3_min(t[i].v1, t[i].v2)));
-        b.hi = rs_v3_max(b.hi, rs_v3_max(t[i].v0, rs_v3_max(t[i].v1, t[i].v2)));
-    }
-    return b;
-}
-
-static int rays_alloc(ray_set *s, const char *name, uint32_t n)
-{
-    s->name = name;
-    s->n = n;
-    s->rays = (rs_ray *)malloc((size_t)n * sizeof *s->rays);
-    s->hits = (rs_hit *)malloc((size_t)n * sizeof *s->hits);
-    return s->rays && s->hits;
-}
-
-static void rays_free(ray_set *s)
-{
-    free(s->rays);
-    free(s->hits);
-}
-
-/* A W x W pinhole camera on the diagonal (1, 0.6, 1.4) of the box, looking at its centre, with a
- * field of view that just holds the bounding sphere. */
-static int rays_primary(ray_set *s, rs_aabb box, uint32_t w)
-{
-    rs_vec3 c = rs_v3_scale(rs_v3_add(box.lo, box.hi), 0.5f);
-    float r = 0.5f * rs_v3_length(rs_v3_sub(box.hi, box.lo));
-    rs_vec3 dir = rs_v3_normalize(rs_v3(1.0f, 0.6f, 1.4f));
-    rs_vec3 eye = rs_v3_madd(c, dir, 2.5f * r), fwd = rs_v3_neg(dir);
-    rs_vec3 right = rs_v3_normalize(rs_v3_cross(fwd, rs_v3(0, 1, 0)));
-    rs_vec3 up = rs_v3_cross(right, fwd);
-    /* the sphere fills the view: sin(half angle) = r / (2.5 r) */
-    float tan_half = 1.0f / sqrtf(2.5f * 2.5f - 1.0f);
-    uint32_t x, y;
-    if (!rays_alloc(s, "primary", w * w))
-        return 0;
-    for (y = 0; y < w; ++y)
-        for (x = 0; x < w; ++x) {
-            float px = (2.0f * ((float)x + 0.5f) / (float)w - 1.0f) * tan_half;
-            float py = (1.0f - 2.0f * ((float)y + 0.5f) / (float)w) * tan_half;
-            rs_vec3 d = rs_v3_add(fwd, rs_v3_add(rs_v3_scale(right, px), rs_v3_scale(up, py)));
-            s->rays[y * w + x] = mk_ray(eye, rs_v3_normalize(d), 0.0f, INFINITY);
-        }
-    return 1;
-}
-
-static int rays_diffuse(ray_set *s, const rs_tri *t, uint32_t nt, rs_aabb box, uint32_t n,
-                        uint64_t seed)
-{
-    float eps = 1e-4f * rs_v3_length(rs_v3_sub(box.hi, box.lo));
-    uint32_t i;
-    if (!rays_alloc(s, "diffuse", n))
-        return 0;
-    for (i = 0; i < n; ++i) {
-        const rs_tri *tr = &t[(uint32_t)(rnd01(&seed) * nt)];
-        double a = rnd01(&seed), b = rnd01(&seed);
-        rs_vec3 nrm = rs_v3_cross(rs_v3_sub(tr->v1, tr->v0), rs_v3_sub(tr->v2, tr->v0)), p, d;
-        if (a + b > 1.0)
-            a = 1.0 - a, b = 1.0 - b;
-        p = rs_v3_madd(rs_v3_madd(tr->v0, rs_v3_sub(tr->v1, tr->v0), (float)a),
-                       rs_v3_sub(tr->v2, tr->v0), (float)b);
-        if (rs_v3_length2(nrm) > 0.0f)
-            nrm = rs_v3_normalize(nrm);
-        else
-            nrm = rs_v3(0, 1, 0);
-        if (rnd01(&seed) < 0.5)
-            nrm = rs_v3_neg(nrm);
-        /* cosine-distributed: normal plus a uniform unit vector (Shirley, RTIOW §9.4) */
-        d = rs_v3_add(nrm, rnd_unit(&seed));
-        if (rs_v3_length2(d) < 1e-12f)
-            d = nrm;
-        s->rays[i] = mk_ray(p, rs_v3_normalize(d), eps, INFINITY);
-    }
-    return 1;
-}
-
 /* ---- measuring ----------------------------------------------------------------------------- */
 
 static rs_bvh *build_timed(const rs_geom *g, const rs_bvh_builder *b, uint32_t max_leaf,
@@ -192,14 +64,14 @@ static rs_bvh *build_timed(const rs_geom *g, const rs_bvh_builder *b, uint32_t m
         o.threads = (uint32_t)threads;
         rs_bvh_destroy(bvh);
         bvh = NULL;
-        t0 = now_s();
+        t0 = rs_bench_now();
         if (rs_bvh_build(g, &o, &bvh) != RS_OK) {
             fprintf(stderr, "bvh_bench: %s\n", rs_error_message());
             return NULL;
         }
-        t[k] = now_s() - t0;
+        t[k] = rs_bench_now() - t0;
     }
-    *median_s = median_of(t, runs);
+    *median_s = rs_bench_median(t, runs);
     return bvh;
 }
 
@@ -207,7 +79,7 @@ static rs_bvh *build_timed(const rs_geom *g, const rs_bvh_builder *b, uint32_t m
 static double trace(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads)
 {
     rs_bvh_view v = rs_bvh_view_of(bvh);
-    double t0 = now_s();
+    double t0 = rs_bench_now();
     long i, n = (long)s->n;
     if (threads == 1) {
         for (i = 0; i < n; ++i)
@@ -217,7 +89,7 @@ static double trace(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads
         for (i = 0; i < n; ++i)
             rs_bvh_closest(&v, g, s->rays[i], &s->hits[i]);
     }
-    return now_s() - t0;
+    return rs_bench_now() - t0;
 }
 
 static double mrays(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads, int runs)
@@ -226,7 +98,7 @@ static double mrays(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads
     int k;
     for (k = 0; k < runs; ++k)
         t[k] = trace(bvh, g, s, threads);
-    return (double)s->n / median_of(t, runs) / 1e6;
+    return (double)s->n / rs_bench_median(t, runs) / 1e6;
 }
 
 /* Same answer: the same t bit for bit, and the same prim or an exact tie. */
@@ -250,10 +122,12 @@ typedef struct settings {
     FILE *csv;
 } settings;
 
-static int bench_scene(const char *scene, const rs_tri *tris, uint32_t nt, const settings *st)
+static int bench_scene(const bs_scene *sc, const settings *st)
 {
-    rs_geom g;
-    rs_aabb box = scene_box(tris, nt);
+    const char *scene = sc->label;
+    rs_geom g = sc->g;
+    uint32_t nt = rs_geom_prim_count(&g);
+    bs_rays made[BS_N_SETS];
     ray_set sets[2];
     rs_hit *ref[2] = {NULL, NULL};
     row rows[MAX_VARIANTS];
@@ -262,14 +136,19 @@ static int bench_scene(const char *scene, const rs_tri *tris, uint32_t nt, const
     uint32_t i;
     long hits[2] = {0, 0};
     char name[64];
-    memset(&g, 0, sizeof g);
-    g.tris = tris;
-    g.n_tris = nt;
     memset(sets, 0, sizeof sets);
-    if (!rays_primary(&sets[0], box, st->size) ||
-        !rays_diffuse(&sets[1], tris, nt, box, st->n_diffuse, 0xd1ffu)) {
-        fprintf(stderr, "bvh_bench: out of memory for rays\n");
-        goto out;
+    if (!bs_make_rays(sc, st->size, st->n_diffuse, made))
+        return 0;
+    free(made[BS_SHADOW].rays);
+    for (k = 0; k < 2; ++k) {
+        sets[k].name = made[k].name;
+        sets[k].rays = made[k].rays;
+        sets[k].n = made[k].n;
+        sets[k].hits = (rs_hit *)malloc((size_t)(made[k].n ? made[k].n : 1) * sizeof(rs_hit));
+        if (!sets[k].hits) {
+            fprintf(stderr, "bvh_bench: out of memory for rays\n");
+            goto out;
+        }
     }
     /* the reference: the median builder, checked against brute force on a subset */
     {
@@ -345,10 +224,10 @@ static int bench_scene(const char *scene, const rs_tri *tris, uint32_t nt, const
             fprintf(stderr, "  %s: %s done\n", scene, name);
     }
 
-    printf("\n### %s: %u triangles; %u primary rays (%ux%u), %u diffuse rays; %.1f%% / %.1f%% "
+    printf("\n### %s: %u primitives; %u primary rays (%ux%u), %u diffuse rays; %.1f%% / %.1f%% "
            "hit\n\n",
            scene, nt, sets[0].n, st->size, st->size, sets[1].n, 100.0 * hits[0] / sets[0].n,
-           100.0 * hits[1] / sets[1].n);
+           sets[1].n ? 100.0 * hits[1] / sets[1].n : 0.0);
     printf("| builder | build ms 1 thr | build ms %d thr | build vs median | SAH cost | SAH vs "
            "median | nodes | depth | primary Mrays/s 1 thr | primary %d thr | diffuse 1 thr | "
            "diffuse %d thr | primary vs median | diffuse vs median | box+prim tests/ray primary | "
@@ -375,8 +254,10 @@ out:
     rs_bvh_destroy(median_bvh);
     free(ref[0]);
     free(ref[1]);
-    rays_free(&sets[0]);
-    rays_free(&sets[1]);
+    for (k = 0; k < 2; ++k) {
+        free(sets[k].rays);
+        free(sets[k].hits);
+    }
     return ok;
 }
 
@@ -397,15 +278,15 @@ static int parse_list(const char *list, rs_bvh_builder *out, int cap)
     return n;
 }
 
+#define MAX_SCENES 8
+
 int main(int argc, char **argv)
 {
     rs_bvh_builder variants[MAX_VARIANTS];
     settings st;
-    const char *model = NULL, *csv = NULL, *list = NULL;
-    uint32_t n_tris = 100000;
-    int quick = 0, i, ok = 1, have_median = 0;
-    rs_tri *soup;
-    char label[64];
+    const char *csv = NULL, *list = NULL, *models = NULL, *scenes[MAX_SCENES];
+    char dragon[4200];
+    int quick = 0, i, ok = 1, have_median = 0, n_scenes = 0;
 
     memset(&st, 0, sizeof st);
     st.runs = 3;
@@ -417,8 +298,10 @@ int main(int argc, char **argv)
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--quick") == 0) {
             quick = 1;
-        } else if (strcmp(argv[i], "--tris") == 0 && i + 1 < argc) {
-            n_tris = (uint32_t)atol(argv[++i]);
+        } else if (strcmp(argv[i], "--scene") == 0 && i + 1 < argc && n_scenes < MAX_SCENES) {
+            scenes[n_scenes++] = argv[++i];
+        } else if (strcmp(argv[i], "--models") == 0 && i + 1 < argc) {
+            models = argv[++i];
         } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
             st.size = (uint32_t)atoi(argv[++i]);
         } else if (strcmp(argv[i], "--diffuse") == 0 && i + 1 < argc) {
@@ -429,31 +312,26 @@ int main(int argc, char **argv)
             st.max_leaf = (uint32_t)atoi(argv[++i]);
         } else if (strcmp(argv[i], "--bvh") == 0 && i + 1 < argc) {
             list = argv[++i];
-        } else if (strcmp(argv[i], "--model") == 0 && i + 1 < argc) {
-            model = argv[++i];
         } else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
             csv = argv[++i];
         } else {
-            fprintf(stderr, "usage: bvh_bench [--quick] [--tris N] [--size W] [--diffuse N] "
-                            "[--runs N] [--max-leaf N] [--bvh NAME,...] [--model FILE|none] "
-                            "[--csv FILE]\n");
+            fprintf(stderr, "usage: bvh_bench [--quick] [--scene soup:N|builtin:NAME|FILE]... "
+                            "[--models DIR] [--size W] [--diffuse N] [--runs N] [--max-leaf N] "
+                            "[--bvh NAME,...] [--csv FILE]\n");
             return 2;
         }
     }
     st.progress = !quick;
     if (quick) {
-        n_tris = 3000;
         st.size = 64;
         st.n_diffuse = 4096;
         st.runs = 1;
         st.brute_rays = 64;
-        if (!model)
-            model = "none";
+        if (n_scenes == 0)
+            scenes[n_scenes++] = "soup:3000";
     }
-    if (n_tris < 1 || st.size < 1 || st.n_diffuse < 1 || st.runs < 1 || st.runs > MAX_RUNS ||
-        st.max_leaf < 1) {
-        fprintf(stderr, "bvh_bench: tris, size, diffuse, max-leaf must be >= 1, runs 1..%d\n",
-                MAX_RUNS);
+    if (st.size < 1 || st.n_diffuse < 1 || st.runs < 1 || st.runs > MAX_RUNS || st.max_leaf < 1) {
+        fprintf(stderr, "bvh_bench: size, diffuse, max-leaf must be >= 1, runs 1..%d\n", MAX_RUNS);
         return 2;
     }
     /* the builders: the given list, or every standard variant plus SAH with 8 and 32 bins; the
@@ -481,7 +359,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "bvh_bench: cannot write %s\n", csv);
             return 1;
         }
-        fprintf(st.csv, "scene,triangles,builder,max_leaf,build_s_1thr,build_s_nthr,sah_cost,"
+        fprintf(st.csv, "scene,primitives,builder,max_leaf,build_s_1thr,build_s_nthr,sah_cost,"
                         "nodes,depth,leaves,fallback,primary_mrays_1thr,primary_mrays_nthr,"
                         "diffuse_mrays_1thr,diffuse_mrays_nthr\n");
     }
@@ -492,36 +370,26 @@ int main(int argc, char **argv)
            "area\n",
            st.max_leaf, st.n_variants, st.runs, st.runs == 1 ? "" : "s", st.threads);
 
-    soup = soup_make(n_tris, 0x50u);
-    if (!soup) {
-        fprintf(stderr, "bvh_bench: out of memory\n");
-        return 1;
-    }
-    snprintf(label, sizeof label, "soup of %u random triangles", n_tris);
-    ok = bench_scene(label, soup, n_tris, &st);
-    free(soup);
-
-    if (ok && !(model && strcmp(model, "none") == 0)) {
-        test_mesh m;
-        char path[4200];
-        const char *why = "";
-        if (!model) {
-            const char *dir = test_models_dir(&why);
-            if (dir) {
-                snprintf(path, sizeof path, "%s/bunny/bun_zipper.ply", dir);
-                model = path;
-            }
-        }
-        if (!model) {
-            printf("\n(bunny skipped: %s)\n", why);
-        } else if (!test_mesh_load(model, &m)) {
-            fprintf(stderr, "bvh_bench: cannot read %s (ascii PLY or OBJ)\n", model);
-            ok = 0;
+    if (n_scenes == 0) {
+        const char *dir = bs_models_dir(models);
+        scenes[n_scenes++] = "soup:100000";
+        if (dir) {
+            scenes[n_scenes++] = "builtin:cornell-bunny-teapot";
+            snprintf(dragon, sizeof dragon, "%s/dragon/dragon_100k.ply", dir);
+            scenes[n_scenes++] = dragon;
         } else {
-            const char *base = strrchr(model, '/');
-            ok = bench_scene(base ? base + 1 : model, m.tris, m.n_tris, &st);
-            test_mesh_free(&m);
+            printf("\n(the model scenes are skipped: no shared models folder at %s)\n",
+                   rs_builtin_models_dir(models));
         }
+    }
+    for (i = 0; ok && i < n_scenes; ++i) {
+        bs_scene sc;
+        if (!bs_load(scenes[i], models, &sc)) {
+            ok = 0;
+            break;
+        }
+        ok = bench_scene(&sc, &st);
+        bs_scene_free(&sc);
     }
     if (st.csv)
         fclose(st.csv);

@@ -1,0 +1,608 @@
+/* bench/traversal_bench.c — the CPU traversal kernels' speed, and Intel Embree's on the same rays.
+ *
+ * For each scene (bench/bench_scene.h; by default the teapot+bunny Cornell box, the bunny and the
+ * dragon from the shared models) it builds our BVH (binned SAH by default, --bvh) and traces the
+ * three ray sets, primary, diffuse-bounce and shadow, with both queries, closest hit and any hit,
+ * on 1 thread and on all threads (an OpenMP loop, dynamic chunks of 256 rays), with both of our
+ * kernels: the binary traversal every device shares (rs_bvh_closest / rs_bvh_occluded, what the
+ * CUDA kernels and the GPU fallback run) and the 4-wide SSE traversal the CPU device runs
+ * (accel/bvh4.h).  Each figure is Mrays/s, the median of --runs runs.  The two kernels must give
+ * the same answers bit for bit (same prim, same t); the run fails otherwise.
+ *
+ * Built with Embree 3 (libembree-dev; optional, found by CMake), the same program puts the same
+ * primitives in an Embree scene (triangles, quads, spheres as RTC_GEOMETRY_TYPE_SPHERE_POINT;
+ * build quality MEDIUM, the default) and traces the same rays with rtcIntersect1 / rtcOccluded1
+ * in the same loops, prints the 4-wide kernel's ratio to Embree, and checks that both find the
+ * same answers: the same occlusion, and the same closest primitive or a hit at the same distance
+ * (relative 1e-4: a tie between neighbours).  A disagreement on more than 0.1% of any set fails the run.
+ *
+ *   traversal_bench [--quick] [--scene SPEC]... [--models DIR] [--bvh NAME] [--size W]
+ *                   [--secondary N] [--runs N] [--threads N] [--no-embree] [--csv FILE]
+ *   --quick: builtin:cornell, 64x64 primary and 4096 secondary rays, one run (the smoke test). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/bvh.h"
+#include "accel/bvh4.h"
+#include "bench_scene.h"
+#include "core/parallel.h"
+#include "machine.h"
+
+#ifdef RS_HAVE_EMBREE
+#  include <embree3/rtcore.h>
+#endif
+
+#define MAX_RUNS   15
+#define MAX_SCENES 8
+#define CHUNK      256
+
+enum { Q_CLOSEST = 0, Q_ANY = 1 };
+enum { ENGINE_BIN = 0, ENGINE_BVH4 = 1, ENGINE_EMBREE = 2, N_ENGINES = 3 };
+
+/* Answers of one engine on one set: the closest hit's prim and t, or occlusion. */
+typedef struct answers {
+    uint32_t *prim;
+    float *t;
+    uint8_t *occluded;
+} answers;
+
+typedef struct settings {
+    const char *bvh_name;
+    rs_bvh_builder builder;
+    uint32_t size, n_secondary;
+    int runs, threads, embree;
+    FILE *csv;
+} settings;
+
+/* ---- our kernel ---------------------------------------------------------------------------- */
+
+static double trace_bin(const rs_bvh_view *v, const rs_geom *g, const bs_rays *s, int q,
+                        int threads, answers *a)
+{
+    double t0 = rs_bench_now();
+    long i, n = (long)s->n;
+    if (q == Q_CLOSEST) {
+#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+        for (i = 0; i < n; ++i) {
+            rs_hit h;
+            rs_bvh_closest(v, g, s->rays[i], &h);
+            a->prim[i] = h.prim;
+            a->t[i] = h.t;
+        }
+    } else {
+#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+        for (i = 0; i < n; ++i)
+            a->occluded[i] = (uint8_t)rs_bvh_occluded(v, g, s->rays[i]);
+    }
+    return rs_bench_now() - t0;
+}
+
+static double trace_bvh4(const rs_bvh4 *b, const rs_geom *g, const bs_rays *s, int q,
+                         int threads, answers *a)
+{
+    double t0 = rs_bench_now();
+    long i, n = (long)s->n;
+    if (q == Q_CLOSEST) {
+#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+        for (i = 0; i < n; ++i) {
+            rs_hit h;
+            rs_bvh4_closest(b, g, s->rays[i], &h);
+            a->prim[i] = h.prim;
+            a->t[i] = h.t;
+        }
+    } else {
+#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+        for (i = 0; i < n; ++i)
+            a->occluded[i] = (uint8_t)rs_bvh4_occluded(b, g, s->rays[i]);
+    }
+    return rs_bench_now() - t0;
+}
+
+/* ---- Embree -------------------------------------------------------------------------------- */
+
+#ifdef RS_HAVE_EMBREE
+typedef struct embree_scene {
+    RTCDevice dev;
+    RTCScene scene;
+    uint32_t base[3]; /* global prim number of each geometry's first primitive */
+} embree_scene;
+
+static void embree_free(embree_scene *e)
+{
+    if (e->scene)
+        rtcReleaseScene(e->scene);
+    if (e->dev)
+        rtcReleaseDevice(e->dev);
+    memset(e, 0, sizeof *e);
+}
+
+/* One geometry of `n` primitives with `nv` vertices each; fills vertices (and for meshes an
+ * index buffer 0, 1, 2, ...); attached with id `id`. */
+static int embree_add(embree_scene *e, const rs_geom *g, enum RTCGeometryType type, uint32_t id,
+                      uint32_t n)
+{
+    RTCGeometry geo;
+    uint32_t i, k;
+    if (n == 0)
+        return 1;
+    geo = rtcNewGeometry(e->dev, type);
+    if (!geo)
+        return 0;
+    if (type == RTC_GEOMETRY_TYPE_SPHERE_POINT) {
+        float *v = (float *)rtcSetNewGeometryBuffer(geo, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                    RTC_FORMAT_FLOAT4, 4 * sizeof(float), n);
+        if (!v)
+            goto fail;
+        for (i = 0; i < n; ++i) {
+            v[4 * i + 0] = g->spheres[i].center.x;
+            v[4 * i + 1] = g->spheres[i].center.y;
+            v[4 * i + 2] = g->spheres[i].center.z;
+            v[4 * i + 3] = g->spheres[i].radius;
+        }
+    } else {
+        uint32_t nv = type == RTC_GEOMETRY_TYPE_QUAD ? 4 : 3;
+        float *v = (float *)rtcSetNewGeometryBuffer(geo, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                    RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv * n);
+        uint32_t *ix = (uint32_t *)rtcSetNewGeometryBuffer(
+            geo, RTC_BUFFER_TYPE_INDEX, 0, nv == 4 ? RTC_FORMAT_UINT4 : RTC_FORMAT_UINT3,
+            nv * sizeof(uint32_t), n);
+        if (!v || !ix)
+            goto fail;
+        for (i = 0; i < n; ++i) {
+            rs_vec3 p[4];
+            if (nv == 4) {
+                const rs_quad *q = &g->quads[i];
+                p[0] = q->q;
+                p[1] = rs_v3_add(q->q, q->u);
+                p[2] = rs_v3_add(p[1], q->v);
+                p[3] = rs_v3_add(q->q, q->v);
+            } else {
+                p[0] = g->tris[i].v0;
+                p[1] = g->tris[i].v1;
+                p[2] = g->tris[i].v2;
+            }
+            for (k = 0; k < nv; ++k) {
+                v[3 * (nv * i + k) + 0] = p[k].x;
+                v[3 * (nv * i + k) + 1] = p[k].y;
+                v[3 * (nv * i + k) + 2] = p[k].z;
+                ix[nv * i + k] = nv * i + k;
+            }
+        }
+    }
+    rtcCommitGeometry(geo);
+    rtcAttachGeometryByID(e->scene, geo, id);
+    rtcReleaseGeometry(geo);
+    return 1;
+fail:
+    rtcReleaseGeometry(geo);
+    return 0;
+}
+
+static int embree_build(embree_scene *e, const rs_geom *g)
+{
+    memset(e, 0, sizeof *e);
+    e->dev = rtcNewDevice(NULL);
+    if (!e->dev)
+        return 0;
+    e->scene = rtcNewScene(e->dev);
+    if (!e->scene) {
+        embree_free(e);
+        return 0;
+    }
+    e->base[0] = 0;
+    e->base[1] = g->n_spheres;
+    e->base[2] = g->n_spheres + g->n_quads;
+    if (!embree_add(e, g, RTC_GEOMETRY_TYPE_SPHERE_POINT, 0, g->n_spheres) ||
+        !embree_add(e, g, RTC_GEOMETRY_TYPE_QUAD, 1, g->n_quads) ||
+        !embree_add(e, g, RTC_GEOMETRY_TYPE_TRIANGLE, 2, g->n_tris)) {
+        embree_free(e);
+        return 0;
+    }
+    rtcCommitScene(e->scene);
+    return rtcGetDeviceError(e->dev) == RTC_ERROR_NONE;
+}
+
+static void embree_ray(const rs_ray *r, struct RTCRay *e)
+{
+    e->org_x = r->o.x;
+    e->org_y = r->o.y;
+    e->org_z = r->o.z;
+    e->dir_x = r->d.x;
+    e->dir_y = r->d.y;
+    e->dir_z = r->d.z;
+    e->tnear = r->tmin;
+    e->tfar = r->tmax;
+    e->time = 0.0f;
+    e->mask = 0xffffffffu;
+    e->id = 0;
+    e->flags = 0;
+}
+
+static double trace_embree(const embree_scene *e, const bs_rays *s, int q, int threads,
+                           answers *a)
+{
+    double t0 = rs_bench_now();
+    long i, n = (long)s->n;
+    if (q == Q_CLOSEST) {
+#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+        for (i = 0; i < n; ++i) {
+            struct RTCIntersectContext ctx;
+            struct RTCRayHit rh;
+            rtcInitIntersectContext(&ctx);
+            embree_ray(&s->rays[i], &rh.ray);
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(e->scene, &ctx, &rh);
+            a->prim[i] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID
+                             ? RS_NO_HIT
+                             : e->base[rh.hit.geomID] + rh.hit.primID;
+            a->t[i] = rh.ray.tfar;
+        }
+    } else {
+#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+        for (i = 0; i < n; ++i) {
+            struct RTCIntersectContext ctx;
+            struct RTCRay r;
+            rtcInitIntersectContext(&ctx);
+            embree_ray(&s->rays[i], &r);
+            rtcOccluded1(e->scene, &ctx, &r);
+            a->occluded[i] = r.tfar < 0.0f;
+        }
+    }
+    return rs_bench_now() - t0;
+}
+#endif
+
+/* ---- one scene ----------------------------------------------------------------------------- */
+
+static int answers_alloc(answers *a, uint32_t n)
+{
+    size_t m = n ? n : 1;
+    a->prim = (uint32_t *)malloc(m * sizeof *a->prim);
+    a->t = (float *)malloc(m * sizeof *a->t);
+    a->occluded = (uint8_t *)malloc(m);
+    return a->prim && a->t && a->occluded;
+}
+
+static void answers_free(answers *a)
+{
+    free(a->prim);
+    free(a->t);
+    free(a->occluded);
+}
+
+/* How many of the n answers differ (see the top of the file). */
+static uint32_t disagreements(const answers *x, const answers *y, uint32_t n, int q)
+{
+    uint32_t i, bad = 0;
+    for (i = 0; i < n; ++i) {
+        if (q == Q_ANY) {
+            bad += x->occluded[i] != y->occluded[i];
+        } else if ((x->prim[i] == RS_NO_HIT) != (y->prim[i] == RS_NO_HIT)) {
+            ++bad;
+        } else if (x->prim[i] != RS_NO_HIT && x->prim[i] != y->prim[i]) {
+            bad += fabsf(x->t[i] - y->t[i]) > 1e-4f * fmaxf(1.0f, fabsf(x->t[i]));
+        }
+    }
+    return bad;
+}
+
+typedef double (*trace_fn)(const void *ctx, const bs_rays *s, int q, int threads, answers *a);
+
+typedef struct ours_ctx {
+    rs_bvh_view v;
+    const rs_bvh4 *b4;
+    const rs_geom *g;
+} ours_ctx;
+
+static double run_bin(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
+{
+    const ours_ctx *c = (const ours_ctx *)ctx;
+    return trace_bin(&c->v, c->g, s, q, threads, a);
+}
+
+static double run_bvh4(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
+{
+    const ours_ctx *c = (const ours_ctx *)ctx;
+    return trace_bvh4(c->b4, c->g, s, q, threads, a);
+}
+
+/* The same answers bit for bit: 0, else the index of the first difference + 1. */
+static uint32_t first_difference(const answers *x, const answers *y, uint32_t n, int q)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i)
+        if (q == Q_ANY ? x->occluded[i] != y->occluded[i]
+                       : x->prim[i] != y->prim[i] || memcmp(&x->t[i], &y->t[i], sizeof(float)))
+            return i + 1;
+    return 0;
+}
+
+#ifdef RS_HAVE_EMBREE
+static double run_embree(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
+{
+    return trace_embree((const embree_scene *)ctx, s, q, threads, a);
+}
+#endif
+
+static double mrays(trace_fn f, const void *ctx, const bs_rays *s, int q, int threads, int runs,
+                    answers *a)
+{
+    double t[MAX_RUNS];
+    int k;
+    for (k = 0; k < runs; ++k)
+        t[k] = f(ctx, s, q, threads, a);
+    return (double)s->n / rs_bench_median(t, runs) / 1e6;
+}
+
+static int bench_scene(const bs_scene *sc, const settings *st)
+{
+    static const char *const QNAME[2] = {"closest", "any"};
+    bs_rays sets[BS_N_SETS];
+    rs_bvh_build_opts bo;
+    rs_bvh *bvh = NULL;
+    rs_bvh4 *bvh4 = NULL;
+    ours_ctx ours;
+    answers ans[N_ENGINES];
+    double m[BS_N_SETS][2][N_ENGINES][2]; /* [set][query][engine][1 thread, all threads] */
+    uint32_t bad[BS_N_SETS][2], hits[BS_N_SETS][2];
+    double build_s, embree_build_s = 0.0;
+    int k, q, e, n_engines = 2, ok = 0;
+#ifdef RS_HAVE_EMBREE
+    embree_scene es;
+    memset(&es, 0, sizeof es);
+#endif
+    memset(ans, 0, sizeof ans);
+    memset(bad, 0, sizeof bad);
+    memset(m, 0, sizeof m);
+    if (!bs_make_rays(sc, st->size, st->n_secondary, sets))
+        return 0;
+    memset(&bo, 0, sizeof bo);
+    bo.builder = st->builder;
+    build_s = rs_bench_now();
+    if (rs_bvh_build(&sc->g, &bo, &bvh) != RS_OK) {
+        fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
+        goto out;
+    }
+    build_s = rs_bench_now() - build_s;
+    if (rs_bvh4_build(bvh, &sc->g, &bvh4) != RS_OK) {
+        fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
+        goto out;
+    }
+    ours.v = rs_bvh_view_of(bvh);
+    ours.b4 = bvh4;
+    ours.g = &sc->g;
+#ifdef RS_HAVE_EMBREE
+    if (st->embree) {
+        if (sc->g.sphere_motion) {
+            printf("\n(Embree left out on %s: it has moving spheres)\n", sc->label);
+        } else {
+            embree_build_s = rs_bench_now();
+            if (!embree_build(&es, &sc->g)) {
+                fprintf(stderr, "traversal_bench: %s: Embree could not build the scene\n",
+                        sc->label);
+                goto out;
+            }
+            embree_build_s = rs_bench_now() - embree_build_s;
+            n_engines = 3;
+        }
+    }
+#endif
+    {
+        uint32_t most = sets[BS_PRIMARY].n > sets[BS_DIFFUSE].n ? sets[BS_PRIMARY].n
+                                                                : sets[BS_DIFFUSE].n;
+        if (!answers_alloc(&ans[0], most) || !answers_alloc(&ans[1], most) ||
+            !answers_alloc(&ans[2], most)) {
+            fprintf(stderr, "traversal_bench: out of memory\n");
+            goto out;
+        }
+    }
+
+    for (k = 0; k < BS_N_SETS; ++k)
+        for (q = 0; q < 2; ++q) {
+            for (e = 0; e < n_engines; ++e) {
+                trace_fn f = e == ENGINE_BIN ? run_bin : run_bvh4;
+                const void *ctx = &ours;
+#ifdef RS_HAVE_EMBREE
+                if (e == ENGINE_EMBREE) {
+                    f = run_embree;
+                    ctx = &es;
+                }
+#endif
+                m[k][q][e][0] = mrays(f, ctx, &sets[k], q, 1, st->runs, &ans[e]);
+                m[k][q][e][1] = mrays(f, ctx, &sets[k], q, st->threads, st->runs, &ans[e]);
+            }
+            {
+                uint32_t i, h = 0;
+                for (i = 0; i < sets[k].n; ++i)
+                    h += q == Q_ANY ? ans[0].occluded[i] : ans[0].prim[i] != RS_NO_HIT;
+                hits[k][q] = h;
+            }
+            {
+                uint32_t d = first_difference(&ans[ENGINE_BIN], &ans[ENGINE_BVH4], sets[k].n, q);
+                if (d) {
+                    fprintf(stderr,
+                            "traversal_bench: %s: the binary and 4-wide kernels answer %s ray %u "
+                            "(%s) differently\n",
+                            sc->label, sets[k].name, d - 1, QNAME[q]);
+                    goto out;
+                }
+            }
+            if (n_engines == 3) {
+                bad[k][q] = disagreements(&ans[ENGINE_BVH4], &ans[ENGINE_EMBREE], sets[k].n, q);
+                if (bad[k][q] > sets[k].n / 1000) {
+                    fprintf(stderr,
+                            "traversal_bench: %s: Embree and raystream disagree on %u of %u %s "
+                            "rays (%s)\n",
+                            sc->label, bad[k][q], sets[k].n, sets[k].name, QNAME[q]);
+                    goto out;
+                }
+            }
+        }
+
+    printf("\n### %s: %u primitives; %u primary rays (%ux%u), %u diffuse and %u shadow rays\n\n",
+           sc->label, rs_geom_prim_count(&sc->g), sets[0].n, st->size, st->size, sets[1].n,
+           sets[2].n);
+    printf("BVH %s: %u nodes, SAH cost %.2f, built in %.1f ms; 4-wide: %u nodes, depth %u (binary "
+           "%u)",
+           st->bvh_name, bvh->n_nodes, rs_bvh_sah_cost(bvh), 1e3 * build_s, bvh4->n_nodes,
+           bvh4->depth, bvh->depth);
+    if (n_engines == 3)
+        printf("; Embree scene committed in %.1f ms", 1e3 * embree_build_s);
+    printf("\n\n");
+    printf("| rays | query | hit %% | binary Mrays/s 1 thr | binary %d thr | 4-wide 1 thr | 4-wide "
+           "%d thr | 4-wide vs binary 1 thr",
+           st->threads, st->threads);
+    if (n_engines == 3)
+        printf(" | Embree 1 thr | Embree %d thr | ours/Embree 1 thr | ours/Embree %d thr | "
+               "answers differ",
+               st->threads, st->threads);
+    printf(" |\n|---|---|---:|---:|---:|---:|---:|---:|%s\n",
+           n_engines == 3 ? "---:|---:|---:|---:|---:|" : "");
+    for (k = 0; k < BS_N_SETS; ++k)
+        for (q = 0; q < 2; ++q) {
+            double hp = sets[k].n ? 100.0 * hits[k][q] / sets[k].n : 0.0;
+            printf("| %s | %s | %.1f | %.2f | %.2f | %.2f | %.2f | %.2fx", sets[k].name, QNAME[q],
+                   hp, m[k][q][ENGINE_BIN][0], m[k][q][ENGINE_BIN][1], m[k][q][ENGINE_BVH4][0],
+                   m[k][q][ENGINE_BVH4][1], m[k][q][ENGINE_BVH4][0] / m[k][q][ENGINE_BIN][0]);
+            if (n_engines == 3)
+                printf(" | %.2f | %.2f | %.2fx | %.2fx | %u", m[k][q][ENGINE_EMBREE][0],
+                       m[k][q][ENGINE_EMBREE][1],
+                       m[k][q][ENGINE_BVH4][0] / m[k][q][ENGINE_EMBREE][0],
+                       m[k][q][ENGINE_BVH4][1] / m[k][q][ENGINE_EMBREE][1], bad[k][q]);
+            printf(" |\n");
+            if (st->csv)
+                fprintf(st->csv, "%s,%s,%s,%s,%u,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u\n", sc->label,
+                        st->bvh_name, sets[k].name, QNAME[q], sets[k].n, m[k][q][0][0],
+                        m[k][q][0][1], m[k][q][1][0], m[k][q][1][1], m[k][q][2][0],
+                        m[k][q][2][1], bad[k][q]);
+        }
+    ok = 1;
+out:
+#ifdef RS_HAVE_EMBREE
+    embree_free(&es);
+#endif
+    for (e = 0; e < N_ENGINES; ++e)
+        answers_free(&ans[e]);
+    rs_bvh4_destroy(bvh4);
+    rs_bvh_destroy(bvh);
+    bs_rays_free(sets, BS_N_SETS);
+    return ok;
+}
+
+/* ---- main ---------------------------------------------------------------------------------- */
+
+int main(int argc, char **argv)
+{
+    settings st;
+    const char *models = NULL, *csv = NULL, *scenes[MAX_SCENES];
+    char paths[2][4200];
+    int quick = 0, i, ok = 1, n_scenes = 0;
+
+    memset(&st, 0, sizeof st);
+    st.bvh_name = "sah";
+    st.size = 512;
+    st.n_secondary = 262144;
+    st.runs = 5;
+    st.threads = rs_default_threads();
+    st.embree = 1;
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--quick") == 0) {
+            quick = 1;
+        } else if (strcmp(argv[i], "--scene") == 0 && i + 1 < argc && n_scenes < MAX_SCENES) {
+            scenes[n_scenes++] = argv[++i];
+        } else if (strcmp(argv[i], "--models") == 0 && i + 1 < argc) {
+            models = argv[++i];
+        } else if (strcmp(argv[i], "--bvh") == 0 && i + 1 < argc) {
+            st.bvh_name = argv[++i];
+        } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
+            st.size = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--secondary") == 0 && i + 1 < argc) {
+            st.n_secondary = (uint32_t)atol(argv[++i]);
+        } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
+            st.runs = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+            st.threads = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--no-embree") == 0) {
+            st.embree = 0;
+        } else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
+            csv = argv[++i];
+        } else {
+            fprintf(stderr, "usage: traversal_bench [--quick] [--scene soup:N|builtin:NAME|FILE]... "
+                            "[--models DIR] [--bvh NAME] [--size W] [--secondary N] [--runs N] "
+                            "[--threads N] [--no-embree] [--csv FILE]\n");
+            return 2;
+        }
+    }
+    if (quick) {
+        st.size = 64;
+        st.n_secondary = 4096;
+        st.runs = 1;
+        if (n_scenes == 0)
+            scenes[n_scenes++] = "builtin:cornell";
+    }
+    if (st.size < 1 || st.n_secondary < 1 || st.runs < 1 || st.runs > MAX_RUNS ||
+        st.threads < 1) {
+        fprintf(stderr, "traversal_bench: size, secondary, threads must be >= 1, runs 1..%d\n",
+                MAX_RUNS);
+        return 2;
+    }
+    if (rs_bvh_builder_parse(st.bvh_name, &st.builder) != RS_OK) {
+        fprintf(stderr, "traversal_bench: --bvh: %s\n", rs_error_message());
+        return 2;
+    }
+    if (csv) {
+        st.csv = fopen(csv, "w");
+        if (!st.csv) {
+            fprintf(stderr, "traversal_bench: cannot write %s\n", csv);
+            return 1;
+        }
+        fprintf(st.csv, "scene,bvh,rays,query,n,binary_mrays_1thr,binary_mrays_nthr,"
+                        "bvh4_mrays_1thr,bvh4_mrays_nthr,embree_mrays_1thr,embree_mrays_nthr,"
+                        "answers_differ\n");
+    }
+
+    rs_bench_print_machine(stdout);
+#ifdef RS_HAVE_EMBREE
+    if (st.embree)
+        printf("Embree %s: rtcIntersect1 / rtcOccluded1, build quality medium\n",
+               RTC_VERSION_STRING);
+    else
+        printf("Embree: left out (--no-embree)\n");
+#else
+    printf("Embree: not built in (install libembree-dev and re-run CMake to compare)\n");
+#endif
+    printf("settings: our BVH %s (max leaf 4); median of %d run%s; %d threads in the "
+           "multi-threaded columns (OpenMP, dynamic chunks of %d rays)\n",
+           st.bvh_name, st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
+
+    if (n_scenes == 0) {
+        const char *dir = bs_models_dir(models);
+        if (dir) {
+            scenes[n_scenes++] = "builtin:cornell-bunny-teapot";
+            snprintf(paths[0], sizeof paths[0], "%s/bunny/bun_zipper.ply", dir);
+            scenes[n_scenes++] = paths[0];
+            snprintf(paths[1], sizeof paths[1], "%s/dragon/dragon_100k.ply", dir);
+            scenes[n_scenes++] = paths[1];
+        } else {
+            printf("\n(no shared models folder at %s: the Cornell box and a soup instead)\n",
+                   rs_builtin_models_dir(models));
+            scenes[n_scenes++] = "builtin:cornell";
+            scenes[n_scenes++] = "soup:100000";
+        }
+    }
+    for (i = 0; ok && i < n_scenes; ++i) {
+        bs_scene sc;
+        if (!bs_load(scenes[i], models, &sc)) {
+            ok = 0;
+            break;
+        }
+        ok = bench_scene(&sc, &st);
+        bs_scene_free(&sc);
+    }
+    if (st.csv)
+        fclose(st.csv);
+    return ok ? 0 : 1;
+}
