@@ -107,8 +107,8 @@ RS_HD float rs_float_next_up(float t)
  * t, and of primitives hit at exactly that t the lowest-numbered (what a brute-force loop over
  * the primitives in order keeps).  After a hit at t, a traversal keeps searching up to
  * rs_float_next_up(t) so that ties are seen, and takes a candidate (t', prim') when this says so
- * (before any hit, best->t is the ray's tmax and best->prim RS_NO_HIT).  So the binary and the 4-wide traversals (accel/bvh4.h), on any device, agree
- * bit for bit. */
+ * (before any hit, best->t is the ray's tmax and best->prim RS_NO_HIT).  So the binary and the
+ * 4-wide traversals (accel/bvh4.h), on any device, agree bit for bit. */
 RS_HD int rs_hit_better(float t, uint32_t prim, const rs_hit *best)
 {
     return t < best->t || (t == best->t && prim < best->prim);

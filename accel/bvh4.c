@@ -156,8 +156,7 @@ rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)
             t->tri4 = (rs_bvh4_tri4 *)rs_alloc_aligned(c.cap_tri4, sizeof *t->tri4);
         if (!t->nodes || (c.cap_tri4 > 0 && !t->tri4)) {
             rs_bvh4_destroy(t);
-            return rs_error_set(RS_ERR_NOMEM, "out of memory for the 4-wide BVH (%u nodes)",
-                                c.cap);
+            return rs_error_set(RS_ERR_NOMEM, "out of memory for the 4-wide BVH (%u nodes)", c.cap);
         }
         c.out = t;
         t->n_nodes = 1;

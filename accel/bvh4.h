@@ -173,8 +173,8 @@ static inline uint32_t rs_bvh4_tri4_hit(const rs_bvh4_tri4 *b, const rs_bvh4_ray
     __m128 px = _mm_sub_ps(_mm_mul_ps(dy, e2z), _mm_mul_ps(dz, e2y));
     __m128 py = _mm_sub_ps(_mm_mul_ps(dz, e2x), _mm_mul_ps(dx, e2z));
     __m128 pz = _mm_sub_ps(_mm_mul_ps(dx, e2y), _mm_mul_ps(dy, e2x));
-    __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)),
-                            _mm_mul_ps(e1z, pz));
+    __m128 det =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
     __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
     /* s = o - v0, u = (s . p) inv */
     __m128 sx = _mm_sub_ps(r->o[0], RS_LD(b->v0[0]));
@@ -189,14 +189,13 @@ static inline uint32_t rs_bvh4_tri4_hit(const rs_bvh4_tri4 *b, const rs_bvh4_ray
     __m128 bv = _mm_mul_ps(
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, qx), _mm_mul_ps(dy, qy)), _mm_mul_ps(dz, qz)), inv);
     __m128 tt = _mm_mul_ps(
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)),
-        inv);
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)), inv);
     __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
     __m128 ok = _mm_cmpneq_ps(det, zero);
     ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(bu, zero), _mm_cmple_ps(bu, one)));
     ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(bv, zero), _mm_cmple_ps(_mm_add_ps(bu, bv), one)));
-    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(tt, _mm_set1_ps(tmin)),
-                                   _mm_cmplt_ps(tt, _mm_set1_ps(tmax))));
+    ok = _mm_and_ps(
+        ok, _mm_and_ps(_mm_cmpgt_ps(tt, _mm_set1_ps(tmin)), _mm_cmplt_ps(tt, _mm_set1_ps(tmax))));
 #  undef RS_LD
     _mm_storeu_ps(t, tt);
     _mm_storeu_ps(u, bu);

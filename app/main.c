@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "app/options.h"
 #include "app/progress.h"
@@ -15,6 +16,7 @@
 #include "core/parallel.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
+#include "scheduler/fault.h"
 #include "scenes/builtin.h"
 #include "scenes/scene_json.h"
 #include "scheduler/render.h"
@@ -92,32 +94,73 @@ static void human(double v, char *buf, size_t n)
         snprintf(buf, n, "%.0f ", v);
 }
 
-/* Creates the devices named on the command line.  A gpu that cannot be used becomes the CPU
- * fallback device (one warning line).  Returns the count, or -1 after printing an error. */
+/* Creates the devices named on the command line (--devices auto: the CPU and every CUDA
+ * device).  A gpu that cannot be used becomes the CPU fallback device (one warning line).  The
+ * cores are shared out without oversubscription: each fallback takes one thread when a cpu
+ * device is beside it (every core when it is alone), and a cpu device without an explicit
+ * thread count gets the rest.  RS_FAULT (scheduler/fault.h) wraps devices that should fail.
+ * Returns the count, or -1 after printing an error. */
 static int create_devices(const rs_cli_options *o, int threads, rs_device **devs)
 {
-    int i, n = 0;
-    for (i = 0; i < o->n_devices; ++i) {
-        const rs_device_spec *d = &o->devices[i];
+    rs_device_spec specs[RS_MAX_DEVICES];
+    int usable[RS_MAX_DEVICES];
+    int i, n = 0, n_specs = 0, n_gpus, has_cpu = 0, fallback_threads = 0;
+    const char *why = "";
+    rs_fault_spec fault;
+
+    if (rs_fault_parse(getenv("RS_FAULT"), &fault) != RS_OK) {
+        fail(RS_EXIT_USAGE, NULL);
+        return -1;
+    }
+    n_gpus = rs_gpu_count(&why);
+    if (o->devices_auto) {
+        memset(&specs[0], 0, sizeof specs[0]);
+        n_specs = 1;
+        for (i = 0; i < n_gpus && n_specs < RS_MAX_DEVICES; ++i) {
+            memset(&specs[n_specs], 0, sizeof specs[0]);
+            specs[n_specs].is_gpu = 1;
+            specs[n_specs++].index = i;
+        }
+    } else {
+        n_specs = o->n_devices;
+        memcpy(specs, o->devices, (size_t)n_specs * sizeof specs[0]);
+    }
+    for (i = 0; i < n_specs; ++i)
+        has_cpu |= !specs[i].is_gpu;
+    for (i = 0; i < n_specs; ++i) {
+        usable[i] = !specs[i].is_gpu || specs[i].index < n_gpus;
+        if (!usable[i])
+            fallback_threads += has_cpu ? 1 : threads;
+    }
+    for (i = 0; i < n_specs; ++i) {
+        const rs_device_spec *d = &specs[i];
         rs_status st;
         if (!d->is_gpu) {
             rs_cpu_device_opts co;
             memset(&co, 0, sizeof co);
-            co.threads = d->threads ? d->threads : threads;
+            co.threads = d->threads
+                             ? d->threads
+                             : (threads - fallback_threads > 1 ? threads - fallback_threads : 1);
             co.name = "cpu";
             co.bvh_width = o->bvh_width;
             st = rs_cpu_device_create_opts(&co, &devs[n]);
         } else {
-            st = rs_gpu_device_create(d->index, &devs[n]);
+            st = usable[i] ? rs_gpu_device_create(d->index, &devs[n]) : RS_ERR_DEVICE_LOST;
             if (st != RS_OK) {
-                /* alone, the fallback may use every core; beside a cpu device, one of them */
-                int ft = o->n_devices == 1 ? threads : 1;
+                int ft = has_cpu ? 1 : threads;
                 fprintf(stderr,
                         "raystream: warning: %s; gpu:%d runs on the CPU fallback (%d thread%s)\n",
-                        rs_error_message(), d->index, ft, ft == 1 ? "" : "s");
+                        usable[i] ? rs_error_message() : why, d->index, ft, ft == 1 ? "" : "s");
                 rs_error_clear();
                 st = rs_cpu_fallback_device_create(ft, d->index, &devs[n]);
             }
+        }
+        if (st == RS_OK) {
+            int after = d->is_gpu ? fault.gpu_after : fault.cpu_after;
+            if (after >= 0)
+                st = rs_fault_wrap(&devs[n], after);
+            if (st != RS_OK)
+                rs_device_destroy(devs[n]);
         }
         if (st != RS_OK) {
             while (n > 0)
@@ -128,6 +171,69 @@ static int create_devices(const rs_cli_options *o, int threads, rs_device **devs
         n++;
     }
     return n;
+}
+
+/* The --stats table (stderr) and --stats-json file.  Returns 0 if the JSON file could not be
+ * written (after printing why). */
+static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *const *devs,
+                        int n_devs, const rs_render_stats *rstats)
+{
+    rs_device_stats ds[RS_MAX_DEVICES];
+    int alive[RS_MAX_DEVICES], i;
+    uint64_t total = 0;
+    double wall = rstats->seconds > 0 ? rstats->seconds : 1e-9;
+    for (i = 0; i < n_devs; ++i) {
+        rs_sched_device_stats(sched, i, &ds[i], &alive[i]);
+        total += ds[i].rays;
+    }
+    if (o->stats) {
+        fprintf(stderr, "%-24s %14s %8s %9s %9s %9s %7s %12s %12s %s\n", "device", "rays", "chunks",
+                "busy s", "idle s", "Mrays/s", "share", "bytes in", "bytes out", "state");
+        for (i = 0; i < n_devs; ++i)
+            fprintf(stderr, "%-24s %14llu %8llu %9.3f %9.3f %9.2f %6.1f%% %12llu %12llu %s\n",
+                    devs[i]->name, (unsigned long long)ds[i].rays, (unsigned long long)ds[i].chunks,
+                    ds[i].busy_s, ds[i].idle_s,
+                    ds[i].busy_s > 0 ? (double)ds[i].rays / ds[i].busy_s / 1e6 : 0.0,
+                    total ? 100.0 * (double)ds[i].rays / (double)total : 0.0,
+                    (unsigned long long)ds[i].bytes_to_device,
+                    (unsigned long long)ds[i].bytes_from_device, alive[i] ? "ok" : "failed");
+    }
+    if (o->stats_json) {
+        FILE *f = fopen(o->stats_json, "w");
+        if (!f) {
+            fprintf(stderr, "raystream: %s: cannot write the stats\n", o->stats_json);
+            return 0;
+        }
+        fprintf(f, "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"devices\": [\n", wall,
+                (unsigned long long)total);
+        for (i = 0; i < n_devs; ++i) {
+            const char *c;
+            fprintf(f, "    {\"name\": \"");
+            for (c = devs[i]->name; *c; ++c)
+                if (*c == '"' || *c == '\\')
+                    fprintf(f, "\\%c", *c);
+                else if ((unsigned char)*c >= 0x20)
+                    fputc(*c, f);
+            fprintf(f,
+                    "\", \"threads\": %d, \"rays\": %llu, \"chunks\": %llu, \"busy_s\": %.6f, "
+                    "\"idle_s\": %.6f, \"mrays_per_s\": %.4f, \"share\": %.6f, "
+                    "\"bytes_to_device\": %llu, \"bytes_from_device\": %llu, \"failures\": %llu, "
+                    "\"failed\": %s}%s\n",
+                    devs[i]->threads, (unsigned long long)ds[i].rays,
+                    (unsigned long long)ds[i].chunks, ds[i].busy_s, ds[i].idle_s,
+                    ds[i].busy_s > 0 ? (double)ds[i].rays / ds[i].busy_s / 1e6 : 0.0,
+                    total ? (double)ds[i].rays / (double)total : 0.0,
+                    (unsigned long long)ds[i].bytes_to_device,
+                    (unsigned long long)ds[i].bytes_from_device, (unsigned long long)ds[i].failures,
+                    alive[i] ? "false" : "true", i + 1 < n_devs ? "," : "");
+        }
+        fprintf(f, "  ]\n}\n");
+        if (fclose(f) != 0) {
+            fprintf(stderr, "raystream: %s: cannot write the stats\n", o->stats_json);
+            return 0;
+        }
+    }
+    return 1;
 }
 
 static int cmd_render(const rs_cli_options *o)
@@ -224,6 +330,21 @@ static int cmd_render(const rs_cli_options *o)
         rs_scene_destroy(scene);
         return fail(rst == RS_ERR_ARG ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
     }
+    if (o->stats_json) {
+        /* its folder must exist and be writable before the render starts */
+        char dir[4096];
+        const char *slash = strrchr(o->stats_json, '/');
+        snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - o->stats_json) : 1,
+                 slash ? (slash == o->stats_json ? "/" : o->stats_json) : ".");
+        if (access(dir, W_OK) != 0) {
+            fprintf(stderr,
+                    "raystream: --stats-json %s: the folder %s does not exist or is not "
+                    "writable\n",
+                    o->stats_json, dir);
+            rs_scene_destroy(scene);
+            return RS_EXIT_USAGE;
+        }
+    }
 
     /* ---- BVH, devices, scheduler, film ---- */
     geom = rs_scene_geom(scene);
@@ -290,6 +411,8 @@ static int cmd_render(const rs_cli_options *o)
         code = fail(RS_EXIT_RUNTIME, NULL);
         goto done;
     }
+    if ((o->stats || o->stats_json) && !report_stats(o, sched, devs, n_devs, &stats))
+        code = RS_EXIT_RUNTIME;
 
     if (!o->quiet) {
         char sps[32], rps[32], rays[32];

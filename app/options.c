@@ -63,6 +63,11 @@ static int parse_devices(const char *text, rs_cli_options *o)
         return usage_error("--devices: list too long: '%s'%s", text, "");
     strcpy(buf, text);
     o->n_devices = 0;
+    o->devices_auto = 0;
+    if (strcmp(text, "auto") == 0) {
+        o->devices_auto = 1;
+        return RS_EXIT_OK;
+    }
     for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         rs_device_spec d = {0, 0, 0};
         char *colon = strchr(tok, ':');
@@ -80,8 +85,8 @@ static int parse_devices(const char *text, rs_cli_options *o)
                 return RS_EXIT_USAGE;
             d.index = colon ? (int)v : 0;
         } else {
-            return usage_error("--devices: unknown device '%s' in '%s' (use cpu, cpu:THREADS, "
-                               "gpu or gpu:INDEX)",
+            return usage_error("--devices: unknown device '%s' in '%s' (use auto, or cpu, "
+                               "cpu:THREADS, gpu, gpu:INDEX)",
                                tok, text);
         }
         for (i = 0; i < o->n_devices; ++i)
@@ -118,8 +123,12 @@ void rs_cli_print_help(const char *command)
             "  --max-depth N       most ray segments per path, camera ray included (default 50)\n"
             "  --seed N            random seed; same seed, same image (default 1)\n"
             "  --threads N         CPU threads (default: every core)\n"
-            "  --devices LIST      comma-separated: cpu, cpu:THREADS, gpu, gpu:INDEX\n"
-            "                      (default cpu).  A gpu without CUDA falls back to the CPU.\n"
+            "  --devices LIST      auto (default: the CPU and every CUDA device), or comma-\n"
+            "                      separated cpu, cpu:THREADS, gpu, gpu:INDEX.  A gpu that\n"
+            "                      cannot be used runs on the CPU fallback (one warning).\n"
+            "  --stats             after the render, a table per device: rays, chunks, busy\n"
+            "                      and idle seconds, Mrays/s, share, bytes moved\n"
+            "  --stats-json FILE   the same as JSON\n"
             "  --sampling MODE     mis (default): light + BSDF sampling, power heuristic;\n"
             "                      mixture: the thesis's light/BSDF mixture pdf;\n"
             "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
@@ -177,8 +186,8 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->sampling = RS_SAMPLING_MIS;
     o->chunk_size = 65536;
     o->wave_paths = 1u << 20;
-    o->n_devices = 1;
-    o->devices[0].is_gpu = 0;
+    o->devices_auto = 1;
+    o->n_devices = 0;
 
     if (argc < 2) {
         o->command = RS_CMD_HELP;
@@ -289,6 +298,14 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
                 rs_error_clear();
                 return RS_EXIT_USAGE;
             }
+        } else if (strcmp(name, "--stats") == 0) {
+            o->stats = 1;
+            continue;
+        } else if (strcmp(name, "--stats-json") == 0) {
+            NEEDS_VALUE();
+            if (!*v)
+                return usage_error("%s needs a file name%s", name, "");
+            o->stats_json = v;
         } else if (strcmp(name, "--bvh-width") == 0) {
             NEEDS_VALUE();
             if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0)

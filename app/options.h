@@ -40,15 +40,18 @@ typedef struct rs_cli_options {
     uint32_t chunk_size;
     uint32_t wave_paths;
     int quiet;
-    const char *mesh;          /* --mesh FILE: into the Cornell box */
-    const char *models;        /* --models DIR */
-    rs_bvh_builder bvh;        /* --bvh NAME */
-    uint32_t isect_sphere;     /* --isect-sphere: rs_isect_sphere_algo */
-    uint32_t isect_tri;        /* --isect-tri: rs_isect_tri_algo */
-    uint32_t isect_aabb;       /* --isect-aabb: rs_isect_aabb_algo */
-    uint32_t bvh_width;        /* --bvh-width 2|4: the CPU device's traversal (default 4) */
+    const char *mesh;      /* --mesh FILE: into the Cornell box */
+    const char *models;    /* --models DIR */
+    rs_bvh_builder bvh;    /* --bvh NAME */
+    uint32_t isect_sphere; /* --isect-sphere: rs_isect_sphere_algo */
+    uint32_t isect_tri;    /* --isect-tri: rs_isect_tri_algo */
+    uint32_t isect_aabb;   /* --isect-aabb: rs_isect_aabb_algo */
+    uint32_t bvh_width;    /* --bvh-width 2|4: the CPU device's traversal (default 4) */
+    int devices_auto;      /* --devices auto (the default): the CPU and every CUDA device */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
+    int stats;              /* --stats: a per-device table after the render */
+    const char *stats_json; /* --stats-json FILE */
 } rs_cli_options;
 
 /* Parses argv.  Returns RS_EXIT_OK, or RS_EXIT_USAGE after printing one line naming the

@@ -232,9 +232,8 @@ static inline int bs_make_rays(const bs_scene *s, uint32_t w, uint32_t n_seconda
                                bs_rays sets[BS_N_SETS])
 {
     const rs_geom *g = &s->g;
-    rs_camera cam = rs_camera_make(s->scene->camera.from, s->scene->camera.at,
-                                   s->scene->camera.up, s->scene->camera.vfov_deg, 0.0f, 0.0f, w,
-                                   w);
+    rs_camera cam = rs_camera_make(s->scene->camera.from, s->scene->camera.at, s->scene->camera.up,
+                                   s->scene->camera.vfov_deg, 0.0f, 0.0f, w, w);
     float eps = 1e-4f * rs_v3_length(rs_v3_sub(s->box.hi, s->box.lo));
     rs_bvh *bvh = NULL;
     rs_bvh_view view;

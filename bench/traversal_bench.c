@@ -14,7 +14,8 @@
  * build quality MEDIUM, the default) and traces the same rays with rtcIntersect1 / rtcOccluded1
  * in the same loops, prints the 4-wide kernel's ratio to Embree, and checks that both find the
  * same answers: the same occlusion, and the same closest primitive or a hit at the same distance
- * (relative 1e-4: a tie between neighbours).  A disagreement on more than 0.1% of any set fails the run.
+ * (relative 1e-4: a tie between neighbours).  A disagreement on more than 0.1% of any set fails the
+ * run.
  *
  *   traversal_bench [--quick] [--scene SPEC]... [--models DIR] [--bvh NAME] [--size W]
  *                   [--secondary N] [--runs N] [--threads N] [--no-embree] [--csv FILE]
@@ -79,8 +80,8 @@ static double trace_bin(const rs_bvh_view *v, const rs_geom *g, const bs_rays *s
     return rs_bench_now() - t0;
 }
 
-static double trace_bvh4(const rs_bvh4 *b, const rs_geom *g, const bs_rays *s, int q,
-                         int threads, answers *a)
+static double trace_bvh4(const rs_bvh4 *b, const rs_geom *g, const bs_rays *s, int q, int threads,
+                         answers *a)
 {
     double t0 = rs_bench_now();
     long i, n = (long)s->n;
@@ -220,13 +221,12 @@ static void embree_ray(const rs_ray *r, struct RTCRay *e)
     e->flags = 0;
 }
 
-static double trace_embree(const embree_scene *e, const bs_rays *s, int q, int threads,
-                           answers *a)
+static double trace_embree(const embree_scene *e, const bs_rays *s, int q, int threads, answers *a)
 {
     double t0 = rs_bench_now();
     long i, n = (long)s->n;
     if (q == Q_CLOSEST) {
-#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+#  pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
         for (i = 0; i < n; ++i) {
             struct RTCIntersectContext ctx;
             struct RTCRayHit rh;
@@ -241,7 +241,7 @@ static double trace_embree(const embree_scene *e, const bs_rays *s, int q, int t
             a->t[i] = rh.ray.tfar;
         }
     } else {
-#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
+#  pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
         for (i = 0; i < n; ++i) {
             struct RTCIntersectContext ctx;
             struct RTCRay r;
@@ -391,8 +391,8 @@ static int bench_scene(const bs_scene *sc, const settings *st)
     }
 #endif
     {
-        uint32_t most = sets[BS_PRIMARY].n > sets[BS_DIFFUSE].n ? sets[BS_PRIMARY].n
-                                                                : sets[BS_DIFFUSE].n;
+        uint32_t most =
+            sets[BS_PRIMARY].n > sets[BS_DIFFUSE].n ? sets[BS_PRIMARY].n : sets[BS_DIFFUSE].n;
         if (!answers_alloc(&ans[0], most) || !answers_alloc(&ans[1], most) ||
             !answers_alloc(&ans[2], most)) {
             fprintf(stderr, "traversal_bench: out of memory\n");
@@ -476,8 +476,8 @@ static int bench_scene(const bs_scene *sc, const settings *st)
             if (st->csv)
                 fprintf(st->csv, "%s,%s,%s,%s,%u,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u\n", sc->label,
                         st->bvh_name, sets[k].name, QNAME[q], sets[k].n, m[k][q][0][0],
-                        m[k][q][0][1], m[k][q][1][0], m[k][q][1][1], m[k][q][2][0],
-                        m[k][q][2][1], bad[k][q]);
+                        m[k][q][0][1], m[k][q][1][0], m[k][q][1][1], m[k][q][2][0], m[k][q][2][1],
+                        bad[k][q]);
         }
     ok = 1;
 out:
@@ -530,9 +530,10 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
             csv = argv[++i];
         } else {
-            fprintf(stderr, "usage: traversal_bench [--quick] [--scene soup:N|builtin:NAME|FILE]... "
-                            "[--models DIR] [--bvh NAME] [--size W] [--secondary N] [--runs N] "
-                            "[--threads N] [--no-embree] [--csv FILE]\n");
+            fprintf(stderr,
+                    "usage: traversal_bench [--quick] [--scene soup:N|builtin:NAME|FILE]... "
+                    "[--models DIR] [--bvh NAME] [--size W] [--secondary N] [--runs N] "
+                    "[--threads N] [--no-embree] [--csv FILE]\n");
             return 2;
         }
     }
@@ -543,8 +544,7 @@ int main(int argc, char **argv)
         if (n_scenes == 0)
             scenes[n_scenes++] = "builtin:cornell";
     }
-    if (st.size < 1 || st.n_secondary < 1 || st.runs < 1 || st.runs > MAX_RUNS ||
-        st.threads < 1) {
+    if (st.size < 1 || st.n_secondary < 1 || st.runs < 1 || st.runs > MAX_RUNS || st.threads < 1) {
         fprintf(stderr, "traversal_bench: size, secondary, threads must be >= 1, runs 1..%d\n",
                 MAX_RUNS);
         return 2;

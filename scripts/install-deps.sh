@@ -3,10 +3,22 @@
 # (Debian bookworm).  Idempotent: prints nothing and changes nothing when all is installed.
 # Run as root (or through sudo).  The CUDA toolkit is optional and not installed here: without
 # nvcc the build simply leaves the CUDA device out.
+#   --bench   also Intel Embree 3 (libembree-dev), which bench/traversal_bench races when CMake
+#             finds it.  Benchmark only; the renderer and its tests never need it.
 set -eu
 
 PACKAGES="gcc g++ make cmake pkg-config libc6-dev
 libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev gnuplot-nox"
+
+for arg in "$@"; do
+    case "$arg" in
+    --bench) PACKAGES="$PACKAGES libembree-dev" ;;
+    *)
+        echo "install-deps.sh: unknown option '$arg' (use --bench)" >&2
+        exit 2
+        ;;
+    esac
+done
 
 missing=""
 for p in $PACKAGES; do

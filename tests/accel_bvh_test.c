@@ -152,9 +152,8 @@ static rs_bvh4 *collapse4(const rs_bvh *b, const rs_geom *g)
 
 /* Compares the queries of the binary tree and, if b4 is not NULL, of the 4-wide one against the
  * brute-force answer for ray r: the same hit bit for bit, and the same occlusion. */
-static void expect_same_hit(const rs_bvh *bvh, const rs_bvh4 *b4, const rs_geom *g,
-                            const rs_ray *r, const rs_hit *ref, int ref_hit, const char *what,
-                            long index)
+static void expect_same_hit(const rs_bvh *bvh, const rs_bvh4 *b4, const rs_geom *g, const rs_ray *r,
+                            const rs_hit *ref, int ref_hit, const char *what, long index)
 {
     static const char *const kernel[2] = {"binary", "4-wide"};
     rs_bvh_view view = rs_bvh_view_of(bvh);
@@ -174,8 +173,8 @@ static void expect_same_hit(const rs_bvh *bvh, const rs_bvh4 *b4, const rs_geom 
         }
         if (occ != ref_hit) {
             describe_ray(ray, sizeof ray, r);
-            fail_msg("%s ray %ld: %s occluded %d, brute force %s; %s", what, index, kernel[k],
-                     occ, ref_hit ? "hit" : "miss", ray);
+            fail_msg("%s ray %ld: %s occluded %d, brute force %s; %s", what, index, kernel[k], occ,
+                     ref_hit ? "hit" : "miss", ray);
         }
     }
 }
@@ -392,8 +391,8 @@ static void soup_grid(soup *s, uint32_t n, uint64_t seed)
 /* Rays from above the grid aimed at one of its vertices, or at a random point. */
 static rs_ray grid_ray(uint64_t *s, long i, uint32_t n, const soup *g)
 {
-    rs_vec3 o = rs_v3(rnd_range(s, -5.0, n + 5.0), rnd_range(s, 5.0, 30.0),
-                      rnd_range(s, -5.0, n + 5.0));
+    rs_vec3 o =
+        rs_v3(rnd_range(s, -5.0, n + 5.0), rnd_range(s, 5.0, 30.0), rnd_range(s, -5.0, n + 5.0));
     rs_vec3 target;
     if (i % 4 != 3) {
         const rs_tri *t = &g->tris[(uint32_t)(rnd01(s) * g->g.n_tris)];
@@ -419,8 +418,7 @@ static int brute_ties(const rs_geom *g, const rs_ray *r, const rs_hit *ref)
 /* n rays (from the soup's generator, or the grid's when grid > 0) against brute force, for trees
  * with max_leaf 1, 4 and 8 and both kernels.  Returns the hits; *ties counts the rays whose
  * closest t several primitives share. */
-static long check_vs_brute_force(const soup *s, const char *name, long n, uint32_t grid,
-                                 long *ties)
+static long check_vs_brute_force(const soup *s, const char *name, long n, uint32_t grid, long *ties)
 {
     static const uint32_t leaf_sizes[] = {1, 4, 8};
     rs_bvh *trees[3];
@@ -490,8 +488,8 @@ static void test_shared_vertices_vs_brute_force(void **state)
     rs_bvh4_destroy(b4);
     rs_bvh_destroy(b);
     hits = check_vs_brute_force(&s, "grid", N_RAYS, GRID, &ties);
-    print_message("grid: %d rays, %ld hit, %ld at a t that several triangles share\n", N_RAYS,
-                  hits, ties);
+    print_message("grid: %d rays, %ld hit, %ld at a t that several triangles share\n", N_RAYS, hits,
+                  ties);
     assert_true(hits > N_RAYS * 3 / 4);
     /* the tie rule was exercised */
     assert_true(ties > 100);

@@ -505,8 +505,7 @@ static void test_usage_errors(void **state)
          {"--sampling", "sobol"}},
         {{"render", "-o", "out.png", "--spp", "1", "--devices", "cpu,tpu", NULL},
          {"--devices", "tpu"}},
-        {{"render", "-o", "out.png", "--spp", "1", "--bvh-width", "8", NULL},
-         {"--bvh-width", "8"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--bvh-width", "8", NULL}, {"--bvh-width", "8"}},
         {{"render", "--width", "8", "--spp", "1", "-o", "out.xyz", NULL}, {"out.xyz"}},
         {{"render", "no-such-scene.rss", "-o", "out.png", "--spp", "1", NULL},
          {"no-such-scene.rss"}},
@@ -896,6 +895,64 @@ static void test_gpu_fallback(void **state)
 /* Scene files and meshes from the command line: a good JSON scene and a mesh render; a bad
  * JSON scene and an unreadable mesh give one line naming the file and exit 1; a mesh with bad
  * faces renders with one warning line counting them. */
+/* RS_FAULT=gpu:after=2 makes the gpu (here its fallback) fail on its third chunk: the render
+ * still finishes on the cpu with every sample (the image is the cpu-only image bit for bit),
+ * and --stats / --stats-json say which device failed.  A malformed RS_FAULT is an error. */
+static void test_device_fault_and_stats(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const cpu_args[] = {"render",    "--width", "24", "--spp",   "4", "-q",
+                                           "--devices", "cpu",     "-o", "ref.exr", NULL};
+    static const char *const fault_args[] = {
+        "render",       "--width",    "24",           "--spp",     "4",
+        "--devices",    "cpu:1,gpu",  "--chunk-size", "50",        "--stats",
+        "--stats-json", "stats.json", "-o",           "fault.exr", NULL};
+    static const char *const bad_args[] = {"render", "--width", "8",       "--spp",
+                                           "1",      "-o",      "bad.png", NULL};
+    const char *why = "";
+    char path[4200], json[4096];
+    proc p, q, r;
+    image a, b;
+    FILE *js;
+    size_t n;
+    if (rs_gpu_count(&why) > 0) {
+        print_message("a CUDA device is present: the fallback's fault is not exercised here\n");
+        skip();
+    }
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, cpu_args);
+    EXPECT(&p, exited_with(&p, 0), "the cpu render should succeed");
+    setenv("RS_FAULT", "gpu:after=2", 1);
+    run(&q, f->dir, DEFAULT_TIMEOUT_S, fault_args);
+    setenv("RS_FAULT", "gpu:sometimes", 1);
+    run(&r, f->dir, DEFAULT_TIMEOUT_S, bad_args);
+    unsetenv("RS_FAULT");
+    EXPECT(&q, exited_with(&q, 0), "the render should survive the gpu's failure");
+    EXPECT(&q, strstr(q.err.data, "failed") != NULL, "the summary should say the gpu failed");
+    a = read_image(&p, f, "ref.exr");
+    b = read_image(&q, f, "fault.exr");
+    EXPECT(&q,
+           a.w == b.w && a.h == b.h &&
+               memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
+           "samples were lost or changed when the gpu failed");
+    rs_free(a.rgb);
+    rs_free(b.rgb);
+    snprintf(path, sizeof path, "%s/stats.json", f->dir);
+    js = fopen(path, "r");
+    EXPECT(&q, js != NULL, "--stats-json should write %s", path);
+    n = fread(json, 1, sizeof json - 1, js);
+    json[n] = '\0';
+    fclose(js);
+    EXPECT(&q,
+           strstr(json, "\"name\": \"gpu-fallback:0\"") && strstr(json, "\"failed\": true") &&
+               strstr(json, "\"name\": \"cpu\"") && strstr(json, "\"failed\": false"),
+           "stats.json should list both devices and the failure: %s", json);
+    EXPECT(&r, !exited_with(&r, 0) && strstr(r.err.data, "RS_FAULT") != NULL,
+           "a malformed RS_FAULT should be an error naming it");
+    proc_free(&p);
+    proc_free(&q);
+    proc_free(&r);
+}
+
 static void test_scene_files_and_meshes(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -968,6 +1025,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_failed_run_keeps_output, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sigint_writes_partial_image, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_device_fault_and_stats, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_files_and_meshes, setup, teardown),
     };

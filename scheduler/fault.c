@@ -1,0 +1,91 @@
+/* scheduler/fault.c — see fault.h. */
+#include "scheduler/fault.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+
+typedef struct fault_impl {
+    rs_device *inner;
+    long after, done;
+} fault_impl;
+
+static rs_status fault_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    return rs_device_upload(f->inner, g, bvh);
+}
+
+static rs_status fault_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin,
+                             uint32_t end)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    rs_status st;
+    if (f->done >= f->after)
+        return rs_error_set(RS_ERR_DEVICE_LOST, "%s: injected fault after %ld chunks (RS_FAULT)",
+                            d->name, f->after);
+    st = f->inner->ops->trace(f->inner, batch, begin, end);
+    if (st == RS_OK)
+        f->done++;
+    return st;
+}
+
+static void fault_destroy(rs_device *d)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    if (f)
+        rs_device_destroy(f->inner);
+    rs_free(f);
+    rs_free(d);
+}
+
+static const rs_device_ops fault_ops = {fault_upload, fault_trace, fault_destroy};
+
+rs_status rs_fault_wrap(rs_device **d, int after)
+{
+    rs_device *w = (rs_device *)rs_calloc(1, sizeof *w);
+    fault_impl *f = (fault_impl *)rs_calloc(1, sizeof *f);
+    if (!w || !f) {
+        rs_free(w);
+        rs_free(f);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory wrapping a device for RS_FAULT");
+    }
+    f->inner = *d;
+    f->after = after < 0 ? 0 : after;
+    w->ops = &fault_ops;
+    w->impl = f;
+    w->threads = (*d)->threads;
+    memcpy(w->name, (*d)->name, sizeof w->name);
+    *d = w;
+    return RS_OK;
+}
+
+rs_status rs_fault_parse(const char *text, rs_fault_spec *out)
+{
+    char buf[256], *tok, *save = NULL;
+    out->cpu_after = out->gpu_after = -1;
+    if (!text || !*text)
+        return RS_OK;
+    if (strlen(text) >= sizeof buf)
+        return rs_error_set(RS_ERR_ARG, "RS_FAULT is too long");
+    strcpy(buf, text);
+    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        int *slot = NULL;
+        char *end = NULL;
+        long n;
+        if (strncmp(tok, "cpu:after=", 10) == 0)
+            slot = &out->cpu_after;
+        else if (strncmp(tok, "gpu:after=", 10) == 0)
+            slot = &out->gpu_after;
+        if (!slot)
+            return rs_error_set(RS_ERR_ARG, "RS_FAULT: '%s' is not cpu:after=N or gpu:after=N",
+                                tok);
+        n = strtol(tok + 10, &end, 10);
+        if (end == tok + 10 || *end || n < 0 || n > 1000000000L)
+            return rs_error_set(RS_ERR_ARG, "RS_FAULT: '%s': N must be a whole number >= 0", tok);
+        *slot = (int)n;
+    }
+    return RS_OK;
+}
