@@ -164,6 +164,22 @@ static inline int bs_load(const char *spec, const char *models_dir, bs_scene *ou
     return 1;
 }
 
+/* Loads each of scenes[n] in turn and hands it to `fn`; stops at the first failure.  Returns 1
+ * when every scene loaded and `fn` returned nonzero for each. */
+static inline int bs_for_each(const char *const *scenes, int n, const char *models_dir,
+                              int (*fn)(const bs_scene *s, const void *ctx), const void *ctx)
+{
+    int i, ok = 1;
+    for (i = 0; ok && i < n; ++i) {
+        bs_scene sc;
+        if (!bs_load(scenes[i], models_dir, &sc))
+            return 0;
+        ok = fn(&sc, ctx);
+        bs_scene_free(&sc);
+    }
+    return ok;
+}
+
 static inline void bs_rays_free(bs_rays *sets, int n)
 {
     int k;

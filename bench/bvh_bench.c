@@ -122,8 +122,9 @@ typedef struct settings {
     FILE *csv;
 } settings;
 
-static int bench_scene(const bs_scene *sc, const settings *st)
+static int bench_scene(const bs_scene *sc, const void *ctx)
 {
+    const settings *st = (const settings *)ctx;
     const char *scene = sc->label;
     rs_geom g = sc->g;
     uint32_t nt = rs_geom_prim_count(&g);
@@ -354,14 +355,12 @@ int main(int argc, char **argv)
     }
     st.variants = variants;
     if (csv) {
-        st.csv = fopen(csv, "w");
-        if (!st.csv) {
-            fprintf(stderr, "bvh_bench: cannot write %s\n", csv);
+        st.csv = rs_bench_csv_open("bvh_bench", csv,
+                                   "scene,primitives,builder,max_leaf,build_s_1thr,build_s_nthr,"
+                                   "sah_cost,nodes,depth,leaves,fallback,primary_mrays_1thr,"
+                                   "primary_mrays_nthr,diffuse_mrays_1thr,diffuse_mrays_nthr\n");
+        if (!st.csv)
             return 1;
-        }
-        fprintf(st.csv, "scene,primitives,builder,max_leaf,build_s_1thr,build_s_nthr,sah_cost,"
-                        "nodes,depth,leaves,fallback,primary_mrays_1thr,primary_mrays_nthr,"
-                        "diffuse_mrays_1thr,diffuse_mrays_nthr\n");
     }
 
     rs_bench_print_machine(stdout);
@@ -382,15 +381,7 @@ int main(int argc, char **argv)
                    rs_builtin_models_dir(models));
         }
     }
-    for (i = 0; ok && i < n_scenes; ++i) {
-        bs_scene sc;
-        if (!bs_load(scenes[i], models, &sc)) {
-            ok = 0;
-            break;
-        }
-        ok = bench_scene(&sc, &st);
-        bs_scene_free(&sc);
-    }
+    ok = bs_for_each(scenes, n_scenes, models, bench_scene, &st);
     if (st.csv)
         fclose(st.csv);
     return ok ? 0 : 1;

@@ -37,6 +37,19 @@ static inline double rs_bench_median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/* Opens `path` for a benchmark's CSV and writes `header` (a line with its newline); NULL after
+ * printing "PROG: cannot write PATH". */
+static inline FILE *rs_bench_csv_open(const char *prog, const char *path, const char *header)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "%s: cannot write %s\n", prog, path);
+        return NULL;
+    }
+    fputs(header, f);
+    return f;
+}
+
 static inline void rs_bench_cpu_model(char *buf, size_t n)
 {
     FILE *f = fopen("/proc/cpuinfo", "r");

@@ -59,8 +59,9 @@ typedef struct settings {
 
 /* ---- our kernel ---------------------------------------------------------------------------- */
 
-static double trace_bin(const rs_bvh_view *v, const rs_geom *g, const bs_rays *s, int q,
-                        int threads, answers *a)
+/* Our kernels over the set: the 4-wide one when b4 is not NULL, else the binary one. */
+static double trace_ours(const rs_bvh_view *v, const rs_bvh4 *b4, const rs_geom *g,
+                         const bs_rays *s, int q, int threads, answers *a)
 {
     double t0 = rs_bench_now();
     long i, n = (long)s->n;
@@ -68,35 +69,18 @@ static double trace_bin(const rs_bvh_view *v, const rs_geom *g, const bs_rays *s
 #pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
         for (i = 0; i < n; ++i) {
             rs_hit h;
-            rs_bvh_closest(v, g, s->rays[i], &h);
+            if (b4)
+                rs_bvh4_closest(b4, g, s->rays[i], &h);
+            else
+                rs_bvh_closest(v, g, s->rays[i], &h);
             a->prim[i] = h.prim;
             a->t[i] = h.t;
         }
     } else {
 #pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
         for (i = 0; i < n; ++i)
-            a->occluded[i] = (uint8_t)rs_bvh_occluded(v, g, s->rays[i]);
-    }
-    return rs_bench_now() - t0;
-}
-
-static double trace_bvh4(const rs_bvh4 *b, const rs_geom *g, const bs_rays *s, int q, int threads,
-                         answers *a)
-{
-    double t0 = rs_bench_now();
-    long i, n = (long)s->n;
-    if (q == Q_CLOSEST) {
-#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
-        for (i = 0; i < n; ++i) {
-            rs_hit h;
-            rs_bvh4_closest(b, g, s->rays[i], &h);
-            a->prim[i] = h.prim;
-            a->t[i] = h.t;
-        }
-    } else {
-#pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
-        for (i = 0; i < n; ++i)
-            a->occluded[i] = (uint8_t)rs_bvh4_occluded(b, g, s->rays[i]);
+            a->occluded[i] = (uint8_t)(b4 ? rs_bvh4_occluded(b4, g, s->rays[i])
+                                          : rs_bvh_occluded(v, g, s->rays[i]));
     }
     return rs_bench_now() - t0;
 }
@@ -300,13 +284,13 @@ typedef struct ours_ctx {
 static double run_bin(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
 {
     const ours_ctx *c = (const ours_ctx *)ctx;
-    return trace_bin(&c->v, c->g, s, q, threads, a);
+    return trace_ours(&c->v, NULL, c->g, s, q, threads, a);
 }
 
 static double run_bvh4(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
 {
     const ours_ctx *c = (const ours_ctx *)ctx;
-    return trace_bvh4(c->b4, c->g, s, q, threads, a);
+    return trace_ours(&c->v, c->b4, c->g, s, q, threads, a);
 }
 
 /* The same answers bit for bit: 0, else the index of the first difference + 1. */
@@ -337,8 +321,9 @@ static double mrays(trace_fn f, const void *ctx, const bs_rays *s, int q, int th
     return (double)s->n / rs_bench_median(t, runs) / 1e6;
 }
 
-static int bench_scene(const bs_scene *sc, const settings *st)
+static int bench_scene(const bs_scene *sc, const void *ctx)
 {
+    const settings *st = (const settings *)ctx;
     static const char *const QNAME[2] = {"closest", "any"};
     bs_rays sets[BS_N_SETS];
     rs_bvh_build_opts bo;
@@ -554,14 +539,12 @@ int main(int argc, char **argv)
         return 2;
     }
     if (csv) {
-        st.csv = fopen(csv, "w");
-        if (!st.csv) {
-            fprintf(stderr, "traversal_bench: cannot write %s\n", csv);
+        st.csv = rs_bench_csv_open("traversal_bench", csv,
+                                   "scene,bvh,rays,query,n,binary_mrays_1thr,binary_mrays_nthr,"
+                                   "bvh4_mrays_1thr,bvh4_mrays_nthr,embree_mrays_1thr,"
+                                   "embree_mrays_nthr,answers_differ\n");
+        if (!st.csv)
             return 1;
-        }
-        fprintf(st.csv, "scene,bvh,rays,query,n,binary_mrays_1thr,binary_mrays_nthr,"
-                        "bvh4_mrays_1thr,bvh4_mrays_nthr,embree_mrays_1thr,embree_mrays_nthr,"
-                        "answers_differ\n");
     }
 
     rs_bench_print_machine(stdout);
@@ -593,15 +576,7 @@ int main(int argc, char **argv)
             scenes[n_scenes++] = "soup:100000";
         }
     }
-    for (i = 0; ok && i < n_scenes; ++i) {
-        bs_scene sc;
-        if (!bs_load(scenes[i], models, &sc)) {
-            ok = 0;
-            break;
-        }
-        ok = bench_scene(&sc, &st);
-        bs_scene_free(&sc);
-    }
+    ok = bs_for_each(scenes, n_scenes, models, bench_scene, &st);
     if (st.csv)
         fclose(st.csv);
     return ok ? 0 : 1;
