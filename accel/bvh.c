@@ -274,8 +274,15 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
         centroid[i] = rs_v3_scale(rs_v3_add(bounds[i].lo, bounds[i].hi), 0.5f);
         b->prim_ids[i] = (uint32_t)i;
     }
-    if (lbvh)
+    if (lbvh && opts->lbvh_sort) {
+        float lo[3], scale[3];
+        rs_bvh_lbvh_frame(centroid, n, threads, lo, scale);
+        if ((st = opts->lbvh_sort(opts->lbvh_sort_user, centroid, n, lo, scale, b->prim_ids,
+                                  codes)) != RS_OK)
+            goto nomem; /* not only memory: the hook's error is kept below */
+    } else if (lbvh) {
         rs_bvh_lbvh_sort(centroid, n, b->prim_ids, codes, codes_tmp, ids_tmp, threads);
+    }
 
     memset(&c, 0, sizeof c);
     c.bounds = bounds;
@@ -310,7 +317,7 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
     b->max_leaf_count = max_count;
     st = RS_OK;
 
-nomem: /* success falls through here too: the scratch buffers go either way */
+nomem: /* success and a failed lbvh_sort come here too: the scratch buffers go either way */
     rs_free(bounds);
     rs_free(centroid);
     rs_free(slots);
@@ -321,7 +328,10 @@ nomem: /* success falls through here too: the scratch buffers go either way */
     rs_free(ids_tmp);
     if (st != RS_OK) {
         rs_bvh_destroy(b);
-        return rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH over %u primitives", n);
+        return st != RS_ERR_NOMEM
+                   ? st
+                   : rs_error_set(RS_ERR_NOMEM, "out of memory building the BVH over %u primitives",
+                                  n);
     }
     *out = b;
     return RS_OK;

@@ -299,7 +299,19 @@ typedef struct rs_bvh_build_opts {
     rs_bvh_builder builder; /* which builder; zeroed: RS_BVH_MEDIAN */
     uint32_t threads;       /* OpenMP threads for the build; 0: the default.  The tree does not
                                depend on it. */
+    /* LBVH only: where the Morton codes are computed and sorted (the GPU: gpu/gpu_device.h's
+     * rs_gpu_lbvh_sort); NULL: on the host.  It must write codes[i] = rs_morton3(centroid[i],
+     * lo, scale) (accel/morton.h) for i < n and sort the pairs (codes[i], ids[i] = i) stably by
+     * code, so that the tree is the host builder's, bit for bit. */
+    rs_status (*lbvh_sort)(void *user, const rs_vec3 *centroid, uint32_t n, const float lo[3],
+                           const float scale[3], uint32_t *ids, uint32_t *codes);
+    void *lbvh_sort_user;
 } rs_bvh_build_opts;
+
+/* The Morton frame of the LBVH builder: the centroids' bounds as an origin and a scale per axis
+ * (1024 / extent; 0 for an axis without extent). */
+void rs_bvh_lbvh_frame(const rs_vec3 *centroid, uint32_t n, int threads, float lo[3],
+                       float scale[3]);
 
 /* Builds a BVH over every primitive of `g` with the builder and leaf size in `opts` (NULL: the
  * defaults above).  The result owns its arrays; the same inputs give the same tree, bit for bit,

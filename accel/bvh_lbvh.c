@@ -19,38 +19,18 @@
  * 4. Bounds are then formed bottom-up by the frame: leaf boxes from their primitives, interior
  *    boxes as the union of the children's. */
 #include "accel/internal.h"
+#include "accel/morton.h"
 
 #define SORT_CHUNKS 16
 #define PAR_SORT    32768u
 
-/* Spreads the low 10 bits of v so that two zero bits separate each (Karras 2012's blog post,
- * "Thinking parallel, part III"). */
-static uint32_t expand_bits(uint32_t v)
-{
-    v = (v * 0x00010001u) & 0xFF0000FFu;
-    v = (v * 0x00000101u) & 0x0F00F00Fu;
-    v = (v * 0x00000011u) & 0xC30C30C3u;
-    v = (v * 0x00000005u) & 0x49249249u;
-    return v;
-}
-
-/* x in [lo, lo + 1/scale] to 0..1023; NaN to 0. */
-static uint32_t quantise(float x, float lo, float scale)
-{
-    float f = (x - lo) * scale;
-    return f > 0.0f ? (f < 1023.0f ? (uint32_t)f : 1023u) : 0u;
-}
-
-void rs_bvh_lbvh_sort(const rs_vec3 *centroid, uint32_t n, uint32_t *ids, uint32_t *codes,
-                      uint32_t *codes_tmp, uint32_t *ids_tmp, int threads)
+void rs_bvh_lbvh_frame(const rs_vec3 *centroid, uint32_t n, int threads, float lo[3],
+                       float scale[3])
 {
     rs_aabb part[SORT_CHUNKS], cb;
-    uint32_t counts[SORT_CHUNKS][256], chunk = (n + SORT_CHUNKS - 1) / SORT_CHUNKS;
-    uint32_t *src_c = codes, *src_i = ids, *dst_c = codes_tmp, *dst_i = ids_tmp, *t;
-    float lo[3], scale[3];
-    int par = n >= PAR_SORT && threads > 1, k, a, pass;
+    uint32_t chunk = (n + SORT_CHUNKS - 1) / SORT_CHUNKS;
+    int par = n >= PAR_SORT && threads > 1, k, a;
     (void)par; /* read only by the OpenMP clauses */
-    long i;
 
     /* centroid bounds, chunk by chunk (min and max merge exactly) */
 #pragma omp parallel for num_threads(threads) if (par) schedule(static)
@@ -73,13 +53,22 @@ void rs_bvh_lbvh_sort(const rs_vec3 *centroid, uint32_t n, uint32_t *ids, uint32
         lo[a] = rs_v3_get(cb.lo, a);
         scale[a] = ext > 0.0f && ext < INFINITY ? 1024.0f / ext : 0.0f;
     }
+}
 
+void rs_bvh_lbvh_sort(const rs_vec3 *centroid, uint32_t n, uint32_t *ids, uint32_t *codes,
+                      uint32_t *codes_tmp, uint32_t *ids_tmp, int threads)
+{
+    uint32_t counts[SORT_CHUNKS][256], chunk = (n + SORT_CHUNKS - 1) / SORT_CHUNKS;
+    uint32_t *src_c = codes, *src_i = ids, *dst_c = codes_tmp, *dst_i = ids_tmp, *t;
+    float lo[3], scale[3];
+    int par = n >= PAR_SORT && threads > 1, k, pass;
+    (void)par; /* read only by the OpenMP clauses */
+    long i;
+
+    rs_bvh_lbvh_frame(centroid, n, threads, lo, scale);
 #pragma omp parallel for num_threads(threads) if (par) schedule(static)
     for (i = 0; i < (long)n; ++i) {
-        rs_vec3 p = centroid[ids[i]];
-        codes[i] = (expand_bits(quantise(p.x, lo[0], scale[0])) << 2) |
-                   (expand_bits(quantise(p.y, lo[1], scale[1])) << 1) |
-                   expand_bits(quantise(p.z, lo[2], scale[2]));
+        codes[i] = rs_morton3(centroid[ids[i]], lo, scale);
     }
 
     for (pass = 0; pass < 4; ++pass) {

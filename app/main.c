@@ -100,7 +100,7 @@ static void human(double v, char *buf, size_t n)
  * device is beside it (every core when it is alone), and a cpu device without an explicit
  * thread count gets the rest.  RS_FAULT (scheduler/fault.h) wraps devices that should fail.
  * Returns the count, or -1 after printing an error. */
-static int create_devices(const rs_cli_options *o, int threads, rs_device **devs)
+static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores, rs_device **devs)
 {
     rs_device_spec specs[RS_MAX_DEVICES];
     int usable[RS_MAX_DEVICES];
@@ -143,6 +143,7 @@ static int create_devices(const rs_cli_options *o, int threads, rs_device **devs
                              : (threads - fallback_threads > 1 ? threads - fallback_threads : 1);
             co.name = "cpu";
             co.bvh_width = o->bvh_width;
+            co.cores = cores;
             st = rs_cpu_device_create_opts(&co, &devs[n]);
         } else {
             st = usable[i] ? rs_gpu_device_create(d->index, &devs[n]) : RS_ERR_DEVICE_LOST;
@@ -152,7 +153,7 @@ static int create_devices(const rs_cli_options *o, int threads, rs_device **devs
                         "raystream: warning: %s; gpu:%d runs on the CPU fallback (%d thread%s)\n",
                         usable[i] ? rs_error_message() : why, d->index, ft, ft == 1 ? "" : "s");
                 rs_error_clear();
-                st = rs_cpu_fallback_device_create(ft, d->index, &devs[n]);
+                st = rs_gpu_fallback_create(ft, d->index, cores, &devs[n]);
             }
         }
         if (st == RS_OK) {
@@ -252,6 +253,7 @@ static int cmd_render(const rs_cli_options *o)
     rs_render_hooks hooks;
     rs_progress progress;
     rs_sched_config cfg;
+    rs_cores cores;
     rs_status rst;
     double t0, bvh_ms;
     rs_geom geom;
@@ -315,8 +317,12 @@ static int cmd_render(const rs_cli_options *o)
     st.seed = o->seed;
     st.sampling = o->sampling;
     st.wave_paths = o->wave_paths;
+    st.waves_in_flight = o->waves;
     threads = o->threads ? o->threads : rs_cpu_count();
     st.threads = threads;
+    /* the CPU devices and the shading share `threads` cores (core/cores.h) */
+    rs_cores_init(&cores, threads);
+    st.cores = &cores;
 
     /* ---- the output is checked before any work ---- */
     if (o->output) {
@@ -354,13 +360,21 @@ static int cmd_render(const rs_cli_options *o)
     memset(&bvh_opts, 0, sizeof bvh_opts);
     bvh_opts.builder = o->bvh;
     bvh_opts.threads = (uint32_t)threads;
+    if (o->bvh_on_gpu) {
+        const char *why = "";
+        if (rs_gpu_count(&why) > 0) {
+            bvh_opts.lbvh_sort = rs_gpu_lbvh_sort; /* device 0 */
+        } else {
+            fprintf(stderr, "raystream: warning: %s; the lbvh is built on the CPU\n", why);
+        }
+    }
     t0 = rs_now_s();
     if (rs_bvh_build(&geom, &bvh_opts, &bvh) != RS_OK) {
         code = fail(RS_EXIT_RUNTIME, "building the BVH");
         goto done;
     }
     bvh_ms = 1e3 * (rs_now_s() - t0);
-    n_devs = create_devices(o, threads, devs);
+    n_devs = create_devices(o, threads, &cores, devs);
     if (n_devs < 0) {
         n_devs = 0;
         code = RS_EXIT_RUNTIME;

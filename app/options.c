@@ -135,14 +135,19 @@ void rs_cli_print_help(const char *command)
             "  --bvh NAME          BVH builder: median (default), sah or sah:BINS, lbvh, or the\n"
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
+            "  --bvh-device cpu|gpu where the lbvh builder computes and sorts its Morton codes\n"
+            "                      (gpu: CUDA device 0; the tree is the same)\n"
             "  --bvh-width W       the CPU's traversal: 4 (default; the binary BVH collapsed to\n"
             "                      4-wide nodes, SSE box tests) or 2 (the binary BVH, as on\n"
             "                      the GPU).  Same image either way.\n"
             "  --isect-sphere A    algebraic (default) or geometric\n"
             "  --isect-tri A       moller (default), snyder-barr or watertight\n"
             "  --isect-aabb A      slab (default), branchless, williams, kensler or swap\n"
-            "  --chunk-size N      rays per scheduler chunk (default 65536)\n"
+            "  --chunk-size N|auto rays per scheduler chunk (default auto: each device's from\n"
+            "                      its measured speed, a few ms of work per chunk)\n"
             "  --wave-size N       paths in flight (default 1048576): bounds memory\n"
+            "  --waves N|auto      waves in flight, 1..4: the CPU shades one while the devices\n"
+            "                      trace another (default auto: 2 with a GPU, else 1)\n"
             "  -q, --quiet         no progress bar and no summary\n"
             "  -h, --help          this text\n"
             "\n"
@@ -184,8 +189,9 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->max_depth = 50;
     o->seed = 1;
     o->sampling = RS_SAMPLING_MIS;
-    o->chunk_size = 65536;
+    o->chunk_size = 0; /* adaptive */
     o->wave_paths = 1u << 20;
+    o->waves = 0; /* auto */
     o->devices_auto = 1;
     o->n_devices = 0;
 
@@ -298,6 +304,11 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
                 rs_error_clear();
                 return RS_EXIT_USAGE;
             }
+        } else if (strcmp(name, "--bvh-device") == 0) {
+            NEEDS_VALUE();
+            if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)
+                return usage_error("--bvh-device: '%s'%s (use cpu or gpu)", v, "");
+            o->bvh_on_gpu = v[0] == 'g';
         } else if (strcmp(name, "--stats") == 0) {
             o->stats = 1;
             continue;
@@ -331,7 +342,16 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
                                    v, "");
         } else if (strcmp(name, "--chunk-size") == 0) {
             NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
+            if (strcmp(v, "auto") == 0)
+                o->chunk_size = 0;
+            else
+                rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
+        } else if (strcmp(name, "--waves") == 0) {
+            NEEDS_VALUE();
+            if (strcmp(v, "auto") == 0)
+                o->waves = 0;
+            else
+                rc = parse_u32(name, v, 1, 4, &o->waves);
         } else if (strcmp(name, "--wave-size") == 0) {
             NEEDS_VALUE();
             rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
@@ -342,6 +362,8 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
         if (rc != RS_EXIT_OK)
             return rc;
     }
+    if (o->bvh_on_gpu && o->bvh.method != RS_BVH_LBVH)
+        return usage_error("--bvh-device gpu builds the lbvh only (add --bvh lbvh)%s%s", "", "");
     if (o->mesh) {
         if (o->scene && strcmp(o->scene, "builtin:cornell") != 0)
             return usage_error("--mesh puts a mesh into the Cornell box; it cannot be combined "

@@ -37,12 +37,14 @@ typedef struct rs_cli_options {
     uint64_t seed;
     int threads; /* 0: every core */
     rs_sampling sampling;
-    uint32_t chunk_size;
+    uint32_t chunk_size; /* 0: adaptive */
     uint32_t wave_paths;
+    uint32_t waves; /* waves in flight; 0: auto */
     int quiet;
     const char *mesh;      /* --mesh FILE: into the Cornell box */
     const char *models;    /* --models DIR */
     rs_bvh_builder bvh;    /* --bvh NAME */
+    int bvh_on_gpu;        /* --bvh-device gpu: Morton codes and sort on CUDA device 0 */
     uint32_t isect_sphere; /* --isect-sphere: rs_isect_sphere_algo */
     uint32_t isect_tri;    /* --isect-tri: rs_isect_tri_algo */
     uint32_t isect_aabb;   /* --isect-aabb: rs_isect_aabb_algo */

@@ -13,6 +13,7 @@ typedef struct cpu_impl {
     rs_bvh_view bvh;
     rs_bvh4 *bvh4; /* NULL: the binary kernel */
     uint32_t width;
+    rs_cores *cores;
     int uploaded;
 } cpu_impl;
 
@@ -38,19 +39,23 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
     const rs_bvh_view *bv = &c->bvh;
     const rs_geom *g = &c->geom;
     long i;
+    int threads;
     if (!c->uploaded)
         return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
-        /* dynamic schedule: ray costs vary a lot (a miss of the root box vs a deep traversal).
-         * A chunk too small to feed every thread runs on the dispatch thread alone: waking a team
-         * costs more than it saves. */
-#pragma omp parallel for num_threads(d->threads)                                                   \
-    schedule(dynamic, 256) if (d->threads > 1 && end - begin >= 512u)
+    threads = rs_cores_acquire(c->cores, d->threads);
+    (void)threads; /* read only by the OpenMP clauses */
+    /* dynamic schedule: ray costs vary a lot (a miss of the root box vs a deep traversal).
+     * A chunk too small to feed every thread runs on the dispatch thread alone: waking a team
+     * costs more than it saves. */
+#pragma omp parallel for num_threads(threads)                                                      \
+    schedule(dynamic, 256) if (threads > 1 && end - begin >= 512u)
     for (i = (long)begin; i < (long)end; ++i) {
         if (c->bvh4)
             rs_bvh4_trace_one(c->bvh4, g, batch, (uint32_t)i);
         else
             rs_trace_one(bv, g, batch, (uint32_t)i);
     }
+    rs_cores_release(c->cores, threads);
     return RS_OK;
 }
 
@@ -74,18 +79,6 @@ rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
     return rs_cpu_device_create_opts(&o, out);
 }
 
-rs_status rs_cpu_fallback_device_create(int threads, int gpu_index, rs_device **out)
-{
-    rs_cpu_device_opts o;
-    char name[48];
-    snprintf(name, sizeof name, "gpu-fallback:%d", gpu_index);
-    memset(&o, 0, sizeof o);
-    o.threads = threads;
-    o.name = name;
-    o.bvh_width = 2;
-    return rs_cpu_device_create_opts(&o, out);
-}
-
 rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out)
 {
     rs_device *d = (rs_device *)rs_calloc(1, sizeof *d);
@@ -102,6 +95,7 @@ rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out
         return rs_error_set(RS_ERR_ARG, "BVH width %u: 2 or 4", o->bvh_width);
     }
     c->width = o->bvh_width ? o->bvh_width : 4;
+    c->cores = o->cores;
     d->ops = &cpu_ops;
     d->impl = c;
     d->threads = o->threads < 1 ? 1 : o->threads;

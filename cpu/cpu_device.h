@@ -1,10 +1,12 @@
 /* cpu/cpu_device.h — the CPU device: OpenMP workers tracing chunks.  By default it traverses the
  * 4-wide SIMD BVH (accel/bvh4.h), collapsed from the scene's binary BVH at upload; with
- * bvh_width 2 it runs the binary RS_HD traversal the CUDA kernels run, which is how the
- * "gpu-fallback" device stands in for a GPU that is not there.  Both give the same hits. */
+ * bvh_width 2 it runs the binary RS_HD traversal the CUDA kernels run.  Both give the same hits.
+ * Each chunk's team is taken from the core budget (core/cores.h), when one is given, so that the
+ * device and the shading of a pipelined wave share the cores. */
 #ifndef RS_CPU_CPU_DEVICE_H
 #define RS_CPU_CPU_DEVICE_H
 
+#include "core/cores.h"
 #include "scheduler/device.h"
 
 typedef struct rs_cpu_device_opts {
@@ -13,13 +15,11 @@ typedef struct rs_cpu_device_opts {
     uint32_t bvh_width; /* 4 (also 0): the 4-wide SIMD BVH; 2: the binary BVH kernel.  The
                            binary kernel is used anyway when the geometry selects a box test
                            other than the slab test (--isect-aabb). */
+    rs_cores *cores;    /* the budget each chunk's team is taken from; NULL: none */
 } rs_cpu_device_opts;
 
 rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out);
 /* The default device: `threads` threads, `name` (e.g. "cpu"), the 4-wide BVH. */
 rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out);
-/* The stand-in for CUDA device `gpu_index` that cannot be used: named "gpu-fallback:INDEX", it
- * runs the binary BVH kernel of the CUDA build on `threads` host threads. */
-rs_status rs_cpu_fallback_device_create(int threads, int gpu_index, rs_device **out);
 
 #endif

@@ -1,6 +1,8 @@
-/* gpu/cuda_device.cu — the CUDA device: the scene and BVH are uploaded once; each chunk is
- * copied in, traced by a kernel that is a thin shell around the shared RS_HD traversal
- * (accel/trace.h, the very code the CPU device runs), and copied out.
+/* gpu/cuda_device.cu — the CUDA device: the scene and BVH are uploaded once (cudaMalloc, no
+ * managed memory); each chunk is copied in, traced by a kernel that is a thin shell around the
+ * shared RS_HD traversal (accel/trace.h, the very code the CPU device runs; closest hit or any
+ * hit by the batch's kind), and copied out, in pieces pipelined over two CUDA streams with pinned
+ * double buffers.
  *
  * Every CUDA call is checked against its own return value and reported with the call's text,
  * file and line.  Launch sizes come from the occupancy API, not hand-tuned constants. */
@@ -27,46 +29,92 @@ __global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
         rs_trace_one(&b, &g, &batch, i);
 }
 
+/* One of the two staging sets a chunk's pieces alternate between: pinned host buffers (so the
+ * copies are asynchronous DMA), device buffers, and a stream.  While one piece's rays are copied
+ * in, traced and copied out on one stream, the host packs the next piece into the other set's
+ * pinned buffers, and the other stream's copies overlap this one's kernel. */
+typedef struct stage {
+    cudaStream_t stream;
+    rs_ray_soa h_rays, d_rays;
+    rs_hit_soa h_hits, d_hits;
+    uint8_t *h_occ, *d_occ;
+    uint32_t begin, n; /* the piece in flight: rays [begin, begin + n) of the batch */
+    int pending;
+} stage;
+
+#define RS_CUDA_STAGES    2
+#define RS_CUDA_MIN_PIECE 32768u /* pieces smaller than this are not worth a stream switch */
+
 typedef struct cuda_impl {
     int ordinal;
     rs_geom geom;    /* device pointers */
     rs_bvh_view bvh; /* device pointers */
-    rs_ray_soa rays; /* device staging, `cap` entries */
-    rs_hit_soa hits;
-    uint8_t *occluded;
-    uint32_t cap;
-    int block; /* threads per block from the occupancy API */
+    stage st[RS_CUDA_STAGES];
+    uint32_t cap; /* entries per staging set */
+    int block;    /* threads per block from the occupancy API */
 } cuda_impl;
 
 static void free_staging(cuda_impl *c)
 {
-#define FREE_FIELD(type, name) cudaFree(c->rays.name);
-    RS_RAY_FIELDS(FREE_FIELD)
+    int k;
+    for (k = 0; k < RS_CUDA_STAGES; ++k) {
+        stage *s = &c->st[k];
+        if (s->stream)
+            cudaStreamSynchronize(s->stream);
+#define FREE_FIELD(type, name) cudaFreeHost(s->h_rays.name), cudaFree(s->d_rays.name);
+        RS_RAY_FIELDS(FREE_FIELD)
 #undef FREE_FIELD
-#define FREE_FIELD(type, name) cudaFree(c->hits.name);
-    RS_HIT_FIELDS(FREE_FIELD)
+#define FREE_FIELD(type, name) cudaFreeHost(s->h_hits.name), cudaFree(s->d_hits.name);
+        RS_HIT_FIELDS(FREE_FIELD)
 #undef FREE_FIELD
-    cudaFree(c->occluded);
-    memset(&c->rays, 0, sizeof c->rays);
-    memset(&c->hits, 0, sizeof c->hits);
-    c->occluded = NULL;
+        cudaFreeHost(s->h_occ);
+        cudaFree(s->d_occ);
+        memset(&s->h_rays, 0, sizeof s->h_rays);
+        memset(&s->d_rays, 0, sizeof s->d_rays);
+        memset(&s->h_hits, 0, sizeof s->h_hits);
+        memset(&s->d_hits, 0, sizeof s->d_hits);
+        s->h_occ = s->d_occ = NULL;
+        s->pending = 0;
+    }
     c->cap = 0;
 }
 
 static rs_status ensure_staging(cuda_impl *c, uint32_t n)
 {
+    int k;
     if (n <= c->cap)
         return RS_OK;
     free_staging(c);
-#define ALLOC_FIELD(type, name) CUDA_TRY(cudaMalloc((void **)&c->rays.name, n * sizeof(type)));
-    RS_RAY_FIELDS(ALLOC_FIELD)
+    for (k = 0; k < RS_CUDA_STAGES; ++k) {
+        stage *s = &c->st[k];
+        if (!s->stream)
+            CUDA_TRY(cudaStreamCreateWithFlags(&s->stream, cudaStreamNonBlocking));
+#define ALLOC_FIELD(type, name)                                                                    \
+  CUDA_TRY(cudaMallocHost((void **)&s->h_rays.name, n * sizeof(type)));                            \
+  CUDA_TRY(cudaMalloc((void **)&s->d_rays.name, n * sizeof(type)));
+        RS_RAY_FIELDS(ALLOC_FIELD)
 #undef ALLOC_FIELD
-#define ALLOC_FIELD(type, name) CUDA_TRY(cudaMalloc((void **)&c->hits.name, n * sizeof(type)));
-    RS_HIT_FIELDS(ALLOC_FIELD)
+#define ALLOC_FIELD(type, name)                                                                    \
+  CUDA_TRY(cudaMallocHost((void **)&s->h_hits.name, n * sizeof(type)));                            \
+  CUDA_TRY(cudaMalloc((void **)&s->d_hits.name, n * sizeof(type)));
+        RS_HIT_FIELDS(ALLOC_FIELD)
 #undef ALLOC_FIELD
-    CUDA_TRY(cudaMalloc((void **)&c->occluded, n));
+        CUDA_TRY(cudaMallocHost((void **)&s->h_occ, n));
+        CUDA_TRY(cudaMalloc((void **)&s->d_occ, n));
+    }
     c->cap = n;
     return RS_OK;
+}
+
+static void free_scene(cuda_impl *c)
+{
+    cudaFree((void *)c->geom.spheres);
+    cudaFree((void *)c->geom.quads);
+    cudaFree((void *)c->geom.tris);
+    cudaFree((void *)c->bvh.nodes);
+    cudaFree((void *)c->bvh.prim_ids);
+    memset(&c->geom, 0, sizeof c->geom);
+    memset(&c->bvh, 0, sizeof c->bvh);
 }
 
 static rs_status upload_array(void **dst, const void *src, size_t bytes, rs_device *d)
@@ -86,6 +134,7 @@ static rs_status cuda_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     rs_status st;
     void *p;
     CUDA_TRY(cudaSetDevice(c->ordinal));
+    free_scene(c); /* a second upload replaces the first */
     c->geom = *g;
     if ((st = upload_array(&p, g->spheres, g->n_spheres * sizeof(rs_sphere), d)) != RS_OK)
         return st;
@@ -106,57 +155,104 @@ static rs_status cuda_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     return RS_OK;
 }
 
-static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
+/* Waits for the stage's piece and copies its answers from the pinned buffers into the batch. */
+static rs_status finish_piece(rs_device *d, stage *s, const rs_trace_batch *batch)
 {
-    cuda_impl *c = (cuda_impl *)d->impl;
-    uint32_t n = end - begin;
-    rs_trace_batch db;
-    rs_status st;
-    if (n == 0)
+    if (!s->pending)
         return RS_OK;
-    CUDA_TRY(cudaSetDevice(c->ordinal));
-    if ((st = ensure_staging(c, n)) != RS_OK)
-        return st;
+    s->pending = 0;
+    CUDA_TRY(cudaStreamSynchronize(s->stream));
+    if (batch->kind == RS_TRACE_CLOSEST) {
+#define COPY_OUT(type, name)                                                                       \
+  memcpy(batch->hits.name + s->begin, s->h_hits.name, s->n * sizeof(type));
+        RS_HIT_FIELDS(COPY_OUT)
+#undef COPY_OUT
+        d->stats.bytes_from_device += (uint64_t)s->n * RS_HIT_BYTES;
+    } else {
+        memcpy(batch->occluded + s->begin, s->h_occ, s->n);
+        d->stats.bytes_from_device += s->n;
+    }
+    return RS_OK;
+}
+
+/* Packs rays [begin, begin + n) into the stage's pinned buffers and queues copy in, kernel and
+ * copy out on its stream. */
+static rs_status launch_piece(rs_device *d, cuda_impl *c, stage *s, const rs_trace_batch *batch,
+                              uint32_t begin, uint32_t n)
+{
+    rs_trace_batch db;
+#define PACK(type, name) memcpy(s->h_rays.name, batch->rays.name + begin, n * sizeof(type));
+    RS_RAY_FIELDS(PACK)
+#undef PACK
 #define COPY_IN(type, name)                                                                        \
-  CUDA_TRY(cudaMemcpy(c->rays.name, batch->rays.name + begin, n * sizeof(type),                    \
-                      cudaMemcpyHostToDevice));
+  CUDA_TRY(cudaMemcpyAsync(s->d_rays.name, s->h_rays.name, n * sizeof(type),                       \
+                           cudaMemcpyHostToDevice, s->stream));
     RS_RAY_FIELDS(COPY_IN)
 #undef COPY_IN
     d->stats.bytes_to_device += (uint64_t)n * RS_RAY_BYTES;
     memset(&db, 0, sizeof db);
     db.kind = batch->kind;
     db.count = n;
-    db.rays = c->rays;
-    db.hits = c->hits;
-    db.occluded = c->occluded;
-    rs_trace_kernel<<<(n + c->block - 1) / c->block, c->block>>>(c->bvh, c->geom, db);
+    db.rays = s->d_rays;
+    db.hits = s->d_hits;
+    db.occluded = s->d_occ;
+    rs_trace_kernel<<<(n + c->block - 1) / c->block, c->block, 0, s->stream>>>(c->bvh, c->geom, db);
     CUDA_TRY(cudaGetLastError());
-    CUDA_TRY(cudaDeviceSynchronize());
     if (batch->kind == RS_TRACE_CLOSEST) {
 #define COPY_OUT(type, name)                                                                       \
-  CUDA_TRY(cudaMemcpy(batch->hits.name + begin, c->hits.name, n * sizeof(type),                    \
-                      cudaMemcpyDeviceToHost));
+  CUDA_TRY(cudaMemcpyAsync(s->h_hits.name, s->d_hits.name, n * sizeof(type),                       \
+                           cudaMemcpyDeviceToHost, s->stream));
         RS_HIT_FIELDS(COPY_OUT)
 #undef COPY_OUT
-        d->stats.bytes_from_device += (uint64_t)n * RS_HIT_BYTES;
     } else {
-        CUDA_TRY(cudaMemcpy(batch->occluded + begin, c->occluded, n, cudaMemcpyDeviceToHost));
-        d->stats.bytes_from_device += n;
+        CUDA_TRY(cudaMemcpyAsync(s->h_occ, s->d_occ, n, cudaMemcpyDeviceToHost, s->stream));
     }
+    s->begin = begin;
+    s->n = n;
+    s->pending = 1;
     return RS_OK;
+}
+
+/* A chunk is cut into pieces (up to 4, none under RS_CUDA_MIN_PIECE rays) that alternate between
+ * the two stages: piece k + 1 is packed and queued while piece k runs. */
+static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
+{
+    cuda_impl *c = (cuda_impl *)d->impl;
+    uint32_t n = end - begin, piece, off, k;
+    rs_status st = RS_OK;
+    if (n == 0)
+        return RS_OK;
+    CUDA_TRY(cudaSetDevice(c->ordinal));
+    piece = (n + 3) / 4;
+    if (piece < RS_CUDA_MIN_PIECE)
+        piece = n < RS_CUDA_MIN_PIECE ? n : RS_CUDA_MIN_PIECE;
+    if ((st = ensure_staging(c, piece)) != RS_OK)
+        return st;
+    for (off = begin, k = 0; off < end && st == RS_OK; off += piece, ++k) {
+        stage *s = &c->st[k % RS_CUDA_STAGES];
+        uint32_t m = end - off < piece ? end - off : piece;
+        if ((st = finish_piece(d, s, batch)) == RS_OK)
+            st = launch_piece(d, c, s, batch, off, m);
+    }
+    for (k = 0; k < RS_CUDA_STAGES; ++k) {
+        rs_status fs = finish_piece(d, &c->st[k], batch);
+        if (st == RS_OK)
+            st = fs;
+    }
+    return st;
 }
 
 static void cuda_destroy(rs_device *d)
 {
     cuda_impl *c = (cuda_impl *)d->impl;
     if (c) {
+        int k;
         cudaSetDevice(c->ordinal);
         free_staging(c);
-        cudaFree((void *)c->geom.spheres);
-        cudaFree((void *)c->geom.quads);
-        cudaFree((void *)c->geom.tris);
-        cudaFree((void *)c->bvh.nodes);
-        cudaFree((void *)c->bvh.prim_ids);
+        for (k = 0; k < RS_CUDA_STAGES; ++k)
+            if (c->st[k].stream)
+                cudaStreamDestroy(c->st[k].stream);
+        free_scene(c);
         rs_free(c);
     }
     rs_free(d);

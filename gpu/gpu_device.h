@@ -9,6 +9,8 @@
 
 #include "scheduler/device.h"
 
+typedef struct rs_cores rs_cores; /* core/cores.h (C11 atomics: not included from CUDA C++) */
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -19,6 +21,16 @@ int rs_gpu_compiled(void);
 int rs_gpu_count(const char **why);
 /* Creates CUDA device `index` (0-based).  RS_ERR_DEVICE_LOST when it cannot be used. */
 rs_status rs_gpu_device_create(int index, rs_device **out);
+/* The stand-in for CUDA device `gpu_index` where it cannot be used (gpu/gpu_fallback.c, in every
+ * build): named "gpu-fallback:INDEX", it stages each chunk in its own buffers and runs the CUDA
+ * kernel's body (the binary BVH traversal) on `threads` host threads taken from `cores` (NULL:
+ * no budget). */
+/* The LBVH's Morton codes and radix sort on CUDA device *(int *)user (NULL: device 0), as an
+ * rs_bvh_build_opts.lbvh_sort (accel/bvh.h): the tree is the host LBVH's, bit for bit.
+ * RS_ERR_DEVICE_LOST in a build without CUDA, RS_ERR_CUDA when a CUDA call fails. */
+rs_status rs_gpu_lbvh_sort(void *user, const rs_vec3 *centroid, uint32_t n, const float lo[3],
+                           const float scale[3], uint32_t *ids, uint32_t *codes);
+rs_status rs_gpu_fallback_create(int threads, int gpu_index, rs_cores *cores, rs_device **out);
 
 #ifdef __cplusplus
 }

@@ -1,13 +1,16 @@
-/* scheduler/sched.c — dispatch threads and the shared bounded chunk queue.
+/* scheduler/sched.c — dispatch threads, the shared bounded job queue and chunk sizing.
  *
  * Invariants (all under `lock`):
- *   - a chunk is either in the queue, or held by exactly one dispatch thread;
- *   - a held chunk is answered (its batch's `remaining` drops by one) or requeued, never both;
+ *   - the queue holds the jobs that still have rays to hand out (next < count), oldest first;
+ *     a job leaves it when its last ray is handed out (or when it fails);
+ *   - every ray of a job is, at any time, exactly one of: not handed out (>= next), in a chunk
+ *     held by one dispatch thread, in a chunk on `retry`, or answered; `remaining` counts all
+ *     but the answered ones;
  *   - `alive` counts dispatch threads whose device has not failed; when it reaches 0 every
- *     waiting caller is woken and the batch fails;
- *   - a failed device's chunk goes to `retry`, never to the bounded queue: the producer may
- *     have filled the queue since the chunk was popped.  Each device fails at most once, so
- *     `retry` needs one slot per device.  Dispatch threads take retries first. */
+ *     waiting caller is woken and its job fails;
+ *   - a failed device's chunk goes to `retry`.  Each device fails at most once and holds at
+ *     most one chunk, so `retry` needs one slot per device.  Dispatch threads take retries
+ *     first. */
 #include "scheduler/sched.h"
 
 #include <pthread.h>
@@ -17,14 +20,8 @@
 
 #include "core/alloc.h"
 
-typedef struct batch_rec {
-    const rs_trace_batch *batch;
-    uint32_t remaining; /* chunks not yet answered */
-    uint64_t answered;  /* rays answered */
-} batch_rec;
-
 typedef struct chunk {
-    batch_rec *rec;
+    rs_sched_job *job;
     uint32_t begin, end;
 } chunk;
 
@@ -34,18 +31,20 @@ typedef struct worker {
     pthread_t thread;
     int started;
     int alive;
+    double rate;    /* measured rays/s, a running mean; 0 until the first chunk */
+    uint32_t chunk; /* next chunk size (adaptive mode) */
 } worker;
 
 struct rs_sched {
     pthread_mutex_t lock;
-    pthread_cond_t work_cv;  /* queue became non-empty, or stop */
-    pthread_cond_t space_cv; /* queue has room */
+    pthread_cond_t work_cv;  /* a job was queued, a chunk was retried, or stop */
+    pthread_cond_t space_cv; /* the queue has room */
     pthread_cond_t done_cv;  /* a chunk was answered, or a device died */
-    chunk *queue;
+    rs_sched_job **queue;
     uint32_t q_cap, q_head, q_len;
     chunk *retry;
     uint32_t n_retry;
-    uint32_t chunk_size;
+    uint32_t fixed_chunk; /* 0: adaptive */
     int stop;
     int alive;
     int n_workers;
@@ -61,18 +60,78 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void queue_push_back(rs_sched *s, chunk c)
+static rs_sched_job *queue_at(const rs_sched *s, uint32_t k)
 {
-    s->queue[(s->q_head + s->q_len) % s->q_cap] = c;
-    s->q_len++;
+    return s->queue[(s->q_head + k) % s->q_cap];
 }
 
-static chunk queue_pop(rs_sched *s)
+/* The size of w's next chunk, given that `left` rays are still to be handed out. */
+static uint32_t chunk_size_for(const rs_sched *s, const worker *w, uint64_t left)
 {
-    chunk c = s->queue[s->q_head];
-    s->q_head = (s->q_head + 1) % s->q_cap;
-    s->q_len--;
-    return c;
+    double share, rate_sum = 0.0;
+    uint64_t size, cap;
+    int i, measured = 1, alive = 0;
+    if (s->fixed_chunk)
+        return s->fixed_chunk;
+    size = w->chunk;
+    for (i = 0; i < s->n_workers; ++i) {
+        if (!s->workers[i].alive)
+            continue;
+        alive++;
+        rate_sum += s->workers[i].rate;
+        measured &= s->workers[i].rate > 0.0;
+    }
+    /* guided: no more than this device's share of what is left */
+    share = measured && rate_sum > 0.0 ? w->rate / rate_sum : 1.0 / (alive > 0 ? alive : 1);
+    cap = (uint64_t)((double)left * share) + 1;
+    if (cap < RS_SCHED_MIN_CHUNK)
+        cap = RS_SCHED_MIN_CHUNK;
+    return (uint32_t)(size < cap ? size : cap);
+}
+
+/* After a chunk of `rays` took `secs`: update the rate and the next chunk size. */
+static void adapt(worker *w, uint32_t rays, double secs)
+{
+    double target = w->dev->threads == 0 ? RS_SCHED_TARGET_GPU_S : RS_SCHED_TARGET_HOST_S;
+    double r, size;
+    if (secs <= 0.0 || rays == 0)
+        return;
+    r = (double)rays / secs;
+    w->rate = w->rate > 0.0 ? 0.5 * w->rate + 0.5 * r : r;
+    size = w->rate * target;
+    size = size < RS_SCHED_MIN_CHUNK   ? RS_SCHED_MIN_CHUNK
+           : size > RS_SCHED_MAX_CHUNK ? RS_SCHED_MAX_CHUNK
+                                       : size;
+    w->chunk = ((uint32_t)size + 63u) & ~63u;
+}
+
+/* Takes w's next chunk under the lock: a retry, else a cut off the oldest queued job.  0 when
+ * there is nothing to do. */
+static int take_chunk(rs_sched *s, const worker *w, chunk *c)
+{
+    rs_sched_job *j;
+    uint64_t left = 0;
+    uint32_t k, size;
+    if (s->n_retry > 0) {
+        *c = s->retry[--s->n_retry];
+        return 1;
+    }
+    if (s->q_len == 0)
+        return 0;
+    for (k = 0; k < s->q_len; ++k)
+        left += queue_at(s, k)->batch->count - queue_at(s, k)->next;
+    j = queue_at(s, 0);
+    size = chunk_size_for(s, w, left);
+    c->job = j;
+    c->begin = j->next;
+    c->end = j->batch->count - j->next > size ? j->next + size : j->batch->count;
+    j->next = c->end;
+    if (j->next == j->batch->count) {
+        s->q_head = (s->q_head + 1) % s->q_cap;
+        s->q_len--;
+        pthread_cond_broadcast(&s->space_cv);
+    }
+    return 1;
 }
 
 static void *dispatch_main(void *arg)
@@ -90,18 +149,12 @@ static void *dispatch_main(void *arg)
                 pthread_cond_wait(&s->work_cv, &s->lock);
             w->dev->stats.idle_s += now_s() - t0;
         }
-        if (s->n_retry > 0) {
-            c = s->retry[--s->n_retry];
-        } else if (s->q_len > 0) {
-            c = queue_pop(s);
-            pthread_cond_signal(&s->space_cv);
-        } else {
+        if (!take_chunk(s, w, &c))
             break; /* stop, and nothing left */
-        }
         pthread_mutex_unlock(&s->lock);
 
         t0 = now_s();
-        st = w->dev->ops->trace(w->dev, c.rec->batch, c.begin, c.end);
+        st = w->dev->ops->trace(w->dev, c.job->batch, c.begin, c.end);
         t1 = now_s();
 
         pthread_mutex_lock(&s->lock);
@@ -109,10 +162,11 @@ static void *dispatch_main(void *arg)
         if (st == RS_OK) {
             w->dev->stats.rays += c.end - c.begin;
             w->dev->stats.chunks++;
-            c.rec->answered += c.end - c.begin;
+            adapt(w, c.end - c.begin, t1 - t0);
             s->answered += c.end - c.begin;
-            c.rec->remaining--;
-            pthread_cond_broadcast(&s->done_cv);
+            c.job->remaining -= c.end - c.begin;
+            if (c.job->remaining == 0)
+                pthread_cond_broadcast(&s->done_cv);
             continue;
         }
         /* The device failed: give its chunk back and retire it. */
@@ -143,9 +197,9 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
     s = (rs_sched *)rs_calloc(1, sizeof *s);
     if (!s)
         return rs_error_set(RS_ERR_NOMEM, "out of memory creating the scheduler");
-    s->chunk_size = (cfg && cfg->chunk_size) ? cfg->chunk_size : RS_SCHED_DEFAULT_CHUNK;
-    s->q_cap = (cfg && cfg->queue_capacity) ? cfg->queue_capacity : 256;
-    s->queue = (chunk *)rs_alloc(s->q_cap, sizeof *s->queue);
+    s->fixed_chunk = cfg ? cfg->chunk_size : 0;
+    s->q_cap = (cfg && cfg->queue_capacity) ? cfg->queue_capacity : 8;
+    s->queue = (rs_sched_job **)rs_alloc(s->q_cap, sizeof *s->queue);
     s->workers = (worker *)rs_calloc((size_t)n_devices, sizeof *s->workers);
     s->retry = (chunk *)rs_alloc((size_t)n_devices, sizeof *s->retry);
     if (!s->queue || !s->workers || !s->retry) {
@@ -165,6 +219,7 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
         w->s = s;
         w->dev = devices[i];
         w->alive = 1;
+        w->chunk = devices[i]->threads == 0 ? RS_SCHED_FIRST_GPU : RS_SCHED_FIRST_HOST;
     }
     pthread_mutex_lock(&s->lock);
     for (i = 0; i < n_devices; ++i) {
@@ -185,51 +240,65 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
     return RS_OK;
 }
 
-rs_status rs_sched_trace(rs_sched *s, const rs_trace_batch *batch)
+void rs_sched_submit(rs_sched *s, const rs_trace_batch *batch, rs_sched_job *job)
 {
-    batch_rec rec;
-    uint32_t begin = 0, n = batch->count, cs = s->chunk_size;
-    rs_status st = RS_OK;
-    rec.batch = batch;
-    rec.answered = 0;
-    rec.remaining = n == 0 ? 0 : (uint32_t)(((uint64_t)n + cs - 1) / cs);
+    job->batch = batch;
+    job->next = 0;
+    job->remaining = batch->count;
+    job->failed = 0;
     pthread_mutex_lock(&s->lock);
-    s->submitted += n;
-    while (begin < n && s->alive > 0) {
-        chunk c;
+    s->submitted += batch->count;
+    if (batch->count > 0) {
         while (s->q_len == s->q_cap && s->alive > 0)
             pthread_cond_wait(&s->space_cv, &s->lock);
-        if (s->alive == 0)
-            break;
-        c.rec = &rec;
-        c.begin = begin;
-        c.end = (n - begin > cs) ? begin + cs : n;
-        begin = c.end;
-        queue_push_back(s, c);
-        pthread_cond_signal(&s->work_cv);
-    }
-    while (rec.remaining > 0 && s->alive > 0)
-        pthread_cond_wait(&s->done_cv, &s->lock);
-    if (rec.remaining > 0) {
-        /* no device left: drop this batch's chunks so nothing refers to `rec` after we return */
-        uint32_t k, len = s->q_len;
-        chunk *keep = s->queue;
-        uint32_t kept = 0;
-        for (k = 0; k < len; ++k) {
-            chunk c = s->queue[(s->q_head + k) % s->q_cap];
-            if (c.rec != &rec)
-                keep[(s->q_head + kept++) % s->q_cap] = c;
+        if (s->alive > 0) {
+            s->queue[(s->q_head + s->q_len) % s->q_cap] = job;
+            s->q_len++;
+            pthread_cond_broadcast(&s->work_cv);
+        } else {
+            job->failed = 1;
         }
-        s->q_len = kept;
-        for (k = kept = 0; k < s->n_retry; ++k)
-            if (s->retry[k].rec != &rec)
-                s->retry[kept++] = s->retry[k];
-        s->n_retry = kept;
+    }
+    pthread_mutex_unlock(&s->lock);
+}
+
+/* Removes every trace of `job` from the queue and the retry list (no device is left). */
+static void withdraw(rs_sched *s, const rs_sched_job *job)
+{
+    uint32_t k, kept = 0, len = s->q_len;
+    for (k = 0; k < len; ++k) {
+        rs_sched_job *j = queue_at(s, k);
+        if (j != job)
+            s->queue[(s->q_head + kept++) % s->q_cap] = j;
+    }
+    s->q_len = kept;
+    for (k = kept = 0; k < s->n_retry; ++k)
+        if (s->retry[k].job != job)
+            s->retry[kept++] = s->retry[k];
+    s->n_retry = kept;
+}
+
+rs_status rs_sched_wait(rs_sched *s, rs_sched_job *job)
+{
+    rs_status st = RS_OK;
+    pthread_mutex_lock(&s->lock);
+    while (job->remaining > 0 && s->alive > 0)
+        pthread_cond_wait(&s->done_cv, &s->lock);
+    if (job->remaining > 0 || job->failed) {
+        /* no device left, so no chunk of the job is held by a dispatch thread */
+        withdraw(s, job);
+        job->failed = 1;
         st = rs_error_set(RS_ERR_DEVICE_LOST, "every device failed; last: %s", s->last_error);
     }
-    RS_ASSERT(st != RS_OK || rec.answered == n);
     pthread_mutex_unlock(&s->lock);
     return st;
+}
+
+rs_status rs_sched_trace(rs_sched *s, const rs_trace_batch *batch)
+{
+    rs_sched_job job;
+    rs_sched_submit(s, batch, &job);
+    return rs_sched_wait(s, &job);
 }
 
 void rs_sched_destroy(rs_sched *s)

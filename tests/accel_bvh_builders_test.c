@@ -38,6 +38,7 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh4.h"
+#include "accel/morton.h"
 #include "core/alloc.h"
 
 #include "test_mesh.h"
@@ -716,6 +717,80 @@ static void test_identical_centroids(void **state)
     soup_free(&s);
 }
 
+/* The lbvh_sort hook (how the GPU sorts the Morton codes: gpu/cuda_lbvh.cu) as its contract
+ * states it, by a qsort of (code, id): the tree must be the host LBVH's, bit for bit.  A hook
+ * that fails makes the build fail with its error, and nothing leaks (ASan). */
+typedef struct code_id {
+    uint32_t code, id;
+} code_id;
+
+static int code_id_cmp(const void *a, const void *b)
+{
+    const code_id *x = (const code_id *)a, *y = (const code_id *)b;
+    if (x->code != y->code)
+        return x->code < y->code ? -1 : 1;
+    return x->id < y->id ? -1 : x->id > y->id;
+}
+
+static rs_status reference_sort(void *user, const rs_vec3 *centroid, uint32_t n, const float lo[3],
+                                const float scale[3], uint32_t *ids, uint32_t *codes)
+{
+    code_id *p = (code_id *)malloc((n ? n : 1) * sizeof *p);
+    uint32_t i;
+    ++*(int *)user;
+    for (i = 0; i < n; ++i) {
+        p[i].code = rs_morton3(centroid[i], lo, scale);
+        p[i].id = i;
+    }
+    qsort(p, n, sizeof *p, code_id_cmp);
+    for (i = 0; i < n; ++i) {
+        codes[i] = p[i].code;
+        ids[i] = p[i].id;
+    }
+    free(p);
+    return RS_OK;
+}
+
+static rs_status failing_sort(void *user, const rs_vec3 *centroid, uint32_t n, const float lo[3],
+                              const float scale[3], uint32_t *ids, uint32_t *codes)
+{
+    (void)user, (void)centroid, (void)n, (void)lo, (void)scale, (void)ids, (void)codes;
+    return rs_error_set(RS_ERR_CUDA, "injected sort failure");
+}
+
+static void test_lbvh_sort_hook(void **state)
+{
+    soup s[3];
+    int k, calls = 0;
+    (void)state;
+    soup_random(&s[0], 0x1b5);
+    soup_clustered(&s[1], 0x1b6);
+    soup_alloc(&s[2], 40, 30, 30);
+    fill_identical_centroids(s[2].spheres, s[2].g.n_spheres, s[2].quads, s[2].g.n_quads, s[2].tris,
+                             s[2].g.n_tris, rs_v3(1, 2, 3));
+    for (k = 0; k < 3; ++k) {
+        rs_bvh_build_opts o;
+        rs_bvh *host, *hooked = NULL;
+        memset(&o, 0, sizeof o);
+        o.builder.method = RS_BVH_LBVH;
+        host = build_with(&s[k].g, &o.builder, 4, 0);
+        o.lbvh_sort = reference_sort;
+        o.lbvh_sort_user = &calls;
+        assert_int_equal(rs_bvh_build(&s[k].g, &o, &hooked), RS_OK);
+        assert_true(same_tree(host, hooked));
+        rs_bvh_destroy(hooked);
+        o.lbvh_sort = failing_sort;
+        rs_error_clear();
+        assert_int_equal(rs_bvh_build(&s[k].g, &o, &hooked), RS_ERR_CUDA);
+        assert_null(hooked);
+        assert_non_null(strstr(rs_error_message(), "injected sort failure"));
+        rs_error_clear();
+        rs_bvh_destroy(host);
+        soup_free(&s[k]);
+    }
+    assert_int_equal(calls, 3);
+}
+
 static void test_depth_bound(void **state)
 {
     /* Spheres on the three axes at 40^0 .. 40^23 (72 of them).  In any range, the farthest
@@ -868,6 +943,7 @@ int main(void)
         cmocka_unit_test(test_small_counts),
         cmocka_unit_test(test_identical_centroids),
         cmocka_unit_test(test_depth_bound),
+        cmocka_unit_test(test_lbvh_sort_hook),
         cmocka_unit_test(test_out_of_memory),
         cmocka_unit_test(test_bunny),
     };

@@ -79,6 +79,45 @@ static void test_two_devices(void **state)
     expect_identical(&a);
 }
 
+/* Waves in flight (the pipelined loop, films added in wave order) at several wave sizes. */
+static void test_waves_in_flight(void **state)
+{
+    static const uint32_t waves[] = {1, 2, 3, 4};
+    static const uint32_t sizes[] = {0, 7, 1000};
+    size_t i, j;
+    (void)state;
+    for (i = 0; i < sizeof waves / sizeof waves[0]; ++i)
+        for (j = 0; j < sizeof sizes / sizeof sizes[0]; ++j) {
+            rt_args a = rt_defaults("cornell", SIZE, SPP);
+            a.waves = waves[i];
+            a.wave_paths = sizes[j];
+            a.threads = 2;
+            a.shared_cores = 1;
+            expect_identical(&a);
+        }
+}
+
+/* --devices cpu, gpu (the fallback, with its staging buffers) and cpu,gpu: the same image, at
+ * adaptive and fixed chunk sizes, one and two waves in flight, cores shared. */
+static void test_device_sets(void **state)
+{
+    static const uint32_t chunks[] = {0, 61};
+    int set;
+    size_t c;
+    (void)state;
+    for (set = 0; set < 3; ++set)
+        for (c = 0; c < sizeof chunks / sizeof chunks[0]; ++c) {
+            rt_args a = rt_defaults("cornell", SIZE, SPP);
+            a.threads = 2;
+            a.fallback_only = set == 1;
+            a.with_fallback = set == 2;
+            a.chunk_size = chunks[c];
+            a.waves = 1 + (uint32_t)c;
+            a.shared_cores = 1;
+            expect_identical(&a);
+        }
+}
+
 /* The comparison above could pass vacuously if the image ignored its inputs: a different seed
  * must change it, and the same seed twice must not. */
 static void test_seed_matters(void **state)
@@ -100,7 +139,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_threads),      cmocka_unit_test(test_chunk_sizes),
         cmocka_unit_test(test_wave_sizes),   cmocka_unit_test(test_two_devices),
-        cmocka_unit_test(test_seed_matters),
+        cmocka_unit_test(test_seed_matters), cmocka_unit_test(test_waves_in_flight),
+        cmocka_unit_test(test_device_sets),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -9,6 +9,7 @@
 
 #include "core/alloc.h"
 #include "cpu/cpu_device.h"
+#include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/render.h"
 
@@ -20,7 +21,11 @@ typedef struct rt_args {
     int threads;         /* CPU device and shading threads */
     uint32_t chunk_size; /* 0: default */
     uint32_t wave_paths; /* 0: default */
-    int with_fallback;   /* add a second, one-thread "gpu-fallback" CPU device */
+    int with_fallback;   /* add a second, one-thread "gpu-fallback" device */
+    int fallback_only;   /* the "gpu-fallback" device alone, with `threads` threads */
+    uint32_t waves;      /* waves in flight; 0: auto */
+    int real_gpu;        /* CUDA device 0 instead of the fallback in the two options above */
+    int shared_cores;    /* devices and shading share a budget of `threads` cores */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -52,11 +57,20 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     rs_geom g;
     float *rgb = NULL;
     int n = a->with_fallback ? 2 : 1, i, ok = 0;
+    rs_cpu_device_opts co;
+    rs_cores cores, *budget = a->shared_cores ? &cores : NULL;
 
     g = rs_scene_geom(scene);
+    rs_cores_init(&cores, a->threads);
+    memset(&co, 0, sizeof co);
+    co.threads = a->threads;
+    co.cores = budget;
     if (rs_bvh_build(&g, NULL, &bvh) != RS_OK ||
-        rs_cpu_device_create(a->threads, "cpu", &devs[0]) != RS_OK ||
-        (n == 2 && rs_cpu_fallback_device_create(1, 0, &devs[1]) != RS_OK))
+        (a->fallback_only ? (a->real_gpu ? rs_gpu_device_create(0, &devs[0])
+                                         : rs_gpu_fallback_create(a->threads, 0, budget, &devs[0]))
+                          : rs_cpu_device_create_opts(&co, &devs[0])) != RS_OK ||
+        (n == 2 && (a->real_gpu ? rs_gpu_device_create(0, &devs[1])
+                                : rs_gpu_fallback_create(1, 0, budget, &devs[1])) != RS_OK))
         goto out;
     for (i = 0; i < n; ++i)
         if (rs_device_upload(devs[i], &g, bvh) != RS_OK)
@@ -74,7 +88,9 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     st.seed = a->seed;
     st.sampling = a->sampling;
     st.wave_paths = a->wave_paths;
+    st.waves_in_flight = a->waves;
     st.threads = a->threads;
+    st.cores = budget;
     if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK)
         goto out;
     rgb = (float *)malloc((size_t)a->width * a->height * 3 * sizeof *rgb);

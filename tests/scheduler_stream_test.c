@@ -14,15 +14,18 @@
 
 #include "core/alloc.h"
 #include "core/rng.h"
+#include "core/cores.h"
 #include "cpu/cpu_device.h"
+#include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/sched.h"
 
 /* ---- a test device: counts how often each ray is answered --------------------------------- */
 
 typedef struct counting {
-    atomic_uint *answers; /* per ray of the batch */
+    atomic_uint *answers; /* per ray of the batch; NULL: count in batch->occluded only */
     int sleep_us;         /* per chunk, to make devices slow */
+    int ns_per_ray;       /* and per ray: a device of a given throughput */
     long fail_on_chunk;   /* fail the n-th trace call (1-based); 0 = never */
     long calls;           /* only touched by this device's dispatch thread */
 } counting;
@@ -43,16 +46,22 @@ static rs_status counting_trace(rs_device *d, const rs_trace_batch *batch, uint3
     c->calls++;
     if (c->fail_on_chunk && c->calls >= c->fail_on_chunk)
         return rs_error_set(RS_ERR_DEVICE_LOST, "injected failure");
-    if (c->sleep_us) {
-        struct timespec ts = {0, (long)c->sleep_us * 1000L};
+    if (c->sleep_us || c->ns_per_ray) {
+        long ns = (long)c->sleep_us * 1000L + (long)c->ns_per_ray * (long)(end - begin);
+        struct timespec ts = {ns / 1000000000L, ns % 1000000000L};
         nanosleep(&ts, NULL);
     }
     for (i = begin; i < end; ++i) {
-        atomic_fetch_add(&c->answers[i], 1u);
-        if (batch->kind == RS_TRACE_CLOSEST)
+        if (c->answers) {
+            atomic_fetch_add(&c->answers[i], 1u);
+            if (batch->kind == RS_TRACE_CLOSEST)
+                batch->hits.prim[i] = i;
+            else
+                batch->occluded[i] = 1;
+        } else {
             batch->hits.prim[i] = i;
-        else
-            batch->occluded[i] = 1;
+            batch->occluded[i]++; /* a ray answered twice shows as 2 (or as a race under TSan) */
+        }
     }
     return RS_OK;
 }
@@ -289,10 +298,157 @@ static void test_all_devices_fail(void **state)
     fixture_free(&f);
 }
 
-/* The real CPU device behind the scheduler gives exactly what direct traversal gives. */
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* The property behind DESIGN rule 3, over random configurations (fixed seed, 40 trials): 1 to 4
+ * devices of random speeds (per-chunk and per-ray sleeps), fixed or adaptive chunk sizes, every
+ * device but one failing at a random chunk, and 1 to 3 jobs of random sizes (0 and 1 included)
+ * in flight at once.  Every ray of every job is answered exactly once; the device counters add
+ * up to the rays submitted. */
+static void test_random_property(void **state)
+{
+    enum { TRIALS = 40, MAX_DEV = 4, MAX_JOBS = 3 };
+    uint64_t seed = 0x51ed;
+    int trial;
+    (void)state;
+    for (trial = 0; trial < TRIALS; ++trial) {
+        counting c[MAX_DEV];
+        rs_device *d[MAX_DEV];
+        batch_fixture f[MAX_JOBS];
+        rs_trace_batch b[MAX_JOBS];
+        rs_sched_job jobs[MAX_JOBS];
+        rs_sched *s;
+        rs_sched_config cfg;
+        uint64_t sum = 0, sub, ans, expect = 0;
+        int n_dev, n_jobs, i, healthy;
+        uint32_t k;
+#define RND(n) ((uint32_t)(splitmix64(&seed) % (uint64_t)(n)))
+        n_dev = 1 + (int)RND(MAX_DEV);
+        n_jobs = 1 + (int)RND(MAX_JOBS);
+        healthy = (int)RND((uint32_t)n_dev);
+        memset(c, 0, sizeof c);
+        for (i = 0; i < n_dev; ++i) {
+            c[i].sleep_us = (int)RND(200);
+            c[i].ns_per_ray = (int)RND(300);
+            c[i].fail_on_chunk = i == healthy || RND(2) == 0 ? 0 : 1 + (long)RND(20);
+            d[i] = counting_device(&c[i], "rnd");
+            d[i]->threads = RND(4) == 0 ? 0 : 1; /* now and then a "GPU": other chunk sizes */
+        }
+        cfg.chunk_size = RND(2) == 0 ? 0 : 1 + RND(5000);
+        cfg.queue_capacity = 1 + RND(4);
+        assert_int_equal(rs_sched_create(d, n_dev, &cfg, &s), RS_OK);
+        for (i = 0; i < n_jobs; ++i) {
+            uint32_t pick = RND(8), n = pick == 0 ? 0 : pick == 1 ? 1 : 1 + RND(60000);
+            fixture_init(&f[i], n);
+            b[i] = fixture_batch(&f[i], RND(2) ? RS_TRACE_CLOSEST : RS_TRACE_OCCLUDED);
+            expect += n;
+        }
+        for (i = 0; i < n_jobs; ++i)
+            rs_sched_submit(s, &b[i], &jobs[i]);
+        for (i = n_jobs - 1; i >= 0; --i) /* waiting out of order is allowed too */
+            assert_int_equal(rs_sched_wait(s, &jobs[i]), RS_OK);
+        for (i = 0; i < n_jobs; ++i)
+            for (k = 0; k < f[i].n; ++k)
+                if (f[i].occluded[k] != 1 || f[i].hits.prim[k] != k)
+                    fail_msg("trial %d job %d ray %u: answered %u times", trial, i, k,
+                             f[i].occluded[k]);
+        for (i = 0; i < n_dev; ++i) {
+            rs_device_stats ds;
+            int alive;
+            rs_sched_device_stats(s, i, &ds, &alive);
+            sum += ds.rays;
+            if (i == healthy)
+                assert_true(alive);
+        }
+        rs_sched_totals(s, &sub, &ans);
+        assert_int_equal(sub, expect);
+        assert_int_equal(ans, expect);
+        assert_int_equal(sum, expect);
+        rs_sched_destroy(s);
+        for (i = 0; i < n_dev; ++i)
+            rs_device_destroy(d[i]);
+        for (i = 0; i < n_jobs; ++i)
+            fixture_free(&f[i]);
+#undef RND
+    }
+}
+
+/* Adaptive chunk sizes: a device ten times faster (per ray) gets larger chunks and most of the
+ * rays, and both grow past their first chunk. */
+static void test_adaptive_chunks(void **state)
+{
+    const uint32_t n = 300000;
+    counting fast = {0}, slow = {0};
+    rs_device *d[2];
+    batch_fixture f;
+    rs_sched *s;
+    rs_trace_batch b;
+    rs_device_stats st[2];
+    double mean[2];
+    int i, alive;
+    (void)state;
+    fixture_init(&f, n);
+    fast.ns_per_ray = 20;
+    slow.ns_per_ray = 200;
+    d[0] = counting_device(&fast, "fast");
+    d[1] = counting_device(&slow, "slow");
+    assert_int_equal(rs_sched_create(d, 2, NULL, &s), RS_OK);
+    b = fixture_batch(&f, RS_TRACE_CLOSEST);
+    assert_int_equal(rs_sched_trace(s, &b), RS_OK);
+    for (i = 0; i < (int)n; ++i)
+        assert_int_equal(f.occluded[i], 1);
+    for (i = 0; i < 2; ++i) {
+        rs_sched_device_stats(s, i, &st[i], &alive);
+        mean[i] = (double)st[i].rays / (double)st[i].chunks;
+    }
+    print_message("adaptive: fast %llu rays in %llu chunks, slow %llu rays in %llu chunks\n",
+                  (unsigned long long)st[0].rays, (unsigned long long)st[0].chunks,
+                  (unsigned long long)st[1].rays, (unsigned long long)st[1].chunks);
+    assert_int_equal(st[0].rays + st[1].rays, n);
+    /* ideal share 10/11; sleeps overshoot, so only the order and a loose bound are checked */
+    assert_true(st[0].rays > 3 * st[1].rays);
+    assert_true(mean[0] > mean[1]);
+    assert_true(mean[0] > RS_SCHED_FIRST_HOST);
+    rs_sched_destroy(s);
+    rs_device_destroy(d[0]);
+    rs_device_destroy(d[1]);
+    fixture_free(&f);
+}
+
+/* The core budget: grants at most what is asked, at least one, never more than is free beyond
+ * that one, and gives everything back. */
+static void test_core_budget(void **state)
+{
+    rs_cores c;
+    int a, b, d;
+    (void)state;
+    rs_cores_init(&c, 4);
+    a = rs_cores_acquire(&c, 3);
+    assert_int_equal(a, 3);
+    b = rs_cores_acquire(&c, 4);
+    assert_int_equal(b, 1); /* one left */
+    d = rs_cores_acquire(&c, 2);
+    assert_int_equal(d, 1); /* none left: still one, the caller's own thread */
+    assert_int_equal(atomic_load(&c.free), -1);
+    rs_cores_release(&c, a);
+    rs_cores_release(&c, b);
+    rs_cores_release(&c, d);
+    assert_int_equal(atomic_load(&c.free), 4);
+    assert_int_equal(rs_cores_acquire(NULL, 7), 7);
+    assert_int_equal(rs_cores_acquire(&c, 0), 1);
+}
+
+/* The real CPU device and the GPU fallback (staging buffers), alone and together, behind the
+ * scheduler give exactly what direct traversal gives, at fixed and adaptive chunk sizes. */
 static void test_cpu_device_matches_direct(void **state)
 {
-    static const uint32_t sizes[] = {1, 7, 4096, 1u << 20};
+    static const uint32_t sizes[] = {1, 7, 4096, 1u << 20, 0};
     const uint32_t n = 30000;
     rs_scene *scene;
     rs_bvh *bvh;
@@ -319,23 +475,36 @@ static void test_cpu_device_matches_direct(void **state)
     }
     for (k = 0; k < sizeof sizes / sizeof sizes[0]; ++k) {
         int kind;
-        for (kind = 0; kind < 2; ++kind) {
-            rs_device *d;
+        for (kind = 0; kind < 6; ++kind) {
+            rs_device *d[2];
             rs_sched *s;
             rs_sched_config cfg = {sizes[k], 0};
-            rs_trace_batch b = fixture_batch(&f, (rs_trace_kind)kind);
+            rs_trace_batch b = fixture_batch(&f, (rs_trace_kind)(kind & 1));
+            int set = kind >> 1, n_dev = set == 2 ? 2 : 1, j; /* cpu, fallback, both */
+            rs_cores cores;
+            rs_cpu_device_opts co;
             memset(f.occluded, 0xAB, n);
             for (i = 0; i < n; ++i)
                 f.hits.prim[i] = 0xDEADBEEFu;
-            assert_int_equal(rs_cpu_device_create(2, "cpu", &d), RS_OK);
-            assert_int_equal(rs_device_upload(d, &g, bvh), RS_OK);
-            assert_int_equal(rs_sched_create(&d, 1, &cfg, &s), RS_OK);
+            rs_cores_init(&cores, 2);
+            memset(&co, 0, sizeof co);
+            co.threads = 2;
+            co.cores = &cores;
+            if (set == 1)
+                assert_int_equal(rs_gpu_fallback_create(2, 0, &cores, &d[0]), RS_OK);
+            else
+                assert_int_equal(rs_cpu_device_create_opts(&co, &d[0]), RS_OK);
+            if (set == 2)
+                assert_int_equal(rs_gpu_fallback_create(1, 0, &cores, &d[1]), RS_OK);
+            for (j = 0; j < n_dev; ++j)
+                assert_int_equal(rs_device_upload(d[j], &g, bvh), RS_OK);
+            assert_int_equal(rs_sched_create(d, n_dev, &cfg, &s), RS_OK);
             assert_int_equal(rs_sched_trace(s, &b), RS_OK);
             for (i = 0; i < n; ++i) {
                 rs_ray ray = rs_ray_soa_get(&f.rays, i);
                 rs_hit h;
                 int hit = rs_bvh_closest(&bv, &g, ray, &h);
-                if (kind == RS_TRACE_CLOSEST) {
+                if ((kind & 1) == RS_TRACE_CLOSEST) {
                     assert_int_equal(f.hits.prim[i], h.prim);
                     if (hit)
                         assert_true(f.hits.t[i] == h.t);
@@ -345,7 +514,9 @@ static void test_cpu_device_matches_direct(void **state)
                 }
             }
             rs_sched_destroy(s);
-            rs_device_destroy(d);
+            for (j = 0; j < n_dev; ++j)
+                rs_device_destroy(d[j]);
+            assert_int_equal(atomic_load(&cores.free), 2); /* every team given back */
         }
     }
     fixture_free(&f);
@@ -359,6 +530,8 @@ int main(void)
         cmocka_unit_test(test_chunk_sizes),      cmocka_unit_test(test_many_devices_queue_pressure),
         cmocka_unit_test(test_empty_and_single), cmocka_unit_test(test_device_failure),
         cmocka_unit_test(test_all_devices_fail), cmocka_unit_test(test_cpu_device_matches_direct),
+        cmocka_unit_test(test_random_property),  cmocka_unit_test(test_adaptive_chunks),
+        cmocka_unit_test(test_core_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,28 @@
+/* core/cores.c — see cores.h. */
+#include "core/cores.h"
+
+void rs_cores_init(rs_cores *c, int total)
+{
+    c->total = total < 1 ? 1 : total;
+    atomic_init(&c->free, c->total);
+}
+
+int rs_cores_acquire(rs_cores *c, int want)
+{
+    int f, n;
+    if (want < 1)
+        want = 1;
+    if (!c)
+        return want;
+    f = atomic_load(&c->free);
+    do {
+        n = f >= want ? want : (f > 1 ? f : 1);
+    } while (!atomic_compare_exchange_weak(&c->free, &f, f - n));
+    return n;
+}
+
+void rs_cores_release(rs_cores *c, int n)
+{
+    if (c)
+        atomic_fetch_add(&c->free, n);
+}
