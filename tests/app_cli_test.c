@@ -506,6 +506,13 @@ static void test_usage_errors(void **state)
         {{"render", "-o", "out.png", "--spp", "1", "--devices", "cpu,tpu", NULL},
          {"--devices", "tpu"}},
         {{"render", "-o", "out.png", "--spp", "1", "--bvh-width", "8", NULL}, {"--bvh-width", "8"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--waves", "5", NULL}, {"--waves", "5"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--chunk-size", "big", NULL},
+         {"--chunk-size", "big"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--bvh-device", "tpu", NULL},
+         {"--bvh-device", "tpu"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--bvh-device", "gpu", NULL},
+         {"--bvh-device", "lbvh"}},
         {{"render", "--width", "8", "--spp", "1", "-o", "out.xyz", NULL}, {"out.xyz"}},
         {{"render", "no-such-scene.rss", "-o", "out.png", "--spp", "1", NULL},
          {"no-such-scene.rss"}},
@@ -806,7 +813,7 @@ static void test_sigint_writes_partial_image(void **state)
 static void test_threads_and_chunks_change_nothing(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const runs[][16] = {
+    static const char *const runs[][24] = {
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "1", "-o",
          "t1.exr", NULL},
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2", "-o",
@@ -818,6 +825,12 @@ static void test_threads_and_chunks_change_nothing(void **state)
         /* the binary BVH kernel instead of the 4-wide one: the same hits, the same image */
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
          "--bvh-width", "2", "-o", "b2.exr", NULL},
+        /* waves in flight and fixed vs adaptive chunks, on the CPU and its GPU stand-in */
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
+         "--waves", "3", "--chunk-size", "auto", "--devices", "cpu:1,gpu", "-o", "v3.exr", NULL},
+        /* the LBVH with its sort on the GPU (here: a warning, then the host's): the same tree */
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2", "--bvh",
+         "lbvh", "--bvh-device", "gpu", "-o", "lg.exr", NULL},
     };
     image ref = {0, 0, NULL};
     size_t r;
