@@ -15,6 +15,7 @@
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "cpu/cpu_device.h"
+#include "cpu/megakernel.h"
 #include "gpu/gpu_device.h"
 #include "scheduler/fault.h"
 #include "scenes/builtin.h"
@@ -142,8 +143,9 @@ static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores,
                              ? d->threads
                              : (threads - fallback_threads > 1 ? threads - fallback_threads : 1);
             co.name = "cpu";
-            co.bvh_width = o->bvh_width;
+            co.bvh_width = o->no_bvh ? 2 : o->bvh_width; /* 4-wide leaves hold < 2^15 */
             co.cores = cores;
+            co.strategy = o->strategy;
             st = rs_cpu_device_create_opts(&co, &devs[n]);
         } else {
             st = usable[i] ? rs_gpu_device_create(d->index, &devs[n]) : RS_ERR_DEVICE_LOST;
@@ -323,6 +325,7 @@ static int cmd_render(const rs_cli_options *o)
     /* the CPU devices and the shading share `threads` cores (core/cores.h) */
     rs_cores_init(&cores, threads);
     st.cores = &cores;
+    st.strategy = o->strategy;
 
     /* ---- the output is checked before any work ---- */
     if (o->output) {
@@ -360,6 +363,8 @@ static int cmd_render(const rs_cli_options *o)
     memset(&bvh_opts, 0, sizeof bvh_opts);
     bvh_opts.builder = o->bvh;
     bvh_opts.threads = (uint32_t)threads;
+    if (o->no_bvh) /* one leaf holding everything: each ray tests every primitive */
+        bvh_opts.max_leaf = UINT32_MAX;
     if (o->bvh_on_gpu) {
         const char *why = "";
         if (rs_gpu_count(&why) > 0) {
@@ -374,6 +379,13 @@ static int cmd_render(const rs_cli_options *o)
         goto done;
     }
     bvh_ms = 1e3 * (rs_now_s() - t0);
+    if (o->megakernel) {
+        if (rs_film_create(st.width, st.height, &film) != RS_OK) {
+            code = fail(RS_EXIT_RUNTIME, "starting the render");
+            goto done;
+        }
+        goto render;
+    }
     n_devs = create_devices(o, threads, &cores, devs);
     if (n_devs < 0) {
         n_devs = 0;
@@ -394,6 +406,7 @@ static int cmd_render(const rs_cli_options *o)
         code = fail(RS_EXIT_RUNTIME, "starting the render");
         goto done;
     }
+render:
     rgb = (float *)rs_alloc((size_t)st.width * st.height * 3, sizeof *rgb);
     if (!rgb) {
         fprintf(stderr, "raystream: out of memory for a %ux%u image\n", st.width, st.height);
@@ -407,7 +420,14 @@ static int cmd_render(const rs_cli_options *o)
     hooks.progress = rs_progress_update;
     hooks.user = &progress;
     hooks.cancel = &g_cancel;
-    rst = rs_render(scene, sched, &st, &hooks, film, &stats);
+    if (o->megakernel) {
+        rs_megakernel_opts mo;
+        mo.strategy = o->strategy;
+        mo.bvh_width = o->no_bvh ? 2 : o->bvh_width;
+        rst = rs_render_megakernel(scene, &geom, bvh, &st, &mo, &hooks, film, &stats);
+    } else {
+        rst = rs_render(scene, sched, &st, &hooks, film, &stats);
+    }
     rs_progress_end(&progress);
     signal(SIGINT, SIG_DFL);
     if (rst != RS_OK && rst != RS_ERR_CANCELLED) {
@@ -456,7 +476,11 @@ static int cmd_render(const rs_cli_options *o)
                     rays_total ? 100.0 * (double)ds.rays / (double)rays_total : 0.0,
                     alive ? "" : " and then failed", i + 1 == n_devs ? ". " : "");
         }
-        fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", stats.shade_s, stats.trace_s);
+        if (o->megakernel)
+            fprintf(stderr, "Integrator: megakernel (%s, %d threads). ",
+                    rs_par_strategy_name(o->strategy), threads);
+        else
+            fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", stats.shade_s, stats.trace_s);
         if (film->nonfinite)
             fprintf(stderr, "%llu non-finite samples were dropped. ",
                     (unsigned long long)film->nonfinite);

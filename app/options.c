@@ -135,6 +135,11 @@ void rs_cli_print_help(const char *command)
             "  --bvh NAME          BVH builder: median (default), sah or sah:BINS, lbvh, or the\n"
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
+            "  --integrator NAME   stream (default: the wavefront engine on every device) or\n"
+            "                      megakernel (the thesis's per-pixel loop, CPU only; same image)\n"
+            "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
+            "                      tasks (the thesis's three OpenMP strategies)\n"
+            "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
             "  --bvh-device cpu|gpu where the lbvh builder computes and sorts its Morton codes\n"
             "                      (gpu: CUDA device 0; the tree is the same)\n"
             "  --bvh-width W       the CPU's traversal: 4 (default; the binary BVH collapsed to\n"
@@ -304,6 +309,18 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
                 rs_error_clear();
                 return RS_EXIT_USAGE;
             }
+        } else if (strcmp(name, "--integrator") == 0) {
+            NEEDS_VALUE();
+            if (strcmp(v, "stream") != 0 && strcmp(v, "megakernel") != 0)
+                return usage_error("--integrator: '%s'%s (use stream or megakernel)", v, "");
+            o->megakernel = v[0] == 'm';
+        } else if (strcmp(name, "--cpu-strategy") == 0) {
+            NEEDS_VALUE();
+            if (!rs_par_strategy_parse(v, &o->strategy))
+                return usage_error("--cpu-strategy: '%s'%s (use for-dynamic, columns or tasks)", v,
+                                   "");
+        } else if (strcmp(name, "--no-bvh") == 0) {
+            o->no_bvh = 1;
         } else if (strcmp(name, "--bvh-device") == 0) {
             NEEDS_VALUE();
             if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)
@@ -361,6 +378,14 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
 #undef NEEDS_VALUE
         if (rc != RS_EXIT_OK)
             return rc;
+    }
+    if (o->megakernel && !o->devices_auto) {
+        int k;
+        for (k = 0; k < o->n_devices; ++k)
+            if (o->devices[k].is_gpu)
+                return usage_error("--integrator megakernel runs on the CPU only%s%s (drop the "
+                                   "gpu from --devices)",
+                                   "", "");
     }
     if (o->bvh_on_gpu && o->bvh.method != RS_BVH_LBVH)
         return usage_error("--bvh-device gpu builds the lbvh only (add --bvh lbvh)%s%s", "", "");

@@ -52,8 +52,11 @@ typedef struct rs_cli_options {
     int devices_auto;      /* --devices auto (the default): the CPU and every CUDA device */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
-    int stats;              /* --stats: a per-device table after the render */
-    const char *stats_json; /* --stats-json FILE */
+    int megakernel;           /* --integrator megakernel: the per-pixel loop on the CPU */
+    rs_par_strategy strategy; /* --cpu-strategy */
+    int no_bvh;               /* --no-bvh: every ray tests every primitive */
+    int stats;                /* --stats: a per-device table after the render */
+    const char *stats_json;   /* --stats-json FILE */
 } rs_cli_options;
 
 /* Parses argv.  Returns RS_EXIT_OK, or RS_EXIT_USAGE after printing one line naming the

@@ -7,6 +7,7 @@
 
 #include "accel/bvh4.h"
 #include "core/alloc.h"
+#include "core/parallel.h"
 
 typedef struct cpu_impl {
     rs_geom geom;
@@ -14,6 +15,7 @@ typedef struct cpu_impl {
     rs_bvh4 *bvh4; /* NULL: the binary kernel */
     uint32_t width;
     rs_cores *cores;
+    rs_par_strategy strategy;
     int uploaded;
 } cpu_impl;
 
@@ -96,6 +98,7 @@ rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out
     }
     c->width = o->bvh_width ? o->bvh_width : 4;
     c->cores = o->cores;
+    c->strategy = o->strategy;
     d->ops = &cpu_ops;
     d->impl = c;
     d->threads = o->threads < 1 ? 1 : o->threads;

@@ -7,15 +7,17 @@
 #define RS_CPU_CPU_DEVICE_H
 
 #include "core/cores.h"
+#include "core/parallel.h"
 #include "scheduler/device.h"
 
 typedef struct rs_cpu_device_opts {
-    int threads;        /* OpenMP threads per chunk (>= 1) */
-    const char *name;   /* copied; NULL: "cpu" */
-    uint32_t bvh_width; /* 4 (also 0): the 4-wide SIMD BVH; 2: the binary BVH kernel.  The
-                           binary kernel is used anyway when the geometry selects a box test
-                           other than the slab test (--isect-aabb). */
-    rs_cores *cores;    /* the budget each chunk's team is taken from; NULL: none */
+    int threads;              /* OpenMP threads per chunk (>= 1) */
+    const char *name;         /* copied; NULL: "cpu" */
+    uint32_t bvh_width;       /* 4 (also 0): the 4-wide SIMD BVH; 2: the binary BVH kernel.  The
+                                 binary kernel is used anyway when the geometry selects a box test
+                                 other than the slab test (--isect-aabb). */
+    rs_cores *cores;          /* the budget each chunk's team is taken from; NULL: none */
+    rs_par_strategy strategy; /* how a chunk is split among the team (zeroed: for-dynamic) */
 } rs_cpu_device_opts;
 
 rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out);

@@ -273,6 +273,7 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
     c->it.rr_depth = st.rr_depth;
     c->it.sampling = st.sampling;
     c->it.threads = st.threads;
+    c->it.strategy = st.strategy;
     c->n_slots = n_waves < st.waves_in_flight ? (uint32_t)n_waves : st.waves_in_flight;
     stats->paths_total = total;
 

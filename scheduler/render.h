@@ -41,6 +41,7 @@ typedef struct rs_render_settings {
     uint32_t waves_in_flight; /* 1..RS_RENDER_MAX_WAVES; 0: auto (below) */
     int threads;              /* OpenMP threads for the shading stages (at most) */
     rs_cores *cores;          /* the budget shared with the CPU devices; NULL: none */
+    rs_par_strategy strategy; /* how the shade stage splits a wave among threads */
 } rs_render_settings;
 
 #define RS_RENDER_DEFAULT_WAVE (1u << 20)

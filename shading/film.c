@@ -41,6 +41,8 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
     double *s = &f->sum[3 * (size_t)pixel];
     f->count[pixel]++;
     if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z))) {
+        /* the one counter shared by every pixel: the megakernel adds pixels from many threads */
+#pragma omp atomic
         f->nonfinite++;
         return;
     }

@@ -338,16 +338,45 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
     paths->flags[p] = specular ? RS_PATH_SPECULAR : 0;
 }
 
+typedef struct shade_ctx {
+    const rs_integrator *it;
+    uint64_t wave_start;
+    uint32_t bounce;
+    const rs_ray_soa *rays;
+    const rs_hit_soa *hits;
+    rs_paths *paths;
+    rs_ray_soa *next, *shadow;
+    uint8_t *next_valid, *shadow_valid;
+} shade_ctx;
+
+static void shade_range(void *ctx, uint32_t begin, uint32_t end)
+{
+    const shade_ctx *c = (const shade_ctx *)ctx;
+    uint32_t j;
+    for (j = begin; j < end; ++j)
+        shade_one(c->it, c->wave_start, c->bounce, c->rays, c->hits, j, c->paths, c->next,
+                  c->next_valid, c->shadow, c->shadow_valid);
+}
+
 void rs_integrator_shade(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
                          const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
                          rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
                          uint8_t *shadow_valid)
 {
-    long j;
-#pragma omp parallel for num_threads(it->threads) schedule(dynamic, 512) if (it->threads > 1)
-    for (j = 0; j < (long)count; ++j)
-        shade_one(it, wave_start, bounce, rays, hits, (uint32_t)j, paths, next, next_valid, shadow,
-                  shadow_valid);
+    shade_ctx c;
+    c.it = it;
+    c.wave_start = wave_start;
+    c.bounce = bounce;
+    c.rays = rays;
+    c.hits = hits;
+    c.paths = paths;
+    c.next = next;
+    c.shadow = shadow;
+    c.next_valid = next_valid;
+    c.shadow_valid = shadow_valid;
+    /* shading costs vary by material and by hit or miss: blocks of 512 paths, split as the
+     * strategy says */
+    rs_parallel_range(it->strategy, it->threads, 0, count, 512, shade_range, &c);
 }
 
 void rs_integrator_resolve_shadows(const rs_integrator *it, const rs_ray_soa *shadow,

@@ -9,6 +9,7 @@
 #ifndef RS_SHADING_INTEGRATOR_H
 #define RS_SHADING_INTEGRATOR_H
 
+#include "core/parallel.h"
 #include "scenes/scene.h"
 #include "shading/camera.h"
 #include "streams/stream.h"
@@ -50,7 +51,8 @@ typedef struct rs_integrator {
     uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     rs_sampling sampling;
-    int threads; /* OpenMP threads for the stages */
+    int threads;              /* OpenMP threads for the stages */
+    rs_par_strategy strategy; /* how the shade stage is split among them */
 } rs_integrator;
 
 /* Fills `out` with the camera rays of paths [0, count) and resets their state. */

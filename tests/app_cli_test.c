@@ -507,6 +507,13 @@ static void test_usage_errors(void **state)
          {"--devices", "tpu"}},
         {{"render", "-o", "out.png", "--spp", "1", "--bvh-width", "8", NULL}, {"--bvh-width", "8"}},
         {{"render", "-o", "out.png", "--spp", "1", "--waves", "5", NULL}, {"--waves", "5"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--integrator", "bdpt", NULL},
+         {"--integrator", "bdpt"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--cpu-strategy", "guided", NULL},
+         {"--cpu-strategy", "guided"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--integrator", "megakernel", "--devices",
+          "cpu,gpu", NULL},
+         {"megakernel", "CPU only"}},
         {{"render", "-o", "out.png", "--spp", "1", "--chunk-size", "big", NULL},
          {"--chunk-size", "big"}},
         {{"render", "-o", "out.png", "--spp", "1", "--bvh-device", "tpu", NULL},
@@ -828,6 +835,11 @@ static void test_threads_and_chunks_change_nothing(void **state)
         /* waves in flight and fixed vs adaptive chunks, on the CPU and its GPU stand-in */
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
          "--waves", "3", "--chunk-size", "auto", "--devices", "cpu:1,gpu", "-o", "v3.exr", NULL},
+        /* the thesis's per-pixel megakernel, its three OpenMP strategies, and no BVH at all */
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
+         "--integrator", "megakernel", "--cpu-strategy", "columns", "-o", "mk.exr", NULL},
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
+         "--cpu-strategy", "tasks", "--no-bvh", "-o", "nb.exr", NULL},
         /* the LBVH with its sort on the GPU (here: a warning, then the host's): the same tree */
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2", "--bvh",
          "lbvh", "--bvh-device", "gpu", "-o", "lg.exr", NULL},

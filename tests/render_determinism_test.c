@@ -118,6 +118,31 @@ static void test_device_sets(void **state)
         }
 }
 
+/* The thesis's three OpenMP strategies, in the CPU device and the shading, and the per-pixel
+ * megakernel under each (which calls the same stages on one path at a time and adds each pixel's
+ * samples in order); and no BVH at all (one leaf: brute force) under both integrators. */
+static void test_strategies_and_megakernel(void **state)
+{
+    int s, mk;
+    (void)state;
+    for (s = 0; s < 3; ++s)
+        for (mk = 0; mk < 2; ++mk) {
+            rt_args a = rt_defaults("cornell", SIZE, SPP);
+            a.threads = 2;
+            a.strategy = (rs_par_strategy)s;
+            a.megakernel = mk;
+            a.chunk_size = 2000; /* chunks big enough for a team: the strategy splits them */
+            expect_identical(&a);
+        }
+    for (mk = 0; mk < 2; ++mk) {
+        rt_args a = rt_defaults("cornell", SIZE, SPP);
+        a.threads = 2;
+        a.no_bvh = 1;
+        a.megakernel = mk;
+        expect_identical(&a);
+    }
+}
+
 /* The comparison above could pass vacuously if the image ignored its inputs: a different seed
  * must change it, and the same seed twice must not. */
 static void test_seed_matters(void **state)
@@ -140,7 +165,7 @@ int main(void)
         cmocka_unit_test(test_threads),      cmocka_unit_test(test_chunk_sizes),
         cmocka_unit_test(test_wave_sizes),   cmocka_unit_test(test_two_devices),
         cmocka_unit_test(test_seed_matters), cmocka_unit_test(test_waves_in_flight),
-        cmocka_unit_test(test_device_sets),
+        cmocka_unit_test(test_device_sets),  cmocka_unit_test(test_strategies_and_megakernel),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -9,6 +9,7 @@
 
 #include "core/alloc.h"
 #include "cpu/cpu_device.h"
+#include "cpu/megakernel.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/render.h"
@@ -18,14 +19,17 @@ typedef struct rt_args {
     uint32_t width, height, spp, max_depth;
     uint64_t seed;
     rs_sampling sampling;
-    int threads;         /* CPU device and shading threads */
-    uint32_t chunk_size; /* 0: default */
-    uint32_t wave_paths; /* 0: default */
-    int with_fallback;   /* add a second, one-thread "gpu-fallback" device */
-    int fallback_only;   /* the "gpu-fallback" device alone, with `threads` threads */
-    uint32_t waves;      /* waves in flight; 0: auto */
-    int real_gpu;        /* CUDA device 0 instead of the fallback in the two options above */
-    int shared_cores;    /* devices and shading share a budget of `threads` cores */
+    int threads;              /* CPU device and shading threads */
+    uint32_t chunk_size;      /* 0: default */
+    uint32_t wave_paths;      /* 0: default */
+    int with_fallback;        /* add a second, one-thread "gpu-fallback" device */
+    int fallback_only;        /* the "gpu-fallback" device alone, with `threads` threads */
+    uint32_t waves;           /* waves in flight; 0: auto */
+    int real_gpu;             /* CUDA device 0 instead of the fallback in the two options above */
+    rs_par_strategy strategy; /* the CPU device's, the shading's and the megakernel's */
+    int megakernel;   /* the per-pixel integrator (cpu/megakernel.h) instead of the stream */
+    int no_bvh;       /* one leaf holding every primitive: brute force */
+    int shared_cores; /* devices and shading share a budget of `threads` cores */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -59,13 +63,18 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     int n = a->with_fallback ? 2 : 1, i, ok = 0;
     rs_cpu_device_opts co;
     rs_cores cores, *budget = a->shared_cores ? &cores : NULL;
+    rs_bvh_build_opts bo;
 
     g = rs_scene_geom(scene);
     rs_cores_init(&cores, a->threads);
     memset(&co, 0, sizeof co);
     co.threads = a->threads;
     co.cores = budget;
-    if (rs_bvh_build(&g, NULL, &bvh) != RS_OK ||
+    co.strategy = a->strategy;
+    co.bvh_width = a->no_bvh ? 2 : 4;
+    memset(&bo, 0, sizeof bo);
+    bo.max_leaf = a->no_bvh ? UINT32_MAX : 0;
+    if (rs_bvh_build(&g, &bo, &bvh) != RS_OK ||
         (a->fallback_only ? (a->real_gpu ? rs_gpu_device_create(0, &devs[0])
                                          : rs_gpu_fallback_create(a->threads, 0, budget, &devs[0]))
                           : rs_cpu_device_create_opts(&co, &devs[0])) != RS_OK ||
@@ -91,8 +100,16 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     st.waves_in_flight = a->waves;
     st.threads = a->threads;
     st.cores = budget;
-    if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK)
+    st.strategy = a->strategy;
+    if (a->megakernel) {
+        rs_megakernel_opts mo;
+        mo.strategy = a->strategy;
+        mo.bvh_width = co.bvh_width;
+        if (rs_render_megakernel(scene, &g, bvh, &st, &mo, NULL, film, &stats) != RS_OK)
+            goto out;
+    } else if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK) {
         goto out;
+    }
     rgb = (float *)malloc((size_t)a->width * a->height * 3 * sizeof *rgb);
     if (!rgb)
         goto out;

@@ -15,6 +15,7 @@
 #include "core/alloc.h"
 #include "core/rng.h"
 #include "core/cores.h"
+#include "core/parallel.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
@@ -421,6 +422,45 @@ static void test_adaptive_chunks(void **state)
     fixture_free(&f);
 }
 
+/* rs_parallel_range: every strategy covers each index exactly once, for any thread count, grain
+ * and range (empty, one item, uneven). */
+static void count_range(void *ctx, uint32_t begin, uint32_t end)
+{
+    atomic_uint *seen = (atomic_uint *)ctx;
+    uint32_t i;
+    assert_true(begin < end);
+    for (i = begin; i < end; ++i)
+        atomic_fetch_add(&seen[i], 1u);
+}
+
+static void test_parallel_range(void **state)
+{
+    static const uint32_t ranges[][2] = {{0, 0}, {5, 6}, {0, 1000}, {17, 10007}};
+    static const uint32_t grains[] = {0, 1, 7, 512, 100000};
+    atomic_uint *seen = (atomic_uint *)calloc(10007, sizeof *seen);
+    int s, t;
+    size_t r, g;
+    uint32_t i;
+    (void)state;
+    for (s = 0; s < 3; ++s)
+        for (t = 1; t <= 3; ++t)
+            for (r = 0; r < sizeof ranges / sizeof ranges[0]; ++r)
+                for (g = 0; g < sizeof grains / sizeof grains[0]; ++g) {
+                    for (i = 0; i < 10007; ++i)
+                        atomic_store(&seen[i], 0u);
+                    rs_parallel_range((rs_par_strategy)s, t, ranges[r][0], ranges[r][1], grains[g],
+                                      count_range, seen);
+                    for (i = 0; i < 10007; ++i) {
+                        unsigned want = i >= ranges[r][0] && i < ranges[r][1];
+                        if (atomic_load(&seen[i]) != want)
+                            fail_msg("%s, %d threads, [%u, %u), grain %u: index %u seen %u times",
+                                     rs_par_strategy_name((rs_par_strategy)s), t, ranges[r][0],
+                                     ranges[r][1], grains[g], i, atomic_load(&seen[i]));
+                    }
+                }
+    free(seen);
+}
+
 /* The core budget: grants at most what is asked, at least one, never more than is free beyond
  * that one, and gives everything back. */
 static void test_core_budget(void **state)
@@ -531,7 +571,7 @@ int main(void)
         cmocka_unit_test(test_empty_and_single), cmocka_unit_test(test_device_failure),
         cmocka_unit_test(test_all_devices_fail), cmocka_unit_test(test_cpu_device_matches_direct),
         cmocka_unit_test(test_random_property),  cmocka_unit_test(test_adaptive_chunks),
-        cmocka_unit_test(test_core_budget),
+        cmocka_unit_test(test_core_budget),      cmocka_unit_test(test_parallel_range),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

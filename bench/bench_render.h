@@ -1,0 +1,92 @@
+/* bench/bench_render.h — one render of a scene the way a benchmark row describes it: the stream
+ * engine on a CPU device (and, optionally, a GPU or its fallback beside it) or the per-pixel
+ * megakernel, with a thread count and an OpenMP strategy (benchmark-only helper). */
+#ifndef RS_BENCH_BENCH_RENDER_H
+#define RS_BENCH_BENCH_RENDER_H
+
+#include <stdio.h>
+#include <string.h>
+
+#include "core/cores.h"
+#include "cpu/cpu_device.h"
+#include "cpu/megakernel.h"
+#include "gpu/gpu_device.h"
+#include "scheduler/render.h"
+
+typedef struct br_config {
+    uint32_t width, height, spp;
+    rs_sampling sampling;
+    int threads;
+    int megakernel;
+    rs_par_strategy strategy;
+    uint32_t bvh_width; /* 2 or 4 */
+    int with_gpu;       /* a CUDA device (else nothing) beside the CPU device: stream only */
+} br_config;
+
+/* Renders; fills *stats and, when rgb is not NULL, the image.  Returns 0 after printing why. */
+static inline int br_render(const char *prog, const rs_scene *scene, const rs_geom *g,
+                            const rs_bvh *bvh, const br_config *c, float *rgb,
+                            rs_render_stats *stats)
+{
+    rs_device *devs[2] = {NULL, NULL};
+    rs_sched *sched = NULL;
+    rs_film *film = NULL;
+    rs_render_settings st;
+    rs_cpu_device_opts co;
+    rs_cores cores;
+    int n = 1, i, ok = 0;
+    rs_status rst;
+    memset(&st, 0, sizeof st);
+    st.width = c->width;
+    st.height = c->height;
+    st.spp = c->spp;
+    st.max_depth = 50;
+    st.seed = 1;
+    st.sampling = c->sampling;
+    st.threads = c->threads;
+    st.strategy = c->strategy;
+    rs_cores_init(&cores, c->threads);
+    st.cores = &cores;
+    if (rs_film_create(c->width, c->height, &film) != RS_OK)
+        goto out;
+    if (c->megakernel) {
+        rs_megakernel_opts mo;
+        mo.strategy = c->strategy;
+        mo.bvh_width = c->bvh_width;
+        rst = rs_render_megakernel(scene, g, bvh, &st, &mo, NULL, film, stats);
+    } else {
+        memset(&co, 0, sizeof co);
+        co.threads = c->with_gpu && c->threads > 1 ? c->threads - 1 : c->threads;
+        co.bvh_width = c->bvh_width;
+        co.strategy = c->strategy;
+        co.cores = &cores;
+        if (rs_cpu_device_create_opts(&co, &devs[0]) != RS_OK)
+            goto out;
+        if (c->with_gpu) {
+            if (rs_gpu_device_create(0, &devs[1]) != RS_OK)
+                goto out;
+            n = 2;
+        }
+        for (i = 0; i < n; ++i)
+            if (rs_device_upload(devs[i], g, bvh) != RS_OK)
+                goto out;
+        if (rs_sched_create(devs, n, NULL, &sched) != RS_OK)
+            goto out;
+        rst = rs_render(scene, sched, &st, NULL, film, stats);
+    }
+    if (rst != RS_OK)
+        goto out;
+    if (rgb)
+        rs_film_resolve(film, rgb);
+    ok = 1;
+out:
+    if (!ok)
+        fprintf(stderr, "%s: %s\n", prog, rs_error_message());
+    rs_sched_destroy(sched);
+    for (i = 0; i < n; ++i)
+        rs_device_destroy(devs[i]);
+    rs_film_destroy(film);
+    return ok;
+}
+
+#endif
