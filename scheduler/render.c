@@ -197,12 +197,36 @@ static rs_status slot_step(render_ctx *c, slot *sl)
     return RS_OK;
 }
 
+typedef struct flush_ctx {
+    const slot *sl;
+    rs_film *film;
+    uint32_t npix;
+} flush_ctx;
+
+/* Paths k, k + npix, k + 2 npix, ... of the wave all land on one pixel, in sample order; distinct
+ * k are distinct pixels, so the lines of k run in parallel and each pixel still sums its samples
+ * in path order (the film is the same bit for bit). */
+static void flush_range(void *ctx, uint32_t begin, uint32_t end)
+{
+    const flush_ctx *f = (const flush_ctx *)ctx;
+    uint32_t k, i;
+    for (k = begin; k < end; ++k)
+        for (i = k; i < f->sl->count; i += f->npix)
+            rs_film_add(f->film, (uint32_t)((f->sl->start + i) % f->npix),
+                        f->sl->b.paths.radiance[i]);
+}
+
 /* Adds the slot's wave to the film in path order. */
 static void slot_flush(render_ctx *c, slot *sl, rs_film *film)
 {
-    uint32_t i, npix = c->it.npix;
-    for (i = 0; i < sl->count; ++i)
-        rs_film_add(film, (uint32_t)((sl->start + i) % npix), sl->b.paths.radiance[i]);
+    flush_ctx f;
+    double t0 = stage_begin(c);
+    f.sl = sl;
+    f.film = film;
+    f.npix = c->it.npix;
+    rs_parallel_range(RS_PAR_FOR_DYNAMIC, c->it.threads, 0, sl->count < f.npix ? sl->count : f.npix,
+                      4096, flush_range, &f);
+    stage_end(c, t0);
     c->stats->paths_done += sl->count;
     c->ended -= sl->count;
     c->stats->waves++;

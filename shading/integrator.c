@@ -105,10 +105,26 @@ void rs_integrator_raygen(const rs_integrator *it, uint64_t wave_start, uint32_t
 /* Moves a ray origin off the surface along n (the side the new ray leaves from); the offset
  * scales with the coordinates so that it stays far above float rounding (~1e-7 relative) at any
  * scene scale. */
-static rs_vec3 offset_origin(rs_vec3 x, rs_vec3 n)
+static rs_vec3 offset_origin(rs_vec3 x, rs_vec3 n, float prim_scale)
 {
     float scale = fmaxf(fmaxf(fabsf(x.x), fabsf(x.y)), fmaxf(fabsf(x.z), 1e-2f));
-    return rs_v3_madd(x, n, 1e-4f * scale);
+    return rs_v3_madd(x, n, fmaxf(1e-4f * scale, 1e-6f * prim_scale));
+}
+
+/* The size of the numbers a primitive's intersection test works with, which bounds the error of
+ * its hit points: for a sphere, its centre's coordinates and its radius (the ground sphere of
+ * rtiow-final, radius 1000 centred 1000 below the origin, puts hit points near the origin with
+ * errors of ~1e-4: offset by the hit point's own size only, a bounce ray there could find the
+ * ground again at t ~ 1e-5, a hit outside the ground's bounding box that a BVH culls and brute
+ * force does not).  The origin moves by 1e-6 of it (~17 float ulps; 2e-3 for that ground).
+ * Triangles and quads: their hit points' own size, 0 here. */
+static float prim_scale(const rs_scene *sc, uint32_t prim)
+{
+    const rs_sphere *s;
+    if (prim >= sc->n_spheres)
+        return 0.0f;
+    s = &sc->spheres[prim];
+    return fmaxf(fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
 }
 
 static float power_heuristic(float a, float b)
@@ -239,13 +255,13 @@ static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bou
         if ((rs_v3_dot(wi, n_geo) > 0.0f) == (bs.transmit != 0))
             return;
         beta = rs_v3_mul(beta, bs.weight);
-        origin = offset_origin(x, bs.transmit ? rs_v3_neg(n_geo) : n_geo);
+        origin = offset_origin(x, bs.transmit ? rs_v3_neg(n_geo) : n_geo, prim_scale(sc, prim));
         specular = 1;
     } else {
         rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
         float ci;
         rs_vec3 f;
-        origin = offset_origin(x, n_geo);
+        origin = offset_origin(x, n_geo, prim_scale(sc, prim));
 
         if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
             /* next-event estimation: a shadow ray toward a sampled point on a light */

@@ -27,9 +27,10 @@ typedef struct rt_args {
     uint32_t waves;           /* waves in flight; 0: auto */
     int real_gpu;             /* CUDA device 0 instead of the fallback in the two options above */
     rs_par_strategy strategy; /* the CPU device's, the shading's and the megakernel's */
-    int megakernel;   /* the per-pixel integrator (cpu/megakernel.h) instead of the stream */
-    int no_bvh;       /* one leaf holding every primitive: brute force */
-    int shared_cores; /* devices and shading share a budget of `threads` cores */
+    int megakernel;    /* the per-pixel integrator (cpu/megakernel.h) instead of the stream */
+    int no_bvh;        /* one leaf holding every primitive: brute force */
+    rs_bvh_method bvh; /* the builder (zeroed: median) */
+    int shared_cores;  /* devices and shading share a budget of `threads` cores */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -74,6 +75,7 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     co.bvh_width = a->no_bvh ? 2 : 4;
     memset(&bo, 0, sizeof bo);
     bo.max_leaf = a->no_bvh ? UINT32_MAX : 0;
+    bo.builder.method = a->bvh;
     if (rs_bvh_build(&g, &bo, &bvh) != RS_OK ||
         (a->fallback_only ? (a->real_gpu ? rs_gpu_device_create(0, &devs[0])
                                          : rs_gpu_fallback_create(a->threads, 0, budget, &devs[0]))
