@@ -56,15 +56,6 @@ std::string temp_name(const char *path)
 
 } // namespace
 
-extern "C" float rs_srgb_encode(float x)
-{
-    if (!(x > 0.0f))
-        return 0.0f;
-    if (x >= 1.0f)
-        return 1.0f;
-    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
-}
-
 extern "C" rs_status rs_image_check_output(const char *path)
 {
     try {
@@ -138,15 +129,6 @@ extern "C" rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, co
         std::remove(tmp.c_str());
         return rs_error_set(RS_ERR_IO, "%s: unknown error writing the image", path);
     }
-}
-
-extern "C" float rs_srgb_decode(float c)
-{
-    if (!(c > 0.0f))
-        return 0.0f;
-    if (c >= 1.0f)
-        return 1.0f;
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **rgb, bool linear);

@@ -14,15 +14,6 @@
 
 #include "core/alloc.h"
 
-rs_mesh_opts rs_mesh_opts_default(uint32_t mat)
-{
-    rs_mesh_opts o;
-    memset(&o, 0, sizeof o);
-    o.scale = rs_v3(1, 1, 1);
-    o.material = mat;
-    return o;
-}
-
 /* Rotation about x, then y, then z (right-handed, degrees). */
 static rs_vec3 rotate_xyz(rs_vec3 p, rs_vec3 deg)
 {

@@ -1,0 +1,92 @@
+/* core/image_io_pfm.c — image files without OpenImageIO (builds configured with
+ * RS_DEPS=OPTIONAL where it is not installed, such as a bare GPU machine): Portable Float Maps
+ * only (.pfm, linear RGB, written bottom row first as the format says), with the same
+ * temporary-file-and-rename write as the OpenImageIO shim.  Every other extension is an error
+ * that says why. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/alloc.h"
+#include "core/image_io.h"
+
+static int is_pfm(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 4 && (strcmp(path + n - 4, ".pfm") == 0 || strcmp(path + n - 4, ".PFM") == 0);
+}
+
+rs_status rs_image_check_output(const char *path)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (!is_pfm(path))
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: this build has no OpenImageIO and writes .pfm files only", path);
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1,
+             slash ? (slash == path ? "/" : path) : ".");
+    if (access(dir, W_OK) != 0)
+        return rs_error_set(RS_ERR_IO, "%s: the folder %s does not exist or is not writable", path,
+                            dir);
+    return RS_OK;
+}
+
+rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, const float *rgb)
+{
+    char tmp[4200];
+    FILE *f;
+    uint32_t y;
+    int ok;
+    rs_status st = rs_image_check_output(path);
+    if (st != RS_OK)
+        return st;
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    if (!(f = fopen(tmp, "wb")))
+        return rs_error_set(RS_ERR_IO, "%s: cannot write", path);
+    ok = fprintf(f, "PF\n%u %u\n-1.0\n", w, h) > 0; /* negative scale: little-endian floats */
+    for (y = h; ok && y-- > 0;)
+        ok = fwrite(rgb + (size_t)y * w * 3, sizeof(float), (size_t)w * 3, f) == (size_t)w * 3;
+    ok = (fclose(f) == 0) && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        return rs_error_set(RS_ERR_IO, "%s: write failed", path);
+    }
+    return RS_OK;
+}
+
+rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned ww, hh;
+    float scale;
+    uint32_t y;
+    int ok;
+    *rgb = NULL;
+    if (!f)
+        return rs_error_set(RS_ERR_IO, "%s: cannot open", path);
+    ok = fscanf(f, "PF %u %u %f", &ww, &hh, &scale) == 3 && fgetc(f) != EOF && scale < 0.0f &&
+         ww > 0 && hh > 0 && ww < 65536 && hh < 65536;
+    if (ok)
+        ok = (*rgb = (float *)rs_alloc((size_t)ww * hh * 3, sizeof(float))) != NULL;
+    for (y = hh; ok && y-- > 0;)
+        ok = fread(*rgb + (size_t)y * ww * 3, sizeof(float), (size_t)ww * 3, f) == (size_t)ww * 3;
+    fclose(f);
+    if (!ok) {
+        rs_free(*rgb);
+        *rgb = NULL;
+        return rs_error_set(RS_ERR_IO,
+                            "%s: not a little-endian RGB .pfm (this build has no OpenImageIO)",
+                            path);
+    }
+    *w = ww;
+    *h = hh;
+    return RS_OK;
+}
+
+rs_status rs_image_read_linear(const char *path, uint32_t *w, uint32_t *h, float **rgb)
+{
+    return rs_image_read(path, w, h, rgb); /* PFM is linear */
+}
+
+const char *rs_image_library_version(void) { return "none (PFM only)"; }

@@ -1,0 +1,17 @@
+/* scenes/scene_json_none.c — scene files in a build without cJSON (RS_DEPS=OPTIONAL on a machine
+ * without libcjson-dev): every call says so; the built-in scenes still work. */
+#include "scenes/scene_json.h"
+
+rs_status rs_scene_load_json(const char *path, rs_scene **out)
+{
+    *out = NULL;
+    return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no scene files", path);
+}
+
+rs_status rs_scene_parse_json(const char *text, size_t len, const char *label,
+                              const char *base_dir, rs_scene **out)
+{
+    (void)text, (void)len, (void)base_dir;
+    *out = NULL;
+    return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no scene files", label);
+}
