@@ -75,9 +75,8 @@ rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
     if (!ok) {
         rs_free(*rgb);
         *rgb = NULL;
-        return rs_error_set(RS_ERR_IO,
-                            "%s: not a little-endian RGB .pfm (this build has no OpenImageIO)",
-                            path);
+        return rs_error_set(
+            RS_ERR_IO, "%s: not a little-endian RGB .pfm (this build has no OpenImageIO)", path);
     }
     *w = ww;
     *h = hh;

@@ -8,8 +8,8 @@ rs_status rs_scene_load_json(const char *path, rs_scene **out)
     return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no scene files", path);
 }
 
-rs_status rs_scene_parse_json(const char *text, size_t len, const char *label,
-                              const char *base_dir, rs_scene **out)
+rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, const char *base_dir,
+                              rs_scene **out)
 {
     (void)text, (void)len, (void)base_dir;
     *out = NULL;

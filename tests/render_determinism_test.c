@@ -118,6 +118,21 @@ static void test_device_sets(void **state)
         }
 }
 
+/* A device that fails mid-render while three waves are in flight: its chunk is retried on the
+ * other, every job of every wave completes, and the image is unchanged. */
+static void test_failure_with_waves_in_flight(void **state)
+{
+    rt_args a = rt_defaults("cornell", SIZE, SPP);
+    (void)state;
+    a.threads = 2;
+    a.with_fallback = 1;
+    a.fail_after = 5;
+    a.waves = 3;
+    a.chunk_size = 97;
+    a.shared_cores = 1;
+    expect_identical(&a);
+}
+
 /* The thesis's three OpenMP strategies, in the CPU device and the shading, and the per-pixel
  * megakernel under each (which calls the same stages on one path at a time and adds each pixel's
  * samples in order); and no BVH at all (one leaf: brute force) under both integrators. */
@@ -198,11 +213,16 @@ static void test_seed_matters(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_threads),          cmocka_unit_test(test_chunk_sizes),
-        cmocka_unit_test(test_wave_sizes),       cmocka_unit_test(test_two_devices),
-        cmocka_unit_test(test_seed_matters),     cmocka_unit_test(test_waves_in_flight),
-        cmocka_unit_test(test_device_sets),      cmocka_unit_test(test_strategies_and_megakernel),
+        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_chunk_sizes),
+        cmocka_unit_test(test_wave_sizes),
+        cmocka_unit_test(test_two_devices),
+        cmocka_unit_test(test_seed_matters),
+        cmocka_unit_test(test_waves_in_flight),
+        cmocka_unit_test(test_device_sets),
+        cmocka_unit_test(test_strategies_and_megakernel),
         cmocka_unit_test(test_bvh_independence),
+        cmocka_unit_test(test_failure_with_waves_in_flight),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -12,6 +12,7 @@
 #include "cpu/megakernel.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
+#include "scheduler/fault.h"
 #include "scheduler/render.h"
 
 typedef struct rt_args {
@@ -30,6 +31,7 @@ typedef struct rt_args {
     int megakernel;    /* the per-pixel integrator (cpu/megakernel.h) instead of the stream */
     int no_bvh;        /* one leaf holding every primitive: brute force */
     rs_bvh_method bvh; /* the builder (zeroed: median) */
+    int fail_after;    /* > 0: the second device fails after this many chunks (RS_FAULT) */
     int shared_cores;  /* devices and shading share a budget of `threads` cores */
 } rt_args;
 
@@ -82,6 +84,8 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
                           : rs_cpu_device_create_opts(&co, &devs[0])) != RS_OK ||
         (n == 2 && (a->real_gpu ? rs_gpu_device_create(0, &devs[1])
                                 : rs_gpu_fallback_create(1, 0, budget, &devs[1])) != RS_OK))
+        goto out;
+    if (n == 2 && a->fail_after > 0 && rs_fault_wrap(&devs[1], a->fail_after) != RS_OK)
         goto out;
     for (i = 0; i < n; ++i)
         if (rs_device_upload(devs[i], &g, bvh) != RS_OK)

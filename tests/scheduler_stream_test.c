@@ -540,6 +540,14 @@ static void test_cpu_device_matches_direct(void **state)
                 assert_int_equal(rs_device_upload(d[j], &g, bvh), RS_OK);
             assert_int_equal(rs_sched_create(d, n_dev, &cfg, &s), RS_OK);
             assert_int_equal(rs_sched_trace(s, &b), RS_OK);
+            if (set == 1) { /* the fallback stages every ray in and every answer out */
+                rs_device_stats ds;
+                int alive;
+                rs_sched_device_stats(s, 0, &ds, &alive);
+                assert_int_equal(ds.bytes_to_device, (uint64_t)n * RS_RAY_BYTES);
+                assert_int_equal(ds.bytes_from_device,
+                                 (uint64_t)n * ((kind & 1) == RS_TRACE_CLOSEST ? RS_HIT_BYTES : 1));
+            }
             for (i = 0; i < n; ++i) {
                 rs_ray ray = rs_ray_soa_get(&f.rays, i);
                 rs_hit h;
