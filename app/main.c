@@ -182,19 +182,31 @@ static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *con
                         int n_devs, const rs_render_stats *rstats)
 {
     rs_device_stats ds[RS_MAX_DEVICES];
-    int alive[RS_MAX_DEVICES], i;
+    const char *names[RS_MAX_DEVICES];
+    int alive[RS_MAX_DEVICES], threads[RS_MAX_DEVICES], i;
     uint64_t total = 0;
     double wall = rstats->seconds > 0 ? rstats->seconds : 1e-9;
     for (i = 0; i < n_devs; ++i) {
         rs_sched_device_stats(sched, i, &ds[i], &alive[i]);
+        names[i] = devs[i]->name;
+        threads[i] = devs[i]->threads;
         total += ds[i].rays;
+    }
+    if (!sched) { /* the megakernel: the CPU traced everything, one path at a time */
+        memset(&ds[0], 0, sizeof ds[0]);
+        ds[0].rays = total = rstats->rays_closest + rstats->rays_shadow;
+        ds[0].busy_s = rstats->seconds;
+        names[0] = "cpu (megakernel)";
+        threads[0] = o->threads ? o->threads : rs_cpu_count();
+        alive[0] = 1;
+        n_devs = 1;
     }
     if (o->stats) {
         fprintf(stderr, "%-24s %14s %8s %9s %9s %9s %7s %12s %12s %s\n", "device", "rays", "chunks",
                 "busy s", "idle s", "Mrays/s", "share", "bytes in", "bytes out", "state");
         for (i = 0; i < n_devs; ++i)
             fprintf(stderr, "%-24s %14llu %8llu %9.3f %9.3f %9.2f %6.1f%% %12llu %12llu %s\n",
-                    devs[i]->name, (unsigned long long)ds[i].rays, (unsigned long long)ds[i].chunks,
+                    names[i], (unsigned long long)ds[i].rays, (unsigned long long)ds[i].chunks,
                     ds[i].busy_s, ds[i].idle_s,
                     ds[i].busy_s > 0 ? (double)ds[i].rays / ds[i].busy_s / 1e6 : 0.0,
                     total ? 100.0 * (double)ds[i].rays / (double)total : 0.0,
@@ -212,7 +224,7 @@ static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *con
         for (i = 0; i < n_devs; ++i) {
             const char *c;
             fprintf(f, "    {\"name\": \"");
-            for (c = devs[i]->name; *c; ++c)
+            for (c = names[i]; *c; ++c)
                 if (*c == '"' || *c == '\\')
                     fprintf(f, "\\%c", *c);
                 else if ((unsigned char)*c >= 0x20)
@@ -222,8 +234,8 @@ static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *con
                     "\"idle_s\": %.6f, \"mrays_per_s\": %.4f, \"share\": %.6f, "
                     "\"bytes_to_device\": %llu, \"bytes_from_device\": %llu, \"failures\": %llu, "
                     "\"failed\": %s}%s\n",
-                    devs[i]->threads, (unsigned long long)ds[i].rays,
-                    (unsigned long long)ds[i].chunks, ds[i].busy_s, ds[i].idle_s,
+                    threads[i], (unsigned long long)ds[i].rays, (unsigned long long)ds[i].chunks,
+                    ds[i].busy_s, ds[i].idle_s,
                     ds[i].busy_s > 0 ? (double)ds[i].rays / ds[i].busy_s / 1e6 : 0.0,
                     total ? (double)ds[i].rays / (double)total : 0.0,
                     (unsigned long long)ds[i].bytes_to_device,
