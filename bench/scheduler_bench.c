@@ -38,8 +38,9 @@
 #include "scenes/builtin.h"
 #include "scheduler/render.h"
 
-#define MAX_SCENES 8
-#define MAX_RUNS   15
+#define MAX_SCENES  8
+#define MAX_RUNS    15
+#define MAX_CONFIGS 10
 
 enum { SET_A, SET_B, SET_AB, N_SETS };
 static const char *const set_names[N_SETS] = {"A alone", "B alone", "A+B"};
@@ -52,6 +53,7 @@ typedef struct config {
 
 typedef struct measure {
     double sps, trace_mrays; /* medians */
+    double run_mrays[MAX_RUNS];
     double idle[2], share[2];
     double seconds;
 } measure;
@@ -144,44 +146,66 @@ out:
     return ok;
 }
 
-/* Medians of b->runs renders; the first run's image is compared with the scene's reference. */
-static int measure_config(bench *b, const rs_scene *scene, const rs_bvh *bvh, const config *c,
-                          measure *m)
+/* Renders each of the n configurations b->runs times, interleaved (run 1 of every configuration,
+ * then run 2, ...) so that a drift of the machine's speed touches them all alike; fills their
+ * medians and per-run trace rates.  The first run's images are compared with the scene's
+ * reference (A alone's, which the first configuration sets when it is A with the defaults). */
+static int measure_configs(bench *b, const rs_scene *scene, const rs_bvh *bvh, const config *cs,
+                           int n, measure *ms)
 {
-    double sps[MAX_RUNS], mr[MAX_RUNS], idle[2][MAX_RUNS], share[2][MAX_RUNS], secs[MAX_RUNS];
+    double sps[MAX_CONFIGS][MAX_RUNS], idle[MAX_CONFIGS][2][MAX_RUNS],
+        share[MAX_CONFIGS][2][MAX_RUNS], secs[MAX_CONFIGS][MAX_RUNS], tmp[MAX_RUNS];
     size_t nf = (size_t)b->size * b->size * 3, k;
     float *img = (float *)malloc(nf * sizeof *img);
-    int r, i;
-    for (r = 0; r < b->runs; ++r) {
-        double id[2], sh[2];
-        if (!render_once(b, scene, bvh, c, &sps[r], &mr[r], id, sh, &secs[r],
-                         r == 0 ? img : NULL)) {
-            free(img);
-            return 0;
+    int r, i, c;
+    for (r = 0; r < b->runs; ++r)
+        for (c = 0; c < n; ++c) {
+            double id[2], sh[2];
+            if (!render_once(b, scene, bvh, &cs[c], &sps[c][r], &ms[c].run_mrays[r], id, sh,
+                             &secs[c][r], r == 0 ? img : NULL)) {
+                free(img);
+                return 0;
+            }
+            for (i = 0; i < 2; ++i) {
+                idle[c][i][r] = id[i];
+                share[c][i][r] = sh[i];
+            }
+            if (r > 0)
+                continue;
+            if (cs[c].set == SET_A && cs[c].chunk == 0 && cs[c].waves == 0) {
+                memcpy(b->ref, img, nf * sizeof *img);
+            } else {
+                for (k = 0; k < nf; ++k) {
+                    double d = fabs((double)img[k] - b->ref[k]);
+                    b->max_diff = d > b->max_diff ? d : b->max_diff;
+                    b->mismatch |= img[k] != b->ref[k];
+                }
+            }
         }
-        for (i = 0; i < 2; ++i) {
-            idle[i][r] = id[i];
-            share[i][r] = sh[i];
-        }
-    }
-    if (c->set == SET_A && c->chunk == 0 && c->waves == 0) {
-        memcpy(b->ref, img, nf * sizeof *img);
-    } else {
-        for (k = 0; k < nf; ++k) {
-            double d = fabs((double)img[k] - b->ref[k]);
-            b->max_diff = d > b->max_diff ? d : b->max_diff;
-            b->mismatch |= img[k] != b->ref[k];
-        }
-    }
     free(img);
-    m->sps = rs_bench_median(sps, b->runs);
-    m->trace_mrays = rs_bench_median(mr, b->runs);
-    m->seconds = rs_bench_median(secs, b->runs);
-    for (i = 0; i < 2; ++i) {
-        m->idle[i] = rs_bench_median(idle[i], b->runs);
-        m->share[i] = rs_bench_median(share[i], b->runs);
+    for (c = 0; c < n; ++c) {
+        measure *m = &ms[c];
+        m->sps = rs_bench_median(sps[c], b->runs);
+        memcpy(tmp, m->run_mrays, (size_t)b->runs * sizeof *tmp);
+        m->trace_mrays = rs_bench_median(tmp, b->runs);
+        m->seconds = rs_bench_median(secs[c], b->runs);
+        for (i = 0; i < 2; ++i) {
+            m->idle[i] = rs_bench_median(idle[c][i], b->runs);
+            m->share[i] = rs_bench_median(share[c][i], b->runs);
+        }
     }
     return 1;
+}
+
+/* The load-balance efficiency of `ab` against the alone runs, run by run (runs are interleaved,
+ * so run r of each set saw the same machine), and its median. */
+static double efficiency(const bench *b, const measure *a, const measure *bb, const measure *ab)
+{
+    double e[MAX_RUNS];
+    int r;
+    for (r = 0; r < b->runs; ++r)
+        e[r] = ab->run_mrays[r] / (a->run_mrays[r] + bb->run_mrays[r]);
+    return rs_bench_median(e, b->runs);
 }
 
 static int load_scene(const char *spec, const char *models, rs_scene **out)
@@ -292,13 +316,13 @@ int main(int argc, char **argv)
         printf("scene %s (%u primitives, SAH BVH)\n", scenes[s], rs_geom_prim_count(&g));
         printf("  %-8s %-22s %12s %14s %9s %9s %8s %8s\n", "set", "devices", "samples/s",
                "trace Mrays/s", "idle A", "idle B", "share A", "share B");
-        for (k = 0; k < N_SETS; ++k) {
-            config c = {k, 0, 0};
-            char devs[96];
-            if (!measure_config(&b, scene, bvh, &c, &m[k])) {
+        {
+            config cs[N_SETS] = {{SET_A, 0, 0}, {SET_B, 0, 0}, {SET_AB, 0, 0}};
+            if (!measure_configs(&b, scene, bvh, cs, N_SETS, m))
                 failed = 1;
-                break;
-            }
+        }
+        for (k = 0; k < N_SETS && !failed; ++k) {
+            char devs[96];
             snprintf(devs, sizeof devs, "%s", k == SET_A ? a_name : k == SET_B ? b_name : "both");
             printf("  %-8s %-22s %12.0f %14.2f %8.1f%% %8.1f%% %7.1f%% %7.1f%%\n", set_names[k],
                    devs, m[k].sps, m[k].trace_mrays, 100.0 * m[k].idle[0],
@@ -314,7 +338,7 @@ int main(int argc, char **argv)
             rs_scene_destroy(scene);
             break;
         }
-        eff_t = m[SET_AB].trace_mrays / (m[SET_A].trace_mrays + m[SET_B].trace_mrays);
+        eff_t = efficiency(&b, &m[SET_A], &m[SET_B], &m[SET_AB]);
         eff_s = m[SET_AB].sps / (m[SET_A].sps + m[SET_B].sps);
         printf("  load-balance efficiency (trace Mrays/s): %.3f   samples/s: %.3f   "
                "A+B vs A alone: %.2fx\n",
@@ -335,33 +359,37 @@ int main(int argc, char **argv)
             printf("  sweep, A+B: chunk size x waves in flight (defaults: adaptive, auto = %s)\n",
                    b.have_gpu ? "2" : "1");
             printf("  %-10s %6s %12s %11s %14s %11s %9s %9s\n", "chunk", "waves", "samples/s",
-                   "vs default", "trace Mrays/s", "efficiency", "idle A", "idle B");
-            for (ci = 0; ci < sizeof chunks / sizeof chunks[0] && !failed; ++ci)
-                for (wi = 0; wi < sizeof waves / sizeof waves[0]; ++wi) {
-                    config c = {SET_AB, chunks[ci], waves[wi]};
-                    measure w;
-                    char cs[16], eff[16];
-                    if (quick && ci > 1)
-                        break;
-                    if (!measure_config(&b, scene, bvh, &c, &w)) {
-                        failed = 1;
-                        break;
+                   "vs row 1", "trace Mrays/s", "efficiency", "idle A", "idle B");
+            /* A and B alone again, interleaved with the sweep, so that each row's efficiency
+             * pairs runs made side by side */
+            config sw[MAX_CONFIGS] = {{SET_A, 0, 0}, {SET_B, 0, 0}};
+            measure wm[MAX_CONFIGS];
+            int n_sw = 2, j;
+            for (ci = 0; ci < sizeof chunks / sizeof chunks[0]; ++ci)
+                for (wi = 0; wi < sizeof waves / sizeof waves[0]; ++wi)
+                    if (!(quick && ci > 1)) {
+                        sw[n_sw].set = SET_AB;
+                        sw[n_sw].chunk = chunks[ci];
+                        sw[n_sw++].waves = waves[wi];
                     }
-                    snprintf(cs, sizeof cs, "%u", chunks[ci]);
-                    /* with 2 waves the render thread waits only for what shading did not hide:
-                     * its "trace" rate is no device throughput, so no efficiency */
-                    snprintf(eff, sizeof eff, "%.3f",
-                             w.trace_mrays / (m[SET_A].trace_mrays + m[SET_B].trace_mrays));
-                    printf("  %-10s %6u %12.0f %10.2fx %14.2f %11s %8.1f%% %8.1f%%\n",
-                           chunks[ci] ? cs : "adaptive", waves[wi], w.sps, w.sps / m[SET_AB].sps,
-                           w.trace_mrays, waves[wi] == 1 ? eff : "-", 100.0 * w.idle[0],
-                           100.0 * w.idle[1]);
-                    if (csv_f)
-                        fprintf(csv_f, "%s,sweep,%s,%u,%.1f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
-                                scenes[s], chunks[ci] ? cs : "auto", waves[wi], w.sps,
-                                w.trace_mrays, w.seconds, w.idle[0], w.idle[1], w.share[0],
-                                w.share[1]);
-                }
+            if (!measure_configs(&b, scene, bvh, sw, n_sw, wm))
+                failed = 1;
+            for (j = 2; j < n_sw && !failed; ++j) {
+                const measure *w = &wm[j];
+                char cs[16], eff[16];
+                snprintf(cs, sizeof cs, "%u", sw[j].chunk);
+                /* with 2 waves the render thread waits only for what shading did not hide: its
+                 * "trace" rate is no device throughput, so no efficiency */
+                snprintf(eff, sizeof eff, "%.3f", efficiency(&b, &wm[0], &wm[1], w));
+                printf("  %-10s %6u %12.0f %10.2fx %14.2f %11s %8.1f%% %8.1f%%\n",
+                       sw[j].chunk ? cs : "adaptive", sw[j].waves, w->sps, w->sps / wm[2].sps,
+                       w->trace_mrays, sw[j].waves == 1 ? eff : "-", 100.0 * w->idle[0],
+                       100.0 * w->idle[1]);
+                if (csv_f)
+                    fprintf(csv_f, "%s,sweep,%s,%u,%.1f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", scenes[s],
+                            sw[j].chunk ? cs : "auto", sw[j].waves, w->sps, w->trace_mrays,
+                            w->seconds, w->idle[0], w->idle[1], w->share[0], w->share[1]);
+            }
             if (b.mismatch && !b.have_gpu)
                 failed = 1;
             printf("  sweep images: %s\n\n", b.mismatch ? "DIFFER" : "bit-identical to A alone");
