@@ -64,6 +64,7 @@ static double trace_ours(const rs_bvh_view *v, const rs_bvh4 *b4, const rs_geom 
                          const bs_rays *s, int q, int threads, answers *a)
 {
     double t0 = rs_bench_now();
+    (void)threads; /* read only by the OpenMP clauses (compiled out under ThreadSanitizer) */
     long i, n = (long)s->n;
     if (q == Q_CLOSEST) {
 #pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)

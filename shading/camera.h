@@ -56,6 +56,7 @@ RS_HD rs_ray rs_camera_ray(const rs_camera *c, uint32_t px, uint32_t py, float j
     }
     r.d = rs_v3_normalize(rs_v3_sub(target, r.o));
     r.tmin = 0.0f;
+    r.time = 0.0f; /* the caller picks the time in the shutter interval */
     r.tmax = 3.402823466e38f;
     return r;
 }

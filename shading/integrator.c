@@ -399,6 +399,7 @@ void rs_integrator_resolve_shadows(const rs_integrator *it, const rs_ray_soa *sh
                                    const uint8_t *occluded, uint32_t count, rs_paths *paths)
 {
     long k;
+    (void)it; /* read only by the OpenMP clauses (compiled out under ThreadSanitizer) */
 #pragma omp parallel for num_threads(it->threads) schedule(static) if (it->threads > 1)
     for (k = 0; k < (long)count; ++k) {
         uint32_t p = shadow->path[k];
