@@ -11,6 +11,7 @@
 #include "cpu/cpu_device.h"
 #include "cpu/megakernel.h"
 #include "gpu/gpu_device.h"
+#include "scenes/builtin.h"
 #include "scheduler/render.h"
 
 typedef struct br_config {
@@ -22,6 +23,43 @@ typedef struct br_config {
     uint32_t bvh_width; /* 2 or 4 */
     int with_gpu;       /* a CUDA device (else nothing) beside the CPU device: stream only */
 } br_config;
+
+/* A benchmark's scene: a built-in one by name, or "cornell-mesh:FILE" (FILE under the models
+ * folder `models`, NULL: the default) dropped into the Cornell box; with its geometry and a SAH
+ * BVH.  Returns 1; 0 when the scene cannot be made (a missing model: "NAME: skipped: why" is
+ * printed and the caller goes on); -1 when the BVH fails (printed). */
+static inline int br_load_scene(const char *prog, const char *spec, const char *models,
+                                rs_scene **scene, rs_geom *g, rs_bvh **bvh)
+{
+    rs_builtin_opts o;
+    rs_bvh_build_opts bo;
+    char path[4096];
+    rs_status st;
+    memset(&o, 0, sizeof o);
+    o.models_dir = models;
+    if (strncmp(spec, "cornell-mesh:", 13) == 0) {
+        snprintf(path, sizeof path, "%s/%s", rs_builtin_models_dir(models), spec + 13);
+        o.mesh_file = path;
+        st = rs_builtin_create_ex("cornell-mesh", &o, scene);
+    } else {
+        st = rs_builtin_create_ex(spec, &o, scene);
+    }
+    if (st != RS_OK) {
+        printf("%s: skipped: %s\n\n", spec, rs_error_message());
+        rs_error_clear();
+        return 0;
+    }
+    *g = rs_scene_geom(*scene);
+    memset(&bo, 0, sizeof bo);
+    bo.builder.method = RS_BVH_SAH;
+    if (rs_bvh_build(g, &bo, bvh) != RS_OK) {
+        fprintf(stderr, "%s: %s\n", prog, rs_error_message());
+        rs_scene_destroy(*scene);
+        *scene = NULL;
+        return -1;
+    }
+    return 1;
+}
 
 /* Renders; fills *stats and, when rgb is not NULL, the image.  Returns 0 after printing why. */
 static inline int br_render(const char *prog, const rs_scene *scene, const rs_geom *g,

@@ -69,7 +69,6 @@ int main(int argc, char **argv)
     for (s = 0; s < 2 && !failed; ++s) {
         rs_scene *scene = NULL;
         rs_bvh *bvh = NULL;
-        rs_bvh_build_opts bo;
         rs_geom g;
         uint32_t w = (uint32_t)(sizes[s][0] * scale + 0.5),
                  h = (uint32_t)(sizes[s][1] * scale + 0.5);
@@ -82,19 +81,11 @@ int main(int argc, char **argv)
             w = 1;
         if (h < 1)
             h = 1;
-        if (rs_builtin_create(scenes[s], &scene) != RS_OK) {
-            printf("%s: skipped: %s\n\n", scenes[s], rs_error_message());
-            rs_error_clear();
-            continue;
-        }
-        g = rs_scene_geom(scene);
-        memset(&bo, 0, sizeof bo);
-        bo.builder.method = RS_BVH_SAH;
-        if (rs_bvh_build(&g, &bo, &bvh) != RS_OK) {
-            fprintf(stderr, "parallel_bench: %s\n", rs_error_message());
-            rs_scene_destroy(scene);
+        int loaded = br_load_scene("parallel_bench", scenes[s], NULL, &scene, &g, &bvh);
+        if (loaded < 0)
             return 1;
-        }
+        if (loaded == 0)
+            continue;
         nf = (size_t)w * h * 3;
         ref = (float *)malloc(nf * sizeof *ref);
         img = (float *)malloc(nf * sizeof *img);

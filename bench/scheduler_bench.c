@@ -30,13 +30,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench_render.h"
 #include "core/alloc.h"
-#include "core/cores.h"
-#include "cpu/cpu_device.h"
-#include "gpu/gpu_device.h"
 #include "machine.h"
-#include "scenes/builtin.h"
-#include "scheduler/render.h"
 
 #define MAX_SCENES  8
 #define MAX_RUNS    15
@@ -208,20 +204,6 @@ static double efficiency(const bench *b, const measure *a, const measure *bb, co
     return rs_bench_median(e, b->runs);
 }
 
-static int load_scene(const char *spec, const char *models, rs_scene **out)
-{
-    rs_builtin_opts o;
-    char path[4096];
-    memset(&o, 0, sizeof o);
-    o.models_dir = models;
-    if (strncmp(spec, "cornell-mesh:", 13) == 0) {
-        snprintf(path, sizeof path, "%s/%s", rs_builtin_models_dir(models), spec + 13);
-        o.mesh_file = path;
-        return rs_builtin_create_ex("cornell-mesh", &o, out) == RS_OK;
-    }
-    return rs_builtin_create_ex(spec, &o, out) == RS_OK;
-}
-
 int main(int argc, char **argv)
 {
     const char *scenes[MAX_SCENES], *models = NULL, *csv = NULL;
@@ -294,23 +276,14 @@ int main(int argc, char **argv)
     for (s = 0; s < n_scenes; ++s) {
         rs_scene *scene = NULL;
         rs_bvh *bvh = NULL;
-        rs_bvh_build_opts bo;
         rs_geom g;
         measure m[N_SETS];
         double eff_t, eff_s;
-        if (!load_scene(scenes[s], models, &scene)) {
-            printf("%s: skipped: %s\n\n", scenes[s], rs_error_message());
-            rs_error_clear();
-            continue;
-        }
-        g = rs_scene_geom(scene);
-        memset(&bo, 0, sizeof bo);
-        bo.builder.method = RS_BVH_SAH;
-        if (rs_bvh_build(&g, &bo, &bvh) != RS_OK) {
-            fprintf(stderr, "scheduler_bench: %s\n", rs_error_message());
-            rs_scene_destroy(scene);
+        int loaded = br_load_scene("scheduler_bench", scenes[s], models, &scene, &g, &bvh);
+        if (loaded < 0)
             return 1;
-        }
+        if (loaded == 0)
+            continue;
         b.max_diff = 0.0;
         b.mismatch = 0;
         printf("scene %s (%u primitives, SAH BVH)\n", scenes[s], rs_geom_prim_count(&g));
