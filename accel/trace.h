@@ -4,6 +4,8 @@
 #ifndef RS_ACCEL_TRACE_H
 #define RS_ACCEL_TRACE_H
 
+#include <string.h>
+
 #include "accel/bvh.h"
 #include "streams/stream.h"
 
@@ -33,6 +35,31 @@ RS_HD void rs_trace_one(const rs_bvh_view *b, const rs_geom *g, const rs_trace_b
     } else {
         batch->occluded[i] = (uint8_t)rs_bvh_occluded(b, g, r);
     }
+}
+
+/* Staging, for devices that trace a chunk in buffers of their own (the CUDA device's pinned
+ * buffers, the fallback's): rays [begin, begin + n) of the batch into entries [0, n) of `rays`,
+ * and the answers back.  Each returns the bytes it moved. */
+static inline uint64_t rs_trace_stage_in(rs_ray_soa *rays, const rs_trace_batch *batch,
+                                         uint32_t begin, uint32_t n)
+{
+#define RS_STAGE_IN(type, name) memcpy(rays->name, batch->rays.name + begin, n * sizeof(type));
+    RS_RAY_FIELDS(RS_STAGE_IN)
+#undef RS_STAGE_IN
+    return (uint64_t)n * RS_RAY_BYTES;
+}
+
+static inline uint64_t rs_trace_stage_out(const rs_trace_batch *batch, uint32_t begin, uint32_t n,
+                                          const rs_hit_soa *hits, const uint8_t *occluded)
+{
+    if (batch->kind == RS_TRACE_CLOSEST) {
+#define RS_STAGE_OUT(type, name) memcpy(batch->hits.name + begin, hits->name, n * sizeof(type));
+        RS_HIT_FIELDS(RS_STAGE_OUT)
+#undef RS_STAGE_OUT
+        return (uint64_t)n * RS_HIT_BYTES;
+    }
+    memcpy(batch->occluded + begin, occluded, n);
+    return n;
 }
 
 #endif

@@ -162,16 +162,7 @@ static rs_status finish_piece(rs_device *d, stage *s, const rs_trace_batch *batc
         return RS_OK;
     s->pending = 0;
     CUDA_TRY(cudaStreamSynchronize(s->stream));
-    if (batch->kind == RS_TRACE_CLOSEST) {
-#define COPY_OUT(type, name)                                                                       \
-  memcpy(batch->hits.name + s->begin, s->h_hits.name, s->n * sizeof(type));
-        RS_HIT_FIELDS(COPY_OUT)
-#undef COPY_OUT
-        d->stats.bytes_from_device += (uint64_t)s->n * RS_HIT_BYTES;
-    } else {
-        memcpy(batch->occluded + s->begin, s->h_occ, s->n);
-        d->stats.bytes_from_device += s->n;
-    }
+    d->stats.bytes_from_device += rs_trace_stage_out(batch, s->begin, s->n, &s->h_hits, s->h_occ);
     return RS_OK;
 }
 
@@ -181,15 +172,13 @@ static rs_status launch_piece(rs_device *d, cuda_impl *c, stage *s, const rs_tra
                               uint32_t begin, uint32_t n)
 {
     rs_trace_batch db;
-#define PACK(type, name) memcpy(s->h_rays.name, batch->rays.name + begin, n * sizeof(type));
-    RS_RAY_FIELDS(PACK)
-#undef PACK
+    uint64_t bytes = rs_trace_stage_in(&s->h_rays, batch, begin, n);
 #define COPY_IN(type, name)                                                                        \
   CUDA_TRY(cudaMemcpyAsync(s->d_rays.name, s->h_rays.name, n * sizeof(type),                       \
                            cudaMemcpyHostToDevice, s->stream));
     RS_RAY_FIELDS(COPY_IN)
 #undef COPY_IN
-    d->stats.bytes_to_device += (uint64_t)n * RS_RAY_BYTES;
+    d->stats.bytes_to_device += bytes;
     memset(&db, 0, sizeof db);
     db.kind = batch->kind;
     db.count = n;

@@ -75,10 +75,7 @@ static rs_status fallback_trace(rs_device *d, const rs_trace_batch *batch, uint3
         return RS_OK;
     if ((st = ensure_staging(f, n)) != RS_OK)
         return st;
-#define COPY_IN(type, name) memcpy(f->rays.name, batch->rays.name + begin, n * sizeof(type));
-    RS_RAY_FIELDS(COPY_IN)
-#undef COPY_IN
-    d->stats.bytes_to_device += (uint64_t)n * RS_RAY_BYTES;
+    d->stats.bytes_to_device += rs_trace_stage_in(&f->rays, batch, begin, n);
 
     memset(&db, 0, sizeof db);
     db.kind = batch->kind;
@@ -93,15 +90,7 @@ static rs_status fallback_trace(rs_device *d, const rs_trace_batch *batch, uint3
         rs_trace_one(&f->bvh, &f->geom, &db, (uint32_t)i);
     rs_cores_release(f->cores, threads);
 
-    if (batch->kind == RS_TRACE_CLOSEST) {
-#define COPY_OUT(type, name) memcpy(batch->hits.name + begin, f->hits.name, n * sizeof(type));
-        RS_HIT_FIELDS(COPY_OUT)
-#undef COPY_OUT
-        d->stats.bytes_from_device += (uint64_t)n * RS_HIT_BYTES;
-    } else {
-        memcpy(batch->occluded + begin, f->occluded, n);
-        d->stats.bytes_from_device += n;
-    }
+    d->stats.bytes_from_device += rs_trace_stage_out(batch, begin, n, &f->hits, f->occluded);
     return RS_OK;
 }
 
