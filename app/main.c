@@ -176,10 +176,41 @@ static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores,
     return n;
 }
 
+/* Where --integrator megakernel runs: --devices cpu[:N] on the CPU; gpu[:INDEX] on that CUDA
+ * device, or where it cannot be used on its host fallback (one warning); auto on CUDA device 0
+ * where there is one, else the CPU. */
+static void megakernel_device(const rs_cli_options *o, int threads, rs_megakernel_opts *mo)
+{
+    const char *why = "";
+    int n_gpus = rs_gpu_count(&why);
+    memset(mo, 0, sizeof *mo);
+    mo->strategy = o->strategy;
+    mo->bvh_width = o->no_bvh ? 2 : o->bvh_width;
+    mo->device = RS_MK_CPU;
+    if (o->devices_auto) {
+        if (n_gpus > 0)
+            mo->device = RS_MK_CUDA;
+        return;
+    }
+    if (!o->devices[0].is_gpu)
+        return;
+    mo->gpu_index = o->devices[0].index;
+    if (mo->gpu_index < n_gpus) {
+        mo->device = RS_MK_CUDA;
+        return;
+    }
+    fprintf(stderr,
+            "raystream: warning: %s; the megakernel for gpu:%d runs on the CPU fallback (%d "
+            "thread%s)\n",
+            n_gpus == 0 ? why : "no such CUDA device", mo->gpu_index, threads,
+            threads == 1 ? "" : "s");
+    mo->device = RS_MK_GPU_FALLBACK;
+}
+
 /* The --stats table (stderr) and --stats-json file.  Returns 0 if the JSON file could not be
  * written (after printing why). */
 static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *const *devs,
-                        int n_devs, const rs_render_stats *rstats)
+                        int n_devs, const rs_render_stats *rstats, const rs_megakernel_opts *mk)
 {
     rs_device_stats ds[RS_MAX_DEVICES];
     const char *names[RS_MAX_DEVICES];
@@ -192,12 +223,15 @@ static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *con
         threads[i] = devs[i]->threads;
         total += ds[i].rays;
     }
-    if (!sched) { /* the megakernel: the CPU traced everything, one path at a time */
+    if (!sched) { /* the megakernel: one device traced everything, one path at a time */
+        static char name[128];
         memset(&ds[0], 0, sizeof ds[0]);
         ds[0].rays = total = rstats->rays_closest + rstats->rays_shadow;
         ds[0].busy_s = rstats->seconds;
-        names[0] = "cpu (megakernel)";
-        threads[0] = o->threads ? o->threads : rs_cpu_count();
+        ds[0].bytes_to_device = mk->bytes_to_device;
+        snprintf(name, sizeof name, "%s (megakernel)", mk->device_name);
+        names[0] = name;
+        threads[0] = mk->device == RS_MK_CUDA ? 0 : o->threads ? o->threads : rs_cpu_count();
         alive[0] = 1;
         n_devs = 1;
     }
@@ -264,6 +298,7 @@ static int cmd_render(const rs_cli_options *o)
     const char *out, *name;
     rs_render_settings st;
     rs_render_stats stats;
+    rs_megakernel_opts mk;
     rs_render_hooks hooks;
     rs_progress progress;
     rs_sched_config cfg;
@@ -274,6 +309,7 @@ static int cmd_render(const rs_cli_options *o)
     rs_bvh_build_opts bvh_opts;
     char bvh_name[64];
 
+    memset(&mk, 0, sizeof mk);
     /* ---- the scene ---- */
     if (strncmp(o->scene, "builtin:", 8) == 0) {
         rs_builtin_opts bo;
@@ -392,6 +428,7 @@ static int cmd_render(const rs_cli_options *o)
     }
     bvh_ms = 1e3 * (rs_now_s() - t0);
     if (o->megakernel) {
+        megakernel_device(o, threads, &mk);
         if (rs_film_create(st.width, st.height, &film) != RS_OK) {
             code = fail(RS_EXIT_RUNTIME, "starting the render");
             goto done;
@@ -433,10 +470,7 @@ render:
     hooks.user = &progress;
     hooks.cancel = &g_cancel;
     if (o->megakernel) {
-        rs_megakernel_opts mo;
-        mo.strategy = o->strategy;
-        mo.bvh_width = o->no_bvh ? 2 : o->bvh_width;
-        rst = rs_render_megakernel(scene, &geom, bvh, &st, &mo, &hooks, film, &stats);
+        rst = rs_render_megakernel(scene, &geom, bvh, &st, &mk, &hooks, film, &stats);
     } else {
         rst = rs_render(scene, sched, &st, &hooks, film, &stats);
     }
@@ -457,7 +491,7 @@ render:
         code = fail(RS_EXIT_RUNTIME, NULL);
         goto done;
     }
-    if ((o->stats || o->stats_json) && !report_stats(o, sched, devs, n_devs, &stats))
+    if ((o->stats || o->stats_json) && !report_stats(o, sched, devs, n_devs, &stats, &mk))
         code = RS_EXIT_RUNTIME;
 
     if (!o->quiet) {
@@ -488,10 +522,13 @@ render:
                     rays_total ? 100.0 * (double)ds.rays / (double)rays_total : 0.0,
                     alive ? "" : " and then failed", i + 1 == n_devs ? ". " : "");
         }
-        if (o->megakernel)
-            fprintf(stderr, "Integrator: megakernel (%s, %d threads). ",
-                    rs_par_strategy_name(o->strategy), threads);
-        else
+        if (o->megakernel) {
+            if (mk.device == RS_MK_CUDA)
+                fprintf(stderr, "Integrator: megakernel on %s. ", mk.device_name);
+            else
+                fprintf(stderr, "Integrator: megakernel on %s (%s, %d threads). ", mk.device_name,
+                        rs_par_strategy_name(o->strategy), threads);
+        } else
             fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", stats.shade_s, stats.trace_s);
         if (film->nonfinite)
             fprintf(stderr, "%llu non-finite samples were dropped. ",

@@ -136,7 +136,9 @@ void rs_cli_print_help(const char *command)
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
             "  --integrator NAME   stream (default: the wavefront engine on every device) or\n"
-            "                      megakernel (the thesis's per-pixel loop, CPU only; same image)\n"
+            "                      megakernel (the thesis's per-pixel loop, on one device: the\n"
+            "                      cpu, or a gpu (CUDA, one thread per pixel); auto picks the\n"
+            "                      gpu where there is one; same image)\n"
             "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
             "                      tasks (the thesis's three OpenMP strategies)\n"
             "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
@@ -379,14 +381,10 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
         if (rc != RS_EXIT_OK)
             return rc;
     }
-    if (o->megakernel && !o->devices_auto) {
-        int k;
-        for (k = 0; k < o->n_devices; ++k)
-            if (o->devices[k].is_gpu)
-                return usage_error("--integrator megakernel runs on the CPU only%s%s (drop the "
-                                   "gpu from --devices)",
-                                   "", "");
-    }
+    if (o->megakernel && !o->devices_auto && o->n_devices > 1)
+        return usage_error("--integrator megakernel runs on one device%s%s (use --devices cpu or "
+                           "--devices gpu[:INDEX])",
+                           "", "");
     if (o->bvh_on_gpu && o->bvh.method != RS_BVH_LBVH)
         return usage_error("--bvh-device gpu builds the lbvh only (add --bvh lbvh)%s%s", "", "");
     if (o->mesh) {

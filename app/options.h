@@ -52,7 +52,7 @@ typedef struct rs_cli_options {
     int devices_auto;      /* --devices auto (the default): the CPU and every CUDA device */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
-    int megakernel;           /* --integrator megakernel: the per-pixel loop on the CPU */
+    int megakernel;           /* --integrator megakernel: the per-pixel loop on one device */
     rs_par_strategy strategy; /* --cpu-strategy */
     int no_bvh;               /* --no-bvh: every ray tests every primitive */
     int stats;                /* --stats: a per-device table after the render */

@@ -21,7 +21,7 @@ typedef struct br_config {
     int megakernel;
     rs_par_strategy strategy;
     uint32_t bvh_width; /* 2 or 4 */
-    int with_gpu;       /* a CUDA device (else nothing) beside the CPU device: stream only */
+    int with_gpu;       /* stream: a CUDA device beside the CPU device; megakernel: on CUDA */
 } br_config;
 
 /* A benchmark's scene: a built-in one by name, or "cornell-mesh:FILE" (FILE under the models
@@ -89,8 +89,10 @@ static inline int br_render(const char *prog, const rs_scene *scene, const rs_ge
         goto out;
     if (c->megakernel) {
         rs_megakernel_opts mo;
+        memset(&mo, 0, sizeof mo);
         mo.strategy = c->strategy;
         mo.bvh_width = c->bvh_width;
+        mo.device = c->with_gpu ? RS_MK_CUDA : RS_MK_CPU; /* CUDA device 0 */
         rst = rs_render_megakernel(scene, g, bvh, &st, &mo, NULL, film, stats);
     } else {
         memset(&co, 0, sizeof co);

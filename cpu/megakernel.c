@@ -1,140 +1,59 @@
 /* cpu/megakernel.c — see megakernel.h. */
 #include "cpu/megakernel.h"
 
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
 #include "accel/bvh4.h"
 #include "core/alloc.h"
+#include "gpu/gpu_device.h"
 
 typedef struct mk_ctx {
-    rs_integrator it; /* threads = 1: every stage runs inline on the calling thread */
-    const rs_geom *g;
-    rs_bvh_view bvh;
-    const rs_bvh4 *bvh4; /* NULL: the binary kernel */
+    rs_integrator it; /* threads = 1: unused, the path code runs inline */
+    rs_path_tracer tracer;
     uint32_t spp, width, height;
     int by_columns;
     const rs_render_hooks *hooks;
     rs_film *film;
     _Atomic uint64_t rays_closest, rays_shadow, paths_done;
     _Atomic uint32_t max_bounce;
-    _Atomic int failed;
 } mk_ctx;
-
-/* One thread's streams of one path. */
-typedef struct scratch {
-    rs_ray_soa ext[2], shadow;
-    rs_hit_soa hits;
-    rs_paths paths;
-    uint8_t next_valid, shadow_valid, occluded;
-} scratch;
-
-static void scratch_free(scratch *w)
-{
-    rs_ray_soa_free(&w->ext[0]);
-    rs_ray_soa_free(&w->ext[1]);
-    rs_ray_soa_free(&w->shadow);
-    rs_hit_soa_free(&w->hits);
-    rs_paths_free(&w->paths);
-}
-
-static int scratch_init(scratch *w)
-{
-    memset(w, 0, sizeof *w);
-    if (rs_ray_soa_init(&w->ext[0], 1) != RS_OK || rs_ray_soa_init(&w->ext[1], 1) != RS_OK ||
-        rs_ray_soa_init(&w->shadow, 1) != RS_OK || rs_hit_soa_init(&w->hits, 1) != RS_OK ||
-        rs_paths_init(&w->paths, 1) != RS_OK) {
-        scratch_free(w);
-        return 0;
-    }
-    return 1;
-}
-
-static void trace(const mk_ctx *c, const rs_trace_batch *b)
-{
-    if (c->bvh4)
-        rs_bvh4_trace_one(c->bvh4, c->g, b, 0);
-    else
-        rs_trace_one(&c->bvh, c->g, b, 0);
-}
-
-/* Path g (sample g / npix of pixel g % npix) from the camera to its end; returns its radiance. */
-static rs_vec3 trace_path(mk_ctx *c, scratch *w, uint64_t g, uint64_t *n_closest,
-                          uint64_t *n_shadow, uint32_t *max_bounce)
-{
-    rs_trace_batch b;
-    uint32_t bounce, cur = 0;
-    rs_integrator_raygen(&c->it, g, 1, &w->paths, &w->ext[0]);
-    for (bounce = 0;; ++bounce) {
-        memset(&b, 0, sizeof b);
-        b.kind = RS_TRACE_CLOSEST;
-        b.count = 1;
-        b.rays = w->ext[cur];
-        b.hits = w->hits;
-        trace(c, &b);
-        ++*n_closest;
-        if (bounce > *max_bounce)
-            *max_bounce = bounce;
-        rs_integrator_shade(&c->it, g, bounce, &w->ext[cur], &w->hits, 1, &w->paths,
-                            &w->ext[cur ^ 1], &w->next_valid, &w->shadow, &w->shadow_valid);
-        if (w->shadow_valid) {
-            memset(&b, 0, sizeof b);
-            b.kind = RS_TRACE_OCCLUDED;
-            b.count = 1;
-            b.rays = w->shadow;
-            b.occluded = &w->occluded;
-            trace(c, &b);
-            ++*n_shadow;
-            rs_integrator_resolve_shadows(&c->it, &w->shadow, &w->occluded, 1, &w->paths);
-        }
-        if (!w->next_valid)
-            break;
-        cur ^= 1;
-    }
-    return w->paths.radiance[0];
-}
 
 /* Rows (or columns) [lo, hi) of the image. */
 static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
 {
     mk_ctx *c = (mk_ctx *)ctx;
-    uint64_t npix = (uint64_t)c->width * c->height, n_closest = 0, n_shadow = 0, paths = 0;
-    uint32_t line, k, s, max_bounce = 0, seen;
-    scratch w;
-    if (!scratch_init(&w)) {
-        atomic_store(&c->failed, 1);
-        return;
-    }
+    uint64_t npix = (uint64_t)c->width * c->height;
+    uint32_t line, k, s, seen;
+    rs_path_counts n = {0, 0, 0};
     for (line = lo; line < hi; ++line) {
-        uint32_t n = c->by_columns ? c->height : c->width;
+        uint32_t len = c->by_columns ? c->height : c->width;
         if (c->hooks && c->hooks->cancel && atomic_load(c->hooks->cancel))
             break;
-        for (k = 0; k < n; ++k) {
+        for (k = 0; k < len; ++k) {
             uint32_t x = c->by_columns ? line : k, y = c->by_columns ? k : line;
             uint32_t pixel = y * c->width + x;
             for (s = 0; s < c->spp; ++s) {
-                rs_vec3 L = trace_path(c, &w, (uint64_t)s * npix + pixel, &n_closest, &n_shadow,
-                                       &max_bounce);
+                rs_vec3 L = rs_path_radiance(&c->it, &c->tracer, (uint64_t)s * npix + pixel, &n);
                 rs_film_add(c->film, pixel, L);
             }
         }
-        paths += (uint64_t)n * c->spp;
         if (c->hooks && c->hooks->progress) {
             uint64_t done =
-                atomic_fetch_add(&c->paths_done, (uint64_t)n * c->spp) + (uint64_t)n * c->spp;
+                atomic_fetch_add(&c->paths_done, (uint64_t)len * c->spp) + (uint64_t)len * c->spp;
 #pragma omp critical(rs_megakernel_progress)
             c->hooks->progress(c->hooks->user, done, npix * c->spp);
         } else {
-            atomic_fetch_add(&c->paths_done, (uint64_t)n * c->spp);
+            atomic_fetch_add(&c->paths_done, (uint64_t)len * c->spp);
         }
     }
-    (void)paths;
-    atomic_fetch_add(&c->rays_closest, n_closest);
-    atomic_fetch_add(&c->rays_shadow, n_shadow);
+    atomic_fetch_add(&c->rays_closest, n.closest);
+    atomic_fetch_add(&c->rays_shadow, n.shadow);
     seen = atomic_load(&c->max_bounce);
-    while (max_bounce > seen && !atomic_compare_exchange_weak(&c->max_bounce, &seen, max_bounce)) {
+    while (n.max_bounce > seen &&
+           !atomic_compare_exchange_weak(&c->max_bounce, &seen, n.max_bounce)) {
     }
-    scratch_free(&w);
 }
 
 static double now_s(void)
@@ -144,16 +63,93 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* The GPU megakernel's pass on the host (its fallback): pixels [lo, hi) of one sample. */
+typedef struct pass_ctx {
+    mk_ctx *c;
+    uint32_t sample;
+    rs_vec3 *radiance;
+} pass_ctx;
+
+static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
+{
+    pass_ctx *p = (pass_ctx *)ctx;
+    rs_path_counts n = {0, 0, 0};
+    uint64_t npix = p->c->it.npix;
+    uint32_t pixel, seen;
+    for (pixel = lo; pixel < hi; ++pixel)
+        p->radiance[pixel] =
+            rs_path_radiance(&p->c->it, &p->c->tracer, (uint64_t)p->sample * npix + pixel, &n);
+    atomic_fetch_add(&p->c->rays_closest, n.closest);
+    atomic_fetch_add(&p->c->rays_shadow, n.shadow);
+    seen = atomic_load(&p->c->max_bounce);
+    while (n.max_bounce > seen &&
+           !atomic_compare_exchange_weak(&p->c->max_bounce, &seen, n.max_bounce)) {
+    }
+}
+
+/* The GPU megakernel: one pass per sample over every pixel, on CUDA (gpu != NULL) or on host
+ * threads; each pass's radiance added to the film pixel by pixel, so every pixel gets its
+ * samples in sample order, as in render_lines. */
+static rs_status render_passes(mk_ctx *c, rs_gpu_megakernel *gpu, rs_par_strategy strategy,
+                               int threads)
+{
+    uint32_t npix = c->it.npix, s, i;
+    rs_vec3 *radiance = (rs_vec3 *)rs_alloc(npix, sizeof *radiance);
+    rs_status st = RS_OK;
+    if (!radiance)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for a %u-pixel pass", npix);
+    for (s = 0; s < c->spp && st == RS_OK; ++s) {
+        if (c->hooks && c->hooks->cancel && atomic_load(c->hooks->cancel))
+            break;
+        if (gpu) {
+            rs_path_counts n = {0, 0, 0};
+            if ((st = rs_gpu_megakernel_pass(gpu, s, radiance, &n)) != RS_OK)
+                break;
+            atomic_fetch_add(&c->rays_closest, n.closest);
+            atomic_fetch_add(&c->rays_shadow, n.shadow);
+            if (n.max_bounce > atomic_load(&c->max_bounce))
+                atomic_store(&c->max_bounce, n.max_bounce);
+        } else {
+            pass_ctx p;
+            p.c = c;
+            p.sample = s;
+            p.radiance = radiance;
+            rs_parallel_range(strategy, threads, 0, npix, 1024, pass_pixels, &p);
+        }
+        for (i = 0; i < npix; ++i)
+            rs_film_add(c->film, i, radiance[i]);
+        atomic_fetch_add(&c->paths_done, npix);
+        if (c->hooks && c->hooks->progress)
+            c->hooks->progress(c->hooks->user, atomic_load(&c->paths_done),
+                               (uint64_t)npix * c->spp);
+    }
+    rs_free(radiance);
+    return st;
+}
+
+const char *rs_megakernel_device_name(rs_megakernel_device d)
+{
+    switch (d) {
+    case RS_MK_CPU: return "cpu";
+    case RS_MK_CUDA: return "cuda";
+    case RS_MK_GPU_FALLBACK: return "gpu-fallback";
+    }
+    return "?";
+}
+
 rs_status rs_render_megakernel(const rs_scene *scene, const rs_geom *g, const rs_bvh *bvh,
-                               const rs_render_settings *st, const rs_megakernel_opts *opts,
+                               const rs_render_settings *st, rs_megakernel_opts *opts,
                                const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats)
 {
     mk_ctx *c;
     rs_bvh4 *bvh4 = NULL;
+    rs_gpu_megakernel *gpu = NULL;
     rs_status status = RS_OK;
     double t0 = now_s();
     uint64_t npix = (uint64_t)st->width * st->height;
     int threads = st->threads < 1 ? 1 : st->threads;
+    rs_megakernel_device where = opts ? opts->device : RS_MK_CPU;
+    rs_par_strategy strategy = opts ? opts->strategy : RS_PAR_FOR_DYNAMIC;
 
     memset(stats, 0, sizeof *stats);
     if (st->width == 0 || st->height == 0 || st->spp == 0 || st->max_depth == 0)
@@ -163,8 +159,9 @@ rs_status rs_render_megakernel(const rs_scene *scene, const rs_geom *g, const rs
                             film->height, st->width, st->height);
     if (npix > UINT32_MAX)
         return rs_error_set(RS_ERR_ARG, "image too large: %ux%u", st->width, st->height);
-    if ((!opts || opts->bvh_width != 2) && g->aabb_algo == RS_ISECT_AABB_SLAB &&
-        (status = rs_bvh4_build(bvh, g, &bvh4)) != RS_OK)
+    /* the CPU's own loop may take the 4-wide BVH; the GPU's (and its fallback) the binary one */
+    if (where == RS_MK_CPU && (!opts || opts->bvh_width != 2) &&
+        g->aabb_algo == RS_ISECT_AABB_SLAB && (status = rs_bvh4_build(bvh, g, &bvh4)) != RS_OK)
         return status;
     c = (mk_ctx *)rs_calloc(1, sizeof *c);
     if (!c) {
@@ -183,28 +180,44 @@ rs_status rs_render_megakernel(const rs_scene *scene, const rs_geom *g, const rs
     c->it.rr_depth = st->rr_depth ? st->rr_depth : 3;
     c->it.sampling = st->sampling;
     c->it.threads = 1;
-    c->g = g;
-    c->bvh = rs_bvh_view_of(bvh);
-    c->bvh4 = bvh4;
+    c->tracer.geom = *g;
+    c->tracer.bvh = rs_bvh_view_of(bvh);
+    c->tracer.bvh4 = bvh4;
     c->spp = st->spp;
     c->width = st->width;
     c->height = st->height;
-    c->by_columns = opts && opts->strategy == RS_PAR_COLUMNS;
+    c->by_columns = strategy == RS_PAR_COLUMNS;
     c->hooks = hooks;
     c->film = film;
     stats->paths_total = npix * st->spp;
+    if (opts) {
+        snprintf(opts->device_name, sizeof opts->device_name, "%s", "cpu");
+        opts->bytes_to_device = 0;
+    }
 
-    rs_parallel_range(opts ? opts->strategy : RS_PAR_FOR_DYNAMIC, threads, 0,
-                      c->by_columns ? st->width : st->height, 1, render_lines, c);
+    if (where == RS_MK_CUDA) {
+        status = rs_gpu_megakernel_create(opts->gpu_index, scene, g, bvh, &c->it, &gpu);
+        if (status == RS_OK) {
+            snprintf(opts->device_name, sizeof opts->device_name, "%s",
+                     rs_gpu_megakernel_name(gpu));
+            opts->bytes_to_device = rs_gpu_megakernel_bytes(gpu);
+            status = render_passes(c, gpu, strategy, threads);
+        }
+    } else if (where == RS_MK_GPU_FALLBACK) {
+        snprintf(opts->device_name, sizeof opts->device_name, "gpu-fallback:%d", opts->gpu_index);
+        status = render_passes(c, NULL, strategy, threads);
+    } else {
+        rs_parallel_range(strategy, threads, 0, c->by_columns ? st->width : st->height, 1,
+                          render_lines, c);
+    }
 
     stats->paths_done = atomic_load(&c->paths_done);
     stats->rays_closest = atomic_load(&c->rays_closest);
     stats->rays_shadow = atomic_load(&c->rays_shadow);
     stats->max_bounce = atomic_load(&c->max_bounce);
-    if (atomic_load(&c->failed))
-        status = rs_error_set(RS_ERR_NOMEM, "out of memory for the megakernel's paths");
-    else if (hooks && hooks->cancel && atomic_load(hooks->cancel))
+    if (status == RS_OK && hooks && hooks->cancel && atomic_load(hooks->cancel))
         status = rs_error_set(RS_ERR_CANCELLED, "render interrupted");
+    rs_gpu_megakernel_destroy(gpu);
     rs_free(c);
     rs_bvh4_destroy(bvh4);
     stats->seconds = now_s() - t0;

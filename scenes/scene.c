@@ -402,44 +402,7 @@ rs_status rs_scene_finalize(rs_scene *s)
     return RS_OK;
 }
 
-rs_geom rs_scene_geom(const rs_scene *s)
-{
-    rs_geom g;
-    g.spheres = s->spheres;
-    g.sphere_motion = s->sphere_motion;
-    g.time0 = fminf(s->camera.shutter_open, s->camera.shutter_close);
-    g.time1 = fmaxf(s->camera.shutter_open, s->camera.shutter_close);
-    g.sphere_algo = 0; /* the default intersection tests; the CLI may choose others */
-    g.tri_algo = 0;
-    g.aabb_algo = 0;
-    g.quads = s->quads;
-    g.tris = s->tris;
-    g.n_spheres = s->n_spheres;
-    g.n_quads = s->n_quads;
-    g.n_tris = s->n_tris;
-    return g;
-}
-
 uint32_t rs_scene_prim_count(const rs_scene *s) { return s->n_spheres + s->n_quads + s->n_tris; }
-
-const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim)
-{
-    if (prim < s->n_spheres)
-        return &s->materials[s->sphere_mat[prim]];
-    prim -= s->n_spheres;
-    if (prim < s->n_quads)
-        return &s->materials[s->quad_mat[prim]];
-    return &s->materials[s->tri_mat[prim - s->n_quads]];
-}
-
-rs_vec3 rs_scene_background(const rs_scene *s, rs_vec3 d)
-{
-    if (s->background_sky) {
-        float a = 0.5f * (d.y / rs_v3_length(d) + 1.0f);
-        return rs_v3_add(rs_v3_scale(s->background, 1.0f - a), rs_v3_scale(s->background_top, a));
-    }
-    return s->background;
-}
 
 static rs_material mat_base(uint32_t type, rs_vec3 albedo)
 {

@@ -8,6 +8,8 @@
 #ifndef RS_SCENES_SCENE_H
 #define RS_SCENES_SCENE_H
 
+#include <stddef.h>
+
 #include "core/geom.h"
 #include "core/status.h"
 
@@ -124,6 +126,47 @@ typedef struct rs_scene {
     uint32_t width, height; /* the scene's preferred image size */
 } rs_scene;
 
+/* The scene's geometry as traversal sees it, with the default intersection tests.  These three
+ * are RS_HD: shading calls them on the host and in the CUDA megakernel alike. */
+RS_HD rs_geom rs_scene_geom(const rs_scene *s)
+{
+    rs_geom g;
+    g.spheres = s->spheres;
+    g.sphere_motion = s->sphere_motion;
+    g.time0 = fminf(s->camera.shutter_open, s->camera.shutter_close);
+    g.time1 = fmaxf(s->camera.shutter_open, s->camera.shutter_close);
+    g.sphere_algo = 0; /* the default intersection tests; the CLI may choose others */
+    g.tri_algo = 0;
+    g.aabb_algo = 0;
+    g.quads = s->quads;
+    g.tris = s->tris;
+    g.n_spheres = s->n_spheres;
+    g.n_quads = s->n_quads;
+    g.n_tris = s->n_tris;
+    return g;
+}
+
+/* The material of global primitive `prim`. */
+RS_HD const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim)
+{
+    if (prim < s->n_spheres)
+        return &s->materials[s->sphere_mat[prim]];
+    prim -= s->n_spheres;
+    if (prim < s->n_quads)
+        return &s->materials[s->quad_mat[prim]];
+    return &s->materials[s->tri_mat[prim - s->n_quads]];
+}
+
+/* Radiance arriving along direction d (unit) from outside the scene. */
+RS_HD rs_vec3 rs_scene_background(const rs_scene *s, rs_vec3 d)
+{
+    if (s->background_sky) {
+        float a = 0.5f * (d.y / rs_v3_length(d) + 1.0f);
+        return rs_v3_add(rs_v3_scale(s->background, 1.0f - a), rs_v3_scale(s->background_top, a));
+    }
+    return s->background;
+}
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -161,12 +204,29 @@ rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg,
 
 rs_status rs_scene_finalize(rs_scene *s);
 
-rs_geom rs_scene_geom(const rs_scene *s);
+/* A copy of a finalized scene's arrays in memory that `ops` allocates and fills: the host's, or
+ * a CUDA device's for the megakernel (gpu/cuda_megakernel.cu), whose shading code then reads
+ * `scene` exactly as the host reads the original.  `scene` is a host struct holding the copies'
+ * pointers (copy it to the device as it is); every block made is listed, so the mirror can be
+ * released without reading device memory. */
+typedef struct rs_mirror_ops {
+    /* Allocates `bytes` at *dst and copies `src` there; RS_OK, or an error already set. */
+    rs_status (*copy)(void *user, void **dst, const void *src, size_t bytes);
+    void (*release)(void *user, void *p);
+    void *user;
+} rs_mirror_ops;
+
+typedef struct rs_scene_mirror {
+    rs_scene scene;
+    void **blocks; /* host array of every block ops->copy made */
+    uint32_t n_blocks, cap_blocks;
+    uint64_t bytes; /* copied in all */
+} rs_scene_mirror;
+
+rs_status rs_scene_mirror_create(const rs_scene *s, const rs_mirror_ops *ops, rs_scene_mirror *out);
+void rs_scene_mirror_release(rs_scene_mirror *m, const rs_mirror_ops *ops);
+
 uint32_t rs_scene_prim_count(const rs_scene *s);
-/* The material of global primitive `prim`. */
-const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim);
-/* Radiance arriving along direction d (unit) from outside the scene. */
-rs_vec3 rs_scene_background(const rs_scene *s, rs_vec3 d);
 
 /* Material constructors with the RTIOW / thesis defaults for the unused fields. */
 rs_material rs_mat_lambertian(rs_vec3 albedo);

@@ -5,29 +5,25 @@
  * state only from that path's own slot, so results do not depend on thread count or order.
  *
  * A path is named by its index in the wave; its global index g = wave_start + path gives the
- * pixel (g mod npix) and the sample (g div npix), and with the bounce, the random numbers. */
+ * pixel (g mod npix) and the sample (g div npix), and with the bounce, the random numbers.
+ * Each stage is a loop around the RS_HD per-path code of shading/path.h. */
 #ifndef RS_SHADING_INTEGRATOR_H
 #define RS_SHADING_INTEGRATOR_H
 
-#include "core/parallel.h"
-#include "scenes/scene.h"
-#include "shading/camera.h"
+#include "shading/path.h"
 #include "streams/stream.h"
 
-typedef enum rs_sampling {
-    RS_SAMPLING_MIS = 0,     /* light sampling + BSDF sampling, power heuristic (Veach 1998) */
-    RS_SAMPLING_MIXTURE = 1, /* one direction from 1/2 light pdf + 1/2 BSDF pdf (the thesis's
-                                radiance_mixture, Shirley's "The Rest of Your Life") */
-    RS_SAMPLING_BSDF = 2,    /* BSDF importance sampling only */
-    RS_SAMPLING_UNIFORM = 3  /* uniform hemisphere, no light sampling ("no importance sampling") */
-} rs_sampling;
+#ifdef __cplusplus
+extern "C" {
+#  ifdef __cplusplus
+}
+#  endif
+
+#endif
 
 const char *rs_sampling_name(rs_sampling s);
 /* Parses "mis", "mixture", "bsdf" or "uniform"; returns 0 if unknown. */
 int rs_sampling_parse(const char *text, rs_sampling *out);
-
-/* Path flags. */
-#define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
 
 /* Per-path state of one wave (SoA, indexed by path). */
 typedef struct rs_paths {
@@ -42,18 +38,6 @@ typedef struct rs_paths {
 
 rs_status rs_paths_init(rs_paths *p, uint32_t capacity);
 void rs_paths_free(rs_paths *p);
-
-typedef struct rs_integrator {
-    const rs_scene *scene;
-    rs_camera camera;
-    uint64_t seed;
-    uint32_t width, height, npix;
-    uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
-    uint32_t rr_depth;  /* Russian roulette from this segment on */
-    rs_sampling sampling;
-    int threads;              /* OpenMP threads for the stages */
-    rs_par_strategy strategy; /* how the shade stage is split among them */
-} rs_integrator;
 
 /* Fills `out` with the camera rays of paths [0, count) and resets their state. */
 void rs_integrator_raygen(const rs_integrator *it, uint64_t wave_start, uint32_t count,
@@ -75,5 +59,9 @@ void rs_integrator_resolve_shadows(const rs_integrator *it, const rs_ray_soa *sh
  * Deterministic for any thread count (a blocked two-pass scan). */
 uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t count,
                            rs_ray_soa *dst, int threads);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

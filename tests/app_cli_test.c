@@ -513,7 +513,7 @@ static void test_usage_errors(void **state)
          {"--cpu-strategy", "guided"}},
         {{"render", "-o", "out.png", "--spp", "1", "--integrator", "megakernel", "--devices",
           "cpu,gpu", NULL},
-         {"megakernel", "CPU only"}},
+         {"megakernel", "one device"}},
         {{"render", "-o", "out.png", "--spp", "1", "--chunk-size", "big", NULL},
          {"--chunk-size", "big"}},
         {{"render", "-o", "out.png", "--spp", "1", "--bvh-device", "tpu", NULL},
@@ -883,7 +883,8 @@ static void test_threads_and_chunks_change_nothing(void **state)
 }
 /* Where no CUDA device can be used (CI: the toolkit but no driver), `--devices cpu:1,gpu` still
  * renders: the gpu becomes the CPU fallback device after one warning line, and the image is the
- * CPU-only image bit for bit (the fallback runs the very same traversal). */
+ * CPU-only image bit for bit (the fallback runs the very same traversal).  The same for
+ * `--integrator megakernel --devices gpu`: the CUDA megakernel's passes run on host threads. */
 static void test_gpu_fallback(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -893,9 +894,12 @@ static void test_gpu_fallback(void **state)
     static const char *const mix_args[] = {
         "render",    "--width",      "24",  "--spp", "4",         "-q", "--devices",
         "cpu:1,gpu", "--chunk-size", "100", "-o",    "mixed.exr", NULL};
+    static const char *const mk_args[] = {
+        "render",     "--width",   "24",  "--spp", "4",      "-q", "--integrator",
+        "megakernel", "--devices", "gpu", "-o",    "mk.exr", NULL};
     const char *why = "";
-    proc p, q;
-    image a, b;
+    proc p, q, r;
+    image a, b, c;
     if (rs_gpu_count(&why) > 0) {
         print_message("a CUDA device is present: the fallback path is not exercised here\n");
         skip();
@@ -906,16 +910,30 @@ static void test_gpu_fallback(void **state)
     EXPECT(&q, exited_with(&q, 0), "the cpu+gpu render should fall back and succeed");
     EXPECT(&q, one_line(&q.err) && contains_ci(q.err.data, "fallback"),
            "expected one warning line naming the fallback");
+    /* the GPU megakernel's fallback: its passes on host threads, the wavefront's image */
+    run(&r, f->dir, DEFAULT_TIMEOUT_S, mk_args);
+    EXPECT(&r, exited_with(&r, 0), "the gpu megakernel should fall back and succeed");
+    EXPECT(&r,
+           one_line(&r.err) && contains_ci(r.err.data, "megakernel") &&
+               contains_ci(r.err.data, "fallback"),
+           "expected one warning line naming the megakernel's fallback");
     a = read_image(&p, f, "cpu.exr");
     b = read_image(&q, f, "mixed.exr");
+    c = read_image(&r, f, "mk.exr");
     EXPECT(&q,
            a.w == b.w && a.h == b.h &&
                memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
            "the fallback changed the image");
+    EXPECT(&r,
+           a.w == c.w && a.h == c.h &&
+               memcmp(a.rgb, c.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
+           "the megakernel's fallback changed the image");
     rs_free(a.rgb);
     rs_free(b.rgb);
+    rs_free(c.rgb);
     proc_free(&p);
     proc_free(&q);
+    proc_free(&r);
 }
 /* Scene files and meshes from the command line: a good JSON scene and a mesh render; a bad
  * JSON scene and an unreadable mesh give one line naming the file and exit 1; a mesh with bad

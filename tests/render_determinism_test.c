@@ -134,18 +134,21 @@ static void test_failure_with_waves_in_flight(void **state)
 }
 
 /* The thesis's three OpenMP strategies, in the CPU device and the shading, and the per-pixel
- * megakernel under each (which calls the same stages on one path at a time and adds each pixel's
- * samples in order); and no BVH at all (one leaf: brute force) under both integrators. */
+ * megakernel under each (rs_path_radiance: the stages' own per-path code, each pixel's samples
+ * added in order), on the CPU and as the GPU megakernel's passes on host threads (its fallback:
+ * one sample of every pixel per pass, the binary BVH); and no BVH at all (one leaf: brute force)
+ * under both integrators. */
 static void test_strategies_and_megakernel(void **state)
 {
     int s, mk;
     (void)state;
     for (s = 0; s < 3; ++s)
-        for (mk = 0; mk < 2; ++mk) {
+        for (mk = 0; mk < 3; ++mk) {
             rt_args a = rt_defaults("cornell", SIZE, SPP);
             a.threads = 2;
             a.strategy = (rs_par_strategy)s;
-            a.megakernel = mk;
+            a.megakernel = mk > 0;
+            a.fallback_only = mk == 2;
             a.chunk_size = 2000; /* chunks big enough for a team: the strategy splits them */
             expect_identical(&a);
         }

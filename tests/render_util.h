@@ -109,8 +109,12 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     st.strategy = a->strategy;
     if (a->megakernel) {
         rs_megakernel_opts mo;
+        memset(&mo, 0, sizeof mo);
         mo.strategy = a->strategy;
         mo.bvh_width = co.bvh_width;
+        /* fallback_only / real_gpu: the GPU megakernel's passes (on host threads / on CUDA) */
+        if (a->fallback_only)
+            mo.device = a->real_gpu ? RS_MK_CUDA : RS_MK_GPU_FALLBACK;
         if (rs_render_megakernel(scene, &g, bvh, &st, &mo, NULL, film, &stats) != RS_OK)
             goto out;
     } else if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK) {

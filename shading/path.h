@@ -1,0 +1,412 @@
+/* shading/path.h — one path of the path tracer, written once for the host and the CUDA device
+ * (every function RS_HD): its camera ray, the shading of each of its vertices, and the whole
+ * path traced to its end for the megakernel integrators.
+ *
+ * The wavefront stages (shading/integrator.c) call rs_path_begin and rs_path_shade on each entry
+ * of a stream; the CPU megakernel (cpu/megakernel.c), the CUDA megakernel (gpu/cuda_megakernel.cu)
+ * and its host fallback call rs_path_radiance, which calls the same two with a traversal between.
+ * A path is named by its global index g: pixel g mod npix, sample g div npix; with the bounce
+ * that picks its random numbers, so every integrator makes the same paths.
+ *
+ * Estimators, per sampling mode, at a non-delta vertex with BSDF f and its sampling pdf p_b:
+ *   mis      next-event: light sample with pdf p_l, weight w_l = p_l^2 / (p_l^2 + p_b^2),
+ *            adds beta f cos Le w_l / p_l if the shadow ray is free; then a BSDF sample,
+ *            beta *= f cos / p_b; an emitter that ray hits adds beta Le w_b with
+ *            w_b = p_b^2 / (p_b^2 + p_l^2)  (Veach 1998, power heuristic).
+ *   mixture  one direction from p = 1/2 p_light + 1/2 p_b; beta *= f cos / p; emitters add
+ *            beta Le in full (the thesis's radiance_mixture).
+ *   bsdf     BSDF sample; emitters add beta Le.
+ *   uniform  uniform hemisphere, p = 1 / 2pi; emitters add beta Le.
+ * Delta materials (mirror, glass) are always sampled by their BSDF, and the emitter their ray
+ * hits counts in full.  All four estimate the same integral (tested). */
+#ifndef RS_SHADING_PATH_H
+#define RS_SHADING_PATH_H
+
+#include <float.h>
+
+#include "accel/bvh.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "shading/bsdf.h"
+#include "shading/camera.h"
+#include "shading/dims.h"
+#include "shading/lights.h"
+#include "shading/texture.h"
+#if !defined(__CUDACC__)
+#  include "accel/bvh4.h" /* SSE: the host's megakernel may trace with the 4-wide BVH */
+#endif
+
+typedef enum rs_sampling {
+    RS_SAMPLING_MIS = 0,     /* light sampling + BSDF sampling, power heuristic (Veach 1998) */
+    RS_SAMPLING_MIXTURE = 1, /* one direction from 1/2 light pdf + 1/2 BSDF pdf (the thesis's
+                                radiance_mixture, Shirley's "The Rest of Your Life") */
+    RS_SAMPLING_BSDF = 2,    /* BSDF importance sampling only */
+    RS_SAMPLING_UNIFORM = 3  /* uniform hemisphere, no light sampling ("no importance sampling") */
+} rs_sampling;
+
+/* Path flags. */
+#define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
+
+/* What rs_path_shade made. */
+#define RS_SHADE_NEXT   1u /* the path goes on with *next */
+#define RS_SHADE_SHADOW 2u /* a shadow ray *shadow carries ps->pending */
+
+/* The render's constants, shared by every path (plain data: the CUDA megakernel takes a copy
+ * whose `scene` points to the device's mirror of the scene). */
+typedef struct rs_integrator {
+    const rs_scene *scene;
+    rs_camera camera;
+    uint64_t seed;
+    uint32_t width, height, npix;
+    uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
+    uint32_t rr_depth;  /* Russian roulette from this segment on */
+    rs_sampling sampling;
+    int threads;              /* OpenMP threads for the wavefront stages (host only) */
+    rs_par_strategy strategy; /* how the shade stage is split among them (host only) */
+} rs_integrator;
+
+/* One path's state between its vertices. */
+typedef struct rs_path_state {
+    rs_vec3 throughput; /* product of f cos / pdf so far */
+    rs_vec3 radiance;   /* light gathered so far */
+    rs_vec3 pending;    /* next-event contribution waiting for its shadow ray */
+    float bsdf_pdf;     /* solid-angle pdf of the BSDF sample that made the current ray */
+    float time;         /* the path's time in the shutter interval (its rays share it) */
+    uint32_t flags;     /* RS_PATH_* */
+} rs_path_state;
+
+/* The camera ray of path g, and its state reset. */
+RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
+{
+    const rs_camera_desc *cd = &it->scene->camera;
+    uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
+    rs_rng_f4 r = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_CAMERA);
+    rs_ray ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, r.v[0], r.v[1],
+                               r.v[2], r.v[3]);
+    float time = cd->shutter_open;
+    if (cd->shutter_close != cd->shutter_open) {
+        rs_rng_f4 rt = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_TIME);
+        time += rt.v[0] * (cd->shutter_close - cd->shutter_open);
+    }
+    ray.time = time;
+    ps->throughput = rs_v3_splat(1.0f);
+    ps->radiance = rs_v3_splat(0.0f);
+    ps->pending = rs_v3_splat(0.0f);
+    ps->bsdf_pdf = 0.0f;
+    ps->time = time;
+    ps->flags = RS_PATH_SPECULAR;
+    return ray;
+}
+
+/* Moves a ray origin off the surface along n (the side the new ray leaves from); the offset
+ * scales with the coordinates so that it stays far above float rounding (~1e-7 relative) at any
+ * scene scale. */
+RS_HD rs_vec3 rs_offset_origin(rs_vec3 x, rs_vec3 n, float prim_scale)
+{
+    float scale = fmaxf(fmaxf(fabsf(x.x), fabsf(x.y)), fmaxf(fabsf(x.z), 1e-2f));
+    return rs_v3_madd(x, n, fmaxf(1e-4f * scale, 1e-6f * prim_scale));
+}
+
+/* The size of the numbers a primitive's intersection test works with, which bounds the error of
+ * its hit points: for a sphere, its centre's coordinates and its radius (the ground sphere of
+ * rtiow-final, radius 1000 centred 1000 below the origin, puts hit points near the origin with
+ * errors of ~1e-4: offset by the hit point's own size only, a bounce ray there could find the
+ * ground again at t ~ 1e-5, a hit outside the ground's bounding box that a BVH culls and brute
+ * force does not).  The origin moves by 1e-6 of it (~17 float ulps; 2e-3 for that ground).
+ * Triangles and quads: their hit points' own size, 0 here. */
+RS_HD float rs_prim_scale(const rs_scene *sc, uint32_t prim)
+{
+    const rs_sphere *s;
+    if (prim >= sc->n_spheres)
+        return 0.0f;
+    s = &sc->spheres[prim];
+    return fmaxf(fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
+}
+
+RS_HD float rs_power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+/* Surface coordinates at a hit: spheres by longitude/latitude (RTIOW), quads by their planar
+ * coordinates, triangles by interpolating their UVs (or the barycentrics). */
+RS_HD void rs_surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, rs_vec3 n_out,
+                         float *u, float *v)
+{
+    if (prim < sc->n_spheres) {
+        float theta = acosf(fminf(1.0f, fmaxf(-1.0f, -n_out.y)));
+        float phi = atan2f(-n_out.z, n_out.x) + RS_PI;
+        *u = phi * (0.5f * RS_INV_PI);
+        *v = theta * RS_INV_PI;
+        return;
+    }
+    prim -= sc->n_spheres;
+    if (prim < sc->n_quads || !sc->tri_uv) {
+        *u = hu;
+        *v = hv;
+        return;
+    }
+    {
+        const float *uv = &sc->tri_uv[6 * (size_t)(prim - sc->n_quads)];
+        float b0 = 1.0f - hu - hv;
+        *u = b0 * uv[0] + hu * uv[2] + hv * uv[4];
+        *v = b0 * uv[1] + hu * uv[3] + hv * uv[5];
+    }
+}
+
+RS_HD rs_vec3 rs_surface_albedo(const rs_scene *sc, const rs_material *m, uint32_t prim, float hu,
+                                float hv, rs_vec3 x, rs_vec3 ng)
+{
+    float u, v;
+    if (m->albedo_tex == RS_NO_TEXTURE)
+        return m->albedo;
+    rs_surface_uv(sc, prim, hu, hv, ng, &u, &v);
+    return rs_texture_eval(&sc->textures[m->albedo_tex], sc->images, u, v, x);
+}
+
+/* The shading normal at a hit: the interpolated vertex normal of a triangle that has them,
+ * turned to the side of n_geo (the geometric normal on the incoming side); n_geo otherwise, or
+ * where the vertex normal would face away from wo. */
+RS_HD rs_vec3 rs_shading_normal(const rs_scene *sc, uint32_t prim, float hu, float hv,
+                                rs_vec3 n_geo, rs_vec3 wo)
+{
+    uint32_t t = prim - sc->n_spheres - sc->n_quads;
+    const float *vn;
+    rs_vec3 ns;
+    float len;
+    if (!sc->tri_normal || prim < sc->n_spheres + sc->n_quads)
+        return n_geo;
+    vn = &sc->tri_normal[9 * (size_t)t];
+    ns = rs_v3_add(rs_v3_add(rs_v3_scale(rs_v3(vn[0], vn[1], vn[2]), 1.0f - hu - hv),
+                             rs_v3_scale(rs_v3(vn[3], vn[4], vn[5]), hu)),
+                   rs_v3_scale(rs_v3(vn[6], vn[7], vn[8]), hv));
+    len = rs_v3_length(ns);
+    if (!(len > 1e-6f))
+        return n_geo;
+    ns = rs_v3_scale(ns, 1.0f / len);
+    if (rs_v3_dot(ns, n_geo) < 0.0f)
+        ns = rs_v3_neg(ns);
+    return rs_v3_dot(ns, wo) > 0.0f ? ns : n_geo;
+}
+
+/* Shades path g's hit h of ray `ray` (segment number `bounce`): adds what the vertex sends to
+ * ps->radiance (background, emitter), and may make the path's next ray (returns RS_SHADE_NEXT,
+ * *next set, ps->throughput/bsdf_pdf/flags updated) and a shadow ray toward a light (returns
+ * RS_SHADE_SHADOW, *shadow set, its contribution in ps->pending if the ray is unoccluded). */
+RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounce,
+                             const rs_ray *ray, const rs_hit *h, rs_path_state *ps, rs_ray *next,
+                             rs_ray *shadow)
+{
+    const rs_scene *sc = it->scene;
+    uint32_t prim = h->prim;
+    uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
+    rs_ray r = *ray;
+    rs_vec3 beta = ps->throughput;
+    const rs_material *m;
+    rs_vec3 x, ng, n, n_geo, wo, wi, albedo, origin;
+    rs_rng_f4 rb;
+    float t = h->t, pdf = 0.0f;
+    int front, specular = 0;
+    uint32_t out = 0;
+
+    if (prim == RS_NO_HIT) {
+        rs_vec3 bg = rs_scene_background(sc, r.d);
+        ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, bg));
+        return 0;
+    }
+    m = rs_scene_prim_material(sc, prim);
+    x = rs_ray_at(&r, t);
+    ng = rs_prim_normal(sc, prim, x, r.time);
+
+    if (m->type == RS_MAT_DIFFUSE_LIGHT) {
+        rs_vec3 le = rs_emitted(m, ng, r.d);
+        float w = 1.0f;
+        int32_t l = sc->prim_light[prim];
+        /* a light reached by BSDF sampling: MIS against the light sampling that could also
+         * have found it (not after a delta bounce or from the camera, where none could) */
+        if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
+            w = rs_power_heuristic(ps->bsdf_pdf,
+                                   rs_light_pdf_hit(sc, (uint32_t)l, r.o, r.time, r.d, t, ng));
+        ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, le), w));
+        return 0; /* emitters reflect nothing */
+    }
+
+    /* The segment after this vertex would be number bounce + 1. */
+    if (bounce + 1 >= it->max_depth)
+        return out;
+    front = rs_v3_dot(ng, r.d) < 0.0f;
+    n_geo = front ? ng : rs_v3_neg(ng); /* the geometric normal on the incoming ray's side */
+    wo = rs_v3_neg(r.d);
+    n = rs_shading_normal(sc, prim, h->u, h->v, n_geo, wo);
+    albedo = rs_surface_albedo(sc, m, prim, h->u, h->v, x, ng);
+    rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
+
+    if (rs_material_is_delta(m)) {
+        /* mirror or glass: the only direction that carries light is the sampled one */
+        rs_scatter bs;
+        if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+            return out;
+        wi = bs.wi;
+        /* with a shading normal, a direction can land on the wrong side of the real surface */
+        if ((rs_v3_dot(wi, n_geo) > 0.0f) == (bs.transmit != 0))
+            return out;
+        beta = rs_v3_mul(beta, bs.weight);
+        origin =
+            rs_offset_origin(x, bs.transmit ? rs_v3_neg(n_geo) : n_geo, rs_prim_scale(sc, prim));
+        specular = 1;
+    } else {
+        rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
+        float ci;
+        rs_vec3 f;
+        origin = rs_offset_origin(x, n_geo, rs_prim_scale(sc, prim));
+
+        if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
+            /* next-event estimation: a shadow ray toward a sampled point on a light */
+            rs_light_sample ls;
+            if (rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls)) {
+                float c = rs_v3_dot(n, ls.wi);
+                rs_vec3 fl = rs_bsdf_eval(m, albedo, n, wo, ls.wi);
+                if (c > 0.0f && rs_v3_dot(n_geo, ls.wi) > 0.0f && !rs_v3_is_zero(ls.le) &&
+                    !rs_v3_is_zero(fl)) {
+                    float w = rs_power_heuristic(ls.pdf, rs_bsdf_pdf(m, albedo, n, wo, ls.wi));
+                    ps->pending =
+                        rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), c * w / ls.pdf);
+                    shadow->o = origin;
+                    shadow->d = rs_v3_sub(ls.point, origin); /* unnormalised: light at t = 1 */
+                    shadow->tmin = 0.0f;
+                    shadow->tmax = 1.0f - 1e-4f;
+                    shadow->time = r.time;
+                    out = RS_SHADE_SHADOW;
+                }
+            }
+        }
+
+        if (it->sampling == RS_SAMPLING_UNIFORM) {
+            /* no importance sampling at all: uniform hemisphere, f cos / (1 / 2pi) */
+            rs_onb frame = rs_onb_from_normal(n);
+            wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
+            ci = rs_v3_dot(n, wi);
+            pdf = rs_pdf_uniform_hemisphere(ci);
+            f = rs_bsdf_eval(m, albedo, n, wo, wi);
+            if (!(pdf > 0.0f))
+                return out;
+            beta = rs_v3_mul(beta, rs_v3_scale(f, ci / pdf));
+        } else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > 0) {
+            /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
+            if (rl.v[3] < 0.5f) {
+                rs_light_sample ls;
+                if (!rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls))
+                    return out;
+                wi = ls.wi;
+            } else {
+                rs_scatter bs;
+                if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+                    return out;
+                wi = bs.wi;
+            }
+            ci = rs_v3_dot(n, wi);
+            if (!(ci > 0.0f))
+                return out; /* f = 0 below the surface: the path carries nothing further */
+            pdf = 0.5f * rs_lights_pdf_dir(sc, origin, r.time, wi) +
+                  0.5f * rs_bsdf_pdf(m, albedo, n, wo, wi);
+            f = rs_bsdf_eval(m, albedo, n, wo, wi);
+            if (!(pdf > 0.0f))
+                return out;
+            beta = rs_v3_mul(beta, rs_v3_scale(f, ci / pdf));
+        } else {
+            /* mis, bsdf, and mixture without lights: the material's own sampling */
+            rs_scatter bs;
+            if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+                return out;
+            wi = bs.wi;
+            pdf = bs.pdf;
+            beta = rs_v3_mul(beta, bs.weight);
+        }
+    }
+
+    if (!specular && !(rs_v3_dot(wi, n_geo) > 0.0f))
+        return out; /* below the real surface (a shading-normal artefact): nothing comes back */
+    if (bounce + 1 >= it->rr_depth) {
+        float q = fminf(rs_v3_max_comp(beta), 0.95f);
+        if (!(rb.v[3] < q))
+            return out;
+        beta = rs_v3_scale(beta, 1.0f / q);
+    }
+    if (rs_v3_is_zero(beta) || !(rs_v3_max_comp(beta) > 0.0f))
+        return out;
+    next->o = origin;
+    next->d = wi;
+    next->tmin = 0.0f;
+    next->tmax = FLT_MAX;
+    next->time = r.time;
+    ps->throughput = beta;
+    ps->bsdf_pdf = pdf;
+    ps->flags = specular ? RS_PATH_SPECULAR : 0;
+    return out | RS_SHADE_NEXT;
+}
+
+/* What a megakernel traces with: the binary BVH over `geom` (device pointers on the GPU), or on
+ * the host the 4-wide one where `bvh4` is set. */
+typedef struct rs_path_tracer {
+    rs_bvh_view bvh;
+    rs_geom geom;
+    const void *bvh4; /* const rs_bvh4 * (accel/bvh4.h), host only; NULL: the binary BVH */
+} rs_path_tracer;
+
+/* Rays a megakernel traced. */
+typedef struct rs_path_counts {
+    uint64_t closest, shadow;
+    uint32_t max_bounce;
+} rs_path_counts;
+
+RS_HD void rs_path_closest(const rs_path_tracer *tr, rs_ray r, rs_hit *h)
+{
+#if !defined(__CUDACC__)
+    if (tr->bvh4) {
+        rs_bvh4_closest((const rs_bvh4 *)tr->bvh4, &tr->geom, r, h);
+        return;
+    }
+#endif
+    rs_bvh_closest(&tr->bvh, &tr->geom, r, h);
+}
+
+RS_HD int rs_path_occluded(const rs_path_tracer *tr, rs_ray r)
+{
+#if !defined(__CUDACC__)
+    if (tr->bvh4)
+        return rs_bvh4_occluded((const rs_bvh4 *)tr->bvh4, &tr->geom, r);
+#endif
+    return rs_bvh_occluded(&tr->bvh, &tr->geom, r);
+}
+
+/* Path g from the camera to its end (the thesis's recursive radiance(), unrolled): each vertex
+ * shaded as the wavefront shades it, each shadow ray resolved before the next segment, so the
+ * radiance is the wavefront's bit for bit (on the same compiler). */
+RS_HD rs_vec3 rs_path_radiance(const rs_integrator *it, const rs_path_tracer *tr, uint64_t g,
+                               rs_path_counts *n)
+{
+    rs_path_state ps;
+    rs_ray r = rs_path_begin(it, g, &ps), next, shadow;
+    uint32_t bounce;
+    for (bounce = 0;; ++bounce) {
+        rs_hit h;
+        uint32_t made;
+        rs_path_closest(tr, r, &h);
+        ++n->closest;
+        if (bounce > n->max_bounce)
+            n->max_bounce = bounce;
+        made = rs_path_shade(it, g, bounce, &r, &h, &ps, &next, &shadow);
+        if (made & RS_SHADE_SHADOW) {
+            ++n->shadow;
+            if (!rs_path_occluded(tr, shadow))
+                ps.radiance = rs_v3_add(ps.radiance, ps.pending);
+        }
+        if (!(made & RS_SHADE_NEXT))
+            break;
+        r = next;
+    }
+    return ps.radiance;
+}
+
+#endif
