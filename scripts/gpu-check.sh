@@ -33,14 +33,20 @@ cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DRS_DEPS=OPTIONAL -DRS_CUDA=
     -DCMOCKA_ROOT="$prefix" >"$out/configure.txt" 2>&1 || { cat "$out/configure.txt"; exit 1; }
 cmake --build build-gpu -j"$jobs" >"$out/build.txt" 2>&1 || { tail -50 "$out/build.txt"; exit 1; }
 status=0
-ctest --test-dir build-gpu --output-on-failure -R 'gpu_trace|scheduler_stream|render_determinism' \
+ctest --test-dir build-gpu --output-on-failure -R 'gpu_trace|scheduler_stream|render_determinism|scenes_mirror' \
     >"$out/ctest.txt" 2>&1 || status=1
 build-gpu/tests/gpu_trace_test >"$out/gpu_trace_test.txt" 2>&1 || status=1
 build-gpu/bench/scheduler_bench $quick --csv "$out/scheduler_bench.csv" >"$out/scheduler_bench.txt" 2>&1 || status=1
 build-gpu/bench/parallel_bench $quick --max-threads "$jobs" --csv "$out/parallel_bench.csv" \
     >"$out/parallel_bench.txt" 2>&1 || status=1
 build-gpu/bench/ablation_bench $quick --csv "$out/ablation_bench.csv" >"$out/ablation_bench.txt" 2>&1 || status=1
+# the CUDA megakernel and the stream engine on the CPU and GPU together, end to end
+for args in "--integrator megakernel --devices gpu" "--devices cpu,gpu" "--devices cpu"; do
+    build-gpu/raystream render builtin:rtiow-final --width 1280 --height 720 --spp 64 --stats \
+        $args -o "$out/render-$(echo "$args" | tr -c 'a-z0-9\n' '_').pfm" >>"$out/render.txt" 2>&1 || status=1
+done
 tail -5 "$out/ctest.txt"
 grep -h "mismatch\|diff\|GPU device" "$out/gpu_trace_test.txt" || true
 grep -h "efficiency" "$out/scheduler_bench.txt" || true
+grep -h "Rendered" "$out/render.txt" || true
 exit $status

@@ -165,7 +165,7 @@ static void test_strategies_and_megakernel(void **state)
  * near the origin carry errors of ~1e-4 there, and a bounce ray offset by less could hit the
  * ground again just above it — outside the ground's box, so found by brute force and culled by
  * a BVH, and the images differed in 2 pixels of 320x180 at 8 spp.  Offsets now scale with the
- * sphere (shading/integrator.c): brute force, median, SAH and LBVH agree bit for bit. */
+ * sphere (rs_prim_scale, shading/path.h): brute force, median, SAH and LBVH agree bit for bit. */
 static void test_bvh_independence(void **state)
 {
     static const rs_bvh_method methods[] = {RS_BVH_MEDIAN, RS_BVH_SAH, RS_BVH_LBVH};

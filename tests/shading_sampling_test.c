@@ -914,7 +914,7 @@ static void test_light_sphere_outside(void **state)
 static void test_light_sphere_far(void **state)
 {
     /* Small or far sphere lights: 20 radii (the cone is 5.7 degrees across), 200 (0.57) and 1000
-     * (0.11).  lights.c computes 1 - cos(theta_max) as sin^2 / (1 + cos) "so that small, far
+     * (0.11).  lights.h computes 1 - cos(theta_max) as sin^2 / (1 + cos) "so that small, far
      * spheres keep their precision"; the sampled cone must then be that cone. */
     int fails = 0;
     (void)state;
