@@ -13,14 +13,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
-
-#define CUDA_TRY(call)                                                                             \
-  do {                                                                                             \
-    cudaError_t e_ = (call);                                                                       \
-    if (e_ != cudaSuccess)                                                                         \
-      return rs_error_set(RS_ERR_CUDA, "%s failed (%s:%d): %s", #call, __FILE__, __LINE__,         \
-                          cudaGetErrorString(e_));                                                 \
-  } while (0)
+#include "gpu/cuda_check.h"
 
 __global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
 {

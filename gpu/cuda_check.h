@@ -1,0 +1,19 @@
+/* gpu/cuda_check.h — CUDA_TRY(call): runs a CUDA runtime call and, if it fails, returns
+ * RS_ERR_CUDA from the enclosing function with the call's text, file, line and CUDA's message.
+ * For the .cu files only. */
+#ifndef RS_GPU_CUDA_CHECK_H
+#define RS_GPU_CUDA_CHECK_H
+
+#include <cuda_runtime.h>
+
+#include "core/status.h"
+
+#define CUDA_TRY(call)                                                                             \
+  do {                                                                                             \
+    cudaError_t e_ = (call);                                                                       \
+    if (e_ != cudaSuccess)                                                                         \
+      return rs_error_set(RS_ERR_CUDA, "%s failed (%s:%d): %s", #call, __FILE__, __LINE__,         \
+                          cudaGetErrorString(e_));                                                 \
+  } while (0)
+
+#endif
