@@ -176,8 +176,8 @@ static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores,
     return n;
 }
 
-/* Where --integrator megakernel runs: --devices cpu[:N] on the CPU; gpu[:INDEX] on that CUDA
- * device, or where it cannot be used on its host fallback (one warning); auto on CUDA device 0
+/* Where --integrator megakernel runs: --devices cpu[:N] on the CPU (N threads); gpu[:INDEX] on that
+ * CUDA device, or where it cannot be used on its host fallback (one warning); auto on CUDA device 0
  * where there is one, else the CPU. */
 static void megakernel_device(const rs_cli_options *o, int threads, rs_megakernel_opts *mo)
 {
@@ -231,7 +231,11 @@ static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *con
         ds[0].bytes_to_device = mk->bytes_to_device;
         snprintf(name, sizeof name, "%s (megakernel)", mk->device_name);
         names[0] = name;
-        threads[0] = mk->device == RS_MK_CUDA ? 0 : o->threads ? o->threads : rs_cpu_count();
+        threads[0] = mk->device == RS_MK_CUDA ? 0
+                     : !o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads
+                         ? o->devices[0].threads
+                     : o->threads ? o->threads
+                                  : rs_cpu_count();
         alive[0] = 1;
         n_devs = 1;
     }
@@ -428,6 +432,8 @@ static int cmd_render(const rs_cli_options *o)
     }
     bvh_ms = 1e3 * (rs_now_s() - t0);
     if (o->megakernel) {
+        if (!o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads)
+            st.threads = threads = o->devices[0].threads; /* --devices cpu:N */
         megakernel_device(o, threads, &mk);
         if (rs_film_create(st.width, st.height, &film) != RS_OK) {
             code = fail(RS_EXIT_RUNTIME, "starting the render");
@@ -526,8 +532,8 @@ render:
             if (mk.device == RS_MK_CUDA)
                 fprintf(stderr, "Integrator: megakernel on %s. ", mk.device_name);
             else
-                fprintf(stderr, "Integrator: megakernel on %s (%s, %d threads). ", mk.device_name,
-                        rs_par_strategy_name(o->strategy), threads);
+                fprintf(stderr, "Integrator: megakernel on %s (%s, %d thread%s). ", mk.device_name,
+                        rs_par_strategy_name(o->strategy), threads, threads == 1 ? "" : "s");
         } else
             fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", stats.shade_s, stats.trace_s);
         if (film->nonfinite)
