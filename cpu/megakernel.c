@@ -20,12 +20,23 @@ typedef struct mk_ctx {
     _Atomic uint32_t max_bounce;
 } mk_ctx;
 
+/* Adds one thread's (or one pass's) ray counts to the render's. */
+static void add_counts(mk_ctx *c, const rs_path_counts *n)
+{
+    uint32_t seen = atomic_load(&c->max_bounce);
+    atomic_fetch_add(&c->rays_closest, n->closest);
+    atomic_fetch_add(&c->rays_shadow, n->shadow);
+    while (n->max_bounce > seen &&
+           !atomic_compare_exchange_weak(&c->max_bounce, &seen, n->max_bounce)) {
+    }
+}
+
 /* Rows (or columns) [lo, hi) of the image. */
 static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
 {
     mk_ctx *c = (mk_ctx *)ctx;
     uint64_t npix = (uint64_t)c->width * c->height;
-    uint32_t line, k, s, seen;
+    uint32_t line, k, s;
     rs_path_counts n = {0, 0, 0};
     for (line = lo; line < hi; ++line) {
         uint32_t len = c->by_columns ? c->height : c->width;
@@ -48,12 +59,7 @@ static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
             atomic_fetch_add(&c->paths_done, (uint64_t)len * c->spp);
         }
     }
-    atomic_fetch_add(&c->rays_closest, n.closest);
-    atomic_fetch_add(&c->rays_shadow, n.shadow);
-    seen = atomic_load(&c->max_bounce);
-    while (n.max_bounce > seen &&
-           !atomic_compare_exchange_weak(&c->max_bounce, &seen, n.max_bounce)) {
-    }
+    add_counts(c, &n);
 }
 
 static double now_s(void)
@@ -75,16 +81,11 @@ static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
     pass_ctx *p = (pass_ctx *)ctx;
     rs_path_counts n = {0, 0, 0};
     uint64_t npix = p->c->it.npix;
-    uint32_t pixel, seen;
+    uint32_t pixel;
     for (pixel = lo; pixel < hi; ++pixel)
         p->radiance[pixel] =
             rs_path_radiance(&p->c->it, &p->c->tracer, (uint64_t)p->sample * npix + pixel, &n);
-    atomic_fetch_add(&p->c->rays_closest, n.closest);
-    atomic_fetch_add(&p->c->rays_shadow, n.shadow);
-    seen = atomic_load(&p->c->max_bounce);
-    while (n.max_bounce > seen &&
-           !atomic_compare_exchange_weak(&p->c->max_bounce, &seen, n.max_bounce)) {
-    }
+    add_counts(p->c, &n);
 }
 
 /* The GPU megakernel: one pass per sample over every pixel, on CUDA (gpu != NULL) or on host
@@ -105,10 +106,7 @@ static rs_status render_passes(mk_ctx *c, rs_gpu_megakernel *gpu, rs_par_strateg
             rs_path_counts n = {0, 0, 0};
             if ((st = rs_gpu_megakernel_pass(gpu, s, radiance, &n)) != RS_OK)
                 break;
-            atomic_fetch_add(&c->rays_closest, n.closest);
-            atomic_fetch_add(&c->rays_shadow, n.shadow);
-            if (n.max_bounce > atomic_load(&c->max_bounce))
-                atomic_store(&c->max_bounce, n.max_bounce);
+            add_counts(c, &n);
         } else {
             pass_ctx p;
             p.c = c;
