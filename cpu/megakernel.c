@@ -88,34 +88,43 @@ static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
     add_counts(p->c, &n);
 }
 
+/* Pixels [lo, hi) of a pass onto the film (one sample each: any split keeps each pixel's
+ * samples in sample order). */
+static void pass_to_film(void *ctx, uint32_t lo, uint32_t hi)
+{
+    const pass_ctx *p = (const pass_ctx *)ctx;
+    uint32_t i;
+    for (i = lo; i < hi; ++i)
+        rs_film_add(p->c->film, i, p->radiance[i]);
+}
+
 /* The GPU megakernel: one pass per sample over every pixel, on CUDA (gpu != NULL) or on host
  * threads; each pass's radiance added to the film pixel by pixel, so every pixel gets its
  * samples in sample order, as in render_lines. */
 static rs_status render_passes(mk_ctx *c, rs_gpu_megakernel *gpu, rs_par_strategy strategy,
                                int threads)
 {
-    uint32_t npix = c->it.npix, s, i;
+    uint32_t npix = c->it.npix, s;
     rs_vec3 *radiance = (rs_vec3 *)rs_alloc(npix, sizeof *radiance);
     rs_status st = RS_OK;
+    pass_ctx p;
     if (!radiance)
         return rs_error_set(RS_ERR_NOMEM, "out of memory for a %u-pixel pass", npix);
+    p.c = c;
+    p.radiance = radiance;
     for (s = 0; s < c->spp && st == RS_OK; ++s) {
         if (c->hooks && c->hooks->cancel && atomic_load(c->hooks->cancel))
             break;
+        p.sample = s;
         if (gpu) {
             rs_path_counts n = {0, 0, 0};
             if ((st = rs_gpu_megakernel_pass(gpu, s, radiance, &n)) != RS_OK)
                 break;
             add_counts(c, &n);
         } else {
-            pass_ctx p;
-            p.c = c;
-            p.sample = s;
-            p.radiance = radiance;
             rs_parallel_range(strategy, threads, 0, npix, 1024, pass_pixels, &p);
         }
-        for (i = 0; i < npix; ++i)
-            rs_film_add(c->film, i, radiance[i]);
+        rs_parallel_range(RS_PAR_FOR_DYNAMIC, threads, 0, npix, 16384, pass_to_film, &p);
         atomic_fetch_add(&c->paths_done, npix);
         if (c->hooks && c->hooks->progress)
             c->hooks->progress(c->hooks->user, atomic_load(&c->paths_done),
