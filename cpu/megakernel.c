@@ -45,6 +45,11 @@ static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
         for (k = 0; k < len; ++k) {
             uint32_t x = c->by_columns ? line : k, y = c->by_columns ? k : line;
             uint32_t pixel = y * c->width + x;
+            /* per pixel: at high spp a row can take seconds, Ctrl-C must not */
+            if (c->hooks && c->hooks->cancel && atomic_load(c->hooks->cancel)) {
+                atomic_fetch_add(&c->paths_done, (uint64_t)k * c->spp);
+                goto out;
+            }
             for (s = 0; s < c->spp; ++s) {
                 rs_vec3 L = rs_path_radiance(&c->it, &c->tracer, (uint64_t)s * npix + pixel, &n);
                 rs_film_add(c->film, pixel, L);
@@ -59,6 +64,7 @@ static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
             atomic_fetch_add(&c->paths_done, (uint64_t)len * c->spp);
         }
     }
+out:
     add_counts(c, &n);
 }
 

@@ -777,12 +777,9 @@ static void test_failed_run_keeps_output(void **state)
 
 /* ---- 6. Ctrl-C ------------------------------------------------------------------------------- */
 
-static void test_sigint_writes_partial_image(void **state)
+/* One long render (args) interrupted after ~1.5 s must exit within limit_s. */
+static void sigint_case(const fixture *f, const char *const *args, double limit_s)
 {
-    const fixture *f = (const fixture *)*state;
-    /* about an hour on 2 cores: it can only end through SIGINT */
-    static const char *const args[] = {"render", "--width", "256", "--height",    "256",
-                                       "--spp",  "100000",  "-o",  "partial.png", NULL};
     char names[512];
     double sent;
     proc p;
@@ -802,8 +799,8 @@ static void test_sigint_writes_partial_image(void **state)
     }
     sent = now_s();
     assert_int_equal(kill(p.pid, SIGINT), 0);
-    proc_finish(&p, (sent - p.start) + SIGINT_EXIT_LIMIT_S);
-    EXPECT(&p, !p.timed_out, "SIGINT should end the render within %.0f s", SIGINT_EXIT_LIMIT_S);
+    proc_finish(&p, (sent - p.start) + limit_s);
+    EXPECT(&p, !p.timed_out, "SIGINT should end the render within %.0f s", limit_s);
     EXPECT(&p, exited_with(&p, 130), "SIGINT should end the render with status 130");
     EXPECT(&p, contains_ci(p.err.data, "partial") || contains_ci(p.err.data, "interrupted"),
            "stderr should say the image is partial");
@@ -813,6 +810,36 @@ static void test_sigint_writes_partial_image(void **state)
     EXPECT(&p, im.w == 256 && im.h == 256, "partial.png is %ux%u, not 256x256", im.w, im.h);
     rs_free(im.rgb);
     proc_free(&p);
+    snprintf(names, sizeof names, "%s/partial.png", f->dir); /* the next case starts clean */
+    unlink(names);
+}
+
+static void test_sigint_writes_partial_image(void **state)
+{
+    /* about an hour on 2 cores: it can only end through SIGINT */
+    static const char *const args[] = {"render", "--width", "256", "--height",    "256",
+                                       "--spp",  "100000",  "-o",  "partial.png", NULL};
+    sigint_case((const fixture *)*state, args, SIGINT_EXIT_LIMIT_S);
+}
+
+/* The megakernel too: on the CPU, split by columns, each thread starts on a column of 256
+ * pixels at 100000 spp (~18 s), so it must stop within a pixel (~0.05 s), not a line: 5 s
+ * allowed (the check per line alone took 17.7 s).  As the GPU megakernel's passes (here on host
+ * threads) it stops between passes. */
+static void test_sigint_megakernel(void **state)
+{
+    static const char *const cpu[] = {"render",     "--width",   "256",         "--height",
+                                      "256",        "--spp",     "100000",      "--integrator",
+                                      "megakernel", "--devices", "cpu",         "--cpu-strategy",
+                                      "columns",    "-o",        "partial.png", NULL};
+    static const char *const gpu[] = {
+        "render",       "--width",    "256",       "--height", "256", "--spp",       "100000",
+        "--integrator", "megakernel", "--devices", "gpu",      "-o",  "partial.png", NULL};
+    const fixture *f = (const fixture *)*state;
+    const char *why = "";
+    sigint_case(f, cpu, 5.0);
+    if (rs_gpu_count(&why) == 0) /* with a GPU its passes are milliseconds: nothing to see */
+        sigint_case(f, gpu, 5.0);
 }
 
 /* ---- 7. scheduling does not show in the pixels ----------------------------------------------- */
@@ -1067,6 +1094,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_render_default_output, setup, teardown),
         cmocka_unit_test_setup_teardown(test_failed_run_keeps_output, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sigint_writes_partial_image, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_sigint_megakernel, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_device_fault_and_stats, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
