@@ -417,6 +417,13 @@ static image read_image(const proc *p, const fixture *f, const char *name)
     return im;
 }
 
+/* 1 if a and b have the same size and the same pixels bit for bit. */
+static int same_image(const image *a, const image *b)
+{
+    return a->w == b->w && a->h == b->h && a->rgb && b->rgb &&
+           memcmp(a->rgb, b->rgb, (size_t)a->w * a->h * 3 * sizeof(float)) == 0;
+}
+
 static double image_mean(const image *im)
 {
     size_t i, n = (size_t)im->w * im->h * 3;
@@ -947,14 +954,8 @@ static void test_gpu_fallback(void **state)
     a = read_image(&p, f, "cpu.exr");
     b = read_image(&q, f, "mixed.exr");
     c = read_image(&r, f, "mk.exr");
-    EXPECT(&q,
-           a.w == b.w && a.h == b.h &&
-               memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
-           "the fallback changed the image");
-    EXPECT(&r,
-           a.w == c.w && a.h == c.h &&
-               memcmp(a.rgb, c.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
-           "the megakernel's fallback changed the image");
+    EXPECT(&q, same_image(&a, &b), "the fallback changed the image");
+    EXPECT(&r, same_image(&a, &c), "the megakernel's fallback changed the image");
     rs_free(a.rgb);
     rs_free(b.rgb);
     rs_free(c.rgb);
@@ -1000,10 +1001,7 @@ static void test_device_fault_and_stats(void **state)
     EXPECT(&q, strstr(q.err.data, "failed") != NULL, "the summary should say the gpu failed");
     a = read_image(&p, f, "ref.exr");
     b = read_image(&q, f, "fault.exr");
-    EXPECT(&q,
-           a.w == b.w && a.h == b.h &&
-               memcmp(a.rgb, b.rgb, (size_t)a.w * a.h * 3 * sizeof(float)) == 0,
-           "samples were lost or changed when the gpu failed");
+    EXPECT(&q, same_image(&a, &b), "samples were lost or changed when the gpu failed");
     rs_free(a.rgb);
     rs_free(b.rgb);
     snprintf(path, sizeof path, "%s/stats.json", f->dir);
