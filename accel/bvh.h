@@ -292,6 +292,13 @@ typedef struct rs_bvh {
                                 split would have broken the depth bound; 0 for median and grid */
 } rs_bvh;
 
+/* Every array of rs_bvh that its view (rs_bvh_view, the same field names) holds, with its
+ * element count (`b` a pointer to the rs_bvh).  A device's copy of the BVH
+ * (scheduler/device_copy.h) is made from this list: a new array of the view goes here. */
+#define RS_BVH_ARRAYS(X, b)                                                                        \
+  X(nodes, (size_t)(b)->n_nodes)                                                                   \
+  X(prim_ids, (size_t)(b)->n_prims)
+
 /* Build options.  A zeroed struct (or NULL) gives the median builder with 4-primitive leaves and
  * the default OpenMP thread count, the behaviour rs_bvh_build always had. */
 typedef struct rs_bvh_build_opts {

@@ -15,11 +15,12 @@
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "cpu/cpu_device.h"
-#include "cpu/megakernel.h"
 #include "gpu/gpu_device.h"
-#include "scheduler/fault.h"
+#include "app/timeline_svg.h"
 #include "scenes/builtin.h"
 #include "scenes/scene_json.h"
+#include "scheduler/fault.h"
+#include "scheduler/passes.h"
 #include "scheduler/render.h"
 
 #ifndef RS_VERSION
@@ -176,167 +177,110 @@ static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores,
     return n;
 }
 
-/* Where --integrator megakernel runs: --devices cpu[:N] on the CPU (N threads); gpu[:INDEX] on that
- * CUDA device, or where it cannot be used on its host fallback (one warning); auto on CUDA device 0
- * where there is one, else the CPU. */
-static void megakernel_device(const rs_cli_options *o, int threads, rs_megakernel_opts *mo)
+/* The one device --integrator megakernel runs on: --devices cpu[:N] the CPU device (N threads);
+ * gpu[:INDEX] that CUDA device, or where it cannot be used its host fallback (one warning); auto
+ * CUDA device 0 where there is one, else the CPU.  Returns 0 after printing an error. */
+static int create_megakernel_device(const rs_cli_options *o, int threads, rs_device **out)
 {
     const char *why = "";
-    int n_gpus = rs_gpu_count(&why);
-    memset(mo, 0, sizeof *mo);
-    mo->strategy = o->strategy;
-    mo->bvh_width = o->no_bvh ? 2 : o->bvh_width;
-    mo->device = RS_MK_CPU;
-    if (o->devices_auto) {
-        if (n_gpus > 0)
-            mo->device = RS_MK_CUDA;
-        return;
+    int n_gpus = rs_gpu_count(&why), gpu = -1;
+    rs_status st;
+    if (o->devices_auto)
+        gpu = n_gpus > 0 ? 0 : -1;
+    else if (o->devices[0].is_gpu)
+        gpu = o->devices[0].index;
+    if (gpu < 0) {
+        rs_cpu_device_opts co;
+        memset(&co, 0, sizeof co);
+        co.threads = threads;
+        co.name = "cpu";
+        co.bvh_width = o->no_bvh ? 2 : o->bvh_width;
+        co.strategy = o->strategy;
+        st = rs_cpu_device_create_opts(&co, out);
+    } else if (gpu < n_gpus && (st = rs_gpu_device_create(gpu, out)) == RS_OK) {
+        /* the CUDA device */
+    } else {
+        fprintf(stderr,
+                "raystream: warning: %s; the megakernel for gpu:%d runs on the CPU fallback (%d "
+                "thread%s)\n",
+                gpu < n_gpus  ? rs_error_message()
+                : n_gpus == 0 ? why
+                              : "no such CUDA device",
+                gpu, threads, threads == 1 ? "" : "s");
+        rs_error_clear();
+        st = rs_gpu_fallback_create(threads, gpu, NULL, out);
     }
-    if (!o->devices[0].is_gpu)
-        return;
-    mo->gpu_index = o->devices[0].index;
-    if (mo->gpu_index < n_gpus) {
-        mo->device = RS_MK_CUDA;
-        return;
-    }
-    fprintf(stderr,
-            "raystream: warning: %s; the megakernel for gpu:%d runs on the CPU fallback (%d "
-            "thread%s)\n",
-            n_gpus == 0 ? why : "no such CUDA device", mo->gpu_index, threads,
-            threads == 1 ? "" : "s");
-    mo->device = RS_MK_GPU_FALLBACK;
-}
-
-/* The --stats table (stderr) and --stats-json file.  Returns 0 if the JSON file could not be
- * written (after printing why). */
-static int report_stats(const rs_cli_options *o, rs_sched *sched, rs_device *const *devs,
-                        int n_devs, const rs_render_stats *rstats, const rs_megakernel_opts *mk)
-{
-    rs_device_stats ds[RS_MAX_DEVICES];
-    const char *names[RS_MAX_DEVICES];
-    int alive[RS_MAX_DEVICES], threads[RS_MAX_DEVICES], i;
-    uint64_t total = 0;
-    double wall = rstats->seconds > 0 ? rstats->seconds : 1e-9;
-    for (i = 0; i < n_devs; ++i) {
-        rs_sched_device_stats(sched, i, &ds[i], &alive[i]);
-        names[i] = devs[i]->name;
-        threads[i] = devs[i]->threads;
-        total += ds[i].rays;
-    }
-    if (!sched) { /* the megakernel: one device traced everything, one path at a time */
-        static char name[128];
-        memset(&ds[0], 0, sizeof ds[0]);
-        ds[0].rays = total = rstats->rays_closest + rstats->rays_shadow;
-        ds[0].busy_s = rstats->seconds;
-        ds[0].bytes_to_device = mk->bytes_to_device;
-        snprintf(name, sizeof name, "%s (megakernel)", mk->device_name);
-        names[0] = name;
-        threads[0] = mk->device == RS_MK_CUDA ? 0
-                     : !o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads
-                         ? o->devices[0].threads
-                     : o->threads ? o->threads
-                                  : rs_cpu_count();
-        alive[0] = 1;
-        n_devs = 1;
-    }
-    if (o->stats) {
-        fprintf(stderr, "%-24s %14s %8s %9s %9s %9s %7s %12s %12s %s\n", "device", "rays", "chunks",
-                "busy s", "idle s", "Mrays/s", "share", "bytes in", "bytes out", "state");
-        for (i = 0; i < n_devs; ++i)
-            fprintf(stderr, "%-24s %14llu %8llu %9.3f %9.3f %9.2f %6.1f%% %12llu %12llu %s\n",
-                    names[i], (unsigned long long)ds[i].rays, (unsigned long long)ds[i].chunks,
-                    ds[i].busy_s, ds[i].idle_s,
-                    ds[i].busy_s > 0 ? (double)ds[i].rays / ds[i].busy_s / 1e6 : 0.0,
-                    total ? 100.0 * (double)ds[i].rays / (double)total : 0.0,
-                    (unsigned long long)ds[i].bytes_to_device,
-                    (unsigned long long)ds[i].bytes_from_device, alive[i] ? "ok" : "failed");
-    }
-    if (o->stats_json) {
-        FILE *f = fopen(o->stats_json, "w");
-        if (!f) {
-            fprintf(stderr, "raystream: %s: cannot write the stats\n", o->stats_json);
-            return 0;
-        }
-        fprintf(f, "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"devices\": [\n", wall,
-                (unsigned long long)total);
-        for (i = 0; i < n_devs; ++i) {
-            const char *c;
-            fprintf(f, "    {\"name\": \"");
-            for (c = names[i]; *c; ++c)
-                if (*c == '"' || *c == '\\')
-                    fprintf(f, "\\%c", *c);
-                else if ((unsigned char)*c >= 0x20)
-                    fputc(*c, f);
-            fprintf(f,
-                    "\", \"threads\": %d, \"rays\": %llu, \"chunks\": %llu, \"busy_s\": %.6f, "
-                    "\"idle_s\": %.6f, \"mrays_per_s\": %.4f, \"share\": %.6f, "
-                    "\"bytes_to_device\": %llu, \"bytes_from_device\": %llu, \"failures\": %llu, "
-                    "\"failed\": %s}%s\n",
-                    threads[i], (unsigned long long)ds[i].rays, (unsigned long long)ds[i].chunks,
-                    ds[i].busy_s, ds[i].idle_s,
-                    ds[i].busy_s > 0 ? (double)ds[i].rays / ds[i].busy_s / 1e6 : 0.0,
-                    total ? (double)ds[i].rays / (double)total : 0.0,
-                    (unsigned long long)ds[i].bytes_to_device,
-                    (unsigned long long)ds[i].bytes_from_device, (unsigned long long)ds[i].failures,
-                    alive[i] ? "false" : "true", i + 1 < n_devs ? "," : "");
-        }
-        fprintf(f, "  ]\n}\n");
-        if (fclose(f) != 0) {
-            fprintf(stderr, "raystream: %s: cannot write the stats\n", o->stats_json);
-            return 0;
-        }
+    if (st != RS_OK) {
+        fail(RS_EXIT_RUNTIME, "creating the device");
+        return 0;
     }
     return 1;
 }
 
-static int cmd_render(const rs_cli_options *o)
-{
-    rs_scene *scene = NULL;
-    rs_bvh *bvh = NULL;
-    rs_device *devs[RS_MAX_DEVICES];
-    rs_sched *sched = NULL;
-    rs_film *film = NULL;
-    float *rgb = NULL;
-    int n_devs = 0, i, code = RS_EXIT_OK, threads;
-    char out_default[96], scene_stem[64];
-    const char *out, *name;
+/* Everything one `raystream render` makes, released by run_release. */
+typedef struct render_run {
+    rs_scene *scene;
+    rs_bvh *bvh;
+    rs_geom geom;
+    double bvh_ms;
+    rs_device *devs[RS_MAX_DEVICES]; /* the stream engine's devices */
+    int n_devs;
+    rs_device *mk; /* the megakernel's one device */
+    rs_sched *sched;
+    rs_film *film;
+    rs_timeline *timeline;
+    float *rgb;
+    rs_cores cores;
+    int threads;
     rs_render_settings st;
     rs_render_stats stats;
-    rs_megakernel_opts mk;
-    rs_render_hooks hooks;
-    rs_progress progress;
-    rs_sched_config cfg;
-    rs_cores cores;
-    rs_status rst;
-    double t0, bvh_ms;
-    rs_geom geom;
-    rs_bvh_build_opts bvh_opts;
-    char bvh_name[64];
+    char name[64]; /* the scene's stem: default output name */
+    char out_default[96];
+    const char *out;
+} render_run;
 
-    memset(&mk, 0, sizeof mk);
-    /* ---- the scene ---- */
+static void run_release(render_run *r)
+{
+    int i;
+    rs_sched_destroy(r->sched);
+    for (i = 0; i < r->n_devs; ++i)
+        rs_device_destroy(r->devs[i]);
+    rs_device_destroy(r->mk);
+    rs_timeline_destroy(r->timeline);
+    rs_film_destroy(r->film);
+    rs_free(r->rgb);
+    rs_bvh_destroy(r->bvh);
+    rs_scene_destroy(r->scene);
+}
+
+/* The stem of a file name: dir/bunny.ply -> bunny. */
+static void file_stem(const char *path, char *out, size_t n)
+{
+    const char *slash = strrchr(path, '/'), *name = slash ? slash + 1 : path;
+    const char *dot = strrchr(name, '.');
+    snprintf(out, n, "%.*s", dot ? (int)(dot - name) : (int)strlen(name), name);
+}
+
+/* The scene: a built-in one (with --mesh, named after the mesh) or a JSON file.  Returns an
+ * exit code. */
+static int load_scene(const rs_cli_options *o, render_run *r)
+{
     if (strncmp(o->scene, "builtin:", 8) == 0) {
         rs_builtin_opts bo;
         rs_status bst;
-        const char *slash, *dot;
         bo.models_dir = o->models;
         bo.mesh_file = o->mesh;
-        name = o->scene + 8;
-        bst = rs_builtin_create_ex(name, &bo, &scene);
+        bst = rs_builtin_create_ex(o->scene + 8, &bo, &r->scene);
         if (bst != RS_OK)
             return fail(bst == RS_ERR_ARG && !o->mesh ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
-        if (o->mesh) {
-            /* the default output is named after the mesh: bunny.ply -> bunny.png */
-            slash = strrchr(o->mesh, '/');
-            name = slash ? slash + 1 : o->mesh;
-            dot = strrchr(name, '.');
-            snprintf(scene_stem, sizeof scene_stem, "%.*s",
-                     dot ? (int)(dot - name) : (int)strlen(name), name);
-            name = scene_stem;
-        }
-    } else {
+        if (o->mesh)
+            file_stem(o->mesh, r->name, sizeof r->name);
+        else
+            snprintf(r->name, sizeof r->name, "%s", o->scene + 8);
+        return RS_EXIT_OK;
+    }
+    {
         struct stat sb;
-        const char *slash = strrchr(o->scene, '/'), *dot;
         if (stat(o->scene, &sb) != 0) {
             fprintf(stderr,
                     "raystream: %s: no such scene file (built-in scenes are named "
@@ -344,221 +288,404 @@ static int cmd_render(const rs_cli_options *o)
                     o->scene);
             return RS_EXIT_USAGE;
         }
-        if (rs_scene_load_json(o->scene, &scene) != RS_OK)
-            return fail(RS_EXIT_RUNTIME, NULL);
-        /* the default output is named after the file: scenes/foo.json -> foo.png */
-        name = slash ? slash + 1 : o->scene;
-        dot = strrchr(name, '.');
-        snprintf(scene_stem, sizeof scene_stem, "%.*s", dot ? (int)(dot - name) : (int)strlen(name),
-                 name);
-        name = scene_stem;
     }
+    if (rs_scene_load_json(o->scene, &r->scene) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, NULL);
+    file_stem(o->scene, r->name, sizeof r->name);
+    return RS_EXIT_OK;
+}
 
-    /* ---- settings ---- */
-    memset(&st, 0, sizeof st);
-    st.width = o->width ? o->width : scene->width;
-    st.height = o->height ? o->height : scene->height;
+/* The render settings from the options and the scene's own size. */
+static void make_settings(const rs_cli_options *o, render_run *r)
+{
+    rs_render_settings *st = &r->st;
+    const rs_scene *scene = r->scene;
+    memset(st, 0, sizeof *st);
+    st->width = o->width ? o->width : scene->width;
+    st->height = o->height ? o->height : scene->height;
     if (o->width && !o->height)
-        st.height = (uint32_t)(0.5 + (double)o->width * scene->height / scene->width);
+        st->height = (uint32_t)(0.5 + (double)o->width * scene->height / scene->width);
     if (!o->width && o->height)
-        st.width = (uint32_t)(0.5 + (double)o->height * scene->width / scene->height);
-    if (st.width < 1)
-        st.width = 1;
-    if (st.height < 1)
-        st.height = 1;
-    st.spp = o->spp;
-    st.max_depth = o->max_depth;
-    st.seed = o->seed;
-    st.sampling = o->sampling;
-    st.wave_paths = o->wave_paths;
-    st.waves_in_flight = o->waves;
-    threads = o->threads ? o->threads : rs_cpu_count();
-    st.threads = threads;
+        st->width = (uint32_t)(0.5 + (double)o->height * scene->width / scene->height);
+    if (st->width < 1)
+        st->width = 1;
+    if (st->height < 1)
+        st->height = 1;
+    st->spp = o->spp;
+    st->max_depth = o->max_depth;
+    st->seed = o->seed;
+    st->sampling = o->sampling;
+    st->wave_paths = o->wave_paths;
+    st->waves_in_flight = o->waves;
+    r->threads = o->threads ? o->threads : rs_cpu_count();
+    /* --integrator megakernel --devices cpu:N runs on N threads */
+    if (o->megakernel && !o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads)
+        r->threads = o->devices[0].threads;
+    st->threads = r->threads;
     /* the CPU devices and the shading share `threads` cores (core/cores.h) */
-    rs_cores_init(&cores, threads);
-    st.cores = &cores;
-    st.strategy = o->strategy;
+    rs_cores_init(&r->cores, r->threads);
+    st->cores = &r->cores;
+    st->strategy = o->strategy;
+}
 
-    /* ---- the output is checked before any work ---- */
+/* 1 if the folder of `path` exists and is writable; else prints why (naming `option`). */
+static int folder_writable(const char *option, const char *path)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1,
+             slash ? (slash == path ? "/" : path) : ".");
+    if (access(dir, W_OK) == 0)
+        return 1;
+    fprintf(stderr, "raystream: %s %s: the folder %s does not exist or is not writable\n", option,
+            path, dir);
+    return 0;
+}
+
+/* Every output is checked before any work.  Returns an exit code. */
+static int check_outputs(const rs_cli_options *o, render_run *r)
+{
+    rs_status rst;
     if (o->output) {
-        out = o->output;
+        r->out = o->output;
     } else {
-        snprintf(out_default, sizeof out_default, "%s.png", name);
-        out = out_default;
+        snprintf(r->out_default, sizeof r->out_default, "%s.png", r->name);
+        r->out = r->out_default;
     }
-    rst = rs_image_check_output(out);
-    if (rst != RS_OK) {
-        rs_scene_destroy(scene);
+    rst = rs_image_check_output(r->out);
+    if (rst != RS_OK)
         return fail(rst == RS_ERR_ARG ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
-    }
-    if (o->stats_json) {
-        /* its folder must exist and be writable before the render starts */
-        char dir[4096];
-        const char *slash = strrchr(o->stats_json, '/');
-        snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - o->stats_json) : 1,
-                 slash ? (slash == o->stats_json ? "/" : o->stats_json) : ".");
-        if (access(dir, W_OK) != 0) {
-            fprintf(stderr,
-                    "raystream: --stats-json %s: the folder %s does not exist or is not "
-                    "writable\n",
-                    o->stats_json, dir);
-            rs_scene_destroy(scene);
-            return RS_EXIT_USAGE;
-        }
-    }
+    if (o->stats_json && !folder_writable("--stats-json", o->stats_json))
+        return RS_EXIT_USAGE;
+    if (o->timeline && !folder_writable("--timeline", o->timeline))
+        return RS_EXIT_USAGE;
+    return RS_EXIT_OK;
+}
 
-    /* ---- BVH, devices, scheduler, film ---- */
-    geom = rs_scene_geom(scene);
-    geom.sphere_algo = o->isect_sphere;
-    geom.tri_algo = o->isect_tri;
-    geom.aabb_algo = o->isect_aabb;
-    memset(&bvh_opts, 0, sizeof bvh_opts);
-    bvh_opts.builder = o->bvh;
-    bvh_opts.threads = (uint32_t)threads;
+/* The BVH over the geometry with the chosen intersection tests.  Returns an exit code. */
+static int build_bvh(const rs_cli_options *o, render_run *r)
+{
+    rs_bvh_build_opts bo;
+    double t0;
+    r->geom = rs_scene_geom(r->scene);
+    r->geom.sphere_algo = o->isect_sphere;
+    r->geom.tri_algo = o->isect_tri;
+    r->geom.aabb_algo = o->isect_aabb;
+    memset(&bo, 0, sizeof bo);
+    bo.builder = o->bvh;
+    bo.threads = (uint32_t)r->threads;
     if (o->no_bvh) /* one leaf holding everything: each ray tests every primitive */
-        bvh_opts.max_leaf = UINT32_MAX;
+        bo.max_leaf = UINT32_MAX;
     if (o->bvh_on_gpu) {
         const char *why = "";
-        if (rs_gpu_count(&why) > 0) {
-            bvh_opts.lbvh_sort = rs_gpu_lbvh_sort; /* device 0 */
-        } else {
+        if (rs_gpu_count(&why) > 0)
+            bo.lbvh_sort = rs_gpu_lbvh_sort; /* device 0 */
+        else
             fprintf(stderr, "raystream: warning: %s; the lbvh is built on the CPU\n", why);
-        }
     }
     t0 = rs_now_s();
-    if (rs_bvh_build(&geom, &bvh_opts, &bvh) != RS_OK) {
-        code = fail(RS_EXIT_RUNTIME, "building the BVH");
-        goto done;
-    }
-    bvh_ms = 1e3 * (rs_now_s() - t0);
+    if (rs_bvh_build(&r->geom, &bo, &r->bvh) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "building the BVH");
+    r->bvh_ms = 1e3 * (rs_now_s() - t0);
+    return RS_EXIT_OK;
+}
+
+/* The devices (one for the megakernel), the scene uploaded to each, the scheduler, the film,
+ * the timeline.  Returns an exit code. */
+static int start_devices(const rs_cli_options *o, render_run *r)
+{
+    rs_device **devs = o->megakernel ? &r->mk : r->devs;
+    int n, i;
     if (o->megakernel) {
-        if (!o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads)
-            st.threads = threads = o->devices[0].threads; /* --devices cpu:N */
-        megakernel_device(o, threads, &mk);
-        if (rs_film_create(st.width, st.height, &film) != RS_OK) {
-            code = fail(RS_EXIT_RUNTIME, "starting the render");
-            goto done;
-        }
-        goto render;
+        if (!create_megakernel_device(o, r->threads, &r->mk))
+            return RS_EXIT_RUNTIME;
+        n = 1;
+    } else {
+        n = create_devices(o, r->threads, &r->cores, r->devs);
+        if (n < 0)
+            return RS_EXIT_RUNTIME;
+        r->n_devs = n;
     }
-    n_devs = create_devices(o, threads, &cores, devs);
-    if (n_devs < 0) {
-        n_devs = 0;
-        code = RS_EXIT_RUNTIME;
-        goto done;
-    }
-    for (i = 0; i < n_devs; ++i)
-        if (rs_device_upload(devs[i], &geom, bvh) != RS_OK) {
+    for (i = 0; i < n; ++i)
+        if (rs_device_upload(devs[i], &r->geom, r->bvh) != RS_OK) {
             char what[96];
             snprintf(what, sizeof what, "uploading the scene to %s", devs[i]->name);
-            code = fail(RS_EXIT_RUNTIME, what);
-            goto done;
+            return fail(RS_EXIT_RUNTIME, what);
         }
-    cfg.chunk_size = o->chunk_size;
-    cfg.queue_capacity = 0;
-    if (rs_sched_create(devs, n_devs, &cfg, &sched) != RS_OK ||
-        rs_film_create(st.width, st.height, &film) != RS_OK) {
-        code = fail(RS_EXIT_RUNTIME, "starting the render");
-        goto done;
+    /* about 200 spans per wave and device; the log never grows past this */
+    if (o->timeline && rs_timeline_create(1u << 20, &r->timeline) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "starting the timeline");
+    r->st.timeline = r->timeline;
+    r->st.timeline_lane = (uint16_t)(o->megakernel ? 1 : n);
+    if (!o->megakernel) {
+        rs_sched_config cfg;
+        memset(&cfg, 0, sizeof cfg);
+        cfg.chunk_size = o->chunk_size;
+        cfg.timeline = r->timeline;
+        if (rs_sched_create(r->devs, n, &cfg, &r->sched) != RS_OK)
+            return fail(RS_EXIT_RUNTIME, "starting the render");
     }
-render:
-    rgb = (float *)rs_alloc((size_t)st.width * st.height * 3, sizeof *rgb);
-    if (!rgb) {
-        fprintf(stderr, "raystream: out of memory for a %ux%u image\n", st.width, st.height);
-        code = RS_EXIT_RUNTIME;
-        goto done;
+    if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "starting the render");
+    r->rgb = (float *)rs_alloc((size_t)r->st.width * r->st.height * 3, sizeof *r->rgb);
+    if (!r->rgb) {
+        fprintf(stderr, "raystream: out of memory for a %ux%u image\n", r->st.width, r->st.height);
+        return RS_EXIT_RUNTIME;
     }
+    return RS_EXIT_OK;
+}
 
-    /* ---- render ---- */
+/* The render itself, with the progress bar and Ctrl-C.  Returns an exit code. */
+static int run_render(const rs_cli_options *o, render_run *r)
+{
+    rs_render_hooks hooks;
+    rs_progress progress;
+    rs_status rst;
     install_sigint();
     rs_progress_begin(&progress, !o->quiet);
     hooks.progress = rs_progress_update;
     hooks.user = &progress;
     hooks.cancel = &g_cancel;
-    if (o->megakernel) {
-        rst = rs_render_megakernel(scene, &geom, bvh, &st, &mk, &hooks, film, &stats);
-    } else {
-        rst = rs_render(scene, sched, &st, &hooks, film, &stats);
-    }
+    if (o->megakernel)
+        rst = rs_render_passes(r->scene, r->mk, &r->st, &hooks, r->film, &r->stats);
+    else
+        rst = rs_render(r->scene, r->sched, &r->st, &hooks, r->film, &r->stats);
     rs_progress_end(&progress);
     signal(SIGINT, SIG_DFL);
-    if (rst != RS_OK && rst != RS_ERR_CANCELLED) {
-        code = fail(RS_EXIT_RUNTIME, "render failed");
-        goto done;
-    }
     if (rst == RS_ERR_CANCELLED) {
         rs_error_clear();
-        code = RS_EXIT_INTERRUPTED;
+        return RS_EXIT_INTERRUPTED;
     }
+    if (rst != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "render failed");
+    return RS_EXIT_OK;
+}
 
-    /* ---- output ---- */
-    rs_film_resolve(film, rgb);
-    if (rs_image_write(out, st.width, st.height, rgb) != RS_OK) {
-        code = fail(RS_EXIT_RUNTIME, NULL);
-        goto done;
+/* Per device: its counters, name and threads, for --stats and --stats-json. */
+typedef struct device_rows {
+    rs_device_stats ds[RS_MAX_DEVICES];
+    char names[RS_MAX_DEVICES][80];
+    int alive[RS_MAX_DEVICES], threads[RS_MAX_DEVICES];
+    int n;
+    uint64_t total;
+} device_rows;
+
+static void collect_rows(const render_run *r, device_rows *t)
+{
+    int i;
+    memset(t, 0, sizeof *t);
+    if (r->mk) { /* the megakernel: one device traced everything, one path at a time */
+        t->ds[0].rays = t->total = r->stats.rays_closest + r->stats.rays_shadow;
+        t->ds[0].busy_s = r->stats.seconds;
+        t->ds[0].chunks = r->stats.waves;
+        t->ds[0].bytes_to_device = r->mk->stats.bytes_to_device;
+        snprintf(t->names[0], sizeof t->names[0], "%s (megakernel)", r->mk->name);
+        t->threads[0] = r->mk->threads;
+        t->alive[0] = 1;
+        t->n = 1;
+        return;
     }
-    if ((o->stats || o->stats_json) && !report_stats(o, sched, devs, n_devs, &stats, &mk))
-        code = RS_EXIT_RUNTIME;
+    for (i = 0; i < r->n_devs; ++i) {
+        rs_sched_device_stats(r->sched, i, &t->ds[i], &t->alive[i]);
+        snprintf(t->names[i], sizeof t->names[i], "%s", r->devs[i]->name);
+        t->threads[i] = r->devs[i]->threads;
+        t->total += t->ds[i].rays;
+    }
+    t->n = r->n_devs;
+}
 
-    if (!o->quiet) {
-        char sps[32], rps[32], rays[32];
-        double secs = stats.seconds > 0 ? stats.seconds : 1e-9;
-        uint64_t rays_total = stats.rays_closest + stats.rays_shadow;
-        human((double)stats.paths_done / secs, sps, sizeof sps);
-        human((double)rays_total / secs, rps, sizeof rps);
-        human((double)rays_total, rays, sizeof rays);
-        fprintf(stderr,
-                "%s %s at %ux%u, %u spp (%s sampling, max depth %u, seed %llu) in %.2f s: "
-                "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
-                "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
-                code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered",
-                o->scene, st.width, st.height, st.spp, rs_sampling_name(st.sampling), st.max_depth,
-                (unsigned long long)st.seed, stats.seconds, sps, rps, rays,
-                (unsigned long long)stats.rays_closest, (unsigned long long)stats.rays_shadow,
-                rs_bvh_builder_name(&bvh->builder, bvh_name, sizeof bvh_name), rs_bvh_sah_cost(bvh),
-                bvh->n_nodes, bvh->n_prims, bvh_ms);
-        for (i = 0; i < n_devs; ++i) {
-            rs_device_stats ds;
-            int alive;
-            rs_sched_device_stats(sched, i, &ds, &alive);
-            human((double)ds.rays, rays, sizeof rays);
-            fprintf(stderr, "%s %s (%d thread%s) traced %srays in %llu chunks (%.0f%%)%s%s",
-                    i == 0 ? "Devices:" : ";", devs[i]->name, devs[i]->threads,
-                    devs[i]->threads == 1 ? "" : "s", rays, (unsigned long long)ds.chunks,
-                    rays_total ? 100.0 * (double)ds.rays / (double)rays_total : 0.0,
-                    alive ? "" : " and then failed", i + 1 == n_devs ? ". " : "");
-        }
-        if (o->megakernel) {
-            if (mk.device == RS_MK_CUDA)
-                fprintf(stderr, "Integrator: megakernel on %s. ", mk.device_name);
-            else
-                fprintf(stderr, "Integrator: megakernel on %s (%s, %d thread%s). ", mk.device_name,
-                        rs_par_strategy_name(o->strategy), threads, threads == 1 ? "" : "s");
-        } else
-            fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", stats.shade_s, stats.trace_s);
-        if (film->nonfinite)
-            fprintf(stderr, "%llu non-finite samples were dropped. ",
-                    (unsigned long long)film->nonfinite);
-        if (code == RS_EXIT_INTERRUPTED)
-            fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", out,
-                    (unsigned long long)stats.paths_done, (unsigned long long)stats.paths_total,
-                    rs_film_min_count(film));
+static void print_stats_table(const render_run *r, const device_rows *t)
+{
+    int i;
+    fprintf(stderr, "%-24s %14s %8s %9s %9s %9s %7s %12s %12s %s\n", "device", "rays", "chunks",
+            "busy s", "idle s", "Mrays/s", "share", "bytes in", "bytes out", "state");
+    for (i = 0; i < t->n; ++i) {
+        const rs_device_stats *d = &t->ds[i];
+        fprintf(stderr, "%-24s %14llu %8llu %9.3f %9.3f %9.2f %6.1f%% %12llu %12llu %s\n",
+                t->names[i], (unsigned long long)d->rays, (unsigned long long)d->chunks, d->busy_s,
+                d->idle_s, d->busy_s > 0 ? (double)d->rays / d->busy_s / 1e6 : 0.0,
+                t->total ? 100.0 * (double)d->rays / (double)t->total : 0.0,
+                (unsigned long long)d->bytes_to_device, (unsigned long long)d->bytes_from_device,
+                t->alive[i] ? "ok" : "failed");
+    }
+    fprintf(stderr, "%-24s %9s %7s\n", "stage (render thread)", "s", "share");
+    for (i = 0; i < RS_STAGE_COUNT; ++i)
+        if (r->stats.stage_s[i] > 0)
+            fprintf(stderr, "%-24s %9.3f %6.1f%%\n", rs_stage_name((rs_stage)i),
+                    r->stats.stage_s[i],
+                    r->stats.seconds > 0 ? 100.0 * r->stats.stage_s[i] / r->stats.seconds : 0.0);
+}
+
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; ++s)
+        if (*s == '"' || *s == '\\')
+            fprintf(f, "\\%c", *s);
+        else if ((unsigned char)*s >= 0x20)
+            fputc(*s, f);
+    fputc('"', f);
+}
+
+/* Returns 0 after printing why the file could not be written. */
+static int write_stats_json(const char *path, const render_run *r, const device_rows *t)
+{
+    double wall = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
+    FILE *f = fopen(path, "w");
+    int i;
+    if (!f) {
+        fprintf(stderr, "raystream: %s: cannot write the stats\n", path);
+        return 0;
+    }
+    fprintf(f, "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"stages\": {", wall,
+            (unsigned long long)t->total);
+    for (i = 0; i < RS_STAGE_COUNT; ++i)
+        fprintf(f, "%s\"%s\": %.6f", i ? ", " : "", rs_stage_name((rs_stage)i),
+                r->stats.stage_s[i]);
+    fprintf(f, "},\n  \"devices\": [\n");
+    for (i = 0; i < t->n; ++i) {
+        const rs_device_stats *d = &t->ds[i];
+        fprintf(f, "    {\"name\": ");
+        json_string(f, t->names[i]);
+        fprintf(f,
+                ", \"threads\": %d, \"rays\": %llu, \"chunks\": %llu, \"busy_s\": %.6f, "
+                "\"idle_s\": %.6f, \"mrays_per_s\": %.4f, \"share\": %.6f, "
+                "\"bytes_to_device\": %llu, \"bytes_from_device\": %llu, \"failures\": %llu, "
+                "\"failed\": %s}%s\n",
+                t->threads[i], (unsigned long long)d->rays, (unsigned long long)d->chunks,
+                d->busy_s, d->idle_s, d->busy_s > 0 ? (double)d->rays / d->busy_s / 1e6 : 0.0,
+                t->total ? (double)d->rays / (double)t->total : 0.0,
+                (unsigned long long)d->bytes_to_device, (unsigned long long)d->bytes_from_device,
+                (unsigned long long)d->failures, t->alive[i] ? "false" : "true",
+                i + 1 < t->n ? "," : "");
+    }
+    fprintf(f, "  ]\n}\n");
+    if (fclose(f) != 0) {
+        fprintf(stderr, "raystream: %s: cannot write the stats\n", path);
+        return 0;
+    }
+    return 1;
+}
+
+/* The --timeline picture: a lane per device, then the render thread's.  0 after printing why. */
+static int write_timeline(const rs_cli_options *o, const render_run *r, const device_rows *t)
+{
+    char lanes[RS_MAX_DEVICES + 1][96], title[160];
+    const char *names[RS_MAX_DEVICES + 1];
+    int i;
+    for (i = 0; i < t->n; ++i) {
+        if (t->threads[i] > 0)
+            snprintf(lanes[i], sizeof lanes[i], "%s (%d thread%s)", t->names[i], t->threads[i],
+                     t->threads[i] == 1 ? "" : "s");
         else
-            fprintf(stderr, "Wrote %s.\n", out);
-    } else if (code == RS_EXIT_INTERRUPTED) {
-        fprintf(stderr,
-                "raystream: interrupted; wrote a partial image (%llu of %llu samples) to %s\n",
-                (unsigned long long)stats.paths_done, (unsigned long long)stats.paths_total, out);
+            snprintf(lanes[i], sizeof lanes[i], "%s", t->names[i]);
+        names[i] = lanes[i];
     }
+    snprintf(lanes[t->n], sizeof lanes[t->n], "shading (render thread)");
+    names[t->n] = lanes[t->n];
+    snprintf(title, sizeof title, "raystream render %s, %ux%u, %u spp, %s integrator", o->scene,
+             r->st.width, r->st.height, r->st.spp, o->megakernel ? "megakernel" : "stream");
+    if (rs_timeline_write_svg(o->timeline, r->timeline, names, t->n + 1, title) != RS_OK) {
+        fail(RS_EXIT_RUNTIME, NULL);
+        return 0;
+    }
+    return 1;
+}
 
-done:
-    rs_sched_destroy(sched);
-    for (i = 0; i < n_devs; ++i)
-        rs_device_destroy(devs[i]);
-    rs_film_destroy(film);
-    rs_free(rgb);
-    rs_bvh_destroy(bvh);
-    rs_scene_destroy(scene);
+/* The summary line on stderr (or, with --quiet, only a word on an interruption). */
+static void print_summary(const rs_cli_options *o, const render_run *r, int code)
+{
+    char sps[32], rps[32], rays[32], bvh_name[64];
+    double secs = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
+    uint64_t rays_total = r->stats.rays_closest + r->stats.rays_shadow;
+    const rs_render_settings *st = &r->st;
+    int i;
+    if (o->quiet) {
+        if (code == RS_EXIT_INTERRUPTED)
+            fprintf(stderr,
+                    "raystream: interrupted; wrote a partial image (%llu of %llu samples) to %s\n",
+                    (unsigned long long)r->stats.paths_done,
+                    (unsigned long long)r->stats.paths_total, r->out);
+        return;
+    }
+    human((double)r->stats.paths_done / secs, sps, sizeof sps);
+    human((double)rays_total / secs, rps, sizeof rps);
+    human((double)rays_total, rays, sizeof rays);
+    fprintf(stderr,
+            "%s %s at %ux%u, %u spp (%s sampling, max depth %u, seed %llu) in %.2f s: "
+            "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
+            "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
+            code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered", o->scene,
+            st->width, st->height, st->spp, rs_sampling_name(st->sampling), st->max_depth,
+            (unsigned long long)st->seed, r->stats.seconds, sps, rps, rays,
+            (unsigned long long)r->stats.rays_closest, (unsigned long long)r->stats.rays_shadow,
+            rs_bvh_builder_name(&r->bvh->builder, bvh_name, sizeof bvh_name),
+            rs_bvh_sah_cost(r->bvh), r->bvh->n_nodes, r->bvh->n_prims, r->bvh_ms);
+    for (i = 0; i < r->n_devs; ++i) {
+        rs_device_stats ds;
+        int alive;
+        rs_sched_device_stats(r->sched, i, &ds, &alive);
+        human((double)ds.rays, rays, sizeof rays);
+        fprintf(stderr, "%s %s (%d thread%s) traced %srays in %llu chunks (%.0f%%)%s%s",
+                i == 0 ? "Devices:" : ";", r->devs[i]->name, r->devs[i]->threads,
+                r->devs[i]->threads == 1 ? "" : "s", rays, (unsigned long long)ds.chunks,
+                rays_total ? 100.0 * (double)ds.rays / (double)rays_total : 0.0,
+                alive ? "" : " and then failed", i + 1 == r->n_devs ? ". " : "");
+    }
+    if (r->mk && rs_device_is_gpu(r->mk))
+        fprintf(stderr, "Integrator: megakernel on %s. ", r->mk->name);
+    else if (r->mk)
+        fprintf(stderr, "Integrator: megakernel on %s (%s, %d thread%s). ", r->mk->name,
+                rs_par_strategy_name(o->strategy), r->mk->threads, r->mk->threads == 1 ? "" : "s");
+    else
+        fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", r->stats.shade_s,
+                r->stats.trace_s);
+    if (r->film->nonfinite)
+        fprintf(stderr, "%llu non-finite samples were dropped. ",
+                (unsigned long long)r->film->nonfinite);
+    if (code == RS_EXIT_INTERRUPTED)
+        fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", r->out,
+                (unsigned long long)r->stats.paths_done, (unsigned long long)r->stats.paths_total,
+                rs_film_min_count(r->film));
+    else
+        fprintf(stderr, "Wrote %s.\n", r->out);
+}
+
+/* The image, then the reports that were asked for.  Returns the exit code. */
+static int write_outputs(const rs_cli_options *o, render_run *r, int code)
+{
+    device_rows rows;
+    rs_film_resolve(r->film, r->rgb);
+    if (rs_image_write(r->out, r->st.width, r->st.height, r->rgb) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, NULL);
+    collect_rows(r, &rows);
+    if (o->stats)
+        print_stats_table(r, &rows);
+    if (o->stats_json && !write_stats_json(o->stats_json, r, &rows))
+        code = RS_EXIT_RUNTIME;
+    if (o->timeline && !write_timeline(o, r, &rows))
+        code = RS_EXIT_RUNTIME;
+    print_summary(o, r, code);
+    return code;
+}
+
+/* `raystream render`: scene, settings, outputs checked, BVH, devices, render, outputs. */
+static int cmd_render(const rs_cli_options *o)
+{
+    render_run r;
+    int code;
+    memset(&r, 0, sizeof r);
+    if ((code = load_scene(o, &r)) == RS_EXIT_OK) {
+        make_settings(o, &r);
+        if ((code = check_outputs(o, &r)) == RS_EXIT_OK &&
+            (code = build_bvh(o, &r)) == RS_EXIT_OK &&
+            (code = start_devices(o, &r)) == RS_EXIT_OK) {
+            code = run_render(o, &r);
+            if (code == RS_EXIT_OK || code == RS_EXIT_INTERRUPTED)
+                code = write_outputs(o, &r, code);
+        }
+    }
+    run_release(&r);
     return code;
 }
 

@@ -155,6 +155,8 @@ void rs_cli_print_help(const char *command)
             "  --wave-size N       paths in flight (default 1048576): bounds memory\n"
             "  --waves N|auto      waves in flight, 1..4: the CPU shades one while the devices\n"
             "                      trace another (default auto: 2 with a GPU, else 1)\n"
+            "  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
+            "                      spans coloured by stage, idle gaps, waves labelled\n"
             "  -q, --quiet         no progress bar and no summary\n"
             "  -h, --help          this text\n"
             "\n"
@@ -176,19 +178,248 @@ void rs_cli_print_help(const char *command)
            "'raystream render --help' lists the render options.\n");
 }
 
-/* Takes the value of option argv[*i] (either "--opt=value" or "--opt value"). */
-static const char *take_value(int argc, char **argv, int *i, const char *eq)
+/* The option being parsed: argv[*i] is `name`, its "=value" part `eq` (or NULL). */
+typedef struct opt_arg {
+    int argc;
+    char **argv;
+    int *i;
+    const char *eq;
+    const char *name;
+} opt_arg;
+
+#define NOT_MINE (-1)
+
+/* Takes the value of the option (either "--opt=value" or "--opt value"). */
+static const char *take_value(opt_arg *x)
 {
-    if (eq)
-        return eq + 1;
-    if (*i + 1 < argc)
-        return argv[++*i];
+    if (x->eq)
+        return x->eq + 1;
+    if (*x->i + 1 < x->argc)
+        return x->argv[++*x->i];
     return NULL;
+}
+
+#define NEEDS_VALUE()                                                                              \
+  v = take_value(x);                                                                               \
+  if (!v)                                                                                          \
+    return usage_error("%s needs a value%s", name, "");
+
+/* The image and the scene: --scene, -o, sizes, spp, depth, seed, sampling, --mesh, --models.
+ * Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or NOT_MINE. */
+static int parse_image_option(opt_arg *x, rs_cli_options *o)
+{
+    const char *name = x->name, *v;
+    int rc = RS_EXIT_OK;
+    if (strcmp(name, "--scene") == 0) {
+        NEEDS_VALUE();
+        if (o->scene)
+            return usage_error("more than one scene given ('%s' and '%s')", o->scene, v);
+        o->scene = v;
+    } else if (strcmp(name, "-o") == 0 || strcmp(name, "--output") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a file name%s", name, "");
+        o->output = v;
+    } else if (strcmp(name, "--width") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 32768, &o->width);
+    } else if (strcmp(name, "--height") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 32768, &o->height);
+    } else if (strcmp(name, "--spp") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 1u << 20, &o->spp);
+    } else if (strcmp(name, "--max-depth") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 10000, &o->max_depth);
+    } else if (strcmp(name, "--seed") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u64(name, v, 0, UINT64_MAX, &o->seed);
+    } else if (strcmp(name, "--sampling") == 0) {
+        NEEDS_VALUE();
+        if (!rs_sampling_parse(v, &o->sampling))
+            return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
+                               "uniform)",
+                               v, "");
+    } else if (strcmp(name, "--mesh") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a file name%s", name, "");
+        o->mesh = v;
+    } else if (strcmp(name, "--models") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a folder%s", name, "");
+        o->models = v;
+    } else {
+        return NOT_MINE;
+    }
+    return rc;
+}
+
+/* How it runs: threads, devices, integrator, CPU strategy, stats and timeline, chunks and waves.
+ * Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or NOT_MINE. */
+static int parse_engine_option(opt_arg *x, rs_cli_options *o)
+{
+    const char *name = x->name, *v;
+    int rc = RS_EXIT_OK;
+    if (strcmp(name, "--threads") == 0) {
+        uint32_t t = 0;
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 1024, &t);
+        o->threads = (int)t;
+    } else if (strcmp(name, "--devices") == 0) {
+        NEEDS_VALUE();
+        rc = parse_devices(v, o);
+    } else if (strcmp(name, "--integrator") == 0) {
+        NEEDS_VALUE();
+        if (strcmp(v, "stream") != 0 && strcmp(v, "megakernel") != 0)
+            return usage_error("--integrator: '%s'%s (use stream or megakernel)", v, "");
+        o->megakernel = v[0] == 'm';
+    } else if (strcmp(name, "--cpu-strategy") == 0) {
+        NEEDS_VALUE();
+        if (!rs_par_strategy_parse(v, &o->strategy))
+            return usage_error("--cpu-strategy: '%s'%s (use for-dynamic, columns or tasks)", v, "");
+    } else if (strcmp(name, "--stats") == 0) {
+        o->stats = 1;
+    } else if (strcmp(name, "--stats-json") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a file name%s", name, "");
+        o->stats_json = v;
+    } else if (strcmp(name, "--timeline") == 0) {
+        size_t n;
+        NEEDS_VALUE();
+        n = strlen(v);
+        if (n < 5 || strcmp(v + n - 4, ".svg") != 0)
+            return usage_error("--timeline writes an SVG picture: '%s'%s must end in .svg", v, "");
+        o->timeline = v;
+    } else if (strcmp(name, "--chunk-size") == 0) {
+        NEEDS_VALUE();
+        if (strcmp(v, "auto") == 0)
+            o->chunk_size = 0;
+        else
+            rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
+    } else if (strcmp(name, "--waves") == 0) {
+        NEEDS_VALUE();
+        if (strcmp(v, "auto") == 0)
+            o->waves = 0;
+        else
+            rc = parse_u32(name, v, 1, 4, &o->waves);
+    } else if (strcmp(name, "--wave-size") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
+    } else {
+        return NOT_MINE;
+    }
+    return rc;
+}
+
+/* The BVH and the intersection tests.  Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or
+ * NOT_MINE. */
+static int parse_accel_option(opt_arg *x, rs_cli_options *o)
+{
+    const char *name = x->name, *v;
+    int rc = RS_EXIT_OK;
+    if (strcmp(name, "--bvh") == 0) {
+        NEEDS_VALUE();
+        if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
+            fprintf(stderr, "raystream: --bvh: %s (see 'raystream render --help')\n",
+                    rs_error_message());
+            rs_error_clear();
+            return RS_EXIT_USAGE;
+        }
+    } else if (strcmp(name, "--no-bvh") == 0) {
+        o->no_bvh = 1;
+    } else if (strcmp(name, "--bvh-device") == 0) {
+        NEEDS_VALUE();
+        if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)
+            return usage_error("--bvh-device: '%s'%s (use cpu or gpu)", v, "");
+        o->bvh_on_gpu = v[0] == 'g';
+    } else if (strcmp(name, "--bvh-width") == 0) {
+        NEEDS_VALUE();
+        if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0)
+            return usage_error("--bvh-width must be 2 or 4, not '%s'%s", v, "");
+        o->bvh_width = (uint32_t)(v[0] - '0');
+    } else if (strcmp(name, "--isect-sphere") == 0) {
+        NEEDS_VALUE();
+        if (!rs_isect_sphere_algo_parse(v, &o->isect_sphere))
+            return usage_error("--isect-sphere: unknown algorithm '%s'%s (use algebraic or "
+                               "geometric)",
+                               v, "");
+    } else if (strcmp(name, "--isect-tri") == 0) {
+        NEEDS_VALUE();
+        if (!rs_isect_tri_algo_parse(v, &o->isect_tri))
+            return usage_error("--isect-tri: unknown algorithm '%s'%s (use moller, snyder-barr "
+                               "or watertight)",
+                               v, "");
+    } else if (strcmp(name, "--isect-aabb") == 0) {
+        NEEDS_VALUE();
+        if (!rs_isect_aabb_algo_parse(v, &o->isect_aabb))
+            return usage_error("--isect-aabb: unknown algorithm '%s'%s (use slab, branchless, "
+                               "williams, kensler or swap)",
+                               v, "");
+    } else {
+        return NOT_MINE;
+    }
+    return rc;
+}
+
+#undef NEEDS_VALUE
+
+/* The command word: sets o->command and returns 1 when argv needs no more parsing. */
+static int parse_command(int argc, char **argv, rs_cli_options *o, int *rc)
+{
+    *rc = RS_EXIT_OK;
+    if (argc < 2) {
+        o->command = RS_CMD_HELP;
+        return 1;
+    }
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
+        strcmp(argv[1], "help") == 0) {
+        o->command = RS_CMD_HELP;
+        o->scene = argc > 2 ? argv[2] : NULL; /* the command to explain */
+        return 1;
+    }
+    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
+        o->command = RS_CMD_VERSION;
+        return 1;
+    }
+    if (strcmp(argv[1], "scenes") == 0) {
+        o->command = RS_CMD_SCENES;
+        return 1;
+    }
+    if (strcmp(argv[1], "render") != 0) {
+        *rc = usage_error("unknown command '%s'%s", argv[1], "");
+        return 1;
+    }
+    return 0;
+}
+
+/* What no single option can check: combinations, and the defaults that depend on them. */
+static int check_render_options(rs_cli_options *o)
+{
+    if (o->megakernel && !o->devices_auto && o->n_devices > 1)
+        return usage_error("--integrator megakernel runs on one device%s%s (use --devices cpu or "
+                           "--devices gpu[:INDEX])",
+                           "", "");
+    if (o->bvh_on_gpu && o->bvh.method != RS_BVH_LBVH)
+        return usage_error("--bvh-device gpu builds the lbvh only (add --bvh lbvh)%s%s", "", "");
+    if (o->mesh) {
+        if (o->scene && strcmp(o->scene, "builtin:cornell") != 0)
+            return usage_error("--mesh puts a mesh into the Cornell box; it cannot be combined "
+                               "with the scene '%s'%s",
+                               o->scene, "");
+        o->scene = "builtin:cornell-mesh";
+    }
+    if (!o->scene)
+        o->scene = "builtin:cornell";
+    return RS_EXIT_OK;
 }
 
 int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
 {
-    int i = 1;
+    int i, rc;
     memset(o, 0, sizeof *o);
     o->command = RS_CMD_RENDER;
     o->scene = NULL;
@@ -201,35 +432,15 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->waves = 0; /* auto */
     o->devices_auto = 1;
     o->n_devices = 0;
-
-    if (argc < 2) {
-        o->command = RS_CMD_HELP;
-        return RS_EXIT_OK;
-    }
-    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
-        strcmp(argv[1], "help") == 0) {
-        o->command = RS_CMD_HELP;
-        o->scene = argc > 2 ? argv[2] : NULL; /* the command to explain */
-        return RS_EXIT_OK;
-    }
-    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "version") == 0) {
-        o->command = RS_CMD_VERSION;
-        return RS_EXIT_OK;
-    }
-    if (strcmp(argv[1], "scenes") == 0) {
-        o->command = RS_CMD_SCENES;
-        return RS_EXIT_OK;
-    }
-    if (strcmp(argv[1], "render") != 0)
-        return usage_error("unknown command '%s'%s", argv[1], "");
+    if (parse_command(argc, argv, o, &rc))
+        return rc;
 
     for (i = 2; i < argc; ++i) {
         const char *a = argv[i];
         const char *eq = (a[0] == '-' && a[1] == '-') ? strchr(a, '=') : NULL;
         char name[64];
-        const char *v;
-        int rc = RS_EXIT_OK;
         size_t len = eq ? (size_t)(eq - a) : strlen(a);
+        opt_arg x;
         if (len >= sizeof name)
             len = sizeof name - 1;
         memcpy(name, a, len);
@@ -250,151 +461,17 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
             o->quiet = 1;
             continue;
         }
-#define NEEDS_VALUE()                                                                              \
-  v = take_value(argc, argv, &i, eq);                                                              \
-  if (!v)                                                                                          \
-    return usage_error("%s needs a value%s", name, "");
-        if (strcmp(name, "--scene") == 0) {
-            NEEDS_VALUE();
-            if (o->scene)
-                return usage_error("more than one scene given ('%s' and '%s')", o->scene, v);
-            o->scene = v;
-        } else if (strcmp(name, "-o") == 0 || strcmp(name, "--output") == 0) {
-            NEEDS_VALUE();
-            if (!*v)
-                return usage_error("%s needs a file name%s", name, "");
-            o->output = v;
-        } else if (strcmp(name, "--width") == 0) {
-            NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 32768, &o->width);
-        } else if (strcmp(name, "--height") == 0) {
-            NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 32768, &o->height);
-        } else if (strcmp(name, "--spp") == 0) {
-            NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 1u << 20, &o->spp);
-        } else if (strcmp(name, "--max-depth") == 0) {
-            NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 10000, &o->max_depth);
-        } else if (strcmp(name, "--seed") == 0) {
-            NEEDS_VALUE();
-            rc = parse_u64(name, v, 0, UINT64_MAX, &o->seed);
-        } else if (strcmp(name, "--threads") == 0) {
-            uint32_t t = 0;
-            NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 1024, &t);
-            o->threads = (int)t;
-        } else if (strcmp(name, "--devices") == 0) {
-            NEEDS_VALUE();
-            rc = parse_devices(v, o);
-        } else if (strcmp(name, "--sampling") == 0) {
-            NEEDS_VALUE();
-            if (!rs_sampling_parse(v, &o->sampling))
-                return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
-                                   "uniform)",
-                                   v, "");
-        } else if (strcmp(name, "--mesh") == 0) {
-            NEEDS_VALUE();
-            if (!*v)
-                return usage_error("%s needs a file name%s", name, "");
-            o->mesh = v;
-        } else if (strcmp(name, "--models") == 0) {
-            NEEDS_VALUE();
-            if (!*v)
-                return usage_error("%s needs a folder%s", name, "");
-            o->models = v;
-        } else if (strcmp(name, "--bvh") == 0) {
-            NEEDS_VALUE();
-            if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
-                fprintf(stderr, "raystream: --bvh: %s (see 'raystream render --help')\n",
-                        rs_error_message());
-                rs_error_clear();
-                return RS_EXIT_USAGE;
-            }
-        } else if (strcmp(name, "--integrator") == 0) {
-            NEEDS_VALUE();
-            if (strcmp(v, "stream") != 0 && strcmp(v, "megakernel") != 0)
-                return usage_error("--integrator: '%s'%s (use stream or megakernel)", v, "");
-            o->megakernel = v[0] == 'm';
-        } else if (strcmp(name, "--cpu-strategy") == 0) {
-            NEEDS_VALUE();
-            if (!rs_par_strategy_parse(v, &o->strategy))
-                return usage_error("--cpu-strategy: '%s'%s (use for-dynamic, columns or tasks)", v,
-                                   "");
-        } else if (strcmp(name, "--no-bvh") == 0) {
-            o->no_bvh = 1;
-        } else if (strcmp(name, "--bvh-device") == 0) {
-            NEEDS_VALUE();
-            if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)
-                return usage_error("--bvh-device: '%s'%s (use cpu or gpu)", v, "");
-            o->bvh_on_gpu = v[0] == 'g';
-        } else if (strcmp(name, "--stats") == 0) {
-            o->stats = 1;
-            continue;
-        } else if (strcmp(name, "--stats-json") == 0) {
-            NEEDS_VALUE();
-            if (!*v)
-                return usage_error("%s needs a file name%s", name, "");
-            o->stats_json = v;
-        } else if (strcmp(name, "--bvh-width") == 0) {
-            NEEDS_VALUE();
-            if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0)
-                return usage_error("--bvh-width must be 2 or 4, not '%s'%s", v, "");
-            o->bvh_width = (uint32_t)(v[0] - '0');
-        } else if (strcmp(name, "--isect-sphere") == 0) {
-            NEEDS_VALUE();
-            if (!rs_isect_sphere_algo_parse(v, &o->isect_sphere))
-                return usage_error("--isect-sphere: unknown algorithm '%s'%s (use algebraic or "
-                                   "geometric)",
-                                   v, "");
-        } else if (strcmp(name, "--isect-tri") == 0) {
-            NEEDS_VALUE();
-            if (!rs_isect_tri_algo_parse(v, &o->isect_tri))
-                return usage_error("--isect-tri: unknown algorithm '%s'%s (use moller, snyder-barr "
-                                   "or watertight)",
-                                   v, "");
-        } else if (strcmp(name, "--isect-aabb") == 0) {
-            NEEDS_VALUE();
-            if (!rs_isect_aabb_algo_parse(v, &o->isect_aabb))
-                return usage_error("--isect-aabb: unknown algorithm '%s'%s (use slab, branchless, "
-                                   "williams, kensler or swap)",
-                                   v, "");
-        } else if (strcmp(name, "--chunk-size") == 0) {
-            NEEDS_VALUE();
-            if (strcmp(v, "auto") == 0)
-                o->chunk_size = 0;
-            else
-                rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
-        } else if (strcmp(name, "--waves") == 0) {
-            NEEDS_VALUE();
-            if (strcmp(v, "auto") == 0)
-                o->waves = 0;
-            else
-                rc = parse_u32(name, v, 1, 4, &o->waves);
-        } else if (strcmp(name, "--wave-size") == 0) {
-            NEEDS_VALUE();
-            rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
-        } else {
+        x.argc = argc;
+        x.argv = argv;
+        x.i = &i;
+        x.eq = eq;
+        x.name = name;
+        if ((rc = parse_image_option(&x, o)) == NOT_MINE &&
+            (rc = parse_engine_option(&x, o)) == NOT_MINE &&
+            (rc = parse_accel_option(&x, o)) == NOT_MINE)
             return usage_error("unknown option '%s'%s", a, "");
-        }
-#undef NEEDS_VALUE
         if (rc != RS_EXIT_OK)
             return rc;
     }
-    if (o->megakernel && !o->devices_auto && o->n_devices > 1)
-        return usage_error("--integrator megakernel runs on one device%s%s (use --devices cpu or "
-                           "--devices gpu[:INDEX])",
-                           "", "");
-    if (o->bvh_on_gpu && o->bvh.method != RS_BVH_LBVH)
-        return usage_error("--bvh-device gpu builds the lbvh only (add --bvh lbvh)%s%s", "", "");
-    if (o->mesh) {
-        if (o->scene && strcmp(o->scene, "builtin:cornell") != 0)
-            return usage_error("--mesh puts a mesh into the Cornell box; it cannot be combined "
-                               "with the scene '%s'%s",
-                               o->scene, "");
-        o->scene = "builtin:cornell-mesh";
-    }
-    if (!o->scene)
-        o->scene = "builtin:cornell";
-    return RS_EXIT_OK;
+    return check_render_options(o);
 }

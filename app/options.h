@@ -57,6 +57,7 @@ typedef struct rs_cli_options {
     int no_bvh;               /* --no-bvh: every ray tests every primitive */
     int stats;                /* --stats: a per-device table after the render */
     const char *stats_json;   /* --stats-json FILE */
+    const char *timeline;     /* --timeline FILE.svg */
 } rs_cli_options;
 
 /* Parses argv.  Returns RS_EXIT_OK, or RS_EXIT_USAGE after printing one line naming the

@@ -9,7 +9,7 @@
 
 #include "core/cores.h"
 #include "cpu/cpu_device.h"
-#include "cpu/megakernel.h"
+#include "scheduler/passes.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/render.h"
@@ -88,12 +88,21 @@ static inline int br_render(const char *prog, const rs_scene *scene, const rs_ge
     if (rs_film_create(c->width, c->height, &film) != RS_OK)
         goto out;
     if (c->megakernel) {
-        rs_megakernel_opts mo;
-        memset(&mo, 0, sizeof mo);
-        mo.strategy = c->strategy;
-        mo.bvh_width = c->bvh_width;
-        mo.device = c->with_gpu ? RS_MK_CUDA : RS_MK_CPU; /* CUDA device 0 */
-        rst = rs_render_megakernel(scene, g, bvh, &st, &mo, NULL, film, stats);
+        /* one device: CUDA device 0, or the CPU device with every thread */
+        if (c->with_gpu) {
+            if (rs_gpu_device_create(0, &devs[0]) != RS_OK)
+                goto out;
+        } else {
+            memset(&co, 0, sizeof co);
+            co.threads = c->threads;
+            co.bvh_width = c->bvh_width;
+            co.strategy = c->strategy;
+            if (rs_cpu_device_create_opts(&co, &devs[0]) != RS_OK)
+                goto out;
+        }
+        if (rs_device_upload(devs[0], g, bvh) != RS_OK)
+            goto out;
+        rst = rs_render_passes(scene, devs[0], &st, NULL, film, stats);
     } else {
         memset(&co, 0, sizeof co);
         co.threads = c->with_gpu && c->threads > 1 ? c->threads - 1 : c->threads;

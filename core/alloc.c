@@ -6,6 +6,15 @@
 #include <string.h>
 
 static atomic_long g_fail_after = -1;
+static rs_alloc_observer g_observer; /* a test hook: set while single-threaded (alloc.h) */
+static void *g_observer_user;
+
+static void *observed(void *p, size_t bytes)
+{
+    if (p && g_observer)
+        g_observer(g_observer_user, p, bytes ? bytes : 1);
+    return p;
+}
 
 int rs_mul_size(size_t a, size_t b, size_t *out)
 {
@@ -30,7 +39,7 @@ void *rs_alloc(size_t n, size_t size)
     size_t bytes;
     if (!rs_mul_size(n, size, &bytes) || should_fail())
         return NULL;
-    return malloc(bytes ? bytes : 1);
+    return observed(malloc(bytes ? bytes : 1), bytes);
 }
 
 void *rs_calloc(size_t n, size_t size)
@@ -38,7 +47,7 @@ void *rs_calloc(size_t n, size_t size)
     size_t bytes;
     if (!rs_mul_size(n, size, &bytes) || should_fail())
         return NULL;
-    return calloc(bytes ? n : 1, bytes ? size : 1);
+    return observed(calloc(bytes ? n : 1, bytes ? size : 1), bytes);
 }
 
 void *rs_alloc_aligned(size_t n, size_t size)
@@ -50,9 +59,20 @@ void *rs_alloc_aligned(size_t n, size_t size)
     bytes = (bytes + 63) & ~(size_t)63;
     if (posix_memalign(&p, 64, bytes ? bytes : 64) != 0)
         return NULL;
-    return p;
+    return observed(p, bytes ? bytes : 64);
 }
 
-void rs_free(void *p) { free(p); }
+void rs_free(void *p)
+{
+    if (p && g_observer)
+        g_observer(g_observer_user, p, 0);
+    free(p);
+}
+
+void rs_alloc_set_observer(rs_alloc_observer fn, void *user)
+{
+    g_observer_user = user;
+    g_observer = fn;
+}
 
 void rs_alloc_fail_after(long n) { atomic_store(&g_fail_after, n < 0 ? -1 : n); }

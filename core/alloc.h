@@ -19,6 +19,13 @@ void *rs_alloc_aligned(size_t n, size_t size);
 void rs_free(void *p);
 /* Test hook: the allocation after the next `n` ones fails; n < 0 switches failures off. */
 void rs_alloc_fail_after(long n);
+/* Test hook: fn(user, p, bytes) after every allocation that succeeds (bytes >= 1, the block's
+ * usable size as asked for; 1 for a zero-byte request), and fn(user, p, 0) from rs_free(p) for
+ * p != NULL before p is freed.  NULL switches it off.  Set it only while no other thread
+ * allocates; fn is called from whatever thread allocates, so it must be thread-safe where the
+ * code it observes allocates on several threads. */
+typedef void (*rs_alloc_observer)(void *user, void *p, size_t bytes);
+void rs_alloc_set_observer(rs_alloc_observer fn, void *user);
 /* Overflow-checked a * b; returns 0 and leaves *out alone on overflow. */
 int rs_mul_size(size_t a, size_t b, size_t *out);
 #ifdef __cplusplus

@@ -23,6 +23,15 @@ typedef struct rs_geom {
     uint32_t n_spheres, n_quads, n_tris;
 } rs_geom;
 
+/* Every array of rs_geom, with its element count (`g` a pointer to the geometry; the element
+ * size is the field's own; a NULL array is copied as NULL).  A device's copy of the geometry
+ * (scheduler/device_copy.h) is made from this list: a new array of rs_geom goes here. */
+#define RS_GEOM_ARRAYS(X, g)                                                                       \
+  X(spheres, (size_t)(g)->n_spheres)                                                               \
+  X(sphere_motion, (size_t)(g)->n_spheres)                                                         \
+  X(quads, (size_t)(g)->n_quads)                                                                   \
+  X(tris, (size_t)(g)->n_tris)
+
 /* Centre of sphere i at `time`. */
 RS_HD rs_vec3 rs_geom_sphere_center(const rs_geom *g, uint32_t i, float time)
 {

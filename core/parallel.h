@@ -43,10 +43,16 @@ typedef void (*rs_par_body)(void *ctx, uint32_t begin, uint32_t end);
 
 /* Calls body(ctx, b, e) over disjoint ranges covering [begin, end) on up to `threads` threads as
  * `s` says; the body must not care how the range is cut.  One thread or one block: a plain call. */
+#ifdef __cplusplus
+extern "C" {
+#endif
 void rs_parallel_range(rs_par_strategy s, int threads, uint32_t begin, uint32_t end, uint32_t grain,
                        rs_par_body body, void *ctx);
 /* "for-dynamic", "columns", "tasks"; 0 for an unknown name. */
 int rs_par_strategy_parse(const char *name, rs_par_strategy *out);
 const char *rs_par_strategy_name(rs_par_strategy s);
+#ifdef __cplusplus
+}
+#endif
 
 #endif

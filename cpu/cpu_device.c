@@ -1,23 +1,13 @@
 /* cpu/cpu_device.c — see cpu_device.h.  Borrows the host scene and BVH arrays (no copy); owns
- * only the 4-wide tree it collapses from the BVH. */
+ * only the 4-wide tree it collapses from the BVH.  Its megakernel is cpu/cpu_megakernel.c. */
 #include "cpu/cpu_device.h"
 
 #include <stdio.h>
 #include <string.h>
 
-#include "accel/bvh4.h"
 #include "core/alloc.h"
 #include "core/parallel.h"
-
-typedef struct cpu_impl {
-    rs_geom geom;
-    rs_bvh_view bvh;
-    rs_bvh4 *bvh4; /* NULL: the binary kernel */
-    uint32_t width;
-    rs_cores *cores;
-    rs_par_strategy strategy;
-    int uploaded;
-} cpu_impl;
+#include "cpu/internal.h"
 
 static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
 {
@@ -70,7 +60,12 @@ static void cpu_destroy(rs_device *d)
     rs_free(d);
 }
 
-static const rs_device_ops cpu_ops = {cpu_upload, cpu_trace, cpu_destroy};
+static const rs_device_ops cpu_ops = {
+    .upload = cpu_upload,
+    .trace = cpu_trace,
+    .destroy = cpu_destroy,
+    .render_pass = rs_cpu_render_pass, /* host memory, no scene copy: no pass_begin */
+};
 
 rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
 {

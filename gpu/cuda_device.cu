@@ -1,19 +1,23 @@
-/* gpu/cuda_device.cu — the CUDA device: the scene and BVH are uploaded once (cudaMalloc, no
- * managed memory); each chunk is copied in, traced by a kernel that is a thin shell around the
- * shared RS_HD traversal (accel/trace.h, the very code the CPU device runs; closest hit or any
- * hit by the batch's kind), and copied out, in pieces pipelined over two CUDA streams with pinned
- * double buffers.
+/* gpu/cuda_device.cu — the CUDA device: the geometry and BVH are copied once at upload
+ * (scheduler/device_copy.h through cudaMalloc + cudaMemcpy, no managed memory, ended with a
+ * device synchronisation); each chunk is copied in, traced by a kernel that is a thin shell
+ * around the shared RS_HD traversal (accel/trace.h, the very code the CPU device runs; closest
+ * hit or any hit by the batch's kind), and copied out, in pieces pipelined over two CUDA streams.
+ * A chunk of a batch from host_alloc (pinned) is copied by DMA straight from and to the batch's
+ * arrays; any other is packed into the stage's pinned buffers first.  The megakernel
+ * (pass_begin, render_pass) is gpu/cuda_megakernel.cu; the state both share is gpu/internal.h.
  *
- * Every CUDA call is checked against its own return value and reported with the call's text,
- * file and line.  Launch sizes come from the occupancy API, not hand-tuned constants. */
-#include "gpu/gpu_device.h"
+ * Every CUDA call that can fail is checked against its own return value (CUDA_TRY, kernel
+ * launches through cudaLaunchKernel) and reported with the call's text, file and line; release
+ * paths (cudaFree, cudaFreeHost, cudaStreamDestroy) have nobody to report to and ignore theirs.
+ * Launch sizes come from the occupancy API, not hand-tuned constants. */
+#include "gpu/internal.h"
 
-#include <cuda_runtime.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "core/alloc.h"
-#include "gpu/cuda_check.h"
+#include "scheduler/sched.h"
 
 __global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
 {
@@ -22,46 +26,70 @@ __global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
         rs_trace_one(&b, &g, &batch, i);
 }
 
-/* One of the two staging sets a chunk's pieces alternate between: pinned host buffers (so the
- * copies are asynchronous DMA), device buffers, and a stream.  While one piece's rays are copied
- * in, traced and copied out on one stream, the host packs the next piece into the other set's
- * pinned buffers, and the other stream's copies overlap this one's kernel. */
-typedef struct stage {
-    cudaStream_t stream;
-    rs_ray_soa h_rays, d_rays;
-    rs_hit_soa h_hits, d_hits;
-    uint8_t *h_occ, *d_occ;
-    uint32_t begin, n; /* the piece in flight: rays [begin, begin + n) of the batch */
-    int pending;
-} stage;
+/* ---- the mirror ops: device memory for device_copy ---------------------------------------- */
 
-#define RS_CUDA_STAGES    2
-#define RS_CUDA_MIN_PIECE 32768u /* pieces smaller than this are not worth a stream switch */
+static rs_status copy_to_device(void *dst, const void *src, size_t bytes)
+{
+    CUDA_TRY(cudaMemcpy(dst, src, bytes, cudaMemcpyHostToDevice));
+    return RS_OK;
+}
 
-typedef struct cuda_impl {
-    int ordinal;
-    rs_geom geom;    /* device pointers */
-    rs_bvh_view bvh; /* device pointers */
-    stage st[RS_CUDA_STAGES];
-    uint32_t cap; /* entries per staging set */
-    int block;    /* threads per block from the occupancy API */
-} cuda_impl;
+static rs_status cuda_copy(void *user, void **dst, const void *src, size_t bytes)
+{
+    rs_status st;
+    (void)user;
+    *dst = NULL;
+    CUDA_TRY(cudaMalloc(dst, bytes));
+    if ((st = copy_to_device(*dst, src, bytes)) != RS_OK) {
+        (void)cudaFree(*dst);
+        *dst = NULL;
+    }
+    return st;
+}
 
-static void free_staging(cuda_impl *c)
+static void cuda_release(void *user, void *p)
+{
+    (void)user;
+    (void)cudaFree(p);
+}
+
+const rs_mirror_ops rs_cuda_mirror_ops = {cuda_copy, cuda_release, NULL};
+
+/* ---- staging ------------------------------------------------------------------------------ */
+
+/* Cuts the arrays of one staging set for `cap` rays out of `base` (NULL: only measures) and
+ * returns the bytes they take, each array 256-byte aligned. */
+static size_t stage_layout(char *base, uint32_t cap, rs_ray_soa *rays, rs_hit_soa *hits,
+                           uint8_t **occ)
+{
+    size_t off = 0;
+#define RS_CUT(ptr, type, count)                                                                   \
+  do {                                                                                             \
+    (ptr) = base ? (type *)(void *)(base + off) : NULL;                                            \
+    off += ((size_t)(count) * sizeof(type) + 255u) & ~(size_t)255u;                                \
+  } while (0);
+#define RS_CUT_RAY(type, name) RS_CUT(rays->name, type, cap)
+#define RS_CUT_HIT(type, name) RS_CUT(hits->name, type, cap)
+    RS_RAY_FIELDS(RS_CUT_RAY)
+    RS_HIT_FIELDS(RS_CUT_HIT)
+    RS_CUT(*occ, uint8_t, cap)
+#undef RS_CUT_HIT
+#undef RS_CUT_RAY
+#undef RS_CUT
+    rays->count = 0;
+    rays->capacity = cap;
+    hits->capacity = cap;
+    return off;
+}
+
+static void free_staging(rs_cuda_impl *c)
 {
     int k;
     for (k = 0; k < RS_CUDA_STAGES; ++k) {
-        stage *s = &c->st[k];
-        if (s->stream)
-            cudaStreamSynchronize(s->stream);
-#define FREE_FIELD(type, name) cudaFreeHost(s->h_rays.name), cudaFree(s->d_rays.name);
-        RS_RAY_FIELDS(FREE_FIELD)
-#undef FREE_FIELD
-#define FREE_FIELD(type, name) cudaFreeHost(s->h_hits.name), cudaFree(s->d_hits.name);
-        RS_HIT_FIELDS(FREE_FIELD)
-#undef FREE_FIELD
-        cudaFreeHost(s->h_occ);
-        cudaFree(s->d_occ);
+        rs_cuda_stage *s = &c->st[k];
+        (void)cudaFreeHost(s->h_block);
+        (void)cudaFree(s->d_block);
+        s->h_block = s->d_block = NULL;
         memset(&s->h_rays, 0, sizeof s->h_rays);
         memset(&s->d_rays, 0, sizeof s->d_rays);
         memset(&s->h_hits, 0, sizeof s->h_hits);
@@ -72,146 +100,144 @@ static void free_staging(cuda_impl *c)
     c->cap = 0;
 }
 
-static rs_status ensure_staging(cuda_impl *c, uint32_t n)
+/* Both staging sets for the largest piece of the largest chunk, once per device. */
+static rs_status make_staging(rs_cuda_impl *c)
 {
+    uint32_t cap = rs_cuda_piece_size(RS_SCHED_MAX_CHUNK);
+    rs_ray_soa r;
+    rs_hit_soa h;
+    uint8_t *o;
+    size_t bytes = stage_layout(NULL, cap, &r, &h, &o);
     int k;
-    if (n <= c->cap)
+    if (c->cap == cap)
         return RS_OK;
-    free_staging(c);
     for (k = 0; k < RS_CUDA_STAGES; ++k) {
-        stage *s = &c->st[k];
-        if (!s->stream)
-            CUDA_TRY(cudaStreamCreateWithFlags(&s->stream, cudaStreamNonBlocking));
-#define ALLOC_FIELD(type, name)                                                                    \
-  CUDA_TRY(cudaMallocHost((void **)&s->h_rays.name, n * sizeof(type)));                            \
-  CUDA_TRY(cudaMalloc((void **)&s->d_rays.name, n * sizeof(type)));
-        RS_RAY_FIELDS(ALLOC_FIELD)
-#undef ALLOC_FIELD
-#define ALLOC_FIELD(type, name)                                                                    \
-  CUDA_TRY(cudaMallocHost((void **)&s->h_hits.name, n * sizeof(type)));                            \
-  CUDA_TRY(cudaMalloc((void **)&s->d_hits.name, n * sizeof(type)));
-        RS_HIT_FIELDS(ALLOC_FIELD)
-#undef ALLOC_FIELD
-        CUDA_TRY(cudaMallocHost((void **)&s->h_occ, n));
-        CUDA_TRY(cudaMalloc((void **)&s->d_occ, n));
+        rs_cuda_stage *s = &c->st[k];
+        CUDA_TRY(cudaHostAlloc(&s->h_block, bytes, cudaHostAllocPortable));
+        CUDA_TRY(cudaMalloc(&s->d_block, bytes));
+        stage_layout((char *)s->h_block, cap, &s->h_rays, &s->h_hits, &s->h_occ);
+        stage_layout((char *)s->d_block, cap, &s->d_rays, &s->d_hits, &s->d_occ);
     }
-    c->cap = n;
+    c->cap = cap;
     return RS_OK;
 }
 
-static void free_scene(cuda_impl *c)
-{
-    cudaFree((void *)c->geom.spheres);
-    cudaFree((void *)c->geom.quads);
-    cudaFree((void *)c->geom.tris);
-    cudaFree((void *)c->bvh.nodes);
-    cudaFree((void *)c->bvh.prim_ids);
-    memset(&c->geom, 0, sizeof c->geom);
-    memset(&c->bvh, 0, sizeof c->bvh);
-}
+/* ---- upload ------------------------------------------------------------------------------- */
 
-static rs_status upload_array(void **dst, const void *src, size_t bytes, rs_device *d)
+static rs_status sync_device(void)
 {
-    *dst = NULL;
-    if (bytes == 0)
-        return RS_OK;
-    CUDA_TRY(cudaMalloc(dst, bytes));
-    CUDA_TRY(cudaMemcpy(*dst, src, bytes, cudaMemcpyHostToDevice));
-    d->stats.bytes_to_device += bytes;
+    CUDA_TRY(cudaDeviceSynchronize());
     return RS_OK;
 }
 
 static rs_status cuda_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
 {
-    cuda_impl *c = (cuda_impl *)d->impl;
+    rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
     rs_status st;
-    void *p;
     CUDA_TRY(cudaSetDevice(c->ordinal));
-    free_scene(c); /* a second upload replaces the first */
-    c->geom = *g;
-    if ((st = upload_array(&p, g->spheres, g->n_spheres * sizeof(rs_sphere), d)) != RS_OK)
+    /* a second upload replaces the first (and the megakernel's copy, which borrowed its BVH) */
+    rs_cuda_pass_release(c);
+    rs_device_geom_release(&c->geom, &rs_cuda_mirror_ops);
+    c->uploaded = 0;
+    if ((st = rs_device_copy_geom(g, bvh, &rs_cuda_mirror_ops, &c->geom)) != RS_OK)
         return st;
-    c->geom.spheres = (const rs_sphere *)p;
-    if ((st = upload_array(&p, g->quads, g->n_quads * sizeof(rs_quad), d)) != RS_OK)
+    /* the copies ran on the legacy stream; the kernels run on non-blocking streams */
+    if ((st = make_staging(c)) != RS_OK || (st = sync_device()) != RS_OK) {
+        free_staging(c);
+        rs_device_geom_release(&c->geom, &rs_cuda_mirror_ops);
         return st;
-    c->geom.quads = (const rs_quad *)p;
-    if ((st = upload_array(&p, g->tris, g->n_tris * sizeof(rs_tri), d)) != RS_OK)
-        return st;
-    c->geom.tris = (const rs_tri *)p;
-    c->bvh.n_nodes = bvh->n_nodes;
-    if ((st = upload_array(&p, bvh->nodes, bvh->n_nodes * sizeof(rs_bvh_node), d)) != RS_OK)
-        return st;
-    c->bvh.nodes = (const rs_bvh_node *)p;
-    if ((st = upload_array(&p, bvh->prim_ids, bvh->n_prims * sizeof(uint32_t), d)) != RS_OK)
-        return st;
-    c->bvh.prim_ids = (const uint32_t *)p;
+    }
+    d->stats.bytes_to_device += c->geom.made.bytes;
+    c->uploaded = 1;
     return RS_OK;
 }
 
-/* Waits for the stage's piece and copies its answers from the pinned buffers into the batch. */
-static rs_status finish_piece(rs_device *d, stage *s, const rs_trace_batch *batch)
+/* ---- trace -------------------------------------------------------------------------------- */
+
+/* Waits for the stage's piece; copies its answers from the pinned buffers into the batch unless
+ * they were copied there directly. */
+static rs_status finish_piece(rs_device *d, rs_cuda_stage *s, const rs_trace_batch *batch)
 {
     if (!s->pending)
         return RS_OK;
     s->pending = 0;
     CUDA_TRY(cudaStreamSynchronize(s->stream));
-    d->stats.bytes_from_device += rs_trace_stage_out(batch, s->begin, s->n, &s->h_hits, s->h_occ);
+    if (!s->direct)
+        d->stats.bytes_from_device +=
+            rs_trace_stage_out(batch, s->begin, s->n, &s->h_hits, s->h_occ);
+    else
+        d->stats.bytes_from_device +=
+            batch->kind == RS_TRACE_CLOSEST ? (uint64_t)s->n * RS_HIT_BYTES : s->n;
     return RS_OK;
 }
 
-/* Packs rays [begin, begin + n) into the stage's pinned buffers and queues copy in, kernel and
- * copy out on its stream. */
-static rs_status launch_piece(rs_device *d, cuda_impl *c, stage *s, const rs_trace_batch *batch,
-                              uint32_t begin, uint32_t n)
+/* Queues copy in, kernel and copy out of rays [begin, begin + n) on the stage's stream: from
+ * and to the batch's own arrays when it is pinned, else through the stage's pinned buffers
+ * (packed here). */
+static rs_status launch_piece(rs_device *d, rs_cuda_impl *c, rs_cuda_stage *s,
+                              const rs_trace_batch *batch, uint32_t begin, uint32_t n)
 {
     rs_trace_batch db;
-    uint64_t bytes = rs_trace_stage_in(&s->h_rays, batch, begin, n);
-#define COPY_IN(type, name)                                                                        \
-  CUDA_TRY(cudaMemcpyAsync(s->d_rays.name, s->h_rays.name, n * sizeof(type),                       \
+    void *args[3];
+    int direct = batch->pinned != 0;
+    const rs_ray_soa *src = direct ? &batch->rays : &s->h_rays;
+    uint32_t off = direct ? begin : 0;
+    if (!direct)
+        rs_trace_stage_in(&s->h_rays, batch, begin, n);
+#define RS_COPY_IN(type, name)                                                                     \
+  CUDA_TRY(cudaMemcpyAsync(s->d_rays.name, src->name + off, n * sizeof(type),                      \
                            cudaMemcpyHostToDevice, s->stream));
-    RS_RAY_FIELDS(COPY_IN)
-#undef COPY_IN
-    d->stats.bytes_to_device += bytes;
+    RS_RAY_FIELDS(RS_COPY_IN)
+#undef RS_COPY_IN
+    d->stats.bytes_to_device += (uint64_t)n * RS_RAY_BYTES;
     memset(&db, 0, sizeof db);
     db.kind = batch->kind;
     db.count = n;
+    db.wave = batch->wave;
     db.rays = s->d_rays;
     db.hits = s->d_hits;
     db.occluded = s->d_occ;
-    rs_trace_kernel<<<(n + c->block - 1) / c->block, c->block, 0, s->stream>>>(c->bvh, c->geom, db);
-    CUDA_TRY(cudaGetLastError());
+    args[0] = &c->geom.bvh;
+    args[1] = &c->geom.geom;
+    args[2] = &db;
+    CUDA_TRY(cudaLaunchKernel((const void *)rs_trace_kernel, dim3((n + c->block - 1) / c->block),
+                              dim3(c->block), args, 0, s->stream));
     if (batch->kind == RS_TRACE_CLOSEST) {
-#define COPY_OUT(type, name)                                                                       \
-  CUDA_TRY(cudaMemcpyAsync(s->h_hits.name, s->d_hits.name, n * sizeof(type),                       \
+        const rs_hit_soa *dst = direct ? &batch->hits : &s->h_hits;
+#define RS_COPY_OUT(type, name)                                                                    \
+  CUDA_TRY(cudaMemcpyAsync(dst->name + off, s->d_hits.name, n * sizeof(type),                      \
                            cudaMemcpyDeviceToHost, s->stream));
-        RS_HIT_FIELDS(COPY_OUT)
-#undef COPY_OUT
+        RS_HIT_FIELDS(RS_COPY_OUT)
+#undef RS_COPY_OUT
     } else {
-        CUDA_TRY(cudaMemcpyAsync(s->h_occ, s->d_occ, n, cudaMemcpyDeviceToHost, s->stream));
+        uint8_t *dst = direct ? batch->occluded + begin : s->h_occ;
+        CUDA_TRY(cudaMemcpyAsync(dst, s->d_occ, n, cudaMemcpyDeviceToHost, s->stream));
     }
     s->begin = begin;
     s->n = n;
+    s->direct = direct;
     s->pending = 1;
     return RS_OK;
 }
 
-/* A chunk is cut into pieces (up to 4, none under RS_CUDA_MIN_PIECE rays) that alternate between
- * the two stages: piece k + 1 is packed and queued while piece k runs. */
+/* A chunk is cut into pieces (up to 4 of a chunk of at most RS_SCHED_MAX_CHUNK rays, none under
+ * RS_CUDA_MIN_PIECE, none over the staging) that alternate between the two stages: piece k + 1
+ * is packed and queued while piece k runs.  Every piece queued is waited for, also on failure. */
 static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
 {
-    cuda_impl *c = (cuda_impl *)d->impl;
+    rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
     uint32_t n = end - begin, piece, off, k;
     rs_status st = RS_OK;
+    if (!c->uploaded)
+        return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
     if (n == 0)
         return RS_OK;
     CUDA_TRY(cudaSetDevice(c->ordinal));
-    piece = (n + 3) / 4;
-    if (piece < RS_CUDA_MIN_PIECE)
-        piece = n < RS_CUDA_MIN_PIECE ? n : RS_CUDA_MIN_PIECE;
-    if ((st = ensure_staging(c, piece)) != RS_OK)
-        return st;
+    piece = rs_cuda_piece_size(n);
+    if (piece > c->cap)
+        piece = c->cap; /* a fixed chunk size above RS_SCHED_MAX_CHUNK: more pieces */
     for (off = begin, k = 0; off < end && st == RS_OK; off += piece, ++k) {
-        stage *s = &c->st[k % RS_CUDA_STAGES];
+        rs_cuda_stage *s = &c->st[k % RS_CUDA_STAGES];
         uint32_t m = end - off < piece ? end - off : piece;
         if ((st = finish_piece(d, s, batch)) == RS_OK)
             st = launch_piece(d, c, s, batch, off, m);
@@ -224,23 +250,55 @@ static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t 
     return st;
 }
 
+/* ---- host memory, destroy, create --------------------------------------------------------- */
+
+static rs_status host_alloc_on(int ordinal, void **p, size_t bytes)
+{
+    CUDA_TRY(cudaSetDevice(ordinal));
+    CUDA_TRY(cudaHostAlloc(p, bytes, cudaHostAllocPortable));
+    return RS_OK;
+}
+
+/* Page-locked (portable), page-aligned; NULL with the CUDA error recorded when it fails. */
+static void *cuda_host_alloc(rs_device *d, size_t bytes)
+{
+    rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
+    void *p = NULL;
+    if (host_alloc_on(c->ordinal, &p, bytes ? bytes : 1) != RS_OK)
+        return NULL;
+    return p;
+}
+
+static void cuda_host_free(rs_device *d, void *p)
+{
+    (void)d;
+    if (p)
+        (void)cudaFreeHost(p);
+}
+
 static void cuda_destroy(rs_device *d)
 {
-    cuda_impl *c = (cuda_impl *)d->impl;
+    rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
     if (c) {
         int k;
-        cudaSetDevice(c->ordinal);
-        free_staging(c);
+        (void)cudaSetDevice(c->ordinal);
         for (k = 0; k < RS_CUDA_STAGES; ++k)
             if (c->st[k].stream)
-                cudaStreamDestroy(c->st[k].stream);
-        free_scene(c);
+                (void)cudaStreamSynchronize(c->st[k].stream);
+        rs_cuda_pass_release(c);
+        free_staging(c);
+        rs_device_geom_release(&c->geom, &rs_cuda_mirror_ops);
+        for (k = 0; k < RS_CUDA_STAGES; ++k)
+            if (c->st[k].stream)
+                (void)cudaStreamDestroy(c->st[k].stream);
         rs_free(c);
     }
     rs_free(d);
 }
 
-static const rs_device_ops cuda_ops = {cuda_upload, cuda_trace, cuda_destroy};
+static const rs_device_ops cuda_ops = {cuda_upload,        cuda_trace,     cuda_destroy,
+                                       cuda_host_alloc,    cuda_host_free, rs_cuda_pass_begin,
+                                       rs_cuda_render_pass};
 
 extern "C" int rs_gpu_compiled(void) { return 1; }
 
@@ -260,13 +318,22 @@ extern "C" int rs_gpu_count(const char **why)
     return n;
 }
 
+static rs_status make_streams(rs_cuda_impl *c)
+{
+    int k;
+    for (k = 0; k < RS_CUDA_STAGES; ++k)
+        CUDA_TRY(cudaStreamCreateWithFlags(&c->st[k].stream, cudaStreamNonBlocking));
+    return RS_OK;
+}
+
 extern "C" rs_status rs_gpu_device_create(int index, rs_device **out)
 {
     const char *why = "";
     int n = rs_gpu_count(&why);
     cudaDeviceProp prop;
     rs_device *d;
-    cuda_impl *c;
+    rs_cuda_impl *c;
+    rs_status st;
     int min_grid = 0, block = 0;
     *out = NULL;
     if (index < 0 || index >= n)
@@ -276,7 +343,7 @@ extern "C" rs_status rs_gpu_device_create(int index, rs_device **out)
     CUDA_TRY(cudaSetDevice(index));
     CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_trace_kernel, 0, 0));
     d = (rs_device *)rs_calloc(1, sizeof *d);
-    c = (cuda_impl *)rs_calloc(1, sizeof *c);
+    c = (rs_cuda_impl *)rs_calloc(1, sizeof *c);
     if (!d || !c) {
         rs_free(d);
         rs_free(c);
@@ -286,8 +353,14 @@ extern "C" rs_status rs_gpu_device_create(int index, rs_device **out)
     c->block = block > 0 ? block : 128;
     d->ops = &cuda_ops;
     d->impl = c;
+    d->flags = RS_DEVICE_OWN_MEMORY;
     d->threads = 0;
-    snprintf(d->name, sizeof d->name, "cuda:%d (%s)", index, prop.name);
+    d->pass_samples = RS_GPU_PASS_SAMPLES;
+    snprintf(d->name, sizeof d->name, "cuda:%d (%.36s)", index, prop.name);
+    if ((st = make_streams(c)) != RS_OK) {
+        cuda_destroy(d);
+        return st;
+    }
     *out = d;
     return RS_OK;
 }

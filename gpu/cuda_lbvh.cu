@@ -9,18 +9,10 @@
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cuda_runtime.h>
+#include <string.h>
 
 #include "accel/morton.h"
-
-#define CUDA_TRY(call)                                                                             \
-  do {                                                                                             \
-    cudaError_t e_ = (call);                                                                       \
-    if (e_ != cudaSuccess) {                                                                       \
-      st = rs_error_set(RS_ERR_CUDA, "%s failed (%s:%d): %s", #call, __FILE__, __LINE__,           \
-                        cudaGetErrorString(e_));                                                   \
-      goto out;                                                                                    \
-    }                                                                                              \
-  } while (0)
+#include "gpu/cuda_check.h"
 
 typedef struct morton_frame {
     float lo[3], scale[3];
@@ -36,47 +28,67 @@ __global__ void rs_morton_kernel(const rs_vec3 *centroid, uint32_t n, morton_fra
     }
 }
 
+/* The device buffers of one sort; freed by the caller whatever happened. */
+typedef struct lbvh_bufs {
+    rs_vec3 *centroid;
+    uint32_t *codes[2], *ids[2];
+    void *temp;
+} lbvh_bufs;
+
+static rs_status lbvh_run(lbvh_bufs *b, int ordinal, const rs_vec3 *centroid, uint32_t n,
+                          morton_frame f, uint32_t *ids, uint32_t *codes)
+{
+    int min_grid = 0, block = 0, a;
+    size_t temp_bytes = 0;
+    void *args[5];
+    CUDA_TRY(cudaSetDevice(ordinal));
+    CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_morton_kernel, 0, 0));
+    CUDA_TRY(cudaMalloc((void **)&b->centroid, n * sizeof(rs_vec3)));
+    for (a = 0; a < 2; ++a) {
+        CUDA_TRY(cudaMalloc((void **)&b->codes[a], n * sizeof(uint32_t)));
+        CUDA_TRY(cudaMalloc((void **)&b->ids[a], n * sizeof(uint32_t)));
+    }
+    CUDA_TRY(cudaMemcpy(b->centroid, centroid, n * sizeof(rs_vec3), cudaMemcpyHostToDevice));
+    args[0] = &b->centroid;
+    args[1] = &n;
+    args[2] = &f;
+    args[3] = &b->codes[0];
+    args[4] = &b->ids[0];
+    CUDA_TRY(cudaLaunchKernel((const void *)rs_morton_kernel, dim3((n + block - 1) / block),
+                              dim3(block), args, 0, 0));
+    /* 30-bit keys: sort bits [0, 30) only */
+    CUDA_TRY(cub::DeviceRadixSort::SortPairs(NULL, temp_bytes, b->codes[0], b->codes[1], b->ids[0],
+                                             b->ids[1], (int)n, 0, 30));
+    CUDA_TRY(cudaMalloc(&b->temp, temp_bytes));
+    CUDA_TRY(cub::DeviceRadixSort::SortPairs(b->temp, temp_bytes, b->codes[0], b->codes[1],
+                                             b->ids[0], b->ids[1], (int)n, 0, 30));
+    CUDA_TRY(cudaMemcpy(codes, b->codes[1], n * sizeof(uint32_t), cudaMemcpyDeviceToHost));
+    CUDA_TRY(cudaMemcpy(ids, b->ids[1], n * sizeof(uint32_t), cudaMemcpyDeviceToHost));
+    return RS_OK;
+}
+
 extern "C" rs_status rs_gpu_lbvh_sort(void *user, const rs_vec3 *centroid, uint32_t n,
                                       const float lo[3], const float scale[3], uint32_t *ids,
                                       uint32_t *codes)
 {
-    int ordinal = user ? *(const int *)user : 0, min_grid = 0, block = 0, a;
-    rs_vec3 *d_centroid = NULL;
-    uint32_t *d_codes[2] = {NULL, NULL}, *d_ids[2] = {NULL, NULL};
-    void *d_temp = NULL;
-    size_t temp_bytes = 0;
+    int ordinal = user ? *(const int *)user : 0, a;
     morton_frame f;
-    rs_status st = RS_OK;
+    lbvh_bufs b;
+    rs_status st;
     if (n == 0)
         return RS_OK;
     for (a = 0; a < 3; ++a) {
         f.lo[a] = lo[a];
         f.scale[a] = scale[a];
     }
-    CUDA_TRY(cudaSetDevice(ordinal));
-    CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_morton_kernel, 0, 0));
-    CUDA_TRY(cudaMalloc((void **)&d_centroid, n * sizeof(rs_vec3)));
+    memset(&b, 0, sizeof b);
+    st = lbvh_run(&b, ordinal, centroid, n, f, ids, codes);
+    /* release: nobody to report a failed free to */
+    (void)cudaFree(b.temp);
+    (void)cudaFree(b.centroid);
     for (a = 0; a < 2; ++a) {
-        CUDA_TRY(cudaMalloc((void **)&d_codes[a], n * sizeof(uint32_t)));
-        CUDA_TRY(cudaMalloc((void **)&d_ids[a], n * sizeof(uint32_t)));
-    }
-    CUDA_TRY(cudaMemcpy(d_centroid, centroid, n * sizeof(rs_vec3), cudaMemcpyHostToDevice));
-    rs_morton_kernel<<<(n + block - 1) / block, block>>>(d_centroid, n, f, d_codes[0], d_ids[0]);
-    CUDA_TRY(cudaGetLastError());
-    /* 30-bit keys: sort bits [0, 30) only */
-    CUDA_TRY(cub::DeviceRadixSort::SortPairs(NULL, temp_bytes, d_codes[0], d_codes[1], d_ids[0],
-                                             d_ids[1], (int)n, 0, 30));
-    CUDA_TRY(cudaMalloc(&d_temp, temp_bytes));
-    CUDA_TRY(cub::DeviceRadixSort::SortPairs(d_temp, temp_bytes, d_codes[0], d_codes[1], d_ids[0],
-                                             d_ids[1], (int)n, 0, 30));
-    CUDA_TRY(cudaMemcpy(codes, d_codes[1], n * sizeof(uint32_t), cudaMemcpyDeviceToHost));
-    CUDA_TRY(cudaMemcpy(ids, d_ids[1], n * sizeof(uint32_t), cudaMemcpyDeviceToHost));
-out:
-    cudaFree(d_temp);
-    cudaFree(d_centroid);
-    for (a = 0; a < 2; ++a) {
-        cudaFree(d_codes[a]);
-        cudaFree(d_ids[a]);
+        (void)cudaFree(b.codes[a]);
+        (void)cudaFree(b.ids[a]);
     }
     return st;
 }

@@ -1,179 +1,203 @@
-/* gpu/cuda_megakernel.cu — the thesis's CUDA megakernel: one thread per pixel traces its path
- * from the camera to the end with rs_path_radiance (shading/path.h), the very function the CPU
- * megakernel and the wavefront's stages run.  The scene is mirrored into device memory once
- * (rs_scene_mirror_create with cudaMalloc + cudaMemcpy); each pass is one sample of every pixel,
- * copied back for the host to add to the film in sample order, so progress and Ctrl-C work
- * between passes and the film sums as on the CPU.
+/* gpu/cuda_megakernel.cu — the CUDA device's megakernel (its pass_begin and render_pass): the
+ * thesis's CUDA integrator, one thread per pixel tracing its path from the camera to the end
+ * with rs_path_radiance (shading/path.h), the very function the CPU megakernel and the
+ * wavefront's stages run.
  *
- * Every CUDA call is checked; the block size comes from the occupancy API. */
-#include "gpu/gpu_device.h"
+ * pass_begin copies the scene into device memory (scheduler/device_copy.h: the scene's arrays
+ * once; the tracer's geometry is the mirror's arrays with the uploaded geometry's algorithms, over
+ * the uploaded BVH copy) and makes a double buffer.  render_pass runs one kernel per sample on
+ * the device's stream and overlaps the host's film add of sample s with the kernel of sample
+ * s + 1:
+ *
+ *   launch s (kernel, copy radiance + counters to slot s&1's pinned buffers, record its event)
+ *   wait for s - 1's event, add its image to the film, read its counters, report progress
+ *   ... after the last sample (or on cancel, checked between samples): wait for and add it.
+ *
+ * Each pixel thus gets its samples in sample order, and the film sums as on the CPU.  A slot's
+ * buffers are reused only after the host has read them (its film add comes before the next
+ * launch into it).  The ray counters are reduced per warp (shuffles over a full warp; threads
+ * past the image count 0) and added with one atomic per warp. */
+#include "gpu/internal.h"
 
-#include <cuda_runtime.h>
-#include <stdio.h>
 #include <string.h>
 
-#include "core/alloc.h"
-#include "gpu/cuda_check.h"
+#include "core/parallel.h"
 
-/* Per pass: rays traced and the deepest segment, summed over the threads. */
-typedef struct mk_counts {
-    unsigned long long closest, shadow;
-    unsigned int max_bounce;
-} mk_counts;
+#define RS_WARP 32
 
-__global__ void rs_megakernel_pass_kernel(rs_integrator it, rs_path_tracer tr, uint32_t sample,
-                                          rs_vec3 *radiance, mk_counts *counts)
+__global__ void rs_megakernel_kernel(rs_integrator it, rs_path_tracer tr, uint32_t sample,
+                                     rs_vec3 *radiance, rs_cuda_mk_counts *counts)
 {
     uint32_t pixel = blockIdx.x * blockDim.x + threadIdx.x;
     rs_path_counts n;
-    if (pixel >= it.npix)
-        return;
+    unsigned long long closest, shadow;
+    unsigned int max_bounce;
+    int off;
     n.closest = n.shadow = 0;
     n.max_bounce = 0;
-    radiance[pixel] = rs_path_radiance(&it, &tr, (uint64_t)sample * it.npix + pixel, &n);
-    atomicAdd(&counts->closest, (unsigned long long)n.closest);
-    atomicAdd(&counts->shadow, (unsigned long long)n.shadow);
-    atomicMax(&counts->max_bounce, n.max_bounce);
-}
-
-struct rs_gpu_megakernel {
-    int ordinal;
-    char name[96];
-    rs_scene_mirror mirror; /* device copies of the scene's arrays */
-    rs_scene *d_scene;      /* the mirror's struct on the device */
-    rs_integrator it;       /* it.scene = d_scene */
-    rs_path_tracer tracer;  /* device pointers: the mirror's geometry, the BVH below */
-    void *d_nodes, *d_prim_ids;
-    rs_vec3 *d_radiance;
-    mk_counts *d_counts;
-    int block;
-    uint64_t bytes;
-};
-
-static rs_status cuda_copy(void *user, void **dst, const void *src, size_t bytes)
-{
-    (void)user;
-    *dst = NULL;
-    CUDA_TRY(cudaMalloc(dst, bytes));
-    if (cudaMemcpy(*dst, src, bytes, cudaMemcpyHostToDevice) != cudaSuccess) {
-        cudaFree(*dst);
-        *dst = NULL;
-        return rs_error_set(RS_ERR_CUDA, "copying %zu bytes of the scene to the GPU failed", bytes);
+    /* no early return: every lane of the warp takes part in the shuffles below */
+    if (pixel < it.npix)
+        radiance[pixel] = rs_path_radiance(&it, &tr, (uint64_t)sample * it.npix + pixel, &n);
+    closest = n.closest;
+    shadow = n.shadow;
+    max_bounce = n.max_bounce;
+    for (off = RS_WARP / 2; off > 0; off /= 2) {
+        closest += __shfl_down_sync(0xffffffffu, closest, off);
+        shadow += __shfl_down_sync(0xffffffffu, shadow, off);
+        max_bounce = max(max_bounce, __shfl_down_sync(0xffffffffu, max_bounce, off));
     }
-    return RS_OK;
+    if ((threadIdx.x & (RS_WARP - 1)) == 0) {
+        atomicAdd(&counts->closest, closest);
+        atomicAdd(&counts->shadow, shadow);
+        atomicMax(&counts->max_bounce, max_bounce);
+    }
 }
 
-static void cuda_release(void *user, void *p)
+void rs_cuda_pass_release(rs_cuda_impl *c)
 {
-    (void)user;
-    cudaFree(p);
+    rs_cuda_mk *mk = &c->mk;
+    int k;
+    for (k = 0; k < 2; ++k) {
+        rs_cuda_mk_slot *sl = &mk->slot[k];
+        if (sl->done)
+            (void)cudaEventSynchronize(sl->done);
+        (void)cudaFree(sl->d_rad);
+        (void)cudaFree(sl->d_cnt);
+        if (sl->h_rad)
+            (void)cudaFreeHost(sl->h_rad);
+        if (sl->h_cnt)
+            (void)cudaFreeHost(sl->h_cnt);
+        if (sl->done)
+            (void)cudaEventDestroy(sl->done);
+    }
+    rs_device_scene_release(&mk->copy, &rs_cuda_mirror_ops);
+    memset(mk, 0, sizeof *mk);
 }
 
-static const rs_mirror_ops cuda_mirror_ops = {cuda_copy, cuda_release, NULL};
-
-extern "C" void rs_gpu_megakernel_destroy(rs_gpu_megakernel *m)
+/* Everything pass_begin makes; on failure the caller releases what was made. */
+static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_integrator *it)
 {
-    if (!m)
-        return;
-    cudaSetDevice(m->ordinal);
-    rs_scene_mirror_release(&m->mirror, &cuda_mirror_ops);
-    cudaFree(m->d_scene);
-    cudaFree(m->d_nodes);
-    cudaFree(m->d_prim_ids);
-    cudaFree(m->d_radiance);
-    cudaFree(m->d_counts);
-    rs_free(m);
-}
-
-static rs_status upload(rs_gpu_megakernel *m, const rs_scene *scene, const rs_geom *g,
-                        const rs_bvh *bvh, const rs_integrator *it)
-{
+    rs_cuda_mk *mk = &c->mk;
+    size_t image = (size_t)it->npix * sizeof(rs_vec3);
+    int min_grid = 0, block = 0, k;
     rs_status st;
-    const rs_scene *d;
-    size_t nodes = (size_t)bvh->n_nodes * sizeof(rs_bvh_node),
-           ids = (size_t)bvh->n_prims * sizeof(uint32_t);
-    if ((st = rs_scene_mirror_create(scene, &cuda_mirror_ops, &m->mirror)) != RS_OK)
+    CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_megakernel_kernel, 0, 0));
+    /* whole warps only: the counters' shuffles need every lane */
+    block -= block % RS_WARP;
+    mk->block = block >= RS_WARP ? block : RS_WARP;
+    if ((st = rs_device_copy_scene(scene, &c->geom, &rs_cuda_mirror_ops, &mk->copy)) != RS_OK)
         return st;
-    d = &m->mirror.scene;
-    CUDA_TRY(cudaMalloc((void **)&m->d_scene, sizeof(rs_scene)));
-    CUDA_TRY(cudaMemcpy(m->d_scene, d, sizeof(rs_scene), cudaMemcpyHostToDevice));
-    if (nodes) {
-        CUDA_TRY(cudaMalloc(&m->d_nodes, nodes));
-        CUDA_TRY(cudaMemcpy(m->d_nodes, bvh->nodes, nodes, cudaMemcpyHostToDevice));
+    mk->it = *it;
+    mk->it.scene = mk->copy.scene;
+    for (k = 0; k < 2; ++k) {
+        rs_cuda_mk_slot *sl = &mk->slot[k];
+        CUDA_TRY(cudaMalloc((void **)&sl->d_rad, image));
+        CUDA_TRY(cudaMalloc((void **)&sl->d_cnt, sizeof *sl->d_cnt));
+        CUDA_TRY(cudaHostAlloc((void **)&sl->h_rad, image, cudaHostAllocPortable));
+        CUDA_TRY(cudaHostAlloc((void **)&sl->h_cnt, sizeof *sl->h_cnt, cudaHostAllocPortable));
+        CUDA_TRY(cudaEventCreateWithFlags(&sl->done, cudaEventDisableTiming));
     }
-    if (ids) {
-        CUDA_TRY(cudaMalloc(&m->d_prim_ids, ids));
-        CUDA_TRY(cudaMemcpy(m->d_prim_ids, bvh->prim_ids, ids, cudaMemcpyHostToDevice));
-    }
-    CUDA_TRY(cudaMalloc((void **)&m->d_radiance, (size_t)it->npix * sizeof(rs_vec3)));
-    CUDA_TRY(cudaMalloc((void **)&m->d_counts, sizeof(mk_counts)));
-    m->bytes = m->mirror.bytes + sizeof(rs_scene) + nodes + ids;
-    m->it = *it;
-    m->it.scene = m->d_scene;
-    /* the render's geometry (its intersection algorithms, its shutter) over the mirror's arrays */
-    m->tracer.geom = *g;
-    m->tracer.geom.spheres = d->spheres;
-    m->tracer.geom.sphere_motion = d->sphere_motion;
-    m->tracer.geom.quads = d->quads;
-    m->tracer.geom.tris = d->tris;
-    m->tracer.bvh.nodes = (const rs_bvh_node *)m->d_nodes;
-    m->tracer.bvh.prim_ids = (const uint32_t *)m->d_prim_ids;
-    m->tracer.bvh.n_nodes = bvh->n_nodes;
-    m->tracer.bvh4 = NULL;
+    /* the scene was copied on the legacy stream; the kernels run on the device's own */
+    CUDA_TRY(cudaDeviceSynchronize());
     return RS_OK;
 }
 
-extern "C" rs_status rs_gpu_megakernel_create(int index, const rs_scene *scene, const rs_geom *g,
-                                              const rs_bvh *bvh, const rs_integrator *it,
-                                              rs_gpu_megakernel **out)
+rs_status rs_cuda_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it)
 {
-    const char *why = "";
-    int n = rs_gpu_count(&why), min_grid = 0, block = 0;
-    cudaDeviceProp prop;
-    rs_gpu_megakernel *m;
+    rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
     rs_status st;
-    *out = NULL;
-    if (index < 0 || index >= n)
-        return rs_error_set(RS_ERR_DEVICE_LOST, "gpu:%d: not available (%s)", index,
-                            n == 0 ? why : "index out of range");
-    CUDA_TRY(cudaGetDeviceProperties(&prop, index));
-    CUDA_TRY(cudaSetDevice(index));
+    CUDA_TRY(cudaSetDevice(c->ordinal));
+    rs_cuda_pass_release(c);
+    if (!c->uploaded)
+        return rs_error_set(RS_ERR_ARG, "device %s: pass_begin before upload", d->name);
+    if (it->npix == 0)
+        return rs_error_set(RS_ERR_ARG, "device %s: a pass of no pixels", d->name);
+    if ((st = pass_make(c, scene, it)) != RS_OK) {
+        rs_cuda_pass_release(c);
+        return st;
+    }
+    d->stats.bytes_to_device += c->mk.copy.mirror.made.bytes;
+    c->mk.ready = 1;
+    return RS_OK;
+}
+
+/* Queues sample s into slot sl on `stream`: counters zeroed, kernel, both copies, event. */
+static rs_status launch_sample(rs_cuda_mk *mk, rs_cuda_mk_slot *sl, uint32_t s, cudaStream_t stream)
+{
+    uint32_t npix = mk->it.npix, grid = (npix + mk->block - 1) / mk->block;
+    void *args[5];
+    args[0] = &mk->it;
+    args[1] = &mk->copy.tracer;
+    args[2] = &s;
+    args[3] = &sl->d_rad;
+    args[4] = &sl->d_cnt;
+    CUDA_TRY(cudaMemsetAsync(sl->d_cnt, 0, sizeof *sl->d_cnt, stream));
+    CUDA_TRY(cudaLaunchKernel((const void *)rs_megakernel_kernel, dim3(grid), dim3(mk->block), args,
+                              0, stream));
+    CUDA_TRY(cudaMemcpyAsync(sl->h_rad, sl->d_rad, (size_t)npix * sizeof(rs_vec3),
+                             cudaMemcpyDeviceToHost, stream));
     CUDA_TRY(
-        cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_megakernel_pass_kernel, 0, 0));
-    m = (rs_gpu_megakernel *)rs_calloc(1, sizeof *m);
-    if (!m)
-        return rs_error_set(RS_ERR_NOMEM, "out of memory creating the CUDA megakernel");
-    m->ordinal = index;
-    m->block = block > 0 ? block : 128;
-    snprintf(m->name, sizeof m->name, "cuda:%d (%s)", index, prop.name);
-    if ((st = upload(m, scene, g, bvh, it)) != RS_OK) {
-        rs_gpu_megakernel_destroy(m);
-        return st;
-    }
-    *out = m;
+        cudaMemcpyAsync(sl->h_cnt, sl->d_cnt, sizeof *sl->h_cnt, cudaMemcpyDeviceToHost, stream));
+    CUDA_TRY(cudaEventRecord(sl->done, stream));
+    sl->sample = s;
+    sl->pending = 1;
     return RS_OK;
 }
 
-extern "C" rs_status rs_gpu_megakernel_pass(rs_gpu_megakernel *m, uint32_t sample,
-                                            rs_vec3 *radiance, rs_path_counts *n)
+/* Waits for slot sl's sample; with `add`, puts it on the film, its counters into *counts and
+ * reports its paths.  Without (after a failure), only waits, so the buffers are free. */
+static rs_status finish_sample(rs_device *d, rs_cuda_mk_slot *sl, const rs_pass_job *job,
+                               rs_path_counts *counts, int add)
 {
-    mk_counts c;
-    uint32_t npix = m->it.npix;
-    CUDA_TRY(cudaSetDevice(m->ordinal));
-    CUDA_TRY(cudaMemset(m->d_counts, 0, sizeof(mk_counts)));
-    rs_megakernel_pass_kernel<<<(npix + m->block - 1) / m->block, m->block>>>(
-        m->it, m->tracer, sample, m->d_radiance, m->d_counts);
-    CUDA_TRY(cudaGetLastError());
-    CUDA_TRY(cudaMemcpy(radiance, m->d_radiance, (size_t)npix * sizeof(rs_vec3),
-                        cudaMemcpyDeviceToHost));
-    CUDA_TRY(cudaMemcpy(&c, m->d_counts, sizeof c, cudaMemcpyDeviceToHost));
-    n->closest += c.closest;
-    n->shadow += c.shadow;
-    if (c.max_bounce > n->max_bounce)
-        n->max_bounce = c.max_bounce;
+    uint32_t npix = ((rs_cuda_impl *)d->impl)->mk.it.npix;
+    if (!sl->pending)
+        return RS_OK;
+    sl->pending = 0;
+    CUDA_TRY(cudaEventSynchronize(sl->done));
+    if (!add)
+        return RS_OK;
+    /* the host is otherwise idle while the GPU runs the next sample: every core adds */
+    rs_film_add_image(job->film, sl->h_rad, rs_cpu_count());
+    counts->closest += sl->h_cnt->closest;
+    counts->shadow += sl->h_cnt->shadow;
+    if (sl->h_cnt->max_bounce > counts->max_bounce)
+        counts->max_bounce = sl->h_cnt->max_bounce;
+    d->stats.bytes_from_device += (uint64_t)npix * sizeof(rs_vec3) + sizeof *sl->h_cnt;
+    if (job->progress)
+        job->progress(job->user, npix);
     return RS_OK;
 }
 
-extern "C" const char *rs_gpu_megakernel_name(const rs_gpu_megakernel *m) { return m->name; }
-
-extern "C" uint64_t rs_gpu_megakernel_bytes(const rs_gpu_megakernel *m) { return m->bytes; }
+rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
+                              rs_path_counts *counts)
+{
+    rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
+    rs_cuda_mk *mk = &c->mk;
+    cudaStream_t stream = c->st[0].stream;
+    rs_status st = RS_OK;
+    uint32_t s;
+    int k;
+    if (!mk->ready)
+        return rs_error_set(RS_ERR_ARG, "device %s: render_pass before pass_begin", d->name);
+    if (job->film->width * job->film->height != mk->it.npix)
+        return rs_error_set(RS_ERR_ARG, "device %s: the film is not the pass_begin's image size",
+                            d->name);
+    CUDA_TRY(cudaSetDevice(c->ordinal));
+    for (s = s0; s - s0 < n && st == RS_OK; ++s) {
+        rs_cuda_mk_slot *cur = &mk->slot[s & 1], *prev = &mk->slot[(s & 1) ^ 1];
+        if (job->cancelled && job->cancelled(job->user))
+            break;
+        /* cur was finished (or never used) before: its film add is done */
+        if ((st = launch_sample(mk, cur, s, stream)) == RS_OK)
+            st = finish_sample(d, prev, job, counts, 1);
+    }
+    /* the last sample launched (both slots, oldest first, after a failure) */
+    for (k = 0; k < 2; ++k) {
+        rs_cuda_mk_slot *a = &mk->slot[0], *b = &mk->slot[1];
+        rs_cuda_mk_slot *first = a->pending && (!b->pending || a->sample < b->sample) ? a : b;
+        rs_status fs = finish_sample(d, first, job, counts, st == RS_OK);
+        if (st == RS_OK)
+            st = fs;
+    }
+    return st;
+}

@@ -205,24 +205,64 @@ rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg,
 rs_status rs_scene_finalize(rs_scene *s);
 
 /* A copy of a finalized scene's arrays in memory that `ops` allocates and fills: the host's, or
- * a CUDA device's for the megakernel (gpu/cuda_megakernel.cu), whose shading code then reads
- * `scene` exactly as the host reads the original.  `scene` is a host struct holding the copies'
- * pointers (copy it to the device as it is); every block made is listed, so the mirror can be
- * released without reading device memory. */
+ * a CUDA device's for the megakernel (scheduler/device_copy.h builds both), whose shading code
+ * then reads `scene` exactly as the host reads the original.  `scene` is a host struct holding
+ * the copies' pointers (copy it to the device as it is); every block made is listed, so the
+ * mirror can be released without reading device memory. */
 typedef struct rs_mirror_ops {
-    /* Allocates `bytes` at *dst and copies `src` there; RS_OK, or an error already set. */
+    /* Allocates `bytes` (>= 1) at *dst and copies `src` there; RS_OK, or an error already set
+     * (and *dst NULL). */
     rs_status (*copy)(void *user, void **dst, const void *src, size_t bytes);
     void (*release)(void *user, void *p);
     void *user;
 } rs_mirror_ops;
 
+/* Every block a copy made, in order (a host array), and the bytes copied in all. */
+typedef struct rs_mirror_blocks {
+    void **blocks;
+    uint32_t n_blocks, cap_blocks;
+    uint64_t bytes;
+} rs_mirror_blocks;
+
 typedef struct rs_scene_mirror {
     rs_scene scene;
-    void **blocks; /* host array of every block ops->copy made */
-    uint32_t n_blocks, cap_blocks;
-    uint64_t bytes; /* copied in all */
+    rs_mirror_blocks made;
 } rs_scene_mirror;
 
+/* Every array of rs_scene that a copy of the scene holds, with its element count (`s` a pointer
+ * to the scene; the element size is the field's own).  An array that is NULL or has no
+ * elements is copied as NULL.  The images are nested (each points to its texels) and are the
+ * one special case: rs_scene_mirror_create copies their texels first, then an image array that
+ * points to those copies.  A new array of rs_scene goes here, or the device copies miss it
+ * (tests/scenes_mirror_test.c checks every pointer-sized word of a copy). */
+/* clang-format off */
+#define RS_SCENE_ARRAYS(X, s)                                                                      \
+    X(spheres, (size_t)(s)->n_spheres)                                                             \
+    X(sphere_mat, (size_t)(s)->n_spheres)                                                          \
+    X(sphere_motion, (size_t)(s)->n_spheres)                                                       \
+    X(quads, (size_t)(s)->n_quads)                                                                 \
+    X(quad_mat, (size_t)(s)->n_quads)                                                              \
+    X(tris, (size_t)(s)->n_tris)                                                                   \
+    X(tri_mat, (size_t)(s)->n_tris)                                                                \
+    X(tri_uv, 6 * (size_t)(s)->n_tris)                                                             \
+    X(tri_normal, 9 * (size_t)(s)->n_tris)                                                         \
+    X(materials, (size_t)(s)->n_materials)                                                         \
+    X(textures, (size_t)(s)->n_textures)                                                           \
+    X(lights, (size_t)(s)->n_lights)                                                               \
+    X(light_cdf, (s)->n_lights ? (size_t)(s)->n_lights + 1 : 0)                                    \
+    X(prim_light, (size_t)(s)->n_spheres + (s)->n_quads + (s)->n_tris)
+/* clang-format on */
+
+/* Copies n elements of `size` bytes from `src` through ops into a new block at *dst and lists
+ * it in *made; NULL src or n = 0: *dst = NULL and nothing is made.  On failure nothing is
+ * added (the blocks made before stay listed for the caller to release). */
+rs_status rs_mirror_copy(rs_mirror_blocks *made, const rs_mirror_ops *ops, void **dst,
+                         const void *src, size_t n, size_t size);
+/* Releases every listed block through ops and frees the list; *made is zeroed. */
+void rs_mirror_blocks_release(rs_mirror_blocks *made, const rs_mirror_ops *ops);
+
+/* Copies every array of `s` (RS_SCENE_ARRAYS, then the images) through `ops`.  On failure every
+ * block made is released, *out is zeroed and the error returned. */
 rs_status rs_scene_mirror_create(const rs_scene *s, const rs_mirror_ops *ops, rs_scene_mirror *out);
 void rs_scene_mirror_release(rs_scene_mirror *m, const rs_mirror_ops *ops);
 

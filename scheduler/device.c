@@ -11,3 +11,5 @@ void rs_device_destroy(rs_device *d)
     if (d)
         d->ops->destroy(d);
 }
+
+int rs_device_is_gpu(const rs_device *d) { return (d->flags & RS_DEVICE_OWN_MEMORY) != 0; }

@@ -1,28 +1,73 @@
-/* scheduler/device.h — what the scheduler knows of a device: a table of functions.
+/* scheduler/device.h — what the render loops know of a device: a table of functions.
  *
- * The CPU device, the CUDA device and the CUDA fallback all implement this interface; the
- * scheduler sees nothing else.  Life cycle: create (device-specific constructor) -> upload once
- * -> trace many chunks (from exactly one dispatch thread at a time) -> destroy.
+ * One device model serves both integrators.  The CPU device (cpu/), the CUDA device and its CPU
+ * fallback (gpu/) each fill this table; the wavefront loop (scheduler/render.c) and the pass
+ * loop of the megakernel (scheduler/passes.c) see nothing else, and cpu/ and gpu/ never include
+ * each other.
  *
- * Thread safety: `trace` is only called from the device's dispatch thread.  `stats` is written
- * by the scheduler under its lock; read it after rs_sched_destroy or through rs_sched_stats. */
+ * Life cycle: create (device-specific constructor) -> upload once -> trace many chunks (from
+ * exactly one dispatch thread at a time) and/or pass_begin once, render_pass many times (from the
+ * render thread) -> destroy.
+ *
+ * Memory.  A device with RS_DEVICE_OWN_MEMORY traces in memory of its own (a CUDA device): the
+ * geometry is copied at upload and every chunk is copied in and out.  Where it offers host_alloc,
+ * the wave buffers are allocated with it (page-locked memory that the device reads and writes by
+ * DMA), and it copies a chunk straight from the caller's arrays without staging.  A host device
+ * borrows the caller's arrays: they must outlive it.
+ *
+ * Thread safety: `trace` is only called from the device's dispatch thread, `pass_begin` and
+ * `render_pass` only from the render thread, never both in one render.  `stats` is written by
+ * the scheduler under its lock; read it after rs_sched_destroy or through rs_sched_stats. */
 #ifndef RS_SCHEDULER_DEVICE_H
 #define RS_SCHEDULER_DEVICE_H
 
 #include "accel/bvh.h"
 #include "accel/trace.h"
+#include "core/parallel.h"
+#include "shading/film.h"
+#include "shading/path.h"
 
 typedef struct rs_device rs_device;
 
+/* Device flags. */
+#define RS_DEVICE_OWN_MEMORY 1u /* traces in memory of its own (a GPU), not on host threads */
+
+/* One call of the megakernel's pass loop: what render_pass needs besides its sample range. */
+typedef struct rs_pass_job {
+    const rs_integrator *it;  /* the render's constants; it->scene is the host scene */
+    rs_film *film;            /* each pixel's samples are added in sample order */
+    rs_par_strategy strategy; /* how host threads split the pixels */
+    /* Polled between pixels (host devices) or passes (GPUs); NULL: never.  Non-zero: stop and
+     * return RS_OK with the samples finished so far on the film. */
+    int (*cancelled)(void *user);
+    /* `paths` more paths are on the film; called from one thread at a time.  May be NULL. */
+    void (*progress)(void *user, uint64_t paths);
+    void *user;
+} rs_pass_job;
+
 typedef struct rs_device_ops {
     /* Makes the scene geometry and BVH available to the device (a copy for a GPU; the host
-     * arrays are only borrowed by CPU devices and must outlive the device). */
+     * arrays are only borrowed by host devices and must outlive the device). */
     rs_status (*upload)(rs_device *d, const rs_geom *g, const rs_bvh *bvh);
     /* Traces rays [begin, end) of `batch`, writing the matching answers.  Blocking.  On failure
      * the answers for the range are undefined and the scheduler hands the range to another
      * device. */
     rs_status (*trace)(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end);
     void (*destroy)(rs_device *d);
+    /* Optional (NULL: malloc'd memory).  `bytes` of host memory the device copies to and from
+     * without staging (page-locked on a GPU), 64-byte aligned; NULL when short.  Freed with
+     * host_free. */
+    void *(*host_alloc)(rs_device *d, size_t bytes);
+    void (*host_free)(rs_device *d, void *p);
+    /* Optional (NULL: the device cannot run the megakernel).  After upload: makes the scene's
+     * shading data (materials, textures, lights) available to render_pass, for the constants
+     * `it` (copied).  Released by destroy. */
+    rs_status (*pass_begin)(rs_device *d, const rs_scene *scene, const rs_integrator *it);
+    /* Samples [s0, s0 + n) of every pixel, traced path by path (rs_path_radiance) and added to
+     * job->film, each pixel's samples in sample order; the rays traced are added to *counts.
+     * Stops early, with RS_OK, when job->cancelled says so. */
+    rs_status (*render_pass)(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
+                             rs_path_counts *counts);
 } rs_device_ops;
 
 typedef struct rs_device_stats {
@@ -36,8 +81,10 @@ typedef struct rs_device_stats {
 
 struct rs_device {
     const rs_device_ops *ops;
-    char name[48]; /* "cpu", "cuda:0 (NVIDIA H100 ...)", "gpu-fallback", ... */
-    int threads;   /* host threads the device uses (0 for a GPU) */
+    char name[48];         /* "cpu", "cuda:0 (NVIDIA H100 ...)", "gpu-fallback:0", ... */
+    uint32_t flags;        /* RS_DEVICE_* */
+    int threads;           /* host threads the device uses (0 for a GPU) */
+    uint32_t pass_samples; /* samples per render_pass call the pass loop hands it; 0: all */
     rs_device_stats stats;
     void *impl;
 };
@@ -48,6 +95,8 @@ extern "C" {
 #endif
 rs_status rs_device_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh);
 void rs_device_destroy(rs_device *d);
+/* 1 if the device traces off the host (RS_DEVICE_OWN_MEMORY). */
+int rs_device_is_gpu(const rs_device *d);
 #ifdef __cplusplus
 }
 #endif

@@ -10,6 +10,7 @@
 typedef struct fault_impl {
     rs_device *inner;
     long after, done;
+    rs_device_ops ops; /* the inner device's optional entries, where it has them */
 } fault_impl;
 
 static rs_status fault_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
@@ -41,7 +42,31 @@ static void fault_destroy(rs_device *d)
     rs_free(d);
 }
 
-static const rs_device_ops fault_ops = {fault_upload, fault_trace, fault_destroy};
+/* The rest goes straight to the wrapped device: only chunks fail. */
+static void *fault_host_alloc(rs_device *d, size_t bytes)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    return f->inner->ops->host_alloc(f->inner, bytes);
+}
+
+static void fault_host_free(rs_device *d, void *p)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    f->inner->ops->host_free(f->inner, p);
+}
+
+static rs_status fault_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    return f->inner->ops->pass_begin(f->inner, scene, it);
+}
+
+static rs_status fault_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
+                                   rs_path_counts *counts)
+{
+    fault_impl *f = (fault_impl *)d->impl;
+    return f->inner->ops->render_pass(f->inner, job, s0, n, counts);
+}
 
 rs_status rs_fault_wrap(rs_device **d, int after)
 {
@@ -54,9 +79,23 @@ rs_status rs_fault_wrap(rs_device **d, int after)
     }
     f->inner = *d;
     f->after = after < 0 ? 0 : after;
-    w->ops = &fault_ops;
+    /* the wrapper offers what the inner device offers */
+    f->ops.upload = fault_upload;
+    f->ops.trace = fault_trace;
+    f->ops.destroy = fault_destroy;
+    if ((*d)->ops->host_alloc && (*d)->ops->host_free) {
+        f->ops.host_alloc = fault_host_alloc;
+        f->ops.host_free = fault_host_free;
+    }
+    if ((*d)->ops->pass_begin)
+        f->ops.pass_begin = fault_pass_begin;
+    if ((*d)->ops->render_pass)
+        f->ops.render_pass = fault_render_pass;
+    w->ops = &f->ops;
     w->impl = f;
+    w->flags = (*d)->flags;
     w->threads = (*d)->threads;
+    w->pass_samples = (*d)->pass_samples;
     memcpy(w->name, (*d)->name, sizeof w->name);
     *d = w;
     return RS_OK;

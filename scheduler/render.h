@@ -1,23 +1,27 @@
-/* scheduler/render.h — the wavefront render loop.
+/* scheduler/render.h — the wavefront render loop, and what both integrators share.
  *
  * Paths are numbered globally sample-major (g = sample * npix + pixel) and processed in waves of
  * at most `wave_paths` consecutive paths, so memory is bounded whatever the image size and spp,
- * and an interrupted render holds whole early passes.  For each wave:
+ * and an interrupted render holds whole early passes.  Each wave runs the named stages of
+ * rs_stage (scheduler/timeline.h) from a table in render.c:
  *
- *   raygen ─► trace closest (scheduler ─► devices) ─► shade ─► trace shadows ─► resolve shadows
- *            ▲                                          │
- *            └──────────── compact next rays ◄─────────┘   ... until no path is alive
- *   then the wave's radiances are added to the film in path order (bit-reproducible).
+ *   raygen -> trace-closest -> shade -> [trace-shadow -> resolve-shadows] -> compact
+ *               ^  (devices, through the scheduler)                            |
+ *               +------------------ while paths are alive ---------------------+
+ *   -> film: the wave's radiances added in path order (bit-reproducible), waves in wave order.
  *
  * Pipelining.  `waves_in_flight` waves (each of wave_paths / waves_in_flight paths) are worked
- * on at once: the loop submits a wave's rays to the scheduler and, instead of waiting, shades the
- * wave whose rays were submitted before, so the CPU shades one wave while the devices trace the
- * other.  Waves are added to the film in wave order, whatever order they end in.  The shading
- * stages and the CPU devices take their OpenMP teams from one core budget (`cores`), so the
- * overlap does not oversubscribe the machine.  Auto (0) means 2 waves when a device traces off
- * the host (a GPU: the shading then runs while the GPU traces) and 1 when every device runs on
- * the host's cores, where overlap only makes the devices and the shading take turns on the same
- * cores (measured in bench/scheduler: docs/scheduler.md).
+ * on at once, each in a slot that holds the index of its next stage.  The loop visits the slots
+ * round robin and runs a slot's stages up to its next trace (a submission to the scheduler) or
+ * its end, so the CPU shades one wave while the devices trace another.  The shading stages and
+ * the CPU devices take their OpenMP teams from one core budget (`cores`), so the overlap does not
+ * oversubscribe the machine.  Auto (0) means 2 waves when a device traces off the host (a GPU:
+ * the shading then runs while the GPU traces) and 1 when every device runs on the host's cores,
+ * where overlap only makes the devices and the shading take turns on the same cores (measured in
+ * bench/scheduler_bench: docs/scheduler.md).
+ *
+ * Every stage is timed under its name (rs_render_stats.stage_s, --stats) and, with a timeline,
+ * logged as a span on the render thread's lane.
  *
  * The image depends only on the seed and the settings below, not on devices, chunk sizes,
  * thread counts or the wave size. */
@@ -28,6 +32,7 @@
 
 #include "core/cores.h"
 #include "scheduler/sched.h"
+#include "scheduler/timeline.h"
 #include "shading/film.h"
 #include "shading/integrator.h"
 
@@ -42,14 +47,18 @@ typedef struct rs_render_settings {
     int threads;              /* OpenMP threads for the shading stages (at most) */
     rs_cores *cores;          /* the budget shared with the CPU devices; NULL: none */
     rs_par_strategy strategy; /* how the shade stage splits a wave among threads */
+    rs_timeline *timeline;    /* stage spans on lane `timeline_lane`; NULL: none */
+    uint16_t timeline_lane;   /* the render thread's lane: the number of devices */
 } rs_render_settings;
 
 #define RS_RENDER_DEFAULT_WAVE (1u << 20)
 #define RS_RENDER_MAX_WAVES    4u
 
 typedef struct rs_render_stats {
-    double seconds;          /* wall time of rs_render */
-    double trace_s, shade_s; /* time waiting for traces / in the shading stages (incl. raygen) */
+    double seconds;                 /* wall time of rs_render */
+    double stage_s[RS_STAGE_COUNT]; /* seconds the render thread spent in each stage (in the
+                                       trace stages: waiting for the devices) */
+    double trace_s, shade_s; /* the trace stages' sum / every other stage's (raygen to film) */
     uint64_t paths_total, paths_done;
     uint64_t rays_closest, rays_shadow;
     uint32_t waves;
@@ -68,5 +77,11 @@ typedef struct rs_render_hooks {
 /* Renders `scene` into `film` (whose size must match settings).  `hooks` may be NULL. */
 rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_settings *settings,
                     const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats);
+
+/* What both integrators check and share: the settings against the film (RS_ERR_ARG with a
+ * message when a size is 0, the film does not match, or the image has 2^32 pixels or more), and
+ * the render's device-safe constants *it (camera, seed, sizes, depths, sampling). */
+rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *settings,
+                              const rs_film *film, rs_integrator *it);
 
 #endif

@@ -19,6 +19,7 @@
 #include <time.h>
 
 #include "core/alloc.h"
+#include "scheduler/timeline.h"
 
 typedef struct chunk {
     rs_sched_job *job;
@@ -50,6 +51,7 @@ struct rs_sched {
     int n_workers;
     worker *workers;
     uint64_t submitted, answered;
+    rs_timeline *timeline; /* chunk spans, one lane per device; NULL: none */
     char last_error[512];
 };
 
@@ -92,7 +94,7 @@ static uint32_t chunk_size_for(const rs_sched *s, const worker *w, uint64_t left
 /* After a chunk of `rays` took `secs`: update the rate and the next chunk size. */
 static void adapt(worker *w, uint32_t rays, double secs)
 {
-    double target = w->dev->threads == 0 ? RS_SCHED_TARGET_GPU_S : RS_SCHED_TARGET_HOST_S;
+    double target = rs_device_is_gpu(w->dev) ? RS_SCHED_TARGET_GPU_S : RS_SCHED_TARGET_HOST_S;
     double r, size;
     if (secs <= 0.0 || rays == 0)
         return;
@@ -156,6 +158,14 @@ static void *dispatch_main(void *arg)
         t0 = now_s();
         st = w->dev->ops->trace(w->dev, c.job->batch, c.begin, c.end);
         t1 = now_s();
+        if (s->timeline && st == RS_OK) {
+            /* the timeline's clock: the span ends now and lasted t1 - t0 */
+            double e = rs_timeline_now(s->timeline);
+            rs_timeline_add(s->timeline, (uint16_t)(w - s->workers),
+                            c.job->batch->kind == RS_TRACE_CLOSEST ? RS_STAGE_TRACE_CLOSEST
+                                                                   : RS_STAGE_TRACE_SHADOW,
+                            c.job->batch->wave, e - (t1 - t0), e);
+        }
 
         pthread_mutex_lock(&s->lock);
         w->dev->stats.busy_s += t1 - t0;
@@ -198,6 +208,7 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
     if (!s)
         return rs_error_set(RS_ERR_NOMEM, "out of memory creating the scheduler");
     s->fixed_chunk = cfg ? cfg->chunk_size : 0;
+    s->timeline = cfg ? cfg->timeline : NULL;
     s->q_cap = (cfg && cfg->queue_capacity) ? cfg->queue_capacity : 8;
     s->queue = (rs_sched_job **)rs_alloc(s->q_cap, sizeof *s->queue);
     s->workers = (worker *)rs_calloc((size_t)n_devices, sizeof *s->workers);
@@ -219,7 +230,7 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
         w->s = s;
         w->dev = devices[i];
         w->alive = 1;
-        w->chunk = devices[i]->threads == 0 ? RS_SCHED_FIRST_GPU : RS_SCHED_FIRST_HOST;
+        w->chunk = rs_device_is_gpu(devices[i]) ? RS_SCHED_FIRST_GPU : RS_SCHED_FIRST_HOST;
     }
     pthread_mutex_lock(&s->lock);
     for (i = 0; i < n_devices; ++i) {

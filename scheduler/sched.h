@@ -27,9 +27,12 @@
 
 typedef struct rs_sched rs_sched;
 
+typedef struct rs_timeline rs_timeline; /* scheduler/timeline.h */
+
 typedef struct rs_sched_config {
     uint32_t chunk_size;     /* rays per chunk; 0: adaptive per device (above) */
     uint32_t queue_capacity; /* jobs the queue holds (>= 1); 0 means 8 */
+    rs_timeline *timeline;   /* where each chunk traced is logged (lane = device index); NULL */
 } rs_sched_config;
 
 #define RS_SCHED_MIN_CHUNK     256u

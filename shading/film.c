@@ -4,6 +4,7 @@
 #include <math.h>
 
 #include "core/alloc.h"
+#include "core/parallel.h"
 
 rs_status rs_film_create(uint32_t width, uint32_t height, rs_film **out)
 {
@@ -49,6 +50,28 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
     s[0] += c.x;
     s[1] += c.y;
     s[2] += c.z;
+}
+
+typedef struct add_image_ctx {
+    rs_film *film;
+    const rs_vec3 *radiance;
+} add_image_ctx;
+
+static void add_image_range(void *ctx, uint32_t lo, uint32_t hi)
+{
+    const add_image_ctx *a = (const add_image_ctx *)ctx;
+    uint32_t i;
+    for (i = lo; i < hi; ++i)
+        rs_film_add(a->film, i, a->radiance[i]);
+}
+
+void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads)
+{
+    add_image_ctx a;
+    a.film = f;
+    a.radiance = radiance;
+    rs_parallel_range(RS_PAR_FOR_DYNAMIC, threads, 0, f->width * f->height, 16384, add_image_range,
+                      &a);
 }
 
 void rs_film_resolve(const rs_film *f, float *rgb)

@@ -15,12 +15,22 @@ typedef struct rs_film {
     uint64_t nonfinite; /* samples that were NaN or infinite: counted, contributed zero */
 } rs_film;
 
+#ifdef __cplusplus
+extern "C" {
+#endif
 rs_status rs_film_create(uint32_t width, uint32_t height, rs_film **out);
 void rs_film_destroy(rs_film *f);
 void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 radiance);
+/* One sample for every pixel: radiance[pixel] for pixel in [0, width * height), the pixels split
+ * among `threads` host threads (a pass of the megakernel: each pixel still gets its samples in
+ * the order of the calls). */
+void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads);
 /* Writes width * height * 3 floats of mean radiance (0 where a pixel has no sample yet). */
 void rs_film_resolve(const rs_film *f, float *rgb);
 /* Fewest samples any pixel has. */
 uint32_t rs_film_min_count(const rs_film *f);
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -3,8 +3,9 @@
  * path traced to its end for the megakernel integrators.
  *
  * The wavefront stages (shading/integrator.c) call rs_path_begin and rs_path_shade on each entry
- * of a stream; the CPU megakernel (cpu/megakernel.c), the CUDA megakernel (gpu/cuda_megakernel.cu)
- * and its host fallback call rs_path_radiance, which calls the same two with a traversal between.
+ * of a stream; the megakernels (the devices' render_pass: cpu/cpu_megakernel.c,
+ * gpu/cuda_megakernel.cu, gpu/gpu_fallback.c) call rs_path_radiance, which calls the same two
+ * with a traversal between.
  * A path is named by its global index g: pixel g mod npix, sample g div npix; with the bounce
  * that picks its random numbers, so every integrator makes the same paths.
  *
@@ -25,13 +26,13 @@
 #include <float.h>
 
 #include "accel/bvh.h"
-#include "core/parallel.h"
 #include "core/rng.h"
 #include "shading/bsdf.h"
 #include "shading/camera.h"
 #include "shading/dims.h"
 #include "shading/lights.h"
 #include "shading/texture.h"
+#include "streams/paths.h"
 #if !defined(__CUDACC__)
 #  include "accel/bvh4.h" /* SSE: the host's megakernel may trace with the 4-wide BVH */
 #endif
@@ -51,8 +52,10 @@ typedef enum rs_sampling {
 #define RS_SHADE_NEXT   1u /* the path goes on with *next */
 #define RS_SHADE_SHADOW 2u /* a shadow ray *shadow carries ps->pending */
 
-/* The render's constants, shared by every path (plain data: the CUDA megakernel takes a copy
- * whose `scene` points to the device's mirror of the scene). */
+/* The render's constants, shared by every path: fixed-width plain data, the same bytes on the
+ * host and a device (the CUDA device takes a copy whose `scene` points to its mirror of the
+ * scene).  Built by rs_render_constants (scheduler/render.h) for both integrators; how many host
+ * threads run a stage is not a constant of the render and is not here. */
 typedef struct rs_integrator {
     const rs_scene *scene;
     rs_camera camera;
@@ -60,20 +63,10 @@ typedef struct rs_integrator {
     uint32_t width, height, npix;
     uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
     uint32_t rr_depth;  /* Russian roulette from this segment on */
-    rs_sampling sampling;
-    int threads;              /* OpenMP threads for the wavefront stages (host only) */
-    rs_par_strategy strategy; /* how the shade stage is split among them (host only) */
+    uint32_t sampling;  /* rs_sampling */
 } rs_integrator;
 
-/* One path's state between its vertices. */
-typedef struct rs_path_state {
-    rs_vec3 throughput; /* product of f cos / pdf so far */
-    rs_vec3 radiance;   /* light gathered so far */
-    rs_vec3 pending;    /* next-event contribution waiting for its shadow ray */
-    float bsdf_pdf;     /* solid-angle pdf of the BSDF sample that made the current ray */
-    float time;         /* the path's time in the shutter interval (its rays share it) */
-    uint32_t flags;     /* RS_PATH_* */
-} rs_path_state;
+/* One path's state between its vertices: rs_path_state, declared once in streams/paths.h. */
 
 /* The camera ray of path g, and its state reset. */
 RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
@@ -190,6 +183,133 @@ RS_HD rs_vec3 rs_shading_normal(const rs_scene *sc, uint32_t prim, float hu, flo
     return rs_v3_dot(ns, wo) > 0.0f ? ns : n_geo;
 }
 
+/* A surface vertex of a path, as its shading steps see it. */
+typedef struct rs_vertex {
+    const rs_material *m;
+    uint32_t prim;
+    int front;      /* the ray arrived on the side ng faces */
+    rs_vec3 x;      /* the hit point */
+    rs_vec3 ng;     /* the geometric normal as the primitive defines it */
+    rs_vec3 n_geo;  /* the geometric normal on the incoming ray's side */
+    rs_vec3 n;      /* the shading normal (rs_shading_normal) */
+    rs_vec3 wo;     /* toward where the ray came from */
+    rs_vec3 albedo; /* the material's albedo there (textured or not) */
+    rs_vec3 origin; /* where rays leaving the reflecting side start (rs_offset_origin) */
+} rs_vertex;
+
+/* An emitter hit: its radiance, MIS-weighted against the light sampling that could also have
+ * found it when the path came by BSDF sampling (not after a delta bounce or from the camera,
+ * where none could). */
+RS_HD void rs_shade_emitter(const rs_integrator *it, const rs_ray *r, float t, uint32_t prim,
+                            const rs_material *m, rs_vec3 ng, rs_vec3 beta, rs_path_state *ps)
+{
+    const rs_scene *sc = it->scene;
+    rs_vec3 le = rs_emitted(m, ng, r->d);
+    float w = 1.0f;
+    int32_t l = sc->prim_light[prim];
+    if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
+        w = rs_power_heuristic(ps->bsdf_pdf,
+                               rs_light_pdf_hit(sc, (uint32_t)l, r->o, r->time, r->d, t, ng));
+    ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, le), w));
+}
+
+/* Mirror or glass: the only direction that carries light is the sampled one.  0: the path ends
+ * here. */
+RS_HD int rs_shade_delta(const rs_scene *sc, rs_vertex *v, rs_rng_f4 rb, rs_vec3 *beta, rs_vec3 *wi)
+{
+    rs_scatter bs;
+    if (!rs_bsdf_sample(v->m, v->albedo, v->n, v->wo, v->front, rb.v[0], rb.v[1], rb.v[2], &bs))
+        return 0;
+    *wi = bs.wi;
+    /* with a shading normal, a direction can land on the wrong side of the real surface */
+    if ((rs_v3_dot(*wi, v->n_geo) > 0.0f) == (bs.transmit != 0))
+        return 0;
+    *beta = rs_v3_mul(*beta, bs.weight);
+    v->origin = rs_offset_origin(v->x, bs.transmit ? rs_v3_neg(v->n_geo) : v->n_geo,
+                                 rs_prim_scale(sc, v->prim));
+    return 1;
+}
+
+/* Next-event estimation (mis): a shadow ray toward a sampled point on a light, its MIS-weighted
+ * contribution in ps->pending.  Returns RS_SHADE_SHADOW when it made one. */
+RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const rs_ray *r,
+                                   rs_rng_f4 rl, rs_vec3 beta, rs_path_state *ps, rs_ray *shadow)
+{
+    rs_light_sample ls;
+    float c;
+    rs_vec3 fl;
+    if (!rs_light_sample_at(sc, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+        return 0;
+    c = rs_v3_dot(v->n, ls.wi);
+    fl = rs_bsdf_eval(v->m, v->albedo, v->n, v->wo, ls.wi);
+    if (!(c > 0.0f && rs_v3_dot(v->n_geo, ls.wi) > 0.0f && !rs_v3_is_zero(ls.le) &&
+          !rs_v3_is_zero(fl)))
+        return 0;
+    {
+        float w = rs_power_heuristic(ls.pdf, rs_bsdf_pdf(v->m, v->albedo, v->n, v->wo, ls.wi));
+        ps->pending = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), c * w / ls.pdf);
+    }
+    shadow->o = v->origin;
+    shadow->d = rs_v3_sub(ls.point, v->origin); /* unnormalised: the light at t = 1 */
+    shadow->tmin = 0.0f;
+    shadow->tmax = 1.0f - 1e-4f;
+    shadow->time = r->time;
+    return RS_SHADE_SHADOW;
+}
+
+/* The next direction at a non-delta vertex, by the render's sampling mode; *beta gains f cos /
+ * pdf and *pdf is the solid-angle pdf it was drawn with.  0: the path ends here. */
+RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const rs_ray *r,
+                             rs_rng_f4 rb, rs_rng_f4 rl, rs_vec3 *beta, rs_vec3 *wi, float *pdf)
+{
+    const rs_scene *sc = it->scene;
+    float ci;
+    rs_vec3 f;
+    if (it->sampling == RS_SAMPLING_UNIFORM) {
+        /* no importance sampling at all: uniform hemisphere, f cos / (1 / 2pi) */
+        rs_onb frame = rs_onb_from_normal(v->n);
+        *wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
+        ci = rs_v3_dot(v->n, *wi);
+        *pdf = rs_pdf_uniform_hemisphere(ci);
+        f = rs_bsdf_eval(v->m, v->albedo, v->n, v->wo, *wi);
+        if (!(*pdf > 0.0f))
+            return 0;
+        *beta = rs_v3_mul(*beta, rs_v3_scale(f, ci / *pdf));
+    } else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > 0) {
+        /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
+        if (rl.v[3] < 0.5f) {
+            rs_light_sample ls;
+            if (!rs_light_sample_at(sc, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+                return 0;
+            *wi = ls.wi;
+        } else {
+            rs_scatter bs;
+            if (!rs_bsdf_sample(v->m, v->albedo, v->n, v->wo, v->front, rb.v[0], rb.v[1], rb.v[2],
+                                &bs))
+                return 0;
+            *wi = bs.wi;
+        }
+        ci = rs_v3_dot(v->n, *wi);
+        if (!(ci > 0.0f))
+            return 0; /* f = 0 below the surface: the path carries nothing further */
+        *pdf = 0.5f * rs_lights_pdf_dir(sc, v->origin, r->time, *wi) +
+               0.5f * rs_bsdf_pdf(v->m, v->albedo, v->n, v->wo, *wi);
+        f = rs_bsdf_eval(v->m, v->albedo, v->n, v->wo, *wi);
+        if (!(*pdf > 0.0f))
+            return 0;
+        *beta = rs_v3_mul(*beta, rs_v3_scale(f, ci / *pdf));
+    } else {
+        /* mis, bsdf, and mixture without lights: the material's own sampling */
+        rs_scatter bs;
+        if (!rs_bsdf_sample(v->m, v->albedo, v->n, v->wo, v->front, rb.v[0], rb.v[1], rb.v[2], &bs))
+            return 0;
+        *wi = bs.wi;
+        *pdf = bs.pdf;
+        *beta = rs_v3_mul(*beta, bs.weight);
+    }
+    return 1;
+}
+
 /* Shades path g's hit h of ray `ray` (segment number `bounce`): adds what the vertex sends to
  * ps->radiance (background, emitter), and may make the path's next ray (returns RS_SHADE_NEXT,
  * *next set, ps->throughput/bsdf_pdf/flags updated) and a shadow ray toward a light (returns
@@ -199,134 +319,53 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
                              rs_ray *shadow)
 {
     const rs_scene *sc = it->scene;
-    uint32_t prim = h->prim;
     uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
     rs_ray r = *ray;
-    rs_vec3 beta = ps->throughput;
-    const rs_material *m;
-    rs_vec3 x, ng, n, n_geo, wo, wi, albedo, origin;
+    rs_vec3 beta = ps->throughput, wi;
+    rs_vertex v;
     rs_rng_f4 rb;
-    float t = h->t, pdf = 0.0f;
-    int front, specular = 0;
+    float pdf = 0.0f;
+    int specular = 0;
     uint32_t out = 0;
 
-    if (prim == RS_NO_HIT) {
+    if (h->prim == RS_NO_HIT) {
         rs_vec3 bg = rs_scene_background(sc, r.d);
         ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, bg));
         return 0;
     }
-    m = rs_scene_prim_material(sc, prim);
-    x = rs_ray_at(&r, t);
-    ng = rs_prim_normal(sc, prim, x, r.time);
-
-    if (m->type == RS_MAT_DIFFUSE_LIGHT) {
-        rs_vec3 le = rs_emitted(m, ng, r.d);
-        float w = 1.0f;
-        int32_t l = sc->prim_light[prim];
-        /* a light reached by BSDF sampling: MIS against the light sampling that could also
-         * have found it (not after a delta bounce or from the camera, where none could) */
-        if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
-            w = rs_power_heuristic(ps->bsdf_pdf,
-                                   rs_light_pdf_hit(sc, (uint32_t)l, r.o, r.time, r.d, t, ng));
-        ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, le), w));
+    v.prim = h->prim;
+    v.m = rs_scene_prim_material(sc, v.prim);
+    v.x = rs_ray_at(&r, h->t);
+    v.ng = rs_prim_normal(sc, v.prim, v.x, r.time);
+    if (v.m->type == RS_MAT_DIFFUSE_LIGHT) {
+        rs_shade_emitter(it, &r, h->t, v.prim, v.m, v.ng, beta, ps);
         return 0; /* emitters reflect nothing */
     }
-
     /* The segment after this vertex would be number bounce + 1. */
     if (bounce + 1 >= it->max_depth)
         return out;
-    front = rs_v3_dot(ng, r.d) < 0.0f;
-    n_geo = front ? ng : rs_v3_neg(ng); /* the geometric normal on the incoming ray's side */
-    wo = rs_v3_neg(r.d);
-    n = rs_shading_normal(sc, prim, h->u, h->v, n_geo, wo);
-    albedo = rs_surface_albedo(sc, m, prim, h->u, h->v, x, ng);
+    v.front = rs_v3_dot(v.ng, r.d) < 0.0f;
+    v.n_geo = v.front ? v.ng : rs_v3_neg(v.ng);
+    v.wo = rs_v3_neg(r.d);
+    v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
+    v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng);
     rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
 
-    if (rs_material_is_delta(m)) {
-        /* mirror or glass: the only direction that carries light is the sampled one */
-        rs_scatter bs;
-        if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
+    if (rs_material_is_delta(v.m)) {
+        if (!rs_shade_delta(sc, &v, rb, &beta, &wi))
             return out;
-        wi = bs.wi;
-        /* with a shading normal, a direction can land on the wrong side of the real surface */
-        if ((rs_v3_dot(wi, n_geo) > 0.0f) == (bs.transmit != 0))
-            return out;
-        beta = rs_v3_mul(beta, bs.weight);
-        origin =
-            rs_offset_origin(x, bs.transmit ? rs_v3_neg(n_geo) : n_geo, rs_prim_scale(sc, prim));
         specular = 1;
     } else {
         rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
-        float ci;
-        rs_vec3 f;
-        origin = rs_offset_origin(x, n_geo, rs_prim_scale(sc, prim));
-
-        if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0) {
-            /* next-event estimation: a shadow ray toward a sampled point on a light */
-            rs_light_sample ls;
-            if (rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls)) {
-                float c = rs_v3_dot(n, ls.wi);
-                rs_vec3 fl = rs_bsdf_eval(m, albedo, n, wo, ls.wi);
-                if (c > 0.0f && rs_v3_dot(n_geo, ls.wi) > 0.0f && !rs_v3_is_zero(ls.le) &&
-                    !rs_v3_is_zero(fl)) {
-                    float w = rs_power_heuristic(ls.pdf, rs_bsdf_pdf(m, albedo, n, wo, ls.wi));
-                    ps->pending =
-                        rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), c * w / ls.pdf);
-                    shadow->o = origin;
-                    shadow->d = rs_v3_sub(ls.point, origin); /* unnormalised: light at t = 1 */
-                    shadow->tmin = 0.0f;
-                    shadow->tmax = 1.0f - 1e-4f;
-                    shadow->time = r.time;
-                    out = RS_SHADE_SHADOW;
-                }
-            }
-        }
-
-        if (it->sampling == RS_SAMPLING_UNIFORM) {
-            /* no importance sampling at all: uniform hemisphere, f cos / (1 / 2pi) */
-            rs_onb frame = rs_onb_from_normal(n);
-            wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
-            ci = rs_v3_dot(n, wi);
-            pdf = rs_pdf_uniform_hemisphere(ci);
-            f = rs_bsdf_eval(m, albedo, n, wo, wi);
-            if (!(pdf > 0.0f))
-                return out;
-            beta = rs_v3_mul(beta, rs_v3_scale(f, ci / pdf));
-        } else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > 0) {
-            /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
-            if (rl.v[3] < 0.5f) {
-                rs_light_sample ls;
-                if (!rs_light_sample_at(sc, origin, r.time, rl.v[0], rl.v[1], rl.v[2], &ls))
-                    return out;
-                wi = ls.wi;
-            } else {
-                rs_scatter bs;
-                if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
-                    return out;
-                wi = bs.wi;
-            }
-            ci = rs_v3_dot(n, wi);
-            if (!(ci > 0.0f))
-                return out; /* f = 0 below the surface: the path carries nothing further */
-            pdf = 0.5f * rs_lights_pdf_dir(sc, origin, r.time, wi) +
-                  0.5f * rs_bsdf_pdf(m, albedo, n, wo, wi);
-            f = rs_bsdf_eval(m, albedo, n, wo, wi);
-            if (!(pdf > 0.0f))
-                return out;
-            beta = rs_v3_mul(beta, rs_v3_scale(f, ci / pdf));
-        } else {
-            /* mis, bsdf, and mixture without lights: the material's own sampling */
-            rs_scatter bs;
-            if (!rs_bsdf_sample(m, albedo, n, wo, front, rb.v[0], rb.v[1], rb.v[2], &bs))
-                return out;
-            wi = bs.wi;
-            pdf = bs.pdf;
-            beta = rs_v3_mul(beta, bs.weight);
-        }
+        v.origin = rs_offset_origin(v.x, v.n_geo, rs_prim_scale(sc, v.prim));
+        if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0)
+            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow);
+        if (!rs_shade_direction(it, &v, &r, rb, rl, &beta, &wi, &pdf))
+            return out;
+        if (!(rs_v3_dot(wi, v.n_geo) > 0.0f))
+            return out; /* below the real surface (a shading-normal artefact): nothing comes back */
     }
-
-    if (!specular && !(rs_v3_dot(wi, n_geo) > 0.0f))
-        return out; /* below the real surface (a shading-normal artefact): nothing comes back */
+    /* Russian roulette, then the next segment */
     if (bounce + 1 >= it->rr_depth) {
         float q = fminf(rs_v3_max_comp(beta), 0.95f);
         if (!(rb.v[3] < q))
@@ -335,7 +374,7 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
     }
     if (rs_v3_is_zero(beta) || !(rs_v3_max_comp(beta) > 0.0f))
         return out;
-    next->o = origin;
+    next->o = v.origin;
     next->d = wi;
     next->tmin = 0.0f;
     next->tmax = FLT_MAX;

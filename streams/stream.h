@@ -10,6 +10,8 @@
 #ifndef RS_STREAMS_STREAM_H
 #define RS_STREAMS_STREAM_H
 
+#include <stddef.h>
+
 #include "core/ray.h"
 #include "core/status.h"
 
@@ -84,16 +86,36 @@ RS_HD rs_hit rs_hit_soa_get(const rs_hit_soa *s, uint32_t i)
     return h;
 }
 
+/* Where a stream's arrays come from: NULL means rs_alloc_aligned / rs_free; a device's
+ * host_alloc (scheduler/device.h) gives page-locked memory a GPU copies by DMA. */
+typedef struct rs_host_allocator {
+    void *(*alloc)(void *user, size_t bytes); /* 64-byte aligned, or NULL */
+    void (*release)(void *user, void *p);
+    void *user;
+} rs_host_allocator;
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 /* Allocates every field for `capacity` entries (64-byte aligned); count starts at 0. */
 rs_status rs_ray_soa_init(rs_ray_soa *s, uint32_t capacity);
 void rs_ray_soa_free(rs_ray_soa *s);
+/* The same with the arrays from `a` (NULL: as above); free with the same `a`. */
+rs_status rs_ray_soa_init_in(rs_ray_soa *s, uint32_t capacity, const rs_host_allocator *a);
+void rs_ray_soa_free_in(rs_ray_soa *s, const rs_host_allocator *a);
+rs_status rs_hit_soa_init_in(rs_hit_soa *s, uint32_t capacity, const rs_host_allocator *a);
+void rs_hit_soa_free_in(rs_hit_soa *s, const rs_host_allocator *a);
+/* One array of n * size bytes from `a` (NULL: rs_alloc_aligned), and its release. */
+void *rs_host_alloc(const rs_host_allocator *a, size_t n, size_t size);
+void rs_host_free(const rs_host_allocator *a, void *p);
 /* Copies entry `from` of `src` to entry `to` of `dst`. */
 void rs_ray_soa_copy(rs_ray_soa *dst, uint32_t to, const rs_ray_soa *src, uint32_t from);
 rs_status rs_hit_soa_init(rs_hit_soa *s, uint32_t capacity);
 void rs_hit_soa_free(rs_hit_soa *s);
+/* Compacts the valid entries of src[0, count) into dst, keeping their order; returns how many.
+ * Deterministic for any thread count (a blocked two-pass scan; streams/compact.c). */
+uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t count,
+                           rs_ray_soa *dst, int threads);
 #ifdef __cplusplus
 }
 #endif

@@ -9,7 +9,7 @@
 
 #include "core/alloc.h"
 #include "cpu/cpu_device.h"
-#include "cpu/megakernel.h"
+#include "scheduler/passes.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/fault.h"
@@ -28,7 +28,8 @@ typedef struct rt_args {
     uint32_t waves;           /* waves in flight; 0: auto */
     int real_gpu;             /* CUDA device 0 instead of the fallback in the two options above */
     rs_par_strategy strategy; /* the CPU device's, the shading's and the megakernel's */
-    int megakernel;    /* the per-pixel integrator (cpu/megakernel.h) instead of the stream */
+    int megakernel;    /* the per-pixel integrator (scheduler/passes.h, on devs[0]) instead of the
+                          stream */
     int no_bvh;        /* one leaf holding every primitive: brute force */
     rs_bvh_method bvh; /* the builder (zeroed: median) */
     int fail_after;    /* > 0: the second device fails after this many chunks (RS_FAULT) */
@@ -90,8 +91,8 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     for (i = 0; i < n; ++i)
         if (rs_device_upload(devs[i], &g, bvh) != RS_OK)
             goto out;
+    memset(&cfg, 0, sizeof cfg);
     cfg.chunk_size = a->chunk_size;
-    cfg.queue_capacity = 0;
     if (rs_sched_create(devs, n, &cfg, &sched) != RS_OK ||
         rs_film_create(a->width, a->height, &film) != RS_OK)
         goto out;
@@ -108,14 +109,9 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     st.cores = budget;
     st.strategy = a->strategy;
     if (a->megakernel) {
-        rs_megakernel_opts mo;
-        memset(&mo, 0, sizeof mo);
-        mo.strategy = a->strategy;
-        mo.bvh_width = co.bvh_width;
-        /* fallback_only / real_gpu: the GPU megakernel's passes (on host threads / on CUDA) */
-        if (a->fallback_only)
-            mo.device = a->real_gpu ? RS_MK_CUDA : RS_MK_GPU_FALLBACK;
-        if (rs_render_megakernel(scene, &g, bvh, &st, &mo, NULL, film, &stats) != RS_OK)
+        /* devs[0] runs it: the CPU device, or with fallback_only the GPU megakernel's passes
+         * (on host threads / on CUDA with real_gpu) */
+        if (rs_render_passes(scene, devs[0], &st, NULL, film, &stats) != RS_OK)
             goto out;
     } else if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK) {
         goto out;

@@ -69,7 +69,8 @@ static rs_status counting_trace(rs_device *d, const rs_trace_batch *batch, uint3
 
 static void counting_destroy(rs_device *d) { free(d); }
 
-static const rs_device_ops counting_ops = {counting_upload, counting_trace, counting_destroy};
+static const rs_device_ops counting_ops = {
+    .upload = counting_upload, .trace = counting_trace, .destroy = counting_destroy};
 
 static rs_device *counting_device(counting *c, const char *name)
 {
@@ -144,7 +145,7 @@ static void test_chunk_sizes(void **state)
         batch_fixture f;
         rs_device *d;
         rs_sched *s;
-        rs_sched_config cfg = {sizes[k], 0};
+        rs_sched_config cfg = {sizes[k], 0, NULL};
         rs_trace_batch b;
         rs_device_stats ds;
         uint64_t sub, ans;
@@ -178,7 +179,7 @@ static void test_many_devices_queue_pressure(void **state)
     rs_device *d[3];
     batch_fixture f;
     rs_sched *s;
-    rs_sched_config cfg = {113, 4};
+    rs_sched_config cfg = {113, 4, NULL};
     rs_trace_batch b;
     uint64_t total = 0;
     int i, rep;
@@ -243,7 +244,7 @@ static void test_device_failure(void **state)
     rs_device *d[2];
     batch_fixture f;
     rs_sched *s;
-    rs_sched_config cfg = {100, 8};
+    rs_sched_config cfg = {100, 8, NULL};
     rs_trace_batch b;
     rs_device_stats ds;
     int alive;
@@ -279,7 +280,7 @@ static void test_all_devices_fail(void **state)
     batch_fixture f;
     rs_device *d;
     rs_sched *s;
-    rs_sched_config cfg = {10, 2};
+    rs_sched_config cfg = {10, 2, NULL};
     rs_trace_batch b;
     (void)state;
     fixture_init(&f, 1000);
@@ -334,12 +335,16 @@ static void test_random_property(void **state)
         n_jobs = 1 + (int)RND(MAX_JOBS);
         healthy = (int)RND((uint32_t)n_dev);
         memset(c, 0, sizeof c);
+        memset(&cfg, 0, sizeof cfg);
         for (i = 0; i < n_dev; ++i) {
             c[i].sleep_us = (int)RND(200);
             c[i].ns_per_ray = (int)RND(300);
             c[i].fail_on_chunk = i == healthy || RND(2) == 0 ? 0 : 1 + (long)RND(20);
             d[i] = counting_device(&c[i], "rnd");
-            d[i]->threads = RND(4) == 0 ? 0 : 1; /* now and then a "GPU": other chunk sizes */
+            if (RND(4) == 0) { /* now and then a "GPU": other chunk sizes */
+                d[i]->threads = 0;
+                d[i]->flags = RS_DEVICE_OWN_MEMORY;
+            }
         }
         cfg.chunk_size = RND(2) == 0 ? 0 : 1 + RND(5000);
         cfg.queue_capacity = 1 + RND(4);
@@ -518,7 +523,7 @@ static void test_cpu_device_matches_direct(void **state)
         for (kind = 0; kind < 6; ++kind) {
             rs_device *d[2];
             rs_sched *s;
-            rs_sched_config cfg = {sizes[k], 0};
+            rs_sched_config cfg = {sizes[k], 0, NULL};
             rs_trace_batch b = fixture_batch(&f, (rs_trace_kind)(kind & 1));
             int set = kind >> 1, n_dev = set == 2 ? 2 : 1, j; /* cpu, fallback, both */
             rs_cores cores;

@@ -1,0 +1,83 @@
+/* cpu/cpu_megakernel.c — the CPU device's render_pass: the classic integrator as the thesis
+ * wrote it, one loop over the pixels with each pixel's samples traced to the end one after the
+ * other (the recursive radiance() of Ray Tracing in One Weekend, unrolled in rs_path_radiance),
+ * the pixel loop split among the device's threads by one of the thesis's strategies
+ * (core/parallel.h):
+ *   for-dynamic  rows handed out dynamically (`parallel for schedule(dynamic)`);
+ *   columns      each thread one contiguous block of image columns (the thesis's Fig. 5.1);
+ *   tasks        a task per row, made by one thread, run by any (the thesis's Listing 5.8).
+ * It traces with the device's own kernels (the 4-wide BVH where the device built one), and adds
+ * each pixel's samples in sample order: its image is the wavefront's, bit for bit.  Ctrl-C is
+ * checked per pixel (at high spp a row can take seconds), progress reported per line. */
+#include <string.h>
+
+#include "cpu/internal.h"
+#include "shading/path_counts.h"
+
+typedef struct line_ctx {
+    const rs_pass_job *job;
+    rs_path_tracer tracer;
+    uint32_t s0, n, width, height;
+    int by_columns;
+    rs_path_counts_atomic counts; /* every thread's rays */
+} line_ctx;
+
+static void report(const rs_pass_job *job, uint64_t paths)
+{
+    if (!job->progress || paths == 0)
+        return;
+#pragma omp critical(rs_cpu_megakernel_progress)
+    job->progress(job->user, paths);
+}
+
+/* Rows (or columns) [lo, hi) of the image. */
+static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
+{
+    line_ctx *c = (line_ctx *)ctx;
+    const rs_pass_job *job = c->job;
+    uint64_t npix = (uint64_t)c->width * c->height;
+    uint32_t line, k, s;
+    rs_path_counts n = {0, 0, 0};
+    for (line = lo; line < hi; ++line) {
+        uint32_t len = c->by_columns ? c->height : c->width;
+        for (k = 0; k < len; ++k) {
+            uint32_t x = c->by_columns ? line : k, y = c->by_columns ? k : line;
+            uint32_t pixel = y * c->width + x;
+            if (job->cancelled && job->cancelled(job->user)) {
+                report(job, (uint64_t)k * c->n);
+                goto out;
+            }
+            for (s = c->s0; s < c->s0 + c->n; ++s) {
+                rs_vec3 L = rs_path_radiance(job->it, &c->tracer, (uint64_t)s * npix + pixel, &n);
+                rs_film_add(job->film, pixel, L);
+            }
+        }
+        report(job, (uint64_t)len * c->n);
+    }
+out:
+    rs_path_counts_atomic_add(&c->counts, &n);
+}
+
+rs_status rs_cpu_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
+                             rs_path_counts *counts)
+{
+    const cpu_impl *impl = (const cpu_impl *)d->impl;
+    line_ctx c;
+    if (!impl->uploaded)
+        return rs_error_set(RS_ERR_ARG, "device %s: render before upload", d->name);
+    memset(&c, 0, sizeof c);
+    c.job = job;
+    c.tracer.geom = impl->geom;
+    c.tracer.bvh = impl->bvh;
+    c.tracer.bvh4 = impl->bvh4;
+    c.s0 = s0;
+    c.n = n;
+    c.width = job->it->width;
+    c.height = job->it->height;
+    c.by_columns = job->strategy == RS_PAR_COLUMNS;
+    rs_path_counts_atomic_init(&c.counts);
+    rs_parallel_range(job->strategy, d->threads, 0, c.by_columns ? c.width : c.height, 1,
+                      render_lines, &c);
+    rs_path_counts_atomic_drain(&c.counts, counts);
+    return RS_OK;
+}

@@ -1,0 +1,22 @@
+/* cpu/internal.h — the CPU device's state, shared by its files (cpu/ only). */
+#ifndef RS_CPU_INTERNAL_H
+#define RS_CPU_INTERNAL_H
+
+#include "accel/bvh4.h"
+#include "cpu/cpu_device.h"
+
+typedef struct cpu_impl {
+    rs_geom geom; /* the caller's arrays, borrowed */
+    rs_bvh_view bvh;
+    rs_bvh4 *bvh4; /* NULL: the binary kernel */
+    uint32_t width;
+    rs_cores *cores;
+    rs_par_strategy strategy;
+    int uploaded;
+} cpu_impl;
+
+/* The device's render_pass (cpu/cpu_megakernel.c): the thesis's per-pixel loop. */
+rs_status rs_cpu_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
+                             rs_path_counts *counts);
+
+#endif

@@ -1,0 +1,97 @@
+/* gpu/internal.h — the CUDA device's state, shared by its two files (the .cu files of gpu/ only):
+ * gpu/cuda_device.cu (create, upload, trace, host memory, destroy) and gpu/cuda_megakernel.cu
+ * (pass_begin, render_pass).
+ *
+ * Memory the device holds, all made once:
+ *   at create      two streams (stage 0's is "the device's stream": the megakernel runs on it);
+ *   at upload      the geometry + BVH copy (scheduler/device_copy.h, rs_cuda_mirror_ops) and the
+ *                  staging of both stages, sized for the largest piece a chunk is cut into
+ *                  (rs_cuda_piece_size(RS_SCHED_MAX_CHUNK)): one pinned and one device block
+ *                  per stage, carved into the ray, hit and occlusion arrays;
+ *   at pass_begin  the scene copy and, per slot of the megakernel's double buffer, a device and
+ *                  a pinned radiance image, device and pinned ray counters and an event.
+ * Every block is released by destroy; a failed upload or pass_begin releases what it made. */
+#ifndef RS_GPU_INTERNAL_H
+#define RS_GPU_INTERNAL_H
+
+#include <cuda_runtime.h>
+
+#include "gpu/cuda_check.h"
+#include "gpu/gpu_device.h"
+#include "scheduler/device_copy.h"
+
+#define RS_CUDA_STAGES    2
+#define RS_CUDA_MIN_PIECE 32768u /* pieces smaller than this are not worth a stream switch */
+
+/* The piece size for a chunk of n rays: a quarter of it (up to four pieces over the two
+ * stages), but at least RS_CUDA_MIN_PIECE rays (all of a smaller chunk). */
+static inline uint32_t rs_cuda_piece_size(uint32_t n)
+{
+    uint32_t piece = n / 4 + (n % 4 != 0);
+    if (piece < RS_CUDA_MIN_PIECE)
+        piece = n < RS_CUDA_MIN_PIECE ? n : RS_CUDA_MIN_PIECE;
+    return piece;
+}
+
+/* One of the two staging sets a chunk's pieces alternate between.  While one piece's rays are
+ * copied in, traced and copied out on one stream, the host packs the next piece into the other
+ * set's pinned buffers (not needed when the batch itself is pinned: then the copies read and
+ * write the batch's arrays directly), and the other stream's copies overlap this one's kernel. */
+typedef struct rs_cuda_stage {
+    cudaStream_t stream;
+    void *h_block, *d_block; /* the pinned and the device block the arrays below are cut from */
+    rs_ray_soa h_rays, d_rays;
+    rs_hit_soa h_hits, d_hits;
+    uint8_t *h_occ, *d_occ;
+    uint32_t begin, n; /* the piece in flight: rays [begin, begin + n) of the batch */
+    int pending;
+    int direct; /* the piece's copies go straight to and from the (pinned) batch */
+} rs_cuda_stage;
+
+/* The megakernel's ray counters of one sample, summed on the device (one atomic per warp). */
+typedef struct rs_cuda_mk_counts {
+    unsigned long long closest, shadow;
+    unsigned int max_bounce;
+} rs_cuda_mk_counts;
+
+/* One slot of the megakernel's double buffer: sample `sample` is traced into d_rad, copied to
+ * h_rad with its counters, and `done` is recorded after the copies. */
+typedef struct rs_cuda_mk_slot {
+    rs_vec3 *d_rad, *h_rad;
+    rs_cuda_mk_counts *d_cnt, *h_cnt;
+    cudaEvent_t done;
+    uint32_t sample;
+    int pending;
+} rs_cuda_mk_slot;
+
+typedef struct rs_cuda_mk {
+    rs_device_scene copy; /* the scene on the device; borrows the upload's BVH copy */
+    rs_integrator it;     /* the render's constants, it.scene = copy.scene (a device pointer) */
+    rs_cuda_mk_slot slot[2];
+    int block; /* threads per block: the occupancy API's, a multiple of the warp size */
+    int ready;
+} rs_cuda_mk;
+
+typedef struct rs_cuda_impl {
+    int ordinal;
+    int block; /* the trace kernel's threads per block, from the occupancy API */
+    rs_device_geom geom;
+    int uploaded;
+    rs_cuda_stage st[RS_CUDA_STAGES];
+    uint32_t cap; /* entries per staging set */
+    rs_cuda_mk mk;
+} rs_cuda_impl;
+
+/* cudaMalloc + cudaMemcpy (pageable, on the legacy stream: whoever copies through these ends
+ * with cudaDeviceSynchronize before a kernel on the device's own streams reads the copy) and
+ * cudaFree.  Call with the device current. */
+extern const rs_mirror_ops rs_cuda_mirror_ops;
+
+/* gpu/cuda_megakernel.cu: the device's pass_begin and render_pass (scheduler/device.h), and the
+ * release of what pass_begin made (a no-op when it made nothing; the device must be current). */
+rs_status rs_cuda_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it);
+rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
+                              rs_path_counts *counts);
+void rs_cuda_pass_release(rs_cuda_impl *c);
+
+#endif

@@ -1,0 +1,98 @@
+/* scheduler/device_copy.c — see device_copy.h.  Each copy starts from a struct copy of the
+ * original (counts, shutter, algorithms) and replaces every array the lists name; the lists are
+ * the only place that knows which fields are arrays. */
+#include "scheduler/device_copy.h"
+
+#include <string.h>
+
+#include "core/alloc.h"
+
+static rs_status host_copy(void *user, void **dst, const void *src, size_t bytes)
+{
+    (void)user;
+    *dst = rs_alloc_aligned(bytes, 1);
+    if (!*dst)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory copying %zu bytes for a device", bytes);
+    memcpy(*dst, src, bytes);
+    return RS_OK;
+}
+
+static void host_release(void *user, void *p)
+{
+    (void)user;
+    rs_free(p);
+}
+
+const rs_mirror_ops rs_device_copy_host_ops = {host_copy, host_release, NULL};
+
+rs_status rs_device_copy_geom(const rs_geom *g, const rs_bvh *bvh, const rs_mirror_ops *ops,
+                              rs_device_geom *out)
+{
+    rs_status st = RS_OK;
+    void *p;
+    memset(out, 0, sizeof *out);
+    out->geom = *g;
+    out->bvh = rs_bvh_view_of(bvh);
+#define RS_COPY_GEOM(field, count)                                                                 \
+  if (st == RS_OK) {                                                                               \
+    st = rs_mirror_copy(&out->made, ops, &p, g->field, (count), sizeof *g->field);                 \
+    out->geom.field = p;                                                                           \
+  }
+    RS_GEOM_ARRAYS(RS_COPY_GEOM, g)
+#undef RS_COPY_GEOM
+#define RS_COPY_BVH(field, count)                                                                  \
+  if (st == RS_OK) {                                                                               \
+    st = rs_mirror_copy(&out->made, ops, &p, bvh->field, (count), sizeof *bvh->field);             \
+    out->bvh.field = p;                                                                            \
+  }
+    RS_BVH_ARRAYS(RS_COPY_BVH, bvh)
+#undef RS_COPY_BVH
+    if (st != RS_OK)
+        rs_device_geom_release(out, ops);
+    return st;
+}
+
+void rs_device_geom_release(rs_device_geom *c, const rs_mirror_ops *ops)
+{
+    rs_mirror_blocks_release(&c->made, ops);
+    memset(c, 0, sizeof *c);
+}
+
+rs_status rs_device_copy_scene(const rs_scene *s, const rs_device_geom *geom,
+                               const rs_mirror_ops *ops, rs_device_scene *out)
+{
+    rs_geom sg;
+    rs_status st;
+    void *p;
+    memset(out, 0, sizeof *out);
+    if (geom->geom.n_spheres != s->n_spheres || geom->geom.n_quads != s->n_quads ||
+        geom->geom.n_tris != s->n_tris)
+        return rs_error_set(RS_ERR_ARG,
+                            "the device's geometry (%u spheres, %u quads, %u triangles) is not the "
+                            "scene's (%u, %u, %u)",
+                            geom->geom.n_spheres, geom->geom.n_quads, geom->geom.n_tris,
+                            s->n_spheres, s->n_quads, s->n_tris);
+    if ((st = rs_scene_mirror_create(s, ops, &out->mirror)) != RS_OK)
+        return st;
+    if ((st = rs_mirror_copy(&out->mirror.made, ops, &p, &out->mirror.scene, 1,
+                             sizeof out->mirror.scene)) != RS_OK) {
+        rs_device_scene_release(out, ops);
+        return st;
+    }
+    out->scene = (const rs_scene *)p;
+    /* the uploaded geometry's values (algorithms, shutter), the mirror's arrays */
+    sg = rs_scene_geom(&out->mirror.scene);
+    out->tracer.geom = geom->geom;
+#define RS_TAKE_ARRAY(field, count) out->tracer.geom.field = sg.field;
+    RS_GEOM_ARRAYS(RS_TAKE_ARRAY, &sg)
+#undef RS_TAKE_ARRAY
+    out->tracer.bvh = geom->bvh;
+    out->tracer.bvh4 = NULL;
+    return RS_OK;
+}
+
+void rs_device_scene_release(rs_device_scene *c, const rs_mirror_ops *ops)
+{
+    rs_scene_mirror_release(&c->mirror, ops);
+    memset(c, 0, sizeof *c);
+}
