@@ -530,6 +530,10 @@ static void test_usage_errors(void **state)
         {{"render", "--width", "8", "--spp", "1", "-o", "out.xyz", NULL}, {"out.xyz"}},
         {{"render", "no-such-scene.rss", "-o", "out.png", "--spp", "1", NULL},
          {"no-such-scene.rss"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--timeline", "t.png", NULL},
+         {"--timeline", "t.png", ".svg"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--timeline", "/nonexistent-dir/t.svg", NULL},
+         {"--timeline", "/nonexistent-dir"}},
     };
     char known[256], names[512];
     size_t c;
@@ -1021,6 +1025,71 @@ static void test_device_fault_and_stats(void **state)
     proc_free(&r);
 }
 
+/* Reads a whole small file into buf (NUL-terminated); 0 if it cannot be read. */
+static int slurp(const char *path, char *buf, size_t cap)
+{
+    FILE *fp = fopen(path, "r");
+    size_t n;
+    if (!fp)
+        return 0;
+    n = fread(buf, 1, cap - 1, fp);
+    buf[n] = '\0';
+    fclose(fp);
+    return 1;
+}
+
+/* --stats and --stats-json time every stage under its name; --timeline draws a lane per device
+ * and one for the render thread, for both integrators. */
+static void test_stage_stats_and_timeline(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const stream_args[] = {
+        "render",       "--width", "24",         "--spp", "4",  "--devices", "cpu:1,gpu", "--stats",
+        "--stats-json", "st.json", "--timeline", "s.svg", "-o", "s.exr",     NULL};
+    static const char *const mk_args[] = {
+        "render", "--width",    "24",    "--spp", "4",  "--integrator", "megakernel", "--devices",
+        "cpu",    "--timeline", "m.svg", "-q",    "-o", "m.exr",        NULL};
+    static const char *const stages[] = {
+        "raygen", "trace-closest", "shade", "trace-shadow", "resolve-shadows", "compact", "film"};
+    static char svg[1 << 20];
+    char path[4200], json[8192];
+    proc p, q;
+    size_t k;
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, stream_args);
+    EXPECT(&p, exited_with(&p, 0), "the render with --stats and --timeline should succeed");
+    EXPECT(&p, strstr(p.err.data, "stage (render thread)") != NULL,
+           "--stats should print the stage table");
+    snprintf(path, sizeof path, "%s/st.json", f->dir);
+    EXPECT(&p, slurp(path, json, sizeof json), "--stats-json should write %s", path);
+    for (k = 0; k < sizeof stages / sizeof stages[0]; ++k) {
+        char key[64];
+        const char *at;
+        snprintf(key, sizeof key, "\"%s\": ", stages[k]);
+        at = strstr(json, key);
+        EXPECT(&p, at != NULL, "stats.json should time the stage %s: %s", stages[k], json);
+        EXPECT(&p, at && strtod(at + strlen(key), NULL) > 0.0,
+               "the stage %s should have taken some time", stages[k]);
+        EXPECT(&p, strstr(p.err.data, stages[k]) != NULL, "--stats should list %s", stages[k]);
+    }
+    snprintf(path, sizeof path, "%s/s.svg", f->dir);
+    EXPECT(&p, slurp(path, svg, sizeof svg), "--timeline should write %s", path);
+    EXPECT(&p, strncmp(svg, "<svg", 4) == 0 && strstr(svg, "</svg>") != NULL,
+           "the timeline should be an SVG picture");
+    EXPECT(&p,
+           strstr(svg, "gpu-fallback:0") && strstr(svg, "cpu (1 thread)") &&
+               strstr(svg, "shading (render thread)"),
+           "the timeline should have a lane per device and one for shading");
+    EXPECT(&p, strstr(svg, "trace-closest") && strstr(svg, "shade"),
+           "the timeline should name the stages it shows");
+    run(&q, f->dir, DEFAULT_TIMEOUT_S, mk_args);
+    EXPECT(&q, exited_with(&q, 0), "the megakernel render with --timeline should succeed");
+    snprintf(path, sizeof path, "%s/m.svg", f->dir);
+    EXPECT(&q, slurp(path, svg, sizeof svg) && strstr(svg, "pass") && strstr(svg, "cpu"),
+           "the megakernel's timeline should show its passes on the cpu's lane");
+    proc_free(&p);
+    proc_free(&q);
+}
+
 static void test_scene_files_and_meshes(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -1097,6 +1166,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_device_fault_and_stats, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_files_and_meshes, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_stage_stats_and_timeline, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }

@@ -6,6 +6,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <string.h>
+
 #include "render_util.h"
 
 #define SIZE 40
@@ -161,6 +163,38 @@ static void test_strategies_and_megakernel(void **state)
     }
 }
 
+/* Every integrator on every device set, on scenes with every kind of scene array the devices
+ * copy: textures and images (materials), moving spheres (bouncing-spheres), glass (cornell-glass).
+ * The fallback traces and shades in copies of its own (scheduler/device_copy.c), so an array
+ * copied short or wrong changes its image (one left out of the copy is scenes_mirror_test's). */
+static void test_integrators_and_device_sets(void **state)
+{
+    static const char *const scenes[] = {"materials", "bouncing-spheres", "cornell-glass"};
+    size_t k;
+    int cfg;
+    (void)state;
+    for (k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) {
+        rt_args ref = rt_defaults(scenes[k], 24, 4);
+        float *want;
+        ref.threads = 2;
+        want = rt_render(&ref, NULL);
+        assert_non_null(want);
+        for (cfg = 0; cfg < 4; ++cfg) {
+            rt_args a = ref;
+            float *img;
+            a.megakernel = cfg >= 2;    /* stream, stream, megakernel, megakernel */
+            a.fallback_only = cfg & 1;  /* on the CPU device / the GPU's fallback */
+            a.with_fallback = cfg == 0; /* the stream on cpu + fallback */
+            img = rt_render(&a, NULL);
+            assert_non_null(img);
+            if (memcmp(img, want, 24 * 24 * 3 * sizeof(float)) != 0)
+                fail_msg("%s: configuration %d differs from the cpu stream render", scenes[k], cfg);
+            free(img);
+        }
+        free(want);
+    }
+}
+
 /* rtiow-final, whose ground is a sphere of radius 1000 centred 1000 below the origin: hit points
  * near the origin carry errors of ~1e-4 there, and a bounce ray offset by less could hit the
  * ground again just above it — outside the ground's box, so found by brute force and culled by
@@ -225,6 +259,7 @@ int main(void)
         cmocka_unit_test(test_device_sets),
         cmocka_unit_test(test_strategies_and_megakernel),
         cmocka_unit_test(test_bvh_independence),
+        cmocka_unit_test(test_integrators_and_device_sets),
         cmocka_unit_test(test_failure_with_waves_in_flight),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
