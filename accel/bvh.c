@@ -204,43 +204,167 @@ static void compact(const rs_bvh_node *slots, uint32_t from, rs_bvh_node *out, u
     compact(slots, n.left_first + 1, out, out[to].left_first + 1, next, max_count);
 }
 
+/* The builder as rs_bvh.builder records it: the fields of opts->builder that its method reads
+ * (bins filled in), the others zero; the median builder when opts is NULL.  RS_ERR_ARG (with
+ * rs_bvh_builder_check's message) for an invalid builder. */
+static rs_status resolve_builder(const rs_bvh_build_opts *opts, rs_bvh_builder *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!opts)
+        return RS_OK;
+    if (rs_bvh_builder_check(&opts->builder) != RS_OK)
+        return RS_ERR_ARG;
+    out->method = opts->builder.method;
+    if (out->method == RS_BVH_GRID) {
+        out->axis = opts->builder.axis;
+        out->partition = opts->builder.partition;
+        out->key = opts->builder.key;
+    } else if (out->method == RS_BVH_SAH) {
+        out->bins = opts->builder.bins ? opts->builder.bins : RS_BVH_SAH_BINS_DEFAULT;
+    }
+    return RS_OK;
+}
+
+/* What a build allocates up front besides the tree's own arrays, and frees when it ends. */
+typedef struct scratch {
+    rs_aabb *bounds;       /* per primitive */
+    rs_vec3 *centroid;     /* per primitive */
+    rs_bvh_node *slots;    /* 2n - 1 build slots */
+    rs_bvh_key_id *pairs;  /* all but LBVH */
+    rs_bvh_key_id *pairs2; /* RS_BVH_GRID with RS_BVH_PART_SORT */
+    uint32_t *codes;       /* LBVH */
+    uint32_t *codes_tmp;   /* LBVH */
+    uint32_t *ids_tmp;     /* LBVH */
+} scratch;
+
+/* Allocates the scratch `builder` needs for b->n_prims >= 1 primitives, and b->prim_ids (in that
+ * order among them, every allocation tried even after one fails).  1 if all succeeded; on 0 what
+ * was allocated is freed by free_scratch and rs_bvh_destroy. */
+static int alloc_scratch(scratch *s, rs_bvh *b, const rs_bvh_builder *builder)
+{
+    uint32_t n = b->n_prims;
+    int lbvh = builder->method == RS_BVH_LBVH, need_pairs = !lbvh;
+    int need_pairs2 = builder->method == RS_BVH_GRID && builder->partition == RS_BVH_PART_SORT;
+    memset(s, 0, sizeof *s);
+    s->bounds = (rs_aabb *)rs_alloc(n, sizeof *s->bounds);
+    s->centroid = (rs_vec3 *)rs_alloc(n, sizeof *s->centroid);
+    b->prim_ids = (uint32_t *)rs_alloc(n, sizeof *b->prim_ids);
+    s->slots = (rs_bvh_node *)rs_alloc(2 * (size_t)n - 1, sizeof *s->slots);
+    if (need_pairs)
+        s->pairs = (rs_bvh_key_id *)rs_alloc(n, sizeof *s->pairs);
+    if (need_pairs2)
+        s->pairs2 = (rs_bvh_key_id *)rs_alloc(n, sizeof *s->pairs2);
+    if (lbvh) {
+        s->codes = (uint32_t *)rs_alloc(n, sizeof *s->codes);
+        s->codes_tmp = (uint32_t *)rs_alloc(n, sizeof *s->codes_tmp);
+        s->ids_tmp = (uint32_t *)rs_alloc(n, sizeof *s->ids_tmp);
+    }
+    return s->bounds && s->centroid && b->prim_ids && s->slots && (!need_pairs || s->pairs) &&
+           (!need_pairs2 || s->pairs2) && (!lbvh || (s->codes && s->codes_tmp && s->ids_tmp));
+}
+
+static void free_scratch(scratch *s)
+{
+    rs_free(s->bounds);
+    rs_free(s->centroid);
+    rs_free(s->slots);
+    rs_free(s->pairs);
+    rs_free(s->pairs2);
+    rs_free(s->codes);
+    rs_free(s->codes_tmp);
+    rs_free(s->ids_tmp);
+}
+
+/* Each primitive's box and the box's centre, and the identity permutation in ids. */
+static void prim_bounds(const rs_geom *g, uint32_t n, int threads, scratch *s, uint32_t *ids)
+{
+    long i;
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= PAR_BUILD)
+    for (i = 0; i < (long)n; ++i) {
+        s->bounds[i] = rs_geom_prim_bounds(g, (uint32_t)i);
+        s->centroid[i] = rs_v3_scale(rs_v3_add(s->bounds[i].lo, s->bounds[i].hi), 0.5f);
+        ids[i] = (uint32_t)i;
+    }
+}
+
+/* LBVH: ids sorted by the centroids' Morton codes, s->codes[i] the code of ids[i]; through
+ * opts->lbvh_sort where it is set (RS_OK or the hook's error), else on the host. */
+static rs_status lbvh_order(const rs_bvh_build_opts *opts, uint32_t n, int threads, scratch *s,
+                            uint32_t *ids)
+{
+    if (opts->lbvh_sort) {
+        float lo[3], scale[3];
+        rs_bvh_lbvh_frame(s->centroid, n, threads, lo, scale);
+        return opts->lbvh_sort(opts->lbvh_sort_user, s->centroid, n, lo, scale, ids, s->codes);
+    }
+    rs_bvh_lbvh_sort(s->centroid, n, ids, s->codes, s->codes_tmp, s->ids_tmp, threads);
+    return RS_OK;
+}
+
+/* The top-down recursion over all n >= 1 primitives with `builder`'s split rule: the nodes go to
+ * s->slots (the root at slot 0), ids is reordered into the leaves' ranges.  Returns the root's
+ * report. */
+static rec_out build_tree(const scratch *s, uint32_t *ids, uint32_t n, uint32_t max_leaf,
+                          const rs_bvh_builder *builder, int threads)
+{
+    rs_bvh_ctx c;
+    frame f;
+    rec_out res;
+    memset(&c, 0, sizeof c);
+    c.bounds = s->bounds;
+    c.centroid = s->centroid;
+    c.ids = ids;
+    c.max_leaf = max_leaf;
+    c.builder = *builder;
+    c.pairs = s->pairs;
+    c.pairs2 = s->pairs2;
+    c.codes = s->codes;
+    f.c = &c;
+    f.slots = s->slots;
+    f.keep_order = builder->method == RS_BVH_LBVH;
+    switch (builder->method) {
+    case RS_BVH_SAH: f.split = rs_bvh_split_sah; break;
+    case RS_BVH_LBVH: f.split = rs_bvh_split_lbvh; break;
+    default: f.split = rs_bvh_split_grid; break;
+    }
+#pragma omp parallel num_threads(threads) if (n >= PAR_BUILD && threads > 1)
+#pragma omp single
+    res = build_rec(&f, 0, 1, 0, n, 1);
+    return res;
+}
+
+/* The finished tree in b: the statistics from the root's report `res` and the hole-free node
+ * array copied out of the build slots.  RS_ERR_NOMEM (no message yet) if that array cannot be
+ * allocated. */
+static rs_status finish_tree(rs_bvh *b, const rs_bvh_node *slots, rec_out res)
+{
+    uint32_t next = 1, max_count = 0;
+    b->n_nodes = 2 * res.leaves - 1;
+    b->n_leaves = res.leaves;
+    b->depth = res.depth;
+    b->n_fallback = res.fallback;
+    b->nodes = (rs_bvh_node *)rs_alloc(b->n_nodes, sizeof *b->nodes);
+    if (!b->nodes)
+        return RS_ERR_NOMEM;
+    compact(slots, 0, b->nodes, 0, &next, &max_count);
+    RS_ASSERT(next == b->n_nodes);
+    b->max_leaf_count = max_count;
+    return RS_OK;
+}
+
 rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out)
 {
     uint32_t n = rs_geom_prim_count(g), max_leaf = (opts && opts->max_leaf) ? opts->max_leaf : 4;
     int threads = (opts && opts->threads) ? (int)opts->threads : rs_default_threads();
     rs_bvh_builder builder;
-    rs_bvh_ctx c;
-    frame f;
-    rec_out res;
-    rs_bvh *b = NULL;
-    rs_aabb *bounds = NULL;
-    rs_vec3 *centroid = NULL;
-    rs_bvh_node *slots = NULL;
-    rs_bvh_key_id *pairs = NULL, *pairs2 = NULL;
-    uint32_t *codes = NULL, *codes_tmp = NULL, *ids_tmp = NULL, next = 1, max_count = 0;
-    int need_pairs, need_pairs2, lbvh;
-    rs_status st = RS_ERR_NOMEM; /* until the tree is complete */
-    long i;
+    scratch s;
+    rs_bvh *b;
+    rs_status st;
     *out = NULL;
-    memset(&builder, 0, sizeof builder);
-    if (opts) {
-        if (rs_bvh_builder_check(&opts->builder) != RS_OK)
-            return RS_ERR_ARG;
-        /* keep only the fields the method reads, so that rs_bvh.builder names the tree */
-        builder.method = opts->builder.method;
-        if (builder.method == RS_BVH_GRID) {
-            builder.axis = opts->builder.axis;
-            builder.partition = opts->builder.partition;
-            builder.key = opts->builder.key;
-        } else if (builder.method == RS_BVH_SAH) {
-            builder.bins = opts->builder.bins ? opts->builder.bins : RS_BVH_SAH_BINS_DEFAULT;
-        }
-    }
+    if ((st = resolve_builder(opts, &builder)) != RS_OK)
+        return st;
     if (n > 0x7fffffffu)
         return rs_error_set(RS_ERR_ARG, "BVH: %u primitives, at most 2^31 - 1 supported", n);
-    lbvh = builder.method == RS_BVH_LBVH;
-    need_pairs = !lbvh;
-    need_pairs2 = builder.method == RS_BVH_GRID && builder.partition == RS_BVH_PART_SORT;
 
     b = (rs_bvh *)rs_calloc(1, sizeof *b);
     if (!b)
@@ -251,81 +375,15 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
         *out = b;
         return RS_OK;
     }
-    bounds = (rs_aabb *)rs_alloc(n, sizeof *bounds);
-    centroid = (rs_vec3 *)rs_alloc(n, sizeof *centroid);
-    b->prim_ids = (uint32_t *)rs_alloc(n, sizeof *b->prim_ids);
-    slots = (rs_bvh_node *)rs_alloc(2 * (size_t)n - 1, sizeof *slots);
-    if (need_pairs)
-        pairs = (rs_bvh_key_id *)rs_alloc(n, sizeof *pairs);
-    if (need_pairs2)
-        pairs2 = (rs_bvh_key_id *)rs_alloc(n, sizeof *pairs2);
-    if (lbvh) {
-        codes = (uint32_t *)rs_alloc(n, sizeof *codes);
-        codes_tmp = (uint32_t *)rs_alloc(n, sizeof *codes_tmp);
-        ids_tmp = (uint32_t *)rs_alloc(n, sizeof *ids_tmp);
+    st = RS_ERR_NOMEM; /* until the tree is complete */
+    if (alloc_scratch(&s, b, &builder)) {
+        prim_bounds(g, n, threads, &s, b->prim_ids);
+        st = builder.method == RS_BVH_LBVH ? lbvh_order(opts, n, threads, &s, b->prim_ids) : RS_OK;
+        if (st == RS_OK)
+            st = finish_tree(b, s.slots,
+                             build_tree(&s, b->prim_ids, n, max_leaf, &builder, threads));
     }
-    if (!bounds || !centroid || !b->prim_ids || !slots || (need_pairs && !pairs) ||
-        (need_pairs2 && !pairs2) || (lbvh && (!codes || !codes_tmp || !ids_tmp)))
-        goto nomem;
-
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= PAR_BUILD)
-    for (i = 0; i < (long)n; ++i) {
-        bounds[i] = rs_geom_prim_bounds(g, (uint32_t)i);
-        centroid[i] = rs_v3_scale(rs_v3_add(bounds[i].lo, bounds[i].hi), 0.5f);
-        b->prim_ids[i] = (uint32_t)i;
-    }
-    if (lbvh && opts->lbvh_sort) {
-        float lo[3], scale[3];
-        rs_bvh_lbvh_frame(centroid, n, threads, lo, scale);
-        if ((st = opts->lbvh_sort(opts->lbvh_sort_user, centroid, n, lo, scale, b->prim_ids,
-                                  codes)) != RS_OK)
-            goto nomem; /* not only memory: the hook's error is kept below */
-    } else if (lbvh) {
-        rs_bvh_lbvh_sort(centroid, n, b->prim_ids, codes, codes_tmp, ids_tmp, threads);
-    }
-
-    memset(&c, 0, sizeof c);
-    c.bounds = bounds;
-    c.centroid = centroid;
-    c.ids = b->prim_ids;
-    c.max_leaf = max_leaf;
-    c.builder = builder;
-    c.pairs = pairs;
-    c.pairs2 = pairs2;
-    c.codes = codes;
-    f.c = &c;
-    f.slots = slots;
-    f.keep_order = lbvh;
-    switch (builder.method) {
-    case RS_BVH_SAH: f.split = rs_bvh_split_sah; break;
-    case RS_BVH_LBVH: f.split = rs_bvh_split_lbvh; break;
-    default: f.split = rs_bvh_split_grid; break;
-    }
-#pragma omp parallel num_threads(threads) if (n >= PAR_BUILD && threads > 1)
-#pragma omp single
-    res = build_rec(&f, 0, 1, 0, n, 1);
-
-    b->n_nodes = 2 * res.leaves - 1;
-    b->n_leaves = res.leaves;
-    b->depth = res.depth;
-    b->n_fallback = res.fallback;
-    b->nodes = (rs_bvh_node *)rs_alloc(b->n_nodes, sizeof *b->nodes);
-    if (!b->nodes)
-        goto nomem;
-    compact(slots, 0, b->nodes, 0, &next, &max_count);
-    RS_ASSERT(next == b->n_nodes);
-    b->max_leaf_count = max_count;
-    st = RS_OK;
-
-nomem: /* success and a failed lbvh_sort come here too: the scratch buffers go either way */
-    rs_free(bounds);
-    rs_free(centroid);
-    rs_free(slots);
-    rs_free(pairs);
-    rs_free(pairs2);
-    rs_free(codes);
-    rs_free(codes_tmp);
-    rs_free(ids_tmp);
+    free_scratch(&s); /* success and a failed lbvh_sort too: the scratch goes either way */
     if (st != RS_OK) {
         rs_bvh_destroy(b);
         return st != RS_ERR_NOMEM

@@ -1,231 +1,16 @@
-/* accel/bvh.h — the bounding volume hierarchy: one flat node layout shared by host and device,
- * the host builders (median, the thesis's axis/partition/comparator grid, binned SAH, LBVH; see
- * accel/bvh.c for the invariants every one keeps), and the RS_HD traversal kernels that the CPU
- * device, the CUDA kernels and the CUDA fallback all call.
- *
- * Node layout (32 bytes, two per 64-byte cache line):
- *   lo, hi       12 B each  bounds
- *   left_first   4 B        interior: index of the left child; the right child is left_first + 1
- *                           leaf:     index of the first entry in prim_ids
- *   count        4 B        0 for an interior node, else the number of primitives in the leaf
- * Node 0 is the root.  An empty scene has no nodes and every ray misses. */
+/* accel/bvh.h — the bounding volume hierarchy's host side: the builders (median, the thesis's
+ * axis/partition/comparator grid, binned SAH, LBVH; see accel/bvh.c for the invariants every one
+ * keeps), their options and names, the rs_bvh that owns the node and primitive-id arrays, its
+ * SAH cost and destroy.  The node layout, the view and the RS_HD traversal that host and CUDA
+ * both compile are accel/bvh_traverse.h's, included here. */
 #ifndef RS_ACCEL_BVH_H
 #define RS_ACCEL_BVH_H
 
 #include <stddef.h>
 
+#include "accel/bvh_traverse.h"
 #include "core/geom.h"
 #include "core/status.h"
-
-typedef struct rs_bvh_node {
-    rs_vec3 lo;
-    uint32_t left_first;
-    rs_vec3 hi;
-    uint32_t count;
-} rs_bvh_node;
-
-/* What traversal needs: pointers (host or device) and counts.  Plain data, copied by value. */
-typedef struct rs_bvh_view {
-    const rs_bvh_node *nodes;
-    const uint32_t *prim_ids;
-    uint32_t n_nodes;
-} rs_bvh_view;
-
-/* Deepest stack traversal uses.  Every builder keeps depth <= RS_BVH_MAX_DEPTH = 63 nodes: the
- * closest-hit stack then holds at most depth - 1 entries and the any-hit stack depth + 1. */
-#define RS_BVH_STACK 64
-
-/* Traversal counters (the thesis's "ray-object intersection tests" metric): compiled in only in
- * a translation unit that defines RS_COUNTERS before including this header (a benchmark's
- * counting pass), as that unit's thread-local tallies.  Everywhere else RS_COUNT is empty, so
- * the traversal the devices run pays nothing. */
-#if defined(RS_COUNTERS) && !defined(__CUDACC__)
-typedef struct rs_trace_counters {
-    uint64_t rays, nodes, box_tests, prim_tests;
-} rs_trace_counters;
-static _Thread_local rs_trace_counters rs_counters;
-#  define RS_COUNT(field, n) (rs_counters.field += (uint64_t)(n))
-#else
-#  define RS_COUNT(field, n) ((void)0)
-#endif
-
-RS_HD rs_vec3 rs_bvh_inv_dir(rs_vec3 d) { return rs_v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z); }
-
-/* Traversal's box tests are conservative by a relative margin: a box passes when the ray's
- * interval [tn, tf] inside it, clipped to [tmin, tmax], satisfies tn <= tf * RS_BVH_SLACK.  The
- * slab distances (bound - o) / d and a primitive test's t each carry rounding errors of a few
- * ulps; without the margin a primitive hit exactly on its box's face (a ray through a mesh
- * vertex, a point on an axis-aligned wall) could be culled by one ancestor box and found through
- * another, so that the answer would depend on the order of the visit. */
-#define RS_BVH_SLACK (1.0f + 0x1.0p-16f)
-
-/* The slab test (rs_isect_aabb) with the margin. */
-RS_HD int rs_bvh_slab(const rs_aabb *b, rs_vec3 o, rs_vec3 inv_d, float tmin, float tmax,
-                      float *t_entry)
-{
-    float tn = tmin, tf = tmax;
-    rs_slab((b->lo.x - o.x) * inv_d.x, (b->hi.x - o.x) * inv_d.x, &tn, &tf);
-    rs_slab((b->lo.y - o.y) * inv_d.y, (b->hi.y - o.y) * inv_d.y, &tn, &tf);
-    rs_slab((b->lo.z - o.z) * inv_d.z, (b->hi.z - o.z) * inv_d.z, &tn, &tf);
-    *t_entry = tn;
-    return tn <= tf * RS_BVH_SLACK;
-}
-
-/* The node's box test, with the ray/box algorithm the geometry names (g->aabb_algo; the slab
- * test with the margin by default; the other algorithms, benchmark options, get the margin on
- * tmax only).  The id is loop-invariant, so the branch is predicted perfectly. */
-RS_HD int rs_bvh_node_hit(const rs_bvh_node *n, uint32_t algo, rs_vec3 o, rs_vec3 inv_d, float tmin,
-                          float tmax, float *t_entry)
-{
-    rs_aabb b;
-    b.lo = n->lo;
-    b.hi = n->hi;
-    if (algo == 0)
-        return rs_bvh_slab(&b, o, inv_d, tmin, tmax, t_entry);
-    return rs_isect_aabb_by(algo, &b, o, inv_d, tmin, tmax * RS_BVH_SLACK, t_entry);
-}
-
-/* The next float above t (for t >= 0, the common case, the next bit pattern): a bound that lets
- * a primitive hit at exactly t through the primitive tests' strict t < tmax. */
-RS_HD float rs_float_next_up(float t)
-{
-    union {
-        float f;
-        uint32_t u;
-    } x;
-    x.f = t;
-    if (t == 0.0f)
-        x.u = 1u; /* the smallest denormal, also above -0 */
-    else if (t > 0.0f && x.u < 0x7f800000u)
-        x.u++;
-    else if (t < 0.0f)
-        x.u--;
-    return x.f;
-}
-
-/* Which closest hit a traversal reports, whatever order it visits the primitives in: the smallest
- * t, and of primitives hit at exactly that t the lowest-numbered (what a brute-force loop over
- * the primitives in order keeps).  After a hit at t, a traversal keeps searching up to
- * rs_float_next_up(t) so that ties are seen, and takes a candidate (t', prim') when this says so
- * (before any hit, best->t is the ray's tmax and best->prim RS_NO_HIT).  So the binary and the
- * 4-wide traversals (accel/bvh4.h), on any device, agree bit for bit. */
-RS_HD int rs_hit_better(float t, uint32_t prim, const rs_hit *best)
-{
-    return t < best->t || (t == best->t && prim < best->prim);
-}
-
-/* Closest hit along `ray` (ordered, stack-based traversal: the nearer child first, the other
- * pushed).  Returns 1 and fills *hit on a hit; on a miss sets hit->prim = RS_NO_HIT, returns 0.
- * Ties go to the lowest primitive number (rs_hit_better). */
-RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
-{
-    uint32_t stack[RS_BVH_STACK];
-    uint32_t sp = 0, node = 0;
-    rs_vec3 inv_d = rs_bvh_inv_dir(ray.d);
-    float te;
-    hit->prim = RS_NO_HIT;
-    hit->t = ray.tmax;
-    hit->u = hit->v = 0.0f;
-    RS_COUNT(rays, 1);
-    RS_COUNT(box_tests, b->n_nodes > 0);
-    if (b->n_nodes == 0 ||
-        !rs_bvh_node_hit(&b->nodes[0], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &te))
-        return 0;
-    for (;;) {
-        const rs_bvh_node *n = &b->nodes[node];
-        RS_COUNT(nodes, 1);
-        if (n->count > 0) {
-            uint32_t i;
-            RS_COUNT(prim_tests, n->count);
-            for (i = 0; i < n->count; ++i) {
-                uint32_t prim = b->prim_ids[n->left_first + i];
-                float t, u, v;
-                if (rs_geom_intersect(g, prim, &ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
-                    ray.tmax = rs_float_next_up(t);
-                    hit->t = t;
-                    hit->u = u;
-                    hit->v = v;
-                    hit->prim = prim;
-                }
-            }
-        } else {
-            uint32_t l = n->left_first, r = l + 1;
-            float tl = 0.0f, tr = 0.0f;
-            int hl;
-            RS_COUNT(box_tests, 2);
-            hl = rs_bvh_node_hit(&b->nodes[l], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tl);
-            int hr =
-                rs_bvh_node_hit(&b->nodes[r], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tr);
-            if (hl && hr) {
-                if (tr < tl) {
-                    uint32_t tmp = l;
-                    l = r;
-                    r = tmp;
-                }
-                RS_ASSERT(sp < RS_BVH_STACK);
-                stack[sp++] = r;
-                node = l;
-                continue;
-            }
-            if (hl) {
-                node = l;
-                continue;
-            }
-            if (hr) {
-                node = r;
-                continue;
-            }
-        }
-        /* pop the next subtree that can still hold a closer hit */
-        for (;;) {
-            if (sp == 0)
-                return hit->prim != RS_NO_HIT;
-            node = stack[--sp];
-            RS_COUNT(box_tests, 1);
-            if (rs_bvh_node_hit(&b->nodes[node], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax,
-                                &te))
-                break;
-        }
-    }
-}
-
-/* Any hit inside (tmin, tmax): the shadow-ray query.  Returns 1 if something blocks the ray. */
-RS_HD int rs_bvh_occluded(const rs_bvh_view *b, const rs_geom *g, rs_ray ray)
-{
-    uint32_t stack[RS_BVH_STACK];
-    uint32_t sp = 0, node = 0;
-    rs_vec3 inv_d = rs_bvh_inv_dir(ray.d);
-    float te;
-    RS_COUNT(rays, 1);
-    if (b->n_nodes == 0)
-        return 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        const rs_bvh_node *n;
-        node = stack[--sp];
-        n = &b->nodes[node];
-        RS_COUNT(box_tests, 1);
-        if (!rs_bvh_node_hit(n, g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &te))
-            continue;
-        RS_COUNT(nodes, 1);
-        if (n->count > 0) {
-            uint32_t i;
-            for (i = 0; i < n->count; ++i) {
-                float t, u, v;
-                RS_COUNT(prim_tests, 1);
-                if (rs_geom_intersect(g, b->prim_ids[n->left_first + i], &ray, &t, &u, &v))
-                    return 1;
-            }
-        } else {
-            RS_ASSERT(sp + 2 <= RS_BVH_STACK);
-            stack[sp++] = n->left_first + 1;
-            stack[sp++] = n->left_first;
-        }
-    }
-    return 0;
-}
-
-/* ---- host side ---------------------------------------------------------------------------- */
 
 /* How a builder chooses its splits.  Stored as uint32_t fields (fixed width in C and CUDA C++).
  * A zeroed rs_bvh_builder is RS_BVH_MEDIAN, the builder this project always had. */
@@ -292,13 +77,6 @@ typedef struct rs_bvh {
                                 split would have broken the depth bound; 0 for median and grid */
 } rs_bvh;
 
-/* Every array of rs_bvh that its view (rs_bvh_view, the same field names) holds, with its
- * element count (`b` a pointer to the rs_bvh).  A device's copy of the BVH
- * (scheduler/device_copy.h) is made from this list: a new array of the view goes here. */
-#define RS_BVH_ARRAYS(X, b)                                                                        \
-  X(nodes, (size_t)(b)->n_nodes)                                                                   \
-  X(prim_ids, (size_t)(b)->n_prims)
-
 /* Build options.  A zeroed struct (or NULL) gives the median builder with 4-primitive leaves and
  * the default OpenMP thread count, the behaviour rs_bvh_build always had. */
 typedef struct rs_bvh_build_opts {
@@ -328,7 +106,9 @@ void rs_bvh_lbvh_frame(const rs_vec3 *centroid, uint32_t n, int threads, float l
 extern "C" {
 #endif
 rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out);
+/* Frees `b` and its arrays; NULL is a no-op. */
 void rs_bvh_destroy(rs_bvh *b);
+/* What traversal reads of `b` (accel/bvh_traverse.h): its host arrays, borrowed. */
 rs_bvh_view rs_bvh_view_of(const rs_bvh *b);
 /* The SAH cost of the finished tree (MacDonald & Booth 1990; Wald 2007, eq. 1), in units of
  * ray/primitive tests for a ray that hits the root box:

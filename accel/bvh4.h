@@ -1,7 +1,8 @@
 /* accel/bvh4.h — the CPU's 4-wide BVH: the binary tree collapsed so that each node holds up to
  * four children's boxes side by side, tested against one ray with SSE (Wald et al. 2008, "Getting
  * rid of packets"; Dammertz et al. 2008; Embree's BVH4).  Host only: the CUDA kernels and the GPU
- * fallback keep the binary tree (accel/bvh.h), whose 32-byte nodes suit one ray per GPU thread.
+ * fallback keep the binary tree (accel/bvh_traverse.h), whose 32-byte nodes suit one ray per GPU
+ * thread.
  *
  * Same answers as the binary traversal, bit for bit: the 4-wide tree holds the binary tree's own
  * boxes (a subset of them) and its leaves' primitive ranges, each box test is the scalar slab

@@ -4,7 +4,7 @@
 #ifndef RS_ACCEL_TRACE_H
 #define RS_ACCEL_TRACE_H
 
-#include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "streams/batch.h"
 
 RS_HD void rs_trace_one(const rs_bvh_view *b, const rs_geom *g, const rs_trace_batch *batch,

@@ -411,7 +411,7 @@ static void write_binned_lane(FILE *f, const layout *L, int lane, const item *it
 /* Everything the picture is drawn from. */
 typedef struct picture {
     layout L;
-    const item *items;    /* sorted by lane, then t0 */
+    item *items;          /* sorted by lane, then t0 */
     uint32_t *lane_first; /* lane l's spans: items[lane_first[l] ..][.. lane_n[l]] */
     uint32_t *lane_n;
     double *busy; /* seconds lane l was busy (the union of its spans) */
@@ -425,12 +425,12 @@ typedef struct picture {
     uint64_t dropped;
 } picture;
 
-/* The whole picture; a failed write shows in ferror(f). */
-static void write_svg(FILE *f, const picture *P, const char *const *lane_names, const char *title)
+/* The picture's head: the <svg> element, its background, the title and the summary line (total
+ * time, each lane's busy share, the log's size). */
+static void write_head(FILE *f, const picture *P, const char *const *lane_names, const char *title)
 {
     const layout *L = &P->L;
     int l;
-    uint32_t i;
     char buf[32];
     fprintf(f,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
@@ -441,7 +441,6 @@ static void write_svg(FILE *f, const picture *P, const char *const *lane_names, 
     put_xml(f, title ? title : "raystream timeline", 0);
     fputs("</text>\n", f);
 
-    /* the summary: total time, each lane's busy share, the log's size */
     fprintf(f, "<text x=\"12\" y=\"44\">total %.3f s &#183; busy:", L->end);
     for (l = 0; l < L->n_lanes; ++l) {
         fputs(l ? ", " : " ", f);
@@ -461,8 +460,15 @@ static void write_svg(FILE *f, const picture *P, const char *const *lane_names, 
         fputs("</tspan>", f);
     }
     fputs("</text>\n", f);
+}
 
-    /* lanes: label, busy share, background (idle shows through it) */
+/* Each lane's frame: its label (cut to NAME_MAX_LEN, the full name as tooltip), its busy share
+ * and its background (idle shows through it). */
+static void write_lane_frames(FILE *f, const picture *P, const char *const *lane_names)
+{
+    const layout *L = &P->L;
+    int l;
+    char buf[32];
     for (l = 0; l < L->n_lanes; ++l) {
         const char *name = lane_name(lane_names, l, buf, sizeof buf);
         int y = lane_y(L, l);
@@ -481,10 +487,14 @@ static void write_svg(FILE *f, const picture *P, const char *const *lane_names, 
         fprintf(f, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"%s\"/>\n", PLOT_X0, y,
                 PLOT_X1 - PLOT_X0, LANE_H, LANE_BG);
     }
-    write_grid(f, L);
-    if (P->n_ws)
-        write_waves(f, L, P->ws, P->n_ws, P->wave_end);
+}
 
+/* Each lane's spans: one rectangle per span, or binned where the lane is dense. */
+static void write_lane_spans(FILE *f, const picture *P)
+{
+    const layout *L = &P->L;
+    int l;
+    uint32_t i;
     for (l = 0; l < L->n_lanes; ++l) {
         const item *a = P->items + P->lane_first[l];
         if (P->lane_n[l] > P->dense) {
@@ -497,8 +507,19 @@ static void write_svg(FILE *f, const picture *P, const char *const *lane_names, 
             write_span(f, L, &a[i]);
         fputs("</g>\n", f);
     }
-    write_axis(f, L);
-    write_legend(f, L, P->used);
+}
+
+/* The whole picture; a failed write shows in ferror(f). */
+static void write_svg(FILE *f, const picture *P, const char *const *lane_names, const char *title)
+{
+    write_head(f, P, lane_names, title);
+    write_lane_frames(f, P, lane_names);
+    write_grid(f, &P->L);
+    if (P->n_ws)
+        write_waves(f, &P->L, P->ws, P->n_ws, P->wave_end);
+    write_lane_spans(f, P);
+    write_axis(f, &P->L);
+    write_legend(f, &P->L, P->used);
     fputs("</svg>\n", f);
 }
 
@@ -526,20 +547,151 @@ static void find_waves(picture *P, uint32_t n)
         }
 }
 
+/* Allocates P's arrays for P->n_spans spans over n_lanes lanes and *tmp, the name "`path`.tmp"
+ * (every allocation tried, in this order, even after one fails).  RS_ERR_NOMEM with a message
+ * when one failed; free_picture and rs_free(*tmp) release what was made either way. */
+static rs_status alloc_picture(picture *P, const char *path, int n_lanes, char **tmp)
+{
+    size_t plen = strlen(path);
+    *tmp = (char *)rs_alloc(plen + 5, 1);
+    P->items = (item *)rs_alloc(P->n_spans, sizeof *P->items);
+    P->ws = (wave_start *)rs_alloc(P->n_spans, sizeof *P->ws);
+    P->lane_first = (uint32_t *)rs_calloc((size_t)n_lanes, sizeof *P->lane_first);
+    P->lane_n = (uint32_t *)rs_calloc((size_t)n_lanes, sizeof *P->lane_n);
+    P->busy = (double *)rs_calloc((size_t)n_lanes, sizeof *P->busy);
+    if (!*tmp || !P->items || !P->ws || !P->lane_first || !P->lane_n || !P->busy)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for the timeline", path);
+    memcpy(*tmp, path, plen);
+    memcpy(*tmp + plen, ".tmp", 5);
+    return RS_OK;
+}
+
+static void free_picture(picture *P)
+{
+    rs_free(P->items);
+    rs_free(P->ws);
+    rs_free(P->lane_first);
+    rs_free(P->lane_n);
+    rs_free(P->busy);
+    rs_free(P->bins);
+}
+
+/* The spans on known lanes (lanes < n_lanes; the others counted in P->off_lane) into P->items,
+ * sorted by lane then start, with each lane's range and the stages used.  Returns how many;
+ * *tmax is the latest end (0 for none). */
+static uint32_t collect_items(picture *P, const rs_span *spans, int n_lanes, double *tmax)
+{
+    uint32_t n = 0, i;
+    *tmax = 0.0;
+    for (i = 0; i < P->n_spans; ++i) {
+        const rs_span *s = &spans[i];
+        item *it;
+        if (s->lane >= n_lanes) {
+            ++P->off_lane;
+            continue;
+        }
+        it = &P->items[n++];
+        it->t0 = s->t0;
+        it->t1 = s->t1;
+        it->wave = s->wave;
+        it->lane = s->lane;
+        it->stage = s->stage < RS_STAGE_COUNT ? s->stage : RS_STAGE_COUNT;
+        P->used[it->stage] = 1;
+        if (s->t1 > *tmax)
+            *tmax = s->t1;
+    }
+    qsort(P->items, n, sizeof *P->items, cmp_lane_t0);
+    for (i = 0; i < n; ++i)
+        if (P->lane_n[P->items[i].lane]++ == 0)
+            P->lane_first[P->items[i].lane] = i;
+    return n;
+}
+
+/* The time scale and the rows' positions (see the layout at the top of the file). */
+static void lay_out(layout *L, double tmax, int n_lanes, const int *used)
+{
+    L->end = tmax;
+    L->total = tmax > 0.0 ? tmax : 1e-3;
+    L->scale = N_COLS / L->total;
+    L->n_lanes = n_lanes;
+    L->render_y = PLOT_TOP + (n_lanes - 1) * LANE_PITCH + WAVE_ROW;
+    L->axis_y = L->render_y + LANE_H + 8;
+    L->legend_y = L->axis_y + 34;
+    L->height = L->legend_y + legend_rows(used) * LEGEND_ROW + 6;
+}
+
+/* Busy time per lane: the union of its spans (a device may run chunks side by side). */
+static void lane_busy(picture *P)
+{
+    int l;
+    uint32_t i;
+    for (l = 0; l < P->L.n_lanes; ++l) {
+        const item *a = P->items + P->lane_first[l];
+        double end = -1.0, sum = 0.0;
+        for (i = 0; i < P->lane_n[l]; ++i) {
+            double t0 = a[i].t0 > end ? a[i].t0 : end;
+            if (a[i].t1 > t0)
+                sum += a[i].t1 - t0;
+            if (a[i].t1 > end)
+                end = a[i].t1;
+        }
+        P->busy[l] = sum;
+    }
+}
+
+/* Too many spans (n of them) for one rectangle each: the lanes holding most of them are binned,
+ * so at most RS_TIMELINE_SVG_MERGE_SPANS spans are drawn one by one.  Sets P->dense and
+ * allocates P->bins where needed; RS_ERR_NOMEM with a message. */
+static rs_status choose_binning(picture *P, uint32_t n, const char *path)
+{
+    P->dense = UINT32_MAX;
+    if (n > RS_TIMELINE_SVG_MERGE_SPANS) {
+        P->dense = RS_TIMELINE_SVG_MERGE_SPANS / (uint32_t)P->L.n_lanes;
+        P->bins = (bin *)rs_alloc(N_COLS * N_STAGES, sizeof *P->bins);
+        if (!P->bins)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for the timeline", path);
+    }
+    return RS_OK;
+}
+
+/* Writes the picture to `tmp` and renames it to `path`; on failure removes `tmp` and reports
+ * RS_ERR_IO. */
+static rs_status write_file(const char *path, const char *tmp, const picture *P,
+                            const char *const *lane_names, const char *title)
+{
+    FILE *f = fopen(tmp, "wb");
+    int ok;
+    if (!f)
+        return rs_error_set(RS_ERR_IO, "%s: cannot write the timeline (%s)", path, strerror(errno));
+    setvbuf(f, NULL, _IOFBF, 1 << 16);
+    write_svg(f, P, lane_names, title);
+    ok = !ferror(f);
+    if (fclose(f) != 0)
+        ok = 0;
+    if (!ok) {
+        rs_status st =
+            rs_error_set(RS_ERR_IO, "%s: cannot write the timeline (%s)", path, strerror(errno));
+        remove(tmp);
+        return st;
+    }
+    if (rename(tmp, path) != 0) {
+        rs_status st = rs_error_set(RS_ERR_IO, "%s: cannot write the timeline (rename: %s)", path,
+                                    strerror(errno));
+        remove(tmp);
+        return st;
+    }
+    return RS_OK;
+}
+
 rs_status rs_timeline_write_svg(const char *path, const rs_timeline *t,
                                 const char *const *lane_names, int n_lanes, const char *title)
 {
     const rs_span *spans;
-    uint32_t n = 0, i;
-    item *items = NULL;
-    double tmax = 0.0;
-    int l, ok;
+    uint32_t n;
+    double tmax;
     picture P;
-    layout *L = &P.L;
     char *tmp = NULL;
-    size_t plen;
-    FILE *f;
-    rs_status st = RS_OK;
+    rs_status st;
 
     if (!path || !t)
         return rs_error_set(RS_ERR_ARG, "rs_timeline_write_svg: no %s", path ? "timeline" : "path");
@@ -549,107 +701,17 @@ rs_status rs_timeline_write_svg(const char *path, const rs_timeline *t,
     spans = rs_timeline_spans(t, &P.n_spans, &P.dropped);
 
     /* everything is allocated before the file is opened */
-    plen = strlen(path);
-    tmp = (char *)rs_alloc(plen + 5, 1);
-    items = (item *)rs_alloc(P.n_spans, sizeof *items);
-    P.ws = (wave_start *)rs_alloc(P.n_spans, sizeof *P.ws);
-    P.lane_first = (uint32_t *)rs_calloc((size_t)n_lanes, sizeof *P.lane_first);
-    P.lane_n = (uint32_t *)rs_calloc((size_t)n_lanes, sizeof *P.lane_n);
-    P.busy = (double *)rs_calloc((size_t)n_lanes, sizeof *P.busy);
-    if (!tmp || !items || !P.ws || !P.lane_first || !P.lane_n || !P.busy) {
-        st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory for the timeline", path);
-        goto done;
+    st = alloc_picture(&P, path, n_lanes, &tmp);
+    if (st == RS_OK) {
+        n = collect_items(&P, spans, n_lanes, &tmax);
+        lay_out(&P.L, tmax, n_lanes, P.used);
+        lane_busy(&P);
+        find_waves(&P, n);
+        st = choose_binning(&P, n, path);
     }
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, ".tmp", 5);
-
-    /* the spans on known lanes, sorted by lane then start */
-    for (i = 0; i < P.n_spans; ++i) {
-        const rs_span *s = &spans[i];
-        item *it;
-        if (s->lane >= n_lanes) {
-            ++P.off_lane;
-            continue;
-        }
-        it = &items[n++];
-        it->t0 = s->t0;
-        it->t1 = s->t1;
-        it->wave = s->wave;
-        it->lane = s->lane;
-        it->stage = s->stage < RS_STAGE_COUNT ? s->stage : RS_STAGE_COUNT;
-        P.used[it->stage] = 1;
-        if (s->t1 > tmax)
-            tmax = s->t1;
-    }
-    qsort(items, n, sizeof *items, cmp_lane_t0);
-    for (i = 0; i < n; ++i)
-        if (P.lane_n[items[i].lane]++ == 0)
-            P.lane_first[items[i].lane] = i;
-    P.items = items;
-
-    L->end = tmax;
-    L->total = tmax > 0.0 ? tmax : 1e-3;
-    L->scale = N_COLS / L->total;
-    L->n_lanes = n_lanes;
-    L->render_y = PLOT_TOP + (n_lanes - 1) * LANE_PITCH + WAVE_ROW;
-    L->axis_y = L->render_y + LANE_H + 8;
-    L->legend_y = L->axis_y + 34;
-    L->height = L->legend_y + legend_rows(P.used) * LEGEND_ROW + 6;
-
-    /* busy time per lane: the union of its spans (a device may run chunks side by side) */
-    for (l = 0; l < n_lanes; ++l) {
-        const item *a = items + P.lane_first[l];
-        double end = -1.0, sum = 0.0;
-        for (i = 0; i < P.lane_n[l]; ++i) {
-            double t0 = a[i].t0 > end ? a[i].t0 : end;
-            if (a[i].t1 > t0)
-                sum += a[i].t1 - t0;
-            if (a[i].t1 > end)
-                end = a[i].t1;
-        }
-        P.busy[l] = sum;
-    }
-    find_waves(&P, n);
-
-    /* too many spans for one rectangle each: the lanes holding most of them are binned, so at
-     * most RS_TIMELINE_SVG_MERGE_SPANS spans are drawn one by one */
-    P.dense = UINT32_MAX;
-    if (n > RS_TIMELINE_SVG_MERGE_SPANS) {
-        P.dense = RS_TIMELINE_SVG_MERGE_SPANS / (uint32_t)n_lanes;
-        P.bins = (bin *)rs_alloc(N_COLS * N_STAGES, sizeof *P.bins);
-        if (!P.bins) {
-            st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory for the timeline", path);
-            goto done;
-        }
-    }
-
-    f = fopen(tmp, "wb");
-    if (!f) {
-        st = rs_error_set(RS_ERR_IO, "%s: cannot write the timeline (%s)", path, strerror(errno));
-        goto done;
-    }
-    setvbuf(f, NULL, _IOFBF, 1 << 16);
-    write_svg(f, &P, lane_names, title);
-    ok = !ferror(f);
-    if (fclose(f) != 0)
-        ok = 0;
-    if (!ok) {
-        st = rs_error_set(RS_ERR_IO, "%s: cannot write the timeline (%s)", path, strerror(errno));
-        remove(tmp);
-        goto done;
-    }
-    if (rename(tmp, path) != 0) {
-        st = rs_error_set(RS_ERR_IO, "%s: cannot write the timeline (rename: %s)", path,
-                          strerror(errno));
-        remove(tmp);
-    }
-done:
+    if (st == RS_OK)
+        st = write_file(path, tmp, &P, lane_names, title);
     rs_free(tmp);
-    rs_free(items);
-    rs_free(P.ws);
-    rs_free(P.lane_first);
-    rs_free(P.lane_n);
-    rs_free(P.busy);
-    rs_free(P.bins);
+    free_picture(&P);
     return st;
 }

@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "accel/trace.h"
 #include "core/alloc.h"
 #include "scheduler/sched.h"
 

@@ -25,6 +25,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "accel/trace.h"
 #include "core/alloc.h"
 #include "core/cores.h"
 #include "scheduler/device_copy.h"

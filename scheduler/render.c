@@ -401,9 +401,15 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
     choose_host_memory(c);
     for (k = 0; k < c->n_slots; ++k)
         c->slots[k].stage = SLOT_IDLE;
-    for (k = 0; k < c->n_slots && status == RS_OK; ++k)
+    for (k = 0; k < c->n_slots && status == RS_OK; ++k) {
         status = rs_wave_buffers_create(c->st.wave_paths, c->have_pinned ? &c->pinned : NULL,
                                         &c->slots[k].b);
+        if (status == RS_ERR_NOMEM && c->have_pinned) {
+            /* page-locked memory is scarcer than memory: the device then stages its chunks */
+            rs_error_clear();
+            status = rs_wave_buffers_create(c->st.wave_paths, NULL, &c->slots[k].b);
+        }
+    }
     if (status == RS_OK)
         status = run_waves(c, n_waves);
     /* on a failure or an interruption, take back what is still with the scheduler before the

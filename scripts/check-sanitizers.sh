@@ -1,6 +1,7 @@
 #!/bin/sh
 # scripts/check-sanitizers.sh — the test suite under AddressSanitizer + UBSan, and the scheduler
-# and render tests under ThreadSanitizer.  One command; run it before resolving an issue.
+# and render tests (and the timeline, written from several threads) under ThreadSanitizer.  One
+# command; run it before resolving an issue.
 #   sh scripts/check-sanitizers.sh [address|thread]   (default: both)
 # Builds in build-asan/ and build-tsan/ with RS_CUDA=OFF (device code is not instrumented).
 set -eu
@@ -19,5 +20,5 @@ if [ "$which" = both ] || [ "$which" = thread ]; then
     cmake --build build-tsan -j"$jobs"
     # OpenMP is compiled out of this build (core/parallel.h says why): no suppressions needed.
     TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-        ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli"
+        ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli|app_timeline"
 fi

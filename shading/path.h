@@ -25,7 +25,7 @@
 
 #include <float.h>
 
-#include "accel/bvh.h"
+#include "accel/bvh_traverse.h"
 #include "core/rng.h"
 #include "shading/bsdf.h"
 #include "shading/camera.h"

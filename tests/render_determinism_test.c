@@ -195,6 +195,101 @@ static void test_integrators_and_device_sets(void **state)
     }
 }
 
+/* A CPU device that offers host memory (scheduler/device.h host_alloc) as a GPU does: from
+ * rs_alloc_aligned, counted, or failing every time (g_host_fail).  Its trace counts the chunks
+ * whose batch says it came from that memory. */
+static rs_device_ops g_host_ops;
+static const rs_device_ops *g_inner_ops;
+static int g_host_fail, g_host_blocks, g_pinned_chunks;
+
+static void *host_alloc_counted(rs_device *d, size_t bytes)
+{
+    (void)d;
+    if (g_host_fail)
+        return NULL;
+    g_host_blocks++;
+    return rs_alloc_aligned(bytes, 1);
+}
+
+static void host_free_counted(rs_device *d, void *p)
+{
+    (void)d;
+    g_host_blocks--;
+    rs_free(p);
+}
+
+static rs_status trace_counting_pinned(rs_device *d, const rs_trace_batch *b, uint32_t lo,
+                                       uint32_t hi)
+{
+    g_pinned_chunks += b->pinned != 0;
+    return g_inner_ops->trace(d, b, lo, hi);
+}
+
+static float *render_with_host_memory(void)
+{
+    rt_args a = rt_defaults("cornell", SIZE, SPP);
+    rs_scene *scene = NULL;
+    rs_bvh *bvh = NULL;
+    rs_device *dev = NULL;
+    rs_sched *sched = NULL;
+    rs_film *film = NULL;
+    rs_render_settings st;
+    rs_render_stats stats;
+    rs_geom g;
+    float *rgb = (float *)malloc(NF * sizeof *rgb);
+    assert_int_equal(rs_builtin_create("cornell", &scene), RS_OK);
+    g = rs_scene_geom(scene);
+    assert_int_equal(rs_bvh_build(&g, NULL, &bvh), RS_OK);
+    assert_int_equal(rs_cpu_device_create(1, "cpu", &dev), RS_OK);
+    g_inner_ops = dev->ops;
+    g_host_ops = *dev->ops;
+    g_host_ops.host_alloc = host_alloc_counted;
+    g_host_ops.host_free = host_free_counted;
+    g_host_ops.trace = trace_counting_pinned;
+    dev->ops = &g_host_ops;
+    assert_int_equal(rs_device_upload(dev, &g, bvh), RS_OK);
+    assert_int_equal(rs_sched_create(&dev, 1, NULL, &sched), RS_OK);
+    assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
+    memset(&st, 0, sizeof st);
+    st.width = st.height = SIZE;
+    st.spp = SPP;
+    st.max_depth = a.max_depth;
+    st.seed = a.seed;
+    st.sampling = a.sampling;
+    st.threads = 1;
+    st.wave_paths = 3000; /* several waves, each buffer set allocated and freed */
+    assert_int_equal(rs_render(scene, sched, &st, NULL, film, &stats), RS_OK);
+    rs_film_resolve(film, rgb);
+    rs_sched_destroy(sched);
+    rs_device_destroy(dev);
+    rs_film_destroy(film);
+    rs_bvh_destroy(bvh);
+    rs_scene_destroy(scene);
+    return rgb;
+}
+
+/* Wave buffers from a device's host_alloc: every chunk says so (a GPU then copies it by DMA
+ * without staging), every block is given back, and the image is unchanged; where host_alloc
+ * fails the render falls back to plain memory, unpinned, with the same image. */
+static void test_wave_buffers_in_device_memory(void **state)
+{
+    float *img;
+    (void)state;
+    g_host_fail = 0;
+    g_host_blocks = g_pinned_chunks = 0;
+    img = render_with_host_memory();
+    assert_memory_equal(img, g_ref, NF * sizeof(float));
+    assert_true(g_pinned_chunks > 0);
+    assert_int_equal(g_host_blocks, 0);
+    free(img);
+    g_host_fail = 1;
+    g_pinned_chunks = 0;
+    img = render_with_host_memory();
+    assert_memory_equal(img, g_ref, NF * sizeof(float));
+    assert_int_equal(g_pinned_chunks, 0);
+    free(img);
+}
+
 /* rtiow-final, whose ground is a sphere of radius 1000 centred 1000 below the origin: hit points
  * near the origin carry errors of ~1e-4 there, and a bounce ray offset by less could hit the
  * ground again just above it — outside the ground's box, so found by brute force and culled by
@@ -260,6 +355,7 @@ int main(void)
         cmocka_unit_test(test_strategies_and_megakernel),
         cmocka_unit_test(test_bvh_independence),
         cmocka_unit_test(test_integrators_and_device_sets),
+        cmocka_unit_test(test_wave_buffers_in_device_memory),
         cmocka_unit_test(test_failure_with_waves_in_flight),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
