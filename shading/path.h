@@ -87,7 +87,7 @@ RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *p
     ps->pending = rs_v3_splat(0.0f);
     ps->bsdf_pdf = 0.0f;
     ps->time = time;
-    ps->flags = RS_PATH_SPECULAR;
+    ps->flags = (uint8_t)RS_PATH_SPECULAR;
     return ray;
 }
 
@@ -381,7 +381,7 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
     next->time = r.time;
     ps->throughput = beta;
     ps->bsdf_pdf = pdf;
-    ps->flags = specular ? RS_PATH_SPECULAR : 0;
+    ps->flags = (uint8_t)(specular ? RS_PATH_SPECULAR : 0);
     return out | RS_SHADE_NEXT;
 }
 

@@ -1,7 +1,7 @@
 /* streams/wave.h — every buffer one wave of paths needs, allocated once per render (nothing per
  * chunk or per bounce).  Per path slot: two extension-ray streams (current and next, ping-pong),
  * the shadow rays by input slot and compacted, the hits, three flag bytes and the path state:
- * 40 + 40 + 40 + 40 + 16 + 3 + 48 = 227 B.  The streams a device reads and writes (the
+ * 40 + 40 + 40 + 40 + 16 + 3 + 45 = 224 B.  The streams a device reads and writes (the
  * extension rays, the compacted shadow rays, the hits and the occlusion bytes) come from the
  * allocator given (a GPU's page-locked host memory); the rest from rs_alloc. */
 #ifndef RS_STREAMS_WAVE_H
