@@ -42,13 +42,16 @@ build-gpu/bench/scheduler_bench $quick --csv "$out/scheduler_bench.csv" >"$out/s
 build-gpu/bench/parallel_bench $quick --max-threads "$jobs" --csv "$out/parallel_bench.csv" \
     >"$out/parallel_bench.txt" 2>&1 || status=1
 build-gpu/bench/ablation_bench $quick --csv "$out/ablation_bench.csv" >"$out/ablation_bench.txt" 2>&1 || status=1
-# the CUDA megakernel and the stream engine on the CPU and GPU together, end to end
+# the CUDA megakernel and the stream engine on the CPU and GPU together, end to end, each with
+# its --timeline picture (the README's wants one from a real cpu,gpu render)
 # (.pfm without OpenImageIO, the lent machine's case; .exr with it)
 ext=pfm
 build-gpu/raystream --version | grep -q "OpenImageIO: *[0-9]" && ext=exr
 for args in "--integrator megakernel --devices gpu" "--devices cpu,gpu" "--devices cpu"; do
+    name=$(echo "$args" | tr -c 'a-z0-9\n' '_')
     build-gpu/raystream render builtin:rtiow-final --width 1280 --height 720 --spp 64 --stats \
-        $args -o "$out/render-$(echo "$args" | tr -c 'a-z0-9\n' '_').$ext" >>"$out/render.txt" 2>&1 || status=1
+        $args -o "$out/render-$name.$ext" --timeline "$out/timeline-$name.svg" \
+        >>"$out/render.txt" 2>&1 || status=1
 done
 tail -5 "$out/ctest.txt"
 grep -h "mismatch\|diff\|GPU device\|SKIP" "$out/gpu_trace_test.txt" || true
