@@ -33,20 +33,19 @@ rs_status rs_device_copy_geom(const rs_geom *g, const rs_bvh *bvh, const rs_mirr
     memset(out, 0, sizeof *out);
     out->geom = *g;
     out->bvh = rs_bvh_view_of(bvh);
-#define RS_COPY_GEOM(field, count)                                                                 \
+/* One array of `src` copied into `dst` (the field of the same name), listed in out->made. */
+#define RS_COPY_FROM(src, dst, field, count)                                                       \
   if (st == RS_OK) {                                                                               \
-    st = rs_mirror_copy(&out->made, ops, &p, g->field, (count), sizeof *g->field);                 \
-    out->geom.field = p;                                                                           \
+    st = rs_mirror_copy(&out->made, ops, &p, (src)->field, (count), sizeof *(src)->field);         \
+    (dst).field = p;                                                                               \
   }
+#define RS_COPY_GEOM(field, count) RS_COPY_FROM(g, out->geom, field, count)
+#define RS_COPY_BVH(field, count)  RS_COPY_FROM(bvh, out->bvh, field, count)
     RS_GEOM_ARRAYS(RS_COPY_GEOM, g)
-#undef RS_COPY_GEOM
-#define RS_COPY_BVH(field, count)                                                                  \
-  if (st == RS_OK) {                                                                               \
-    st = rs_mirror_copy(&out->made, ops, &p, bvh->field, (count), sizeof *bvh->field);             \
-    out->bvh.field = p;                                                                            \
-  }
     RS_BVH_ARRAYS(RS_COPY_BVH, bvh)
 #undef RS_COPY_BVH
+#undef RS_COPY_GEOM
+#undef RS_COPY_FROM
     if (st != RS_OK)
         rs_device_geom_release(out, ops);
     return st;
