@@ -315,6 +315,7 @@ static void make_settings(const rs_cli_options *o, render_run *r)
     st->max_depth = o->max_depth;
     st->seed = o->seed;
     st->sampling = o->sampling;
+    st->sampler = o->sampler;
     st->wave_paths = o->wave_paths;
     st->waves_in_flight = o->waves;
     r->threads = o->threads ? o->threads : rs_cpu_count();
@@ -612,13 +613,14 @@ static void print_summary(const rs_cli_options *o, const render_run *r, int code
     human((double)rays_total / secs, rps, sizeof rps);
     human((double)rays_total, rays, sizeof rays);
     fprintf(stderr,
-            "%s %s at %ux%u, %u spp (%s sampling, max depth %u, seed %llu) in %.2f s: "
+            "%s %s at %ux%u, %u spp (%s sampling, %s sampler, max depth %u, seed %llu) in %.2f s: "
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
             "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
             code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered", o->scene,
-            st->width, st->height, st->spp, rs_sampling_name(st->sampling), st->max_depth,
-            (unsigned long long)st->seed, r->stats.seconds, sps, rps, rays,
-            (unsigned long long)r->stats.rays_closest, (unsigned long long)r->stats.rays_shadow,
+            st->width, st->height, st->spp, rs_sampling_name(st->sampling),
+            rs_sampler_name(st->sampler), st->max_depth, (unsigned long long)st->seed,
+            r->stats.seconds, sps, rps, rays, (unsigned long long)r->stats.rays_closest,
+            (unsigned long long)r->stats.rays_shadow,
             rs_bvh_builder_name(&r->bvh->builder, bvh_name, sizeof bvh_name),
             rs_bvh_sah_cost(r->bvh), r->bvh->n_nodes, r->bvh->n_prims, r->bvh_ms);
     for (i = 0; i < r->n_devs; ++i) {

@@ -127,11 +127,14 @@ void rs_cli_print_help(const char *command)
             "                      separated cpu, cpu:THREADS, gpu, gpu:INDEX.  A gpu that\n"
             "                      cannot be used runs on the CPU fallback (one warning).\n"
             "  --stats             after the render, a table per device: rays, chunks, busy\n"
-            "                      and idle seconds, Mrays/s, share, bytes moved\n"
+            "                      and idle seconds, Mrays/s, share, bytes moved; and the\n"
+            "                      seconds of each named stage\n"
             "  --stats-json FILE   the same as JSON\n"
             "  --sampling MODE     mis (default): light + BSDF sampling, power heuristic;\n"
             "                      mixture: the thesis's light/BSDF mixture pdf;\n"
             "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
+            "  --sampler NAME      sobol (default): Owen-scrambled Sobol points, 2D-stratified\n"
+            "                      per decision; independent: independent random numbers\n"
             "  --bvh NAME          BVH builder: median (default), sah or sah:BINS, lbvh, or the\n"
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
@@ -241,6 +244,11 @@ static int parse_image_option(opt_arg *x, rs_cli_options *o)
             return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
                                "uniform)",
                                v, "");
+    } else if (strcmp(name, "--sampler") == 0) {
+        NEEDS_VALUE();
+        if (!rs_sampler_parse(v, &o->sampler))
+            return usage_error("--sampler: unknown sampler '%s'%s (use independent or sobol)", v,
+                               "");
     } else if (strcmp(name, "--mesh") == 0) {
         NEEDS_VALUE();
         if (!*v)
@@ -427,6 +435,7 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->max_depth = 50;
     o->seed = 1;
     o->sampling = RS_SAMPLING_MIS;
+    o->sampler = RS_SAMPLER_SOBOL;
     o->chunk_size = 0; /* adaptive */
     o->wave_paths = 1u << 20;
     o->waves = 0; /* auto */

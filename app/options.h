@@ -37,6 +37,7 @@ typedef struct rs_cli_options {
     uint64_t seed;
     int threads; /* 0: every core */
     rs_sampling sampling;
+    rs_sampler sampler;  /* --sampler */
     uint32_t chunk_size; /* 0: adaptive */
     uint32_t wave_paths;
     uint32_t waves; /* waves in flight; 0: auto */

@@ -284,6 +284,7 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     it->max_depth = st->max_depth;
     it->rr_depth = st->rr_depth ? st->rr_depth : 3;
     it->sampling = (uint32_t)st->sampling;
+    it->sampler = (uint32_t)st->sampler;
     return RS_OK;
 }
 

@@ -26,6 +26,22 @@ int rs_sampling_parse(const char *text, rs_sampling *out)
     return 0;
 }
 
+const char *rs_sampler_name(rs_sampler s)
+{
+    return s == RS_SAMPLER_SOBOL ? "sobol" : s == RS_SAMPLER_INDEPENDENT ? "independent" : "?";
+}
+
+int rs_sampler_parse(const char *text, rs_sampler *out)
+{
+    if (strcmp(text, "independent") == 0)
+        *out = RS_SAMPLER_INDEPENDENT;
+    else if (strcmp(text, "sobol") == 0)
+        *out = RS_SAMPLER_SOBOL;
+    else
+        return 0;
+    return 1;
+}
+
 void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
                           uint32_t count, rs_paths *paths, rs_ray_soa *out)
 {

@@ -24,6 +24,10 @@ const char *rs_sampling_name(rs_sampling s);
 /* Parses "mis", "mixture", "bsdf" or "uniform"; returns 0 if unknown. */
 int rs_sampling_parse(const char *text, rs_sampling *out);
 
+const char *rs_sampler_name(rs_sampler s);
+/* Parses "independent" or "sobol"; returns 0 if unknown. */
+int rs_sampler_parse(const char *text, rs_sampler *out);
+
 /* How a stage runs on the host: up to `threads` OpenMP threads, split as `strategy` says (the
  * render loop takes the threads from its core budget for each stage). */
 typedef struct rs_stage_exec {

@@ -27,6 +27,7 @@
 
 #include "accel/bvh_traverse.h"
 #include "core/rng.h"
+#include "core/sobol.h"
 #include "shading/bsdf.h"
 #include "shading/camera.h"
 #include "shading/dims.h"
@@ -44,6 +45,12 @@ typedef enum rs_sampling {
     RS_SAMPLING_BSDF = 2,    /* BSDF importance sampling only */
     RS_SAMPLING_UNIFORM = 3  /* uniform hemisphere, no light sampling ("no importance sampling") */
 } rs_sampling;
+
+/* Where a path's random numbers come from (each group of four: shading/dims.h). */
+typedef enum rs_sampler {
+    RS_SAMPLER_INDEPENDENT = 0, /* Philox-4x32-10 (core/rng.h): independent uniform numbers */
+    RS_SAMPLER_SOBOL = 1        /* Owen-scrambled shuffled Sobol points (core/sobol.h) */
+} rs_sampler;
 
 /* Path flags. */
 #define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
@@ -64,7 +71,28 @@ typedef struct rs_integrator {
     uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     uint32_t sampling;  /* rs_sampling */
+    uint32_t sampler;   /* rs_sampler */
 } rs_integrator;
+
+/* Four numbers in [0, 1) for decision group `group` (shading/dims.h) of path (pixel, sample)
+ * at segment `bounce`, from the render's sampler. */
+RS_HD rs_rng_f4 rs_path_rand(const rs_integrator *it, uint32_t pixel, uint32_t sample,
+                             uint32_t bounce, uint32_t group)
+{
+    if (it->sampler == RS_SAMPLER_SOBOL) {
+        rs_rng_f4 f = rs_sobol_float4(it->seed, pixel, sample, bounce, group);
+        if (group == RS_DIM_LIGHT) {
+            /* the light's point (v[1], v[2]) is one stratified pair, the pick and the mixture
+             * choice (v[0], v[3]) the other */
+            float pick = f.v[2];
+            f.v[2] = f.v[1];
+            f.v[1] = f.v[0];
+            f.v[0] = pick;
+        }
+        return f;
+    }
+    return rs_rng_float4(it->seed, pixel, sample, bounce, group);
+}
 
 /* One path's state between its vertices: rs_path_state, declared once in streams/paths.h. */
 
@@ -73,12 +101,12 @@ RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *p
 {
     const rs_camera_desc *cd = &it->scene->camera;
     uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
-    rs_rng_f4 r = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_CAMERA);
+    rs_rng_f4 r = rs_path_rand(it, pixel, sample, 0, RS_DIM_CAMERA);
     rs_ray ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, r.v[0], r.v[1],
                                r.v[2], r.v[3]);
     float time = cd->shutter_open;
     if (cd->shutter_close != cd->shutter_open) {
-        rs_rng_f4 rt = rs_rng_float4(it->seed, pixel, sample, 0, RS_DIM_TIME);
+        rs_rng_f4 rt = rs_path_rand(it, pixel, sample, 0, RS_DIM_TIME);
         time += rt.v[0] * (cd->shutter_close - cd->shutter_open);
     }
     ray.time = time;
@@ -349,14 +377,14 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
     v.wo = rs_v3_neg(r.d);
     v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
     v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng);
-    rb = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_BSDF);
+    rb = rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
 
     if (rs_material_is_delta(v.m)) {
         if (!rs_shade_delta(sc, &v, rb, &beta, &wi))
             return out;
         specular = 1;
     } else {
-        rs_rng_f4 rl = rs_rng_float4(it->seed, pixel, sample, bounce, RS_DIM_LIGHT);
+        rs_rng_f4 rl = rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
         v.origin = rs_offset_origin(v.x, v.n_geo, rs_prim_scale(sc, v.prim));
         if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0)
             out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow);

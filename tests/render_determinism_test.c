@@ -163,20 +163,22 @@ static void test_strategies_and_megakernel(void **state)
     }
 }
 
-/* Every integrator on every device set, on scenes with every kind of scene array the devices
- * copy: textures and images (materials), moving spheres (bouncing-spheres), glass (cornell-glass).
- * The fallback traces and shades in copies of its own (scheduler/device_copy.c), so an array
- * copied short or wrong changes its image (one left out of the copy is scenes_mirror_test's). */
+/* Every integrator on every device set, with every sampler, on scenes with every kind of scene
+ * array the devices copy: textures and images (materials), moving spheres (bouncing-spheres), glass
+ * (cornell-glass). The fallback traces and shades in copies of its own (scheduler/device_copy.c),
+ * so an array copied short or wrong changes its image (one left out of the copy is
+ * scenes_mirror_test's). */
 static void test_integrators_and_device_sets(void **state)
 {
     static const char *const scenes[] = {"materials", "bouncing-spheres", "cornell-glass"};
     size_t k;
     int cfg;
     (void)state;
-    for (k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) {
-        rt_args ref = rt_defaults(scenes[k], 24, 4);
+    for (k = 0; k < 2 * sizeof scenes / sizeof scenes[0]; ++k) {
+        rt_args ref = rt_defaults(scenes[k / 2], 24, 4);
         float *want;
         ref.threads = 2;
+        ref.sampler = k % 2 ? RS_SAMPLER_SOBOL : RS_SAMPLER_INDEPENDENT; /* every sampler */
         want = rt_render(&ref, NULL);
         assert_non_null(want);
         for (cfg = 0; cfg < 4; ++cfg) {

@@ -20,6 +20,7 @@ typedef struct rt_args {
     uint32_t width, height, spp, max_depth;
     uint64_t seed;
     rs_sampling sampling;
+    rs_sampler sampler;       /* zeroed: independent */
     int threads;              /* CPU device and shading threads */
     uint32_t chunk_size;      /* 0: default */
     uint32_t wave_paths;      /* 0: default */
@@ -103,6 +104,7 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     st.max_depth = a->max_depth;
     st.seed = a->seed;
     st.sampling = a->sampling;
+    st.sampler = a->sampler;
     st.wave_paths = a->wave_paths;
     st.waves_in_flight = a->waves;
     st.threads = a->threads;
