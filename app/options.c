@@ -135,7 +135,7 @@ void rs_cli_print_help(const char *command)
             "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
             "  --sampler NAME      sobol (default): Owen-scrambled Sobol points, 2D-stratified\n"
             "                      per decision; independent: independent random numbers\n"
-            "  --bvh NAME          BVH builder: median (default), sah or sah:BINS, lbvh, or the\n"
+            "  --bvh NAME          BVH builder: sah (default) or sah:BINS, median, lbvh, or the\n"
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
             "  --integrator NAME   stream (default: the wavefront engine on every device) or\n"
@@ -436,6 +436,7 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->seed = 1;
     o->sampling = RS_SAMPLING_MIS;
     o->sampler = RS_SAMPLER_SOBOL;
+    o->bvh.method = RS_BVH_SAH; /* binned, 16 bins: 1.25-1.33x faster traversal than median */
     o->chunk_size = 0; /* adaptive */
     o->wave_paths = 1u << 20;
     o->waves = 0; /* auto */

@@ -211,6 +211,16 @@ RS_HD rs_vec3 rs_shading_normal(const rs_scene *sc, uint32_t prim, float hu, flo
     return rs_v3_dot(ns, wo) > 0.0f ? ns : n_geo;
 }
 
+/* Russian roulette's survival probability at a vertex reached with `throughput`: the throughput
+ * the path expects after reflecting there (times the albedo, plus Phong's specular part), in
+ * [0.05, 0.95].  Any q > 0 keeps the estimate unbiased (the survivors are divided by q); the
+ * floor keeps a surface whose reflectance the estimate misses from ending every path. */
+RS_HD float rs_roulette_survival(rs_vec3 throughput, const rs_material *m, rs_vec3 albedo)
+{
+    rs_vec3 r = m->type == RS_MAT_PHONG ? rs_v3_add(albedo, m->specular) : albedo;
+    return fminf(fmaxf(rs_v3_max_comp(rs_v3_mul(throughput, r)), 0.05f), 0.95f);
+}
+
 /* A surface vertex of a path, as its shading steps see it. */
 typedef struct rs_vertex {
     const rs_material *m;
@@ -393,9 +403,14 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
         if (!(rs_v3_dot(wi, v.n_geo) > 0.0f))
             return out; /* below the real surface (a shading-normal artefact): nothing comes back */
     }
-    /* Russian roulette, then the next segment */
+    /* Russian roulette, then the next segment.  The survival probability follows the path's
+     * throughput before this vertex times what the surface reflects on average, not the sampled
+     * direction's f cos / pdf: under the mixture pdf a direction toward a small light has a large
+     * pdf and so a small f cos / pdf, and a q taken from it killed most of the very paths about
+     * to reach the light (and weighted the survivors up by 1 / q): 2.85x the per-sample standard
+     * deviation of the same estimator without roulette (docs/sampling.md). */
     if (bounce + 1 >= it->rr_depth) {
-        float q = fminf(rs_v3_max_comp(beta), 0.95f);
+        float q = rs_roulette_survival(ps->throughput, v.m, v.albedo);
         if (!(rb.v[3] < q))
             return out;
         beta = rs_v3_scale(beta, 1.0f / q);
