@@ -137,15 +137,6 @@ static void test_float_range(void **state)
 
 /* ---- uniformity ----------------------------------------------------------------------------- */
 
-static double chi_square(const double *observed, int bins, double expected)
-{
-    double x2 = 0.0;
-    int i;
-    for (i = 0; i < bins; ++i)
-        x2 += (observed[i] - expected) * (observed[i] - expected) / expected;
-    return x2;
-}
-
 static void test_uniform_chi_square(void **state)
 {
     /* 10^6 floats: the four lanes of 250000 consecutive pixels.  H0: uniform on [0, 1).

@@ -134,15 +134,6 @@ static void test_pairs_are_nets(void **state)
     }
 }
 
-static double chi_square(const double *observed, int bins, double expected)
-{
-    double c = 0.0;
-    int i;
-    for (i = 0; i < bins; ++i)
-        c += (observed[i] - expected) * (observed[i] - expected) / expected;
-    return c;
-}
-
 static void test_uniform_chi_square(void **state)
 {
     static double bins[4][100];

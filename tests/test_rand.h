@@ -17,6 +17,16 @@ static inline uint64_t splitmix64(uint64_t *s)
     return z ^ (z >> 31);
 }
 
+/* Pearson's statistic of `bins` observed counts that each expect `expected`. */
+static inline double chi_square(const double *observed, int bins, double expected)
+{
+    double c = 0.0;
+    int i;
+    for (i = 0; i < bins; ++i)
+        c += (observed[i] - expected) * (observed[i] - expected) / expected;
+    return c;
+}
+
 /* uniform double in [0, 1) from the top 53 bits */
 static inline double rnd01(uint64_t *s) { return (double)(splitmix64(s) >> 11) * 0x1.0p-53; }
 
