@@ -52,15 +52,16 @@ RS_HD uint32_t rs_sobol_u32(uint32_t index, uint32_t dim)
     return rs_reverse_bits(dim == 0 ? index : rs_superset_xor(index));
 }
 
-/* Laine and Karras's permutation as improved by Burley (2020, listing 2): each output bit
- * depends only on the input bits below it, a random one for each seed. */
+/* Laine and Karras's permutation in Burley's improved form (2020, section 3; the hash Cycles'
+ * Sobol-Burley sampler uses): each output bit depends only on the input bits below it (adds,
+ * odd multiplies and x ^= x * even constant all carry upward only), a random one for each seed. */
 RS_HD uint32_t rs_lk_permute(uint32_t x, uint32_t seed)
 {
+    x ^= x * 0x3d20adeau;
     x += seed;
-    x ^= x * 0x6c50b47cu;
-    x ^= x * 0xb82f1e52u;
-    x ^= x * 0xc7afe638u;
-    x ^= x * 0x8d22f6e6u;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
     return x;
 }
 

@@ -183,6 +183,11 @@ static rs_status launch_piece(rs_device *d, rs_cuda_impl *c, rs_cuda_stage *s,
     int direct = batch->pinned != 0;
     const rs_ray_soa *src = direct ? &batch->rays : &s->h_rays;
     uint32_t off = direct ? begin : 0;
+    /* pending from the first queued call on: a later call failing must still be waited for */
+    s->begin = begin;
+    s->n = n;
+    s->direct = direct;
+    s->pending = 1;
     if (!direct)
         rs_trace_stage_in(&s->h_rays, batch, begin, n);
 #define RS_COPY_IN(type, name)                                                                     \
@@ -214,10 +219,6 @@ static rs_status launch_piece(rs_device *d, rs_cuda_impl *c, rs_cuda_stage *s,
         uint8_t *dst = direct ? batch->occluded + begin : s->h_occ;
         CUDA_TRY(cudaMemcpyAsync(dst, s->d_occ, n, cudaMemcpyDeviceToHost, s->stream));
     }
-    s->begin = begin;
-    s->n = n;
-    s->direct = direct;
-    s->pending = 1;
     return RS_OK;
 }
 
