@@ -284,17 +284,8 @@ static inline int rs_bvh4_closest(const rs_bvh4 *b, const rs_geom *g, rs_ray ray
                 count = 0;
             }
 #endif
-            for (i = 0; i < count; ++i) {
-                uint32_t prim = b->prim_ids[first + i];
-                float t, u, v;
-                if (rs_geom_intersect(g, prim, &ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
-                    ray.tmax = rs_float_next_up(t);
-                    hit->t = t;
-                    hit->u = u;
-                    hit->v = v;
-                    hit->prim = prim;
-                }
-            }
+            for (i = 0; i < count; ++i)
+                rs_bvh_leaf_closest(g, b->prim_ids[first + i], &ray, hit);
         }
         /* pop the next entry that can still hold a hit no farther than the best so far */
         for (;;) {

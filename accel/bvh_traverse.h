@@ -123,6 +123,21 @@ RS_HD int rs_hit_better(float t, uint32_t prim, const rs_hit *best)
     return t < best->t || (t == best->t && prim < best->prim);
 }
 
+/* One primitive of a leaf for closest hit: where it is hit no farther than the best so far (ties
+ * to the lower primitive, rs_hit_better), it becomes the best and the ray is cut just past it.
+ * The binary and the 4-wide traversal (accel/bvh4.h) both take their leaves' primitives here. */
+RS_HD void rs_bvh_leaf_closest(const rs_geom *g, uint32_t prim, rs_ray *ray, rs_hit *hit)
+{
+    float t, u, v;
+    if (rs_geom_intersect(g, prim, ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
+        ray->tmax = rs_float_next_up(t);
+        hit->t = t;
+        hit->u = u;
+        hit->v = v;
+        hit->prim = prim;
+    }
+}
+
 /* Closest hit along `ray` (ordered, stack-based traversal: the nearer child first, the other
  * pushed).  Returns 1 and fills *hit on a hit; on a miss sets hit->prim = RS_NO_HIT, returns 0.
  * Ties go to the lowest primitive number (rs_hit_better). */
@@ -146,17 +161,8 @@ RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_
         if (n->count > 0) {
             uint32_t i;
             RS_COUNT(prim_tests, n->count);
-            for (i = 0; i < n->count; ++i) {
-                uint32_t prim = b->prim_ids[n->left_first + i];
-                float t, u, v;
-                if (rs_geom_intersect(g, prim, &ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
-                    ray.tmax = rs_float_next_up(t);
-                    hit->t = t;
-                    hit->u = u;
-                    hit->v = v;
-                    hit->prim = prim;
-                }
-            }
+            for (i = 0; i < n->count; ++i)
+                rs_bvh_leaf_closest(g, b->prim_ids[n->left_first + i], &ray, hit);
         } else {
             uint32_t l = n->left_first, r = l + 1;
             float tl = 0.0f, tr = 0.0f;
