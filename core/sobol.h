@@ -82,15 +82,34 @@ RS_HD uint32_t rs_hash_u32(uint32_t x)
     return x;
 }
 
-/* The 2D point of sample `sample` for `seed`: shuffled index, both dimensions Owen-scrambled.
- * (The scramble of dimension d is reverse(lk(reverse(sobol_d))), and reverse(sobol_d) is the
- * index itself or its superset-XOR, so each dimension costs one bit reversal.) */
-RS_HD void rs_sobol2(uint32_t seed, uint32_t sample, float *x0, float *x1)
+/* Point `index` of the first two Sobol dimensions, each Owen-scrambled with a seed made from
+ * `seed`.  (The scramble of dimension d is reverse(lk(reverse(sobol_d))), and reverse(sobol_d) is
+ * the index itself or its superset-XOR, so each dimension costs one bit reversal.) */
+RS_HD void rs_owen_sobol2(uint32_t seed, uint32_t index, float *x0, float *x1)
 {
-    uint32_t index = rs_nested_uniform_scramble(sample, seed);
     *x0 = rs_rng_to_float(rs_reverse_bits(rs_lk_permute(index, rs_hash_u32(seed + 1u))));
     *x1 = rs_rng_to_float(
         rs_reverse_bits(rs_lk_permute(rs_superset_xor(index), rs_hash_u32(seed + 2u))));
+}
+
+/* The 2D point of sample `sample` for `seed`: shuffled index, both dimensions Owen-scrambled. */
+RS_HD void rs_sobol2(uint32_t seed, uint32_t sample, float *x0, float *x1)
+{
+    rs_owen_sobol2(seed, rs_nested_uniform_scramble(sample, seed), x0, x1);
+}
+
+/* The two pairs' seeds of one group of four numbers, for (seed, pixel, bounce, group): how every
+ * decision of every bounce gets dimensions of its own, without a table (shading/dims.h numbers
+ * the groups; there are fewer than 8).  core/zsobol.h takes them with pixel 0: its pixels share
+ * one sequence per pair. */
+#define RS_SOBOL_PAIR0 0x5bd1e995u
+#define RS_SOBOL_PAIR1 0x27d4eb2fu
+
+RS_HD uint32_t rs_sobol_group_seed(uint64_t seed, uint32_t pixel, uint32_t bounce, uint32_t group)
+{
+    return rs_hash_u32((uint32_t)seed ^
+                       rs_hash_u32((uint32_t)(seed >> 32) ^
+                                   rs_hash_u32(pixel ^ rs_hash_u32(bounce * 8u + group))));
 }
 
 /* Four numbers in [0, 1) for (seed, pixel, sample, bounce, group), like rs_rng_float4: the 2D
@@ -98,12 +117,10 @@ RS_HD void rs_sobol2(uint32_t seed, uint32_t sample, float *x0, float *x1)
 RS_HD rs_rng_f4 rs_sobol_float4(uint64_t seed, uint32_t pixel, uint32_t sample, uint32_t bounce,
                                 uint32_t group)
 {
-    uint32_t s = rs_hash_u32((uint32_t)seed ^
-                             rs_hash_u32((uint32_t)(seed >> 32) ^
-                                         rs_hash_u32(pixel ^ rs_hash_u32(bounce * 8u + group))));
+    uint32_t s = rs_sobol_group_seed(seed, pixel, bounce, group);
     rs_rng_f4 f;
-    rs_sobol2(rs_hash_u32(s ^ 0x5bd1e995u), sample, &f.v[0], &f.v[1]);
-    rs_sobol2(rs_hash_u32(s ^ 0x27d4eb2fu), sample, &f.v[2], &f.v[3]);
+    rs_sobol2(rs_hash_u32(s ^ RS_SOBOL_PAIR0), sample, &f.v[0], &f.v[1]);
+    rs_sobol2(rs_hash_u32(s ^ RS_SOBOL_PAIR1), sample, &f.v[2], &f.v[3]);
     return f;
 }
 
