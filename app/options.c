@@ -134,7 +134,9 @@ void rs_cli_print_help(const char *command)
             "                      mixture: the thesis's light/BSDF mixture pdf;\n"
             "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
             "  --sampler NAME      sobol (default): Owen-scrambled Sobol points, 2D-stratified\n"
-            "                      per decision; independent: independent random numbers\n"
+            "                      per decision; zsobol: the same, pixels in Morton order on\n"
+            "                      one sequence (blue-noise error, pbrt-v4's ZSobolSampler);\n"
+            "                      independent: independent random numbers\n"
             "  --bvh NAME          BVH builder: sah (default) or sah:BINS, median, lbvh, or the\n"
             "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
             "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
@@ -247,8 +249,9 @@ static int parse_image_option(opt_arg *x, rs_cli_options *o)
     } else if (strcmp(name, "--sampler") == 0) {
         NEEDS_VALUE();
         if (!rs_sampler_parse(v, &o->sampler))
-            return usage_error("--sampler: unknown sampler '%s'%s (use independent or sobol)", v,
-                               "");
+            return usage_error("--sampler: unknown sampler '%s'%s (use independent, sobol or "
+                               "zsobol)",
+                               v, "");
     } else if (strcmp(name, "--mesh") == 0) {
         NEEDS_VALUE();
         if (!*v)

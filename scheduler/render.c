@@ -281,6 +281,7 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     it->width = st->width;
     it->height = st->height;
     it->npix = (uint32_t)npix;
+    it->spp = st->spp;
     it->max_depth = st->max_depth;
     it->rr_depth = st->rr_depth ? st->rr_depth : 3;
     it->sampling = (uint32_t)st->sampling;

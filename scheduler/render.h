@@ -42,7 +42,7 @@ typedef struct rs_render_settings {
     uint32_t rr_depth;  /* Russian roulette from this segment on; 0 means 3 */
     uint64_t seed;
     rs_sampling sampling;
-    rs_sampler sampler;       /* independent (zeroed) or sobol */
+    rs_sampler sampler;       /* independent (zeroed), sobol or zsobol */
     uint32_t wave_paths;      /* paths in flight; 0 means RS_RENDER_DEFAULT_WAVE */
     uint32_t waves_in_flight; /* 1..RS_RENDER_MAX_WAVES; 0: auto (below) */
     int threads;              /* OpenMP threads for the shading stages (at most) */

@@ -1,7 +1,8 @@
 /* shading/dims.h — which group of four random numbers each decision uses at one bounce.
- * Changing a number here changes every image: the groups must stay distinct.  With the sobol
- * sampler (core/sobol.h) each group is two stratified 2D points: (x0, x1) and (x2, x3), except
- * the light's, whose point (u1, u2) is one pair and (pick, choice) the other (rs_path_rand). */
+ * Changing a number here changes every image: the groups must stay distinct.  With the sobol and
+ * zsobol samplers (core/sobol.h, core/zsobol.h) each group is two stratified 2D points: (x0, x1)
+ * and (x2, x3), except the light's, whose point (u1, u2) is one pair and (pick, choice) the other
+ * (rs_path_rand). */
 #ifndef RS_SHADING_DIMS_H
 #define RS_SHADING_DIMS_H
 

@@ -28,18 +28,23 @@ int rs_sampling_parse(const char *text, rs_sampling *out)
 
 const char *rs_sampler_name(rs_sampler s)
 {
-    return s == RS_SAMPLER_SOBOL ? "sobol" : s == RS_SAMPLER_INDEPENDENT ? "independent" : "?";
+    switch (s) {
+    case RS_SAMPLER_INDEPENDENT: return "independent";
+    case RS_SAMPLER_SOBOL: return "sobol";
+    case RS_SAMPLER_ZSOBOL: return "zsobol";
+    }
+    return "?";
 }
 
 int rs_sampler_parse(const char *text, rs_sampler *out)
 {
-    if (strcmp(text, "independent") == 0)
-        *out = RS_SAMPLER_INDEPENDENT;
-    else if (strcmp(text, "sobol") == 0)
-        *out = RS_SAMPLER_SOBOL;
-    else
-        return 0;
-    return 1;
+    int i;
+    for (i = 0; i <= RS_SAMPLER_ZSOBOL; ++i)
+        if (strcmp(text, rs_sampler_name((rs_sampler)i)) == 0) {
+            *out = (rs_sampler)i;
+            return 1;
+        }
+    return 0;
 }
 
 void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,

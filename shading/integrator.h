@@ -25,7 +25,7 @@ const char *rs_sampling_name(rs_sampling s);
 int rs_sampling_parse(const char *text, rs_sampling *out);
 
 const char *rs_sampler_name(rs_sampler s);
-/* Parses "independent" or "sobol"; returns 0 if unknown. */
+/* Parses "independent", "sobol" or "zsobol"; returns 0 if unknown. */
 int rs_sampler_parse(const char *text, rs_sampler *out);
 
 /* How a stage runs on the host: up to `threads` OpenMP threads, split as `strategy` says (the

@@ -28,6 +28,7 @@
 #include "accel/bvh_traverse.h"
 #include "core/rng.h"
 #include "core/sobol.h"
+#include "core/zsobol.h"
 #include "shading/bsdf.h"
 #include "shading/camera.h"
 #include "shading/dims.h"
@@ -49,7 +50,9 @@ typedef enum rs_sampling {
 /* Where a path's random numbers come from (each group of four: shading/dims.h). */
 typedef enum rs_sampler {
     RS_SAMPLER_INDEPENDENT = 0, /* Philox-4x32-10 (core/rng.h): independent uniform numbers */
-    RS_SAMPLER_SOBOL = 1        /* Owen-scrambled shuffled Sobol points (core/sobol.h) */
+    RS_SAMPLER_SOBOL = 1,       /* Owen-scrambled shuffled Sobol points (core/sobol.h) */
+    RS_SAMPLER_ZSOBOL = 2       /* Owen-scrambled Sobol points in Morton order over the image
+                                   (core/zsobol.h): blue-noise error across pixels */
 } rs_sampler;
 
 /* Path flags. */
@@ -68,6 +71,7 @@ typedef struct rs_integrator {
     rs_camera camera;
     uint64_t seed;
     uint32_t width, height, npix;
+    uint32_t spp;       /* the render's samples per pixel (the zsobol sampler's block size) */
     uint32_t max_depth; /* most ray segments a path may have, camera ray included (>= 1) */
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     uint32_t sampling;  /* rs_sampling */
@@ -79,19 +83,25 @@ typedef struct rs_integrator {
 RS_HD rs_rng_f4 rs_path_rand(const rs_integrator *it, uint32_t pixel, uint32_t sample,
                              uint32_t bounce, uint32_t group)
 {
-    if (it->sampler == RS_SAMPLER_SOBOL) {
-        rs_rng_f4 f = rs_sobol_float4(it->seed, pixel, sample, bounce, group);
-        if (group == RS_DIM_LIGHT) {
-            /* the light's point (v[1], v[2]) is one stratified pair, the pick and the mixture
-             * choice (v[0], v[3]) the other */
-            float pick = f.v[2];
-            f.v[2] = f.v[1];
-            f.v[1] = f.v[0];
-            f.v[0] = pick;
-        }
-        return f;
+    rs_rng_f4 f;
+    float pick;
+    if (it->sampler == RS_SAMPLER_SOBOL)
+        f = rs_sobol_float4(it->seed, pixel, sample, bounce, group);
+    else if (it->sampler == RS_SAMPLER_ZSOBOL)
+        f = rs_zsobol_float4(it->seed, pixel % it->width, pixel / it->width, sample,
+                             rs_ceil_log2(it->spp), rs_zsobol_log2_res(it->width, it->height),
+                             bounce, group);
+    else
+        return rs_rng_float4(it->seed, pixel, sample, bounce, group);
+    if (group == RS_DIM_LIGHT) {
+        /* both Sobol samplers: the light's point (v[1], v[2]) is one stratified pair, the pick
+         * and the mixture choice (v[0], v[3]) the other */
+        pick = f.v[2];
+        f.v[2] = f.v[1];
+        f.v[1] = f.v[0];
+        f.v[0] = pick;
     }
-    return rs_rng_float4(it->seed, pixel, sample, bounce, group);
+    return f;
 }
 
 /* One path's state between its vertices: rs_path_state, declared once in streams/paths.h. */

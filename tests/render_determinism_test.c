@@ -174,11 +174,11 @@ static void test_integrators_and_device_sets(void **state)
     size_t k;
     int cfg;
     (void)state;
-    for (k = 0; k < 2 * sizeof scenes / sizeof scenes[0]; ++k) {
-        rt_args ref = rt_defaults(scenes[k / 2], 24, 4);
+    for (k = 0; k < 3 * sizeof scenes / sizeof scenes[0]; ++k) {
+        rt_args ref = rt_defaults(scenes[k / 3], 24, 4);
         float *want;
         ref.threads = 2;
-        ref.sampler = k % 2 ? RS_SAMPLER_SOBOL : RS_SAMPLER_INDEPENDENT; /* every sampler */
+        ref.sampler = (rs_sampler)(k % 3); /* every sampler: independent, sobol, zsobol */
         want = rt_render(&ref, NULL);
         assert_non_null(want);
         for (cfg = 0; cfg < 4; ++cfg) {
@@ -190,11 +190,46 @@ static void test_integrators_and_device_sets(void **state)
             img = rt_render(&a, NULL);
             assert_non_null(img);
             if (memcmp(img, want, 24 * 24 * 3 * sizeof(float)) != 0)
-                fail_msg("%s: configuration %d differs from the cpu stream render", scenes[k], cfg);
+                fail_msg("%s, %s sampler: configuration %d differs from the cpu stream render",
+                         scenes[k / 3], rs_sampler_name(ref.sampler), cfg);
             free(img);
         }
         free(want);
     }
+}
+
+/* The zsobol sampler's index needs the render's whole spp and size (its blocks per pixel, its
+ * Morton square): a 40x27 image (not a power of two, not square) at 6 spp (rounded up to 8, an
+ * odd log2) must not depend on threads, chunks, waves, devices or integrator either, although
+ * the megakernel's fallback passes render one sample of every pixel at a time. */
+static void test_zsobol_settings(void **state)
+{
+    rt_args ref = rt_defaults("cornell", 40, 6);
+    float *want;
+    int cfg;
+    (void)state;
+    ref.height = 27;
+    ref.sampler = RS_SAMPLER_ZSOBOL;
+    want = rt_render(&ref, NULL);
+    assert_non_null(want);
+    for (cfg = 0; cfg < 6; ++cfg) {
+        rt_args a = ref;
+        float *img;
+        a.threads = 2;
+        a.chunk_size = cfg == 1 ? 7 : cfg == 2 ? 61 : 0;
+        a.wave_paths = cfg == 2 ? 333 : 0;
+        a.waves = cfg == 3 ? 3 : 0;
+        a.with_fallback = cfg == 3;
+        a.fallback_only = cfg == 5;
+        a.megakernel = cfg >= 4;
+        a.shared_cores = cfg == 3;
+        img = rt_render(&a, NULL);
+        assert_non_null(img);
+        if (memcmp(img, want, 40 * 27 * 3 * sizeof(float)) != 0)
+            fail_msg("zsobol: configuration %d differs from the one-thread cpu render", cfg);
+        free(img);
+    }
+    free(want);
 }
 
 /* A CPU device that offers host memory (scheduler/device.h host_alloc) as a GPU does: from
@@ -357,6 +392,7 @@ int main(void)
         cmocka_unit_test(test_strategies_and_megakernel),
         cmocka_unit_test(test_bvh_independence),
         cmocka_unit_test(test_integrators_and_device_sets),
+        cmocka_unit_test(test_zsobol_settings),
         cmocka_unit_test(test_wave_buffers_in_device_memory),
         cmocka_unit_test(test_failure_with_waves_in_flight),
     };
