@@ -317,24 +317,26 @@ static void choose_host_memory(render_ctx *c)
     }
 }
 
-/* The settings with the automatic choices made: waves in flight, the wave size per slot. */
+/* The settings with the automatic choices made: the wave size, waves in flight, the wave size
+ * per slot. */
 static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint64_t total)
 {
-    if (st->wave_paths == 0)
-        st->wave_paths = RS_RENDER_DEFAULT_WAVE;
-    if (st->waves_in_flight == 0) {
-        int i;
-        st->waves_in_flight = 1;
-        for (i = 0; i < rs_sched_device_count(sched); ++i)
-            if (rs_device_is_gpu(rs_sched_device(sched, i)))
-                st->waves_in_flight = 2;
+    int i, gpu = 0;
+    for (i = 0; i < rs_sched_device_count(sched); ++i)
+        gpu |= rs_device_is_gpu(rs_sched_device(sched, i));
+    if (st->threads < 1)
+        st->threads = 1;
+    if (st->wave_paths == 0) {
+        uint64_t host = (uint64_t)RS_RENDER_HOST_WAVE * (uint32_t)st->threads;
+        st->wave_paths = gpu || host > RS_RENDER_DEFAULT_WAVE ? RS_RENDER_DEFAULT_WAVE
+                                                               : (uint32_t)host;
     }
+    if (st->waves_in_flight == 0)
+        st->waves_in_flight = gpu ? 2 : 1;
     /* the paths in flight are shared among the waves in flight */
     st->wave_paths = (st->wave_paths + st->waves_in_flight - 1) / st->waves_in_flight;
     if ((uint64_t)st->wave_paths > total)
         st->wave_paths = (uint32_t)total;
-    if (st->threads < 1)
-        st->threads = 1;
 }
 
 /* Round robin over the slots: each visit runs a slot up to its next submission, so the devices
