@@ -137,8 +137,8 @@ RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *p
  * scene scale. */
 RS_HD rs_vec3 rs_offset_origin(rs_vec3 x, rs_vec3 n, float prim_scale)
 {
-    float scale = fmaxf(fmaxf(fabsf(x.x), fabsf(x.y)), fmaxf(fabsf(x.z), 1e-2f));
-    return rs_v3_madd(x, n, fmaxf(1e-4f * scale, 1e-6f * prim_scale));
+    float scale = rs_fmaxf(rs_fmaxf(fabsf(x.x), fabsf(x.y)), rs_fmaxf(fabsf(x.z), 1e-2f));
+    return rs_v3_madd(x, n, rs_fmaxf(1e-4f * scale, 1e-6f * prim_scale));
 }
 
 /* The size of the numbers a primitive's intersection test works with, which bounds the error of
@@ -154,7 +154,7 @@ RS_HD float rs_prim_scale(const rs_scene *sc, uint32_t prim)
     if (prim >= sc->n_spheres)
         return 0.0f;
     s = &sc->spheres[prim];
-    return fmaxf(fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
+    return rs_fmaxf(rs_fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
 }
 
 RS_HD float rs_power_heuristic(float a, float b)
@@ -169,7 +169,7 @@ RS_HD void rs_surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, 
                          float *u, float *v)
 {
     if (prim < sc->n_spheres) {
-        float theta = acosf(fminf(1.0f, fmaxf(-1.0f, -n_out.y)));
+        float theta = acosf(rs_fminf(1.0f, rs_fmaxf(-1.0f, -n_out.y)));
         float phi = atan2f(-n_out.z, n_out.x) + RS_PI;
         *u = phi * (0.5f * RS_INV_PI);
         *v = theta * RS_INV_PI;
@@ -231,7 +231,7 @@ RS_HD rs_vec3 rs_shading_normal(const rs_scene *sc, uint32_t prim, float hu, flo
 RS_HD float rs_roulette_survival(rs_vec3 throughput, const rs_material *m, rs_vec3 albedo)
 {
     rs_vec3 r = m->type == RS_MAT_PHONG ? rs_v3_add(albedo, m->specular) : albedo;
-    return fminf(fmaxf(rs_v3_max_comp(rs_v3_mul(throughput, r)), 0.05f), 0.95f);
+    return rs_fminf(rs_fmaxf(rs_v3_max_comp(rs_v3_mul(throughput, r)), 0.05f), 0.95f);
 }
 
 /* A surface vertex of a path, as its shading steps see it. */
