@@ -33,8 +33,13 @@ uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t
                  hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
         uint32_t o = offsets[b], i;
         for (i = lo; i < hi; ++i)
-            if (valid[i])
-                rs_ray_soa_copy(dst, o++, src, i);
+            if (valid[i]) {
+                /* each field inline (rs_ray_soa_copy is a call into stream.c) */
+#define COPY_FIELD(type, name) dst->name[o] = src->name[i];
+                RS_RAY_FIELDS(COPY_FIELD)
+#undef COPY_FIELD
+                o++;
+            }
     }
     dst->count = offsets[nb];
     return offsets[nb];
