@@ -105,10 +105,8 @@ static uint8_t stage_shade(render_ctx *c, slot *sl, rs_status *status)
     rs_wave_buffers *b = &sl->b;
     (void)status;
     rs_integrator_shade(&c->it, &c->ex, sl->start, sl->bounce, &b->ext[sl->cur], &b->hits,
-                        sl->alive, &b->paths, &b->ext[sl->cur ^ 1], b->next_valid, &b->shadow_raw,
-                        b->shadow_valid);
-    sl->n_shadow =
-        rs_stream_compact(&b->shadow_raw, b->shadow_valid, sl->alive, &b->shadow, c->ex.threads);
+                        sl->alive, &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
+    sl->n_shadow = rs_stream_pack_runs(&b->shadow, &b->runs, 1, sl->alive);
     if (sl->n_shadow == 0)
         return RS_STAGE_COMPACT;
     submit(c, sl, RS_TRACE_OCCLUDED);
@@ -123,15 +121,15 @@ static uint8_t stage_resolve_shadows(render_ctx *c, slot *sl, rs_status *status)
     return RS_STAGE_COMPACT;
 }
 
-/* The surviving paths' next rays, in slot order, become the current stream; they were written
- * in place of the current rays' slots in the other buffer. */
+/* The surviving paths' next rays, in slot order, become the current stream: the shade stage
+ * wrote them in runs into the other buffer, packed here in place. */
 static uint8_t stage_compact(render_ctx *c, slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;
     uint32_t before = sl->alive;
     (void)status;
-    sl->alive = rs_stream_compact(&b->ext[sl->cur ^ 1], b->next_valid, sl->alive, &b->ext[sl->cur],
-                                  c->ex.threads);
+    sl->alive = rs_stream_pack_runs(&b->ext[sl->cur ^ 1], &b->runs, 0, sl->alive);
+    sl->cur ^= 1;
     c->ended += before - sl->alive;
     sl->bounce++;
     report(c);

@@ -119,28 +119,6 @@ void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint
     out->count = count;
 }
 
-/* Entry j of the stream, path (pixel, sample) with its numbers `pre` (NULL: made where
- * needed): path p's state loaded from the SoA, shaded, stored back (rs_path_shade_at changes
- * only what the path's next stage reads). */
-static void shade_one(const rs_integrator *it, uint32_t pixel, uint32_t sample, uint32_t bounce,
-                      const rs_rng_f4 *pre, const rs_ray_soa *rays, const rs_hit_soa *hits,
-                      uint32_t j, rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
-                      rs_ray_soa *shadow, uint8_t *shadow_valid)
-{
-    uint32_t p = rays->path[j], made;
-    rs_ray r = rs_ray_soa_get(rays, j), nr, sr;
-    rs_hit h = rs_hit_soa_get(hits, j);
-    rs_path_state ps = rs_paths_load(paths, p);
-    made = rs_path_shade_at(it, pixel, sample, bounce, pre, &r, &h, &ps, &nr, &sr);
-    rs_paths_store(paths, p, &ps);
-    next_valid[j] = (made & RS_SHADE_NEXT) != 0;
-    shadow_valid[j] = (made & RS_SHADE_SHADOW) != 0;
-    if (made & RS_SHADE_SHADOW)
-        rs_ray_soa_set(shadow, j, &sr, p);
-    if (made & RS_SHADE_NEXT)
-        rs_ray_soa_set(next, j, &nr, p);
-}
-
 typedef struct shade_ctx {
     const rs_integrator *it;
     uint64_t wave_start;
@@ -149,15 +127,17 @@ typedef struct shade_ctx {
     const rs_hit_soa *hits;
     rs_paths *paths;
     rs_ray_soa *next, *shadow;
-    uint8_t *next_valid, *shadow_valid;
+    const rs_stream_runs *runs;
 } shade_ctx;
 
+/* Shades the entries [begin, end) in order; their next rays go packed to next[begin ...] and
+ * their shadow rays to shadow[begin ...], the counts to the range's run record. */
 static void shade_range(void *ctx, uint32_t begin, uint32_t end)
 {
     const shade_ctx *c = (const shade_ctx *)ctx;
     /* a vertex at the last segment only gathers light: it draws no numbers */
     int draws = c->bounce + 1 < c->it->max_depth;
-    uint32_t b, k;
+    uint32_t b, k, on = begin, os = begin;
     for (b = begin; b < end; b += BATCH) {
         uint32_t n = end - b < BATCH ? end - b : BATCH;
         uint32_t pixel[BATCH], sample[BATCH];
@@ -168,20 +148,34 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);
         }
         for (k = 0; k < n; ++k) {
+            /* entry j: path p's state loaded from the SoA, shaded, stored back (rs_path_shade_at
+             * changes only what the path's next stage reads) */
+            uint32_t j = b + k, p = c->rays->path[j], made;
+            rs_ray r = rs_ray_soa_get(c->rays, j), nr, sr;
+            rs_hit h = rs_hit_soa_get(c->hits, j);
+            rs_path_state ps = rs_paths_load(c->paths, p);
             if (draws) {
                 pre[0] = rb[k];
                 pre[1] = rl[k];
             }
-            shade_one(c->it, pixel[k], sample[k], c->bounce, draws ? pre : NULL, c->rays, c->hits,
-                      b + k, c->paths, c->next, c->next_valid, c->shadow, c->shadow_valid);
+            made = rs_path_shade_at(c->it, pixel[k], sample[k], c->bounce, draws ? pre : NULL, &r,
+                                    &h, &ps, &nr, &sr);
+            rs_paths_store(c->paths, p, &ps);
+            if (made & RS_SHADE_SHADOW)
+                rs_ray_soa_set(c->shadow, os++, &sr, p);
+            if (made & RS_SHADE_NEXT)
+                rs_ray_soa_set(c->next, on++, &nr, p);
         }
     }
+    c->runs->first[begin] = on - begin;
+    c->runs->second[begin] = os - begin;
+    c->runs->end[begin] = end;
 }
 
 void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
                          uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
-                         uint32_t count, rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
-                         rs_ray_soa *shadow, uint8_t *shadow_valid)
+                         uint32_t count, rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
+                         const rs_stream_runs *runs)
 {
     shade_ctx c;
     c.it = it;
@@ -192,8 +186,7 @@ void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint6
     c.paths = paths;
     c.next = next;
     c.shadow = shadow;
-    c.next_valid = next_valid;
-    c.shadow_valid = shadow_valid;
+    c.runs = runs;
     /* shading costs vary by material and by hit or miss: blocks of 512 paths, split as the
      * strategy says */
     rs_parallel_range(ex->strategy, ex->threads, 0, count, 512, shade_range, &c);
