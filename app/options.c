@@ -157,7 +157,8 @@ void rs_cli_print_help(const char *command)
             "  --isect-aabb A      slab (default), branchless, williams, kensler or swap\n"
             "  --chunk-size N|auto rays per scheduler chunk (default auto: each device's from\n"
             "                      its measured speed, a few ms of work per chunk)\n"
-            "  --wave-size N       paths in flight (default 1048576): bounds memory\n"
+            "  --wave-size N|auto  paths in flight: bounds memory (default auto: 1048576\n"
+            "                      with a GPU, else 16384 per thread, which the caches hold)\n"
             "  --waves N|auto      waves in flight, 1..4: the CPU shades one while the devices\n"
             "                      trace another (default auto: 2 with a GPU, else 1)\n"
             "  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
@@ -319,7 +320,10 @@ static int parse_engine_option(opt_arg *x, rs_cli_options *o)
             rc = parse_u32(name, v, 1, 4, &o->waves);
     } else if (strcmp(name, "--wave-size") == 0) {
         NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
+        if (strcmp(v, "auto") == 0)
+            o->wave_paths = 0;
+        else
+            rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
     } else {
         return NOT_MINE;
     }
@@ -441,7 +445,7 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->sampler = RS_SAMPLER_SOBOL;
     o->bvh.method = RS_BVH_SAH; /* binned, 16 bins: 1.25-1.33x faster traversal than median */
     o->chunk_size = 0; /* adaptive */
-    o->wave_paths = 1u << 20;
+    o->wave_paths = 0; /* auto */
     o->waves = 0; /* auto */
     o->devices_auto = 1;
     o->n_devices = 0;

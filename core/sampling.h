@@ -45,7 +45,7 @@ RS_HD rs_vec3 rs_onb_to_world(const rs_onb *f, rs_vec3 l)
 RS_HD rs_vec3 rs_sample_uniform_hemisphere(float u1, float u2)
 {
     float z = u1;
-    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float r = sqrtf(rs_fmaxf(0.0f, 1.0f - z * z));
     float phi = 2.0f * RS_PI * u2;
     return rs_v3(r * cosf(phi), r * sinf(phi), z);
 }
@@ -59,7 +59,7 @@ RS_HD rs_vec3 rs_sample_cosine_hemisphere(float u1, float u2)
 {
     float r = sqrtf(u1);
     float phi = 2.0f * RS_PI * u2;
-    return rs_v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u1)));
+    return rs_v3(r * cosf(phi), r * sinf(phi), sqrtf(rs_fmaxf(0.0f, 1.0f - u1)));
 }
 
 RS_HD float rs_pdf_cosine_hemisphere(float cos_theta)
@@ -70,7 +70,7 @@ RS_HD float rs_pdf_cosine_hemisphere(float cos_theta)
 /* Direction from cos(theta) and phi = 2 pi u2 around the z axis. */
 RS_HD rs_vec3 rs_dir_from_z(float z, float u2)
 {
-    float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float r = sqrtf(rs_fmaxf(0.0f, 1.0f - z * z));
     float phi = 2.0f * RS_PI * u2;
     return rs_v3(r * cosf(phi), r * sinf(phi), z);
 }
@@ -99,7 +99,7 @@ RS_HD float rs_pdf_power_cosine(float n, float cos_theta)
 RS_HD rs_vec3 rs_sample_uniform_cone(float omc, float u1, float u2)
 {
     float s = u1 * omc;
-    float r = sqrtf(fmaxf(0.0f, s * (2.0f - s)));
+    float r = sqrtf(rs_fmaxf(0.0f, s * (2.0f - s)));
     float phi = 2.0f * RS_PI * u2;
     return rs_v3(r * cosf(phi), r * sinf(phi), 1.0f - s);
 }

@@ -6,6 +6,30 @@
 #include <math.h>
 #include "core/hd.h"
 
+/* fmaxf and fminf, inline.  The host's libm functions are calls (gcc may not turn them into
+ * maxss / minss, whose NaN rule differs), 5% of the shade stage's instructions with the call
+ * around them.  These give glibc's results bit for bit: the larger (smaller) of two numbers,
+ * the second where they compare equal (so -0 and +0 give the second, as glibc's maxss does), and
+ * the other where one is NaN (checked against libm on zeros, infinities, NaNs in
+ * core_vec3_test).  The device keeps CUDA's own. */
+RS_HD float rs_fmaxf(float a, float b)
+{
+#if defined(__CUDA_ARCH__)
+    return fmaxf(a, b);
+#else
+    return a > b ? a : (b != b ? a : b);
+#endif
+}
+
+RS_HD float rs_fminf(float a, float b)
+{
+#if defined(__CUDA_ARCH__)
+    return fminf(a, b);
+#else
+    return a < b ? a : (b != b ? a : b);
+#endif
+}
+
 typedef struct rs_vec3 {
     float x, y, z;
 } rs_vec3;
@@ -40,13 +64,13 @@ RS_HD float rs_v3_length(rs_vec3 a) { return sqrtf(rs_v3_dot(a, a)); }
 RS_HD rs_vec3 rs_v3_normalize(rs_vec3 a) { return rs_v3_scale(a, 1.0f / rs_v3_length(a)); }
 RS_HD rs_vec3 rs_v3_min(rs_vec3 a, rs_vec3 b)
 {
-    return rs_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z));
+    return rs_v3(rs_fminf(a.x, b.x), rs_fminf(a.y, b.y), rs_fminf(a.z, b.z));
 }
 RS_HD rs_vec3 rs_v3_max(rs_vec3 a, rs_vec3 b)
 {
-    return rs_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z));
+    return rs_v3(rs_fmaxf(a.x, b.x), rs_fmaxf(a.y, b.y), rs_fmaxf(a.z, b.z));
 }
-RS_HD float rs_v3_max_comp(rs_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+RS_HD float rs_v3_max_comp(rs_vec3 a) { return rs_fmaxf(a.x, rs_fmaxf(a.y, a.z)); }
 RS_HD float rs_v3_get(rs_vec3 a, int axis) { return axis == 0 ? a.x : (axis == 1 ? a.y : a.z); }
 RS_HD int rs_v3_is_zero(rs_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 

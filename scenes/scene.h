@@ -133,8 +133,8 @@ RS_HD rs_geom rs_scene_geom(const rs_scene *s)
     rs_geom g;
     g.spheres = s->spheres;
     g.sphere_motion = s->sphere_motion;
-    g.time0 = fminf(s->camera.shutter_open, s->camera.shutter_close);
-    g.time1 = fmaxf(s->camera.shutter_open, s->camera.shutter_close);
+    g.time0 = rs_fminf(s->camera.shutter_open, s->camera.shutter_close);
+    g.time1 = rs_fmaxf(s->camera.shutter_open, s->camera.shutter_close);
     g.sphere_algo = 0; /* the default intersection tests; the CLI may choose others */
     g.tri_algo = 0;
     g.aabb_algo = 0;

@@ -105,10 +105,8 @@ static uint8_t stage_shade(render_ctx *c, slot *sl, rs_status *status)
     rs_wave_buffers *b = &sl->b;
     (void)status;
     rs_integrator_shade(&c->it, &c->ex, sl->start, sl->bounce, &b->ext[sl->cur], &b->hits,
-                        sl->alive, &b->paths, &b->ext[sl->cur ^ 1], b->next_valid, &b->shadow_raw,
-                        b->shadow_valid);
-    sl->n_shadow =
-        rs_stream_compact(&b->shadow_raw, b->shadow_valid, sl->alive, &b->shadow, c->ex.threads);
+                        sl->alive, &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
+    sl->n_shadow = rs_stream_pack_runs(&b->shadow, &b->runs, 1, sl->alive);
     if (sl->n_shadow == 0)
         return RS_STAGE_COMPACT;
     submit(c, sl, RS_TRACE_OCCLUDED);
@@ -123,15 +121,15 @@ static uint8_t stage_resolve_shadows(render_ctx *c, slot *sl, rs_status *status)
     return RS_STAGE_COMPACT;
 }
 
-/* The surviving paths' next rays, in slot order, become the current stream; they were written
- * in place of the current rays' slots in the other buffer. */
+/* The surviving paths' next rays, in slot order, become the current stream: the shade stage
+ * wrote them in runs into the other buffer, packed here in place. */
 static uint8_t stage_compact(render_ctx *c, slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;
     uint32_t before = sl->alive;
     (void)status;
-    sl->alive = rs_stream_compact(&b->ext[sl->cur ^ 1], b->next_valid, sl->alive, &b->ext[sl->cur],
-                                  c->ex.threads);
+    sl->alive = rs_stream_pack_runs(&b->ext[sl->cur ^ 1], &b->runs, 0, sl->alive);
+    sl->cur ^= 1;
     c->ended += before - sl->alive;
     sl->bounce++;
     report(c);
@@ -318,24 +316,26 @@ static void choose_host_memory(render_ctx *c)
     }
 }
 
-/* The settings with the automatic choices made: waves in flight, the wave size per slot. */
+/* The settings with the automatic choices made: the wave size, waves in flight, the wave size
+ * per slot. */
 static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint64_t total)
 {
-    if (st->wave_paths == 0)
-        st->wave_paths = RS_RENDER_DEFAULT_WAVE;
-    if (st->waves_in_flight == 0) {
-        int i;
-        st->waves_in_flight = 1;
-        for (i = 0; i < rs_sched_device_count(sched); ++i)
-            if (rs_device_is_gpu(rs_sched_device(sched, i)))
-                st->waves_in_flight = 2;
+    int i, gpu = 0;
+    for (i = 0; i < rs_sched_device_count(sched); ++i)
+        gpu |= rs_device_is_gpu(rs_sched_device(sched, i));
+    if (st->threads < 1)
+        st->threads = 1;
+    if (st->wave_paths == 0) {
+        uint64_t host = (uint64_t)RS_RENDER_HOST_WAVE * (uint32_t)st->threads;
+        st->wave_paths = gpu || host > RS_RENDER_DEFAULT_WAVE ? RS_RENDER_DEFAULT_WAVE
+                                                               : (uint32_t)host;
     }
+    if (st->waves_in_flight == 0)
+        st->waves_in_flight = gpu ? 2 : 1;
     /* the paths in flight are shared among the waves in flight */
     st->wave_paths = (st->wave_paths + st->waves_in_flight - 1) / st->waves_in_flight;
     if ((uint64_t)st->wave_paths > total)
         st->wave_paths = (uint32_t)total;
-    if (st->threads < 1)
-        st->threads = 1;
 }
 
 /* Round robin over the slots: each visit runs a slot up to its next submission, so the devices

@@ -126,8 +126,8 @@ RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec
     }
     if (m->type == RS_MAT_DIELECTRIC) {
         float eta = front ? 1.0f / m->ior : m->ior;
-        float co = fminf(rs_v3_dot(wo, n), 1.0f);
-        float so = sqrtf(fmaxf(0.0f, 1.0f - co * co));
+        float co = rs_fminf(rs_v3_dot(wo, n), 1.0f);
+        float so = sqrtf(rs_fmaxf(0.0f, 1.0f - co * co));
         out->delta = 1;
         out->weight = albedo;
         if (eta * so > 1.0f || rs_schlick(co, eta) > u3) {

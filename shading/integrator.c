@@ -4,6 +4,8 @@
 
 #include <string.h>
 
+#include "core/rand_batch.h"
+
 const char *rs_sampling_name(rs_sampling s)
 {
     switch (s) {
@@ -47,41 +49,82 @@ int rs_sampler_parse(const char *text, rs_sampler *out)
     return 0;
 }
 
+/* The stages make their paths' random numbers BATCH at a time (core/rand_batch.h: vectors of
+ * eight on AVX2): 64 paths' worth of numbers is 2 KB per group, well inside the L1 cache. */
+#define BATCH 64
+
+/* Pixel and sample of paths wave_start + p, for p = path[i] (or p0 + i where path is NULL),
+ * i < n.  A stream keeps its paths in increasing order, so after one division each entry is a
+ * step from the one before (a step back or past a whole image divides again); the numbers are
+ * those of g mod npix and g div npix. */
+static void locate(uint64_t wave_start, uint32_t npix, const uint32_t *path, uint32_t p0,
+                   uint32_t n, uint32_t *pixel, uint32_t *sample)
+{
+    uint32_t i, prev = 0, px = 0, sm = 0;
+    for (i = 0; i < n; ++i) {
+        uint32_t p = path ? path[i] : p0 + i, step = p - prev;
+        if (i == 0 || p < prev || step >= npix) {
+            uint64_t g = wave_start + p;
+            px = (uint32_t)(g % npix);
+            sm = (uint32_t)(g / npix);
+        } else if (step >= npix - px) {
+            px = step - (npix - px);
+            sm++;
+        } else {
+            px += step;
+        }
+        prev = p;
+        pixel[i] = px;
+        sample[i] = sm;
+    }
+}
+
+/* out[i] = rs_path_rand(it, pixel[i], sample[i], bounce, group), i < n. */
+static void path_rand_batch(const rs_integrator *it, const uint32_t *pixel, const uint32_t *sample,
+                            uint32_t bounce, uint32_t group, uint32_t n, rs_rng_f4 *out)
+{
+    uint32_t i;
+    if (it->sampler == RS_SAMPLER_SOBOL) {
+        rs_rand_batch_sobol(it->seed, pixel, sample, bounce, group, n, out);
+        if (group == RS_DIM_LIGHT)
+            for (i = 0; i < n; ++i)
+                out[i] = rs_path_sobol_order(out[i], group);
+    } else if (it->sampler == RS_SAMPLER_INDEPENDENT) {
+        rs_rand_batch_philox(it->seed, pixel, sample, bounce, group, n, out);
+    } else {
+        for (i = 0; i < n; ++i) /* zsobol: no batched form yet */
+            out[i] = rs_path_rand(it, pixel[i], sample[i], bounce, group);
+    }
+}
+
 void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
                           uint32_t count, rs_paths *paths, rs_ray_soa *out)
 {
-    long i;
+    long blk;
     int threads = ex->threads;
+    int shutter = it->scene->camera.shutter_close != it->scene->camera.shutter_open;
     (void)threads; /* read only by the OpenMP clauses (compiled out under ThreadSanitizer) */
 #pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-    for (i = 0; i < (long)count; ++i) {
-        rs_path_state ps;
-        rs_ray ray = rs_path_begin(it, wave_start + (uint64_t)i, &ps);
-        rs_ray_soa_set(out, (uint32_t)i, &ray, (uint32_t)i);
-        rs_paths_store(paths, (uint32_t)i, &ps);
+    for (blk = 0; blk < (long)((count + BATCH - 1) / BATCH); ++blk) {
+        uint32_t b = (uint32_t)blk * BATCH, n = count - b < BATCH ? count - b : BATCH, k;
+        uint32_t pixel[BATCH], sample[BATCH];
+        rs_rng_f4 cam[BATCH], tim[BATCH];
+        locate(wave_start, it->npix, NULL, b, n, pixel, sample);
+        path_rand_batch(it, pixel, sample, 0, RS_DIM_CAMERA, n, cam);
+        if (shutter)
+            path_rand_batch(it, pixel, sample, 0, RS_DIM_TIME, n, tim);
+        for (k = 0; k < n; ++k) {
+            rs_path_state ps;
+            rs_rng_f4 pre[2];
+            rs_ray ray;
+            pre[0] = cam[k];
+            pre[1] = shutter ? tim[k] : cam[k];
+            ray = rs_path_begin_at(it, pixel[k], sample[k], pre, &ps);
+            rs_ray_soa_set(out, b + k, &ray, b + k);
+            rs_paths_store(paths, b + k, &ps);
+        }
     }
     out->count = count;
-}
-
-/* Entry j of the stream: path p's state loaded from the SoA, shaded, stored back (rs_path_shade
- * changes only what the path's next stage reads). */
-static void shade_one(const rs_integrator *it, uint64_t wave_start, uint32_t bounce,
-                      const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t j, rs_paths *paths,
-                      rs_ray_soa *next, uint8_t *next_valid, rs_ray_soa *shadow,
-                      uint8_t *shadow_valid)
-{
-    uint32_t p = rays->path[j], made;
-    rs_ray r = rs_ray_soa_get(rays, j), nr, sr;
-    rs_hit h = rs_hit_soa_get(hits, j);
-    rs_path_state ps = rs_paths_load(paths, p);
-    made = rs_path_shade(it, wave_start + p, bounce, &r, &h, &ps, &nr, &sr);
-    rs_paths_store(paths, p, &ps);
-    next_valid[j] = (made & RS_SHADE_NEXT) != 0;
-    shadow_valid[j] = (made & RS_SHADE_SHADOW) != 0;
-    if (made & RS_SHADE_SHADOW)
-        rs_ray_soa_set(shadow, j, &sr, p);
-    if (made & RS_SHADE_NEXT)
-        rs_ray_soa_set(next, j, &nr, p);
 }
 
 typedef struct shade_ctx {
@@ -92,22 +135,55 @@ typedef struct shade_ctx {
     const rs_hit_soa *hits;
     rs_paths *paths;
     rs_ray_soa *next, *shadow;
-    uint8_t *next_valid, *shadow_valid;
+    const rs_stream_runs *runs;
 } shade_ctx;
 
+/* Shades the entries [begin, end) in order; their next rays go packed to next[begin ...] and
+ * their shadow rays to shadow[begin ...], the counts to the range's run record. */
 static void shade_range(void *ctx, uint32_t begin, uint32_t end)
 {
     const shade_ctx *c = (const shade_ctx *)ctx;
-    uint32_t j;
-    for (j = begin; j < end; ++j)
-        shade_one(c->it, c->wave_start, c->bounce, c->rays, c->hits, j, c->paths, c->next,
-                  c->next_valid, c->shadow, c->shadow_valid);
+    /* a vertex at the last segment only gathers light: it draws no numbers */
+    int draws = c->bounce + 1 < c->it->max_depth;
+    uint32_t b, k, on = begin, os = begin;
+    for (b = begin; b < end; b += BATCH) {
+        uint32_t n = end - b < BATCH ? end - b : BATCH;
+        uint32_t pixel[BATCH], sample[BATCH];
+        rs_rng_f4 rb[BATCH], rl[BATCH], pre[2];
+        locate(c->wave_start, c->it->npix, c->rays->path + b, 0, n, pixel, sample);
+        if (draws) {
+            path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_BSDF, n, rb);
+            path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);
+        }
+        for (k = 0; k < n; ++k) {
+            /* entry j: path p's state loaded from the SoA, shaded, stored back (rs_path_shade_at
+             * changes only what the path's next stage reads) */
+            uint32_t j = b + k, p = c->rays->path[j], made;
+            rs_ray r = rs_ray_soa_get(c->rays, j), nr, sr;
+            rs_hit h = rs_hit_soa_get(c->hits, j);
+            rs_path_state ps = rs_paths_load(c->paths, p);
+            if (draws) {
+                pre[0] = rb[k];
+                pre[1] = rl[k];
+            }
+            made = rs_path_shade_at(c->it, pixel[k], sample[k], c->bounce, draws ? pre : NULL, &r,
+                                    &h, &ps, &nr, &sr);
+            rs_paths_store(c->paths, p, &ps);
+            if (made & RS_SHADE_SHADOW)
+                rs_ray_soa_set(c->shadow, os++, &sr, p);
+            if (made & RS_SHADE_NEXT)
+                rs_ray_soa_set(c->next, on++, &nr, p);
+        }
+    }
+    c->runs->first[begin] = on - begin;
+    c->runs->second[begin] = os - begin;
+    c->runs->end[begin] = end;
 }
 
 void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
                          uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
-                         uint32_t count, rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
-                         rs_ray_soa *shadow, uint8_t *shadow_valid)
+                         uint32_t count, rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
+                         const rs_stream_runs *runs)
 {
     shade_ctx c;
     c.it = it;
@@ -118,8 +194,7 @@ void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint6
     c.paths = paths;
     c.next = next;
     c.shadow = shadow;
-    c.next_valid = next_valid;
-    c.shadow_valid = shadow_valid;
+    c.runs = runs;
     /* shading costs vary by material and by hit or miss: blocks of 512 paths, split as the
      * strategy says */
     rs_parallel_range(ex->strategy, ex->threads, 0, count, 512, shade_range, &c);

@@ -39,13 +39,16 @@ typedef struct rs_stage_exec {
 void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
                           uint32_t count, rs_paths *paths, rs_ray_soa *out);
 
-/* Shades the hits of `rays` (segment number `bounce`).  For each input slot j it may write the
- * path's next ray to slot j of `next` (next_valid[j] = 1) and a shadow ray to slot j of
- * `shadow` (shadow_valid[j] = 1, contribution in paths->pending). */
+/* Shades the hits of `rays` (segment number `bounce`): each path may make its next ray and a
+ * shadow ray (its contribution in paths->pending).  The stream is split into ranges (by the
+ * strategy); each range writes its next rays packed from its first slot in `next` and its
+ * shadow rays likewise in `shadow`, in slot order, and records the counts in `runs`
+ * (first: next rays, second: shadow rays); rs_stream_pack_runs then packs each stream (the
+ * valid entries in slot order, whatever the split). */
 void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
                          uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
-                         uint32_t count, rs_paths *paths, rs_ray_soa *next, uint8_t *next_valid,
-                         rs_ray_soa *shadow, uint8_t *shadow_valid);
+                         uint32_t count, rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
+                         const rs_stream_runs *runs);
 
 /* Adds each unoccluded shadow ray's pending contribution to its path. */
 void rs_integrator_resolve_shadows(const rs_stage_exec *ex, const rs_ray_soa *shadow,

@@ -71,7 +71,7 @@ RS_HD uint32_t rs_light_pick(const rs_scene *s, float u)
 RS_HD float rs_cone_one_minus_cos(float r, float d2)
 {
     float sin2 = r * r / d2;
-    return sin2 / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - sin2)));
+    return sin2 / (1.0f + sqrtf(rs_fmaxf(0.0f, 1.0f - sin2)));
 }
 
 /* Samples a light as seen from x at `time`.  Returns 0 (and no sample) if the scene has no
@@ -102,7 +102,7 @@ RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_p
              * cancellation in dc^2 - r^2 for far spheres) */
             rs_vec3 perp = rs_v3_sub(rs_v3_scale(w, dc * ct), axis);
             float disc = r * r - rs_v3_dot(perp, perp);
-            float t = dc * ct - sqrtf(fmaxf(0.0f, disc));
+            float t = dc * ct - sqrtf(rs_fmaxf(0.0f, disc));
             out->wi = w;
             out->dist = t;
             out->point = rs_v3_madd(x, w, t);

@@ -78,13 +78,27 @@ typedef struct rs_integrator {
     uint32_t sampler;   /* rs_sampler */
 } rs_integrator;
 
+/* The Sobol samplers' numbers of group `group` in the order the decisions take them: the
+ * light's point (v[1], v[2]) is one stratified pair, the pick and the mixture choice (v[0],
+ * v[3]) the other. */
+RS_HD rs_rng_f4 rs_path_sobol_order(rs_rng_f4 f, uint32_t group)
+{
+    if (group == RS_DIM_LIGHT) {
+        float pick = f.v[2];
+        f.v[2] = f.v[1];
+        f.v[1] = f.v[0];
+        f.v[0] = pick;
+    }
+    return f;
+}
+
 /* Four numbers in [0, 1) for decision group `group` (shading/dims.h) of path (pixel, sample)
- * at segment `bounce`, from the render's sampler. */
+ * at segment `bounce`, from the render's sampler.  (The host's stream stages make them for many
+ * paths at once, shading/integrator.c, with the same result.) */
 RS_HD rs_rng_f4 rs_path_rand(const rs_integrator *it, uint32_t pixel, uint32_t sample,
                              uint32_t bounce, uint32_t group)
 {
     rs_rng_f4 f;
-    float pick;
     if (it->sampler == RS_SAMPLER_SOBOL)
         f = rs_sobol_float4(it->seed, pixel, sample, bounce, group);
     else if (it->sampler == RS_SAMPLER_ZSOBOL)
@@ -93,30 +107,24 @@ RS_HD rs_rng_f4 rs_path_rand(const rs_integrator *it, uint32_t pixel, uint32_t s
                              bounce, group);
     else
         return rs_rng_float4(it->seed, pixel, sample, bounce, group);
-    if (group == RS_DIM_LIGHT) {
-        /* both Sobol samplers: the light's point (v[1], v[2]) is one stratified pair, the pick
-         * and the mixture choice (v[0], v[3]) the other */
-        pick = f.v[2];
-        f.v[2] = f.v[1];
-        f.v[1] = f.v[0];
-        f.v[0] = pick;
-    }
-    return f;
+    return rs_path_sobol_order(f, group);
 }
 
 /* One path's state between its vertices: rs_path_state, declared once in streams/paths.h. */
 
-/* The camera ray of path g, and its state reset. */
-RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
+/* The camera ray of path (pixel, sample), and its state reset.  `pre`: its numbers made ahead,
+ * pre[0] group RS_DIM_CAMERA and pre[1] RS_DIM_TIME (read only with a shutter interval); NULL:
+ * made here. */
+RS_HD rs_ray rs_path_begin_at(const rs_integrator *it, uint32_t pixel, uint32_t sample,
+                              const rs_rng_f4 *pre, rs_path_state *ps)
 {
     const rs_camera_desc *cd = &it->scene->camera;
-    uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
-    rs_rng_f4 r = rs_path_rand(it, pixel, sample, 0, RS_DIM_CAMERA);
+    rs_rng_f4 r = pre ? pre[0] : rs_path_rand(it, pixel, sample, 0, RS_DIM_CAMERA);
     rs_ray ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, r.v[0], r.v[1],
                                r.v[2], r.v[3]);
     float time = cd->shutter_open;
     if (cd->shutter_close != cd->shutter_open) {
-        rs_rng_f4 rt = rs_path_rand(it, pixel, sample, 0, RS_DIM_TIME);
+        rs_rng_f4 rt = pre ? pre[1] : rs_path_rand(it, pixel, sample, 0, RS_DIM_TIME);
         time += rt.v[0] * (cd->shutter_close - cd->shutter_open);
     }
     ray.time = time;
@@ -129,13 +137,19 @@ RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *p
     return ray;
 }
 
+/* The camera ray of path g, and its state reset. */
+RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
+{
+    return rs_path_begin_at(it, (uint32_t)(g % it->npix), (uint32_t)(g / it->npix), NULL, ps);
+}
+
 /* Moves a ray origin off the surface along n (the side the new ray leaves from); the offset
  * scales with the coordinates so that it stays far above float rounding (~1e-7 relative) at any
  * scene scale. */
 RS_HD rs_vec3 rs_offset_origin(rs_vec3 x, rs_vec3 n, float prim_scale)
 {
-    float scale = fmaxf(fmaxf(fabsf(x.x), fabsf(x.y)), fmaxf(fabsf(x.z), 1e-2f));
-    return rs_v3_madd(x, n, fmaxf(1e-4f * scale, 1e-6f * prim_scale));
+    float scale = rs_fmaxf(rs_fmaxf(fabsf(x.x), fabsf(x.y)), rs_fmaxf(fabsf(x.z), 1e-2f));
+    return rs_v3_madd(x, n, rs_fmaxf(1e-4f * scale, 1e-6f * prim_scale));
 }
 
 /* The size of the numbers a primitive's intersection test works with, which bounds the error of
@@ -151,7 +165,7 @@ RS_HD float rs_prim_scale(const rs_scene *sc, uint32_t prim)
     if (prim >= sc->n_spheres)
         return 0.0f;
     s = &sc->spheres[prim];
-    return fmaxf(fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
+    return rs_fmaxf(rs_fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
 }
 
 RS_HD float rs_power_heuristic(float a, float b)
@@ -166,7 +180,7 @@ RS_HD void rs_surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, 
                          float *u, float *v)
 {
     if (prim < sc->n_spheres) {
-        float theta = acosf(fminf(1.0f, fmaxf(-1.0f, -n_out.y)));
+        float theta = acosf(rs_fminf(1.0f, rs_fmaxf(-1.0f, -n_out.y)));
         float phi = atan2f(-n_out.z, n_out.x) + RS_PI;
         *u = phi * (0.5f * RS_INV_PI);
         *v = theta * RS_INV_PI;
@@ -228,7 +242,7 @@ RS_HD rs_vec3 rs_shading_normal(const rs_scene *sc, uint32_t prim, float hu, flo
 RS_HD float rs_roulette_survival(rs_vec3 throughput, const rs_material *m, rs_vec3 albedo)
 {
     rs_vec3 r = m->type == RS_MAT_PHONG ? rs_v3_add(albedo, m->specular) : albedo;
-    return fminf(fmaxf(rs_v3_max_comp(rs_v3_mul(throughput, r)), 0.05f), 0.95f);
+    return rs_fminf(rs_fmaxf(rs_v3_max_comp(rs_v3_mul(throughput, r)), 0.05f), 0.95f);
 }
 
 /* A surface vertex of a path, as its shading steps see it. */
@@ -358,16 +372,17 @@ RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const 
     return 1;
 }
 
-/* Shades path g's hit h of ray `ray` (segment number `bounce`): adds what the vertex sends to
- * ps->radiance (background, emitter), and may make the path's next ray (returns RS_SHADE_NEXT,
- * *next set, ps->throughput/bsdf_pdf/flags updated) and a shadow ray toward a light (returns
- * RS_SHADE_SHADOW, *shadow set, its contribution in ps->pending if the ray is unoccluded). */
-RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounce,
-                             const rs_ray *ray, const rs_hit *h, rs_path_state *ps, rs_ray *next,
-                             rs_ray *shadow)
+/* Shades the hit h of ray `ray` (segment number `bounce`) of path (pixel, sample): adds what the
+ * vertex sends to ps->radiance (background, emitter), and may make the path's next ray (returns
+ * RS_SHADE_NEXT, *next set, ps->throughput/bsdf_pdf/flags updated) and a shadow ray toward a
+ * light (returns RS_SHADE_SHADOW, *shadow set, its contribution in ps->pending if the ray is
+ * unoccluded).  `pre`: the vertex's numbers made ahead, pre[0] group RS_DIM_BSDF and pre[1]
+ * RS_DIM_LIGHT (rs_path_rand's); NULL: made here, only where the vertex needs them. */
+RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_t sample,
+                                uint32_t bounce, const rs_rng_f4 *pre, const rs_ray *ray,
+                                const rs_hit *h, rs_path_state *ps, rs_ray *next, rs_ray *shadow)
 {
     const rs_scene *sc = it->scene;
-    uint32_t pixel = (uint32_t)(g % it->npix), sample = (uint32_t)(g / it->npix);
     rs_ray r = *ray;
     rs_vec3 beta = ps->throughput, wi;
     rs_vertex v;
@@ -397,14 +412,14 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
     v.wo = rs_v3_neg(r.d);
     v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
     v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng);
-    rb = rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
+    rb = pre ? pre[0] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
 
     if (rs_material_is_delta(v.m)) {
         if (!rs_shade_delta(sc, &v, rb, &beta, &wi))
             return out;
         specular = 1;
     } else {
-        rs_rng_f4 rl = rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
+        rs_rng_f4 rl = pre ? pre[1] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
         v.origin = rs_offset_origin(v.x, v.n_geo, rs_prim_scale(sc, v.prim));
         if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0)
             out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow);
@@ -436,6 +451,15 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
     ps->bsdf_pdf = pdf;
     ps->flags = (uint8_t)(specular ? RS_PATH_SPECULAR : 0);
     return out | RS_SHADE_NEXT;
+}
+
+/* rs_path_shade_at for path g, its numbers made where needed. */
+RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounce,
+                             const rs_ray *ray, const rs_hit *h, rs_path_state *ps, rs_ray *next,
+                             rs_ray *shadow)
+{
+    return rs_path_shade_at(it, (uint32_t)(g % it->npix), (uint32_t)(g / it->npix), bounce, NULL,
+                            ray, h, ps, next, shadow);
 }
 
 /* What a megakernel traces with: the binary BVH over `geom` (device pointers on the GPU), or on

@@ -1,41 +1,24 @@
-/* streams/compact.c — rs_stream_compact (stream.h): the valid entries of a ray stream packed in
- * order, by a blocked two-pass scan whose blocks are fixed by the thread count alone, so the
- * result is the same for any schedule. */
+/* streams/compact.c — rs_stream_pack_runs (stream.h): the survivors of a stage, written packed at
+ * the start of each range the stage split the stream into, moved down into one packed stream.
+ * The ranges are in slot order and each holds its survivors in slot order, so the result is the
+ * valid entries in slot order whatever the split (any thread count, any strategy). */
+#include <string.h>
+
 #include "streams/stream.h"
 
-#define COMPACT_MAX_BLOCKS 64
-
-uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t count,
-                           rs_ray_soa *dst, int threads)
+uint32_t rs_stream_pack_runs(rs_ray_soa *s, const rs_stream_runs *runs, int which, uint32_t count)
 {
-    uint32_t offsets[COMPACT_MAX_BLOCKS + 1];
-    int nb = threads < 1 ? 1 : (threads > COMPACT_MAX_BLOCKS ? COMPACT_MAX_BLOCKS : threads);
-    int b;
-    if (count < 4096)
-        nb = 1;
-        /* pass 1: count per block */
-#pragma omp parallel for num_threads(nb) schedule(static, 1) if (nb > 1)
-    for (b = 0; b < nb; ++b) {
-        uint32_t lo = (uint32_t)((uint64_t)count * b / nb),
-                 hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
-        uint32_t c = 0, i;
-        for (i = lo; i < hi; ++i)
-            c += valid[i] != 0;
-        offsets[b + 1] = c;
+    uint32_t b, o = 0;
+    for (b = 0; b < count; b = runs->end[b]) {
+        uint32_t k = which == 0 ? runs->first[b] : runs->second[b];
+        if (k && o != b) {
+            /* o < b: the run moves down; memmove, since a long run overlaps its new place */
+#define MOVE_FIELD(type, name) memmove(s->name + o, s->name + b, (size_t)k * sizeof(type));
+            RS_RAY_FIELDS(MOVE_FIELD)
+#undef MOVE_FIELD
+        }
+        o += k;
     }
-    offsets[0] = 0;
-    for (b = 0; b < nb; ++b)
-        offsets[b + 1] += offsets[b];
-        /* pass 2: copy, each block from its prefix offset */
-#pragma omp parallel for num_threads(nb) schedule(static, 1) if (nb > 1)
-    for (b = 0; b < nb; ++b) {
-        uint32_t lo = (uint32_t)((uint64_t)count * b / nb),
-                 hi = (uint32_t)((uint64_t)count * (b + 1) / nb);
-        uint32_t o = offsets[b], i;
-        for (i = lo; i < hi; ++i)
-            if (valid[i])
-                rs_ray_soa_copy(dst, o++, src, i);
-    }
-    dst->count = offsets[nb];
-    return offsets[nb];
+    s->count = o;
+    return o;
 }

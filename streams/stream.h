@@ -112,10 +112,16 @@ void rs_host_free(const rs_host_allocator *a, void *p);
 void rs_ray_soa_copy(rs_ray_soa *dst, uint32_t to, const rs_ray_soa *src, uint32_t from);
 rs_status rs_hit_soa_init(rs_hit_soa *s, uint32_t capacity);
 void rs_hit_soa_free(rs_hit_soa *s);
-/* Compacts the valid entries of src[0, count) into dst, keeping their order; returns how many.
- * Deterministic for any thread count (a blocked two-pass scan; streams/compact.c). */
-uint32_t rs_stream_compact(const rs_ray_soa *src, const uint8_t *valid, uint32_t count,
-                           rs_ray_soa *dst, int threads);
+/* How a stage that split a stream of `count` entries into ranges left its output: for the range
+ * that starts at slot b, end[b] is its end and first[b], second[b] how many entries of each of
+ * its two output streams it wrote packed from slot b (the next rays and the shadow rays). */
+typedef struct rs_stream_runs {
+    uint32_t *first, *second, *end;
+} rs_stream_runs;
+/* Moves the runs of output stream `which` (0: first, 1: second) of `s` down into one packed
+ * stream from slot 0, keeping their order; sets s->count and returns it.  In place and serial:
+ * memmoves of whole runs, no test per entry (streams/compact.c). */
+uint32_t rs_stream_pack_runs(rs_ray_soa *s, const rs_stream_runs *runs, int which, uint32_t count);
 #ifdef __cplusplus
 }
 #endif

@@ -1,9 +1,10 @@
 /* streams/wave.h — every buffer one wave of paths needs, allocated once per render (nothing per
  * chunk or per bounce).  Per path slot: two extension-ray streams (current and next, ping-pong),
- * the shadow rays by input slot and compacted, the hits, three flag bytes and the path state:
- * 40 + 40 + 40 + 40 + 16 + 3 + 45 = 224 B.  The streams a device reads and writes (the
- * extension rays, the compacted shadow rays, the hits and the occlusion bytes) come from the
- * allocator given (a GPU's page-locked host memory); the rest from rs_alloc. */
+ * the shadow rays, the hits, the occlusion byte, the shade stage's run records (three words,
+ * streams/stream.h) and the path state: 40 + 40 + 40 + 16 + 1 + 12 + 45 = 194 B.  The streams a
+ * device reads and writes (the extension rays, the shadow rays, the hits and the occlusion
+ * bytes) come from the allocator given (a GPU's page-locked host memory); the rest from
+ * rs_alloc. */
 #ifndef RS_STREAMS_WAVE_H
 #define RS_STREAMS_WAVE_H
 
@@ -11,11 +12,11 @@
 #include "streams/stream.h"
 
 typedef struct rs_wave_buffers {
-    rs_ray_soa ext[2];     /* extension rays: current and next (ping-pong) */
-    rs_ray_soa shadow_raw; /* shadow rays by input slot */
-    rs_ray_soa shadow;     /* compacted shadow rays */
+    rs_ray_soa ext[2]; /* extension rays: current and next (ping-pong) */
+    rs_ray_soa shadow; /* shadow rays */
     rs_hit_soa hits;
-    uint8_t *next_valid, *shadow_valid, *occluded;
+    uint8_t *occluded;
+    rs_stream_runs runs; /* where the shade stage left the next and the shadow rays */
     rs_paths paths;
     rs_host_allocator alloc; /* where ext, shadow, hits and occluded came from */
     int pinned;              /* 1: `alloc` is a device's host_alloc */

@@ -346,6 +346,9 @@ static void check_structure(const rs_bvh *b, const rs_geom *g, uint32_t max_leaf
             }
         } else {
             rs_aabb u;
+            /* set from the first prim below; zeroed so that the compiler's flow analysis, which
+             * cannot see that a leaf holds at least one, does not warn */
+            u.lo = u.hi = rs_v3_splat(0.0f);
             ++n_leaves;
             if (nd->count > fullest)
                 fullest = nd->count;

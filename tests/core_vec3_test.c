@@ -8,7 +8,9 @@
  *   - rs_v3_rotate_y turns (1,0,0) by +90° into (0,0,-1) (RTIOW's rotate_y: right-handed about
  *     +y), keeps y and length, composes additively and is undone by the opposite angle;
  *   - rs_onb_from_normal gives an orthonormal, right-handed frame (t × b = n) for random unit
- *     normals, for normals within 1e-7 .. 1e-1 of ±z, and for exactly ±z and z = -0.
+ *     normals, for normals within 1e-7 .. 1e-1 of ±z, and for exactly ±z and z = -0;
+ *   - rs_fmaxf and rs_fminf give libm's fmaxf and fminf bit for bit on every pair of zeros of
+ *     either sign, infinities, NaNs of either sign, denormals and random numbers.
  * Random inputs come from a fixed-seed splitmix64, so every run sees the same vectors. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +20,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "core/sampling.h"
 #include "core/vec3.h"
@@ -235,6 +238,45 @@ static void test_onb_near_poles(void **state)
     }
 }
 
+/* ---- rs_fmaxf / rs_fminf against libm ------------------------------------------------------ */
+
+static uint32_t float_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+static void test_fmax_fmin_match_libm(void **state)
+{
+    /* through volatile pointers: the compiler must call libm, not fold or inline the calls */
+    float (*volatile lib_max)(float, float) = fmaxf;
+    float (*volatile lib_min)(float, float) = fminf;
+    float v[64];
+    uint64_t s = 99;
+    int n = 0, i, j;
+    (void)state;
+    v[n++] = 0.0f;
+    v[n++] = -0.0f;
+    v[n++] = 1.0f;
+    v[n++] = -1.0f;
+    v[n++] = INFINITY;
+    v[n++] = -INFINITY;
+    v[n++] = NAN;
+    v[n++] = -NAN;
+    v[n++] = 1e-45f;
+    v[n++] = -1e-45f;
+    v[n++] = 0.05f;
+    v[n++] = 0.95f;
+    while (n < 64)
+        v[n++] = rnd_range(&s, -2.0, 2.0);
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            assert_int_equal(float_bits(rs_fmaxf(v[i], v[j])), float_bits(lib_max(v[i], v[j])));
+            assert_int_equal(float_bits(rs_fminf(v[i], v[j])), float_bits(lib_min(v[i], v[j])));
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -246,6 +288,7 @@ int main(void)
         cmocka_unit_test(test_rotate_y_properties),
         cmocka_unit_test(test_onb_random_normals),
         cmocka_unit_test(test_onb_near_poles),
+        cmocka_unit_test(test_fmax_fmin_match_libm),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
