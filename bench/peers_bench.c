@@ -1,0 +1,795 @@
+/* bench/peers_bench.c — time to a clean image, raystream against other renderers on one core.
+ *
+ * Renders builtin:cornell (256x256, max depth 50, a 1-pixel box filter everywhere) with
+ * raystream's stream engine (each sampler) and megakernel, with Mitsuba 3 (scalar_rgb and
+ * llvm_ad_rgb, its independent sampler and its low-discrepancy `ldsampler`) and with
+ * LuxCoreRender (PATHCPU, its Sobol sampler), one thread each pinned to one core, interleaved in
+ * rounds.  The peers get raystream's own scene: every quad and triangle exported to OBJ files,
+ * one per material, with the same camera, lights and diffuse materials, as a Mitsuba scene file
+ * and as a JSON description for LuxCore (bench/peers/mitsuba_peer.py and luxcore_peer.py render
+ * them in the peers' Python virtual environment).
+ *
+ * First it checks that the peers render the same picture: each renderer's converged reference is
+ * the mean of two independent halves (whose difference also measures the reference's own noise),
+ * and a block-mean z-test over 16x16-pixel blocks compares the peer's reference with ours.  Then,
+ * per renderer, for each sample count: the median time of mi.render / rs_render over the rounds,
+ * and the RMSE over all pixels and channels against that renderer's own reference, with the
+ * reference's noise removed (E|img - ref|^2 = err^2 + var_ref, var_ref = |A - B|^2 / 4).  A line
+ * log RMSE = a + b log spp fitted through the levels gives the samples needed for RMSE 0.02 and
+ * 0.01 and, at the measured seconds per sample pass, the time, with the ratio to raystream's.
+ *
+ *   peers_bench [--quick] [--size N] [--levels A,B,...] [--ref-spp N] [--runs N]
+ *               [--venv DIR] [--no-peers] [--keep DIR]
+ *
+ * --quick (the test suite's smoke test) renders raystream's part only, small, and exports the
+ * scene without running any peer.  Each peer runs when DIR/bin/python (--venv, else
+ * $RS_PEERS_VENV, else peers-venv in the build folder) imports it (mitsuba, pyluxcore): make it
+ * with `sh scripts/install-peers.sh DIR`.  A peer that is missing is skipped with a message. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <math.h>
+#include <sched.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/parallel.h"
+#include "machine.h"
+#include "render_util.h"
+
+#define MAX_LEVELS 12
+#define MAX_RUNS   9
+#define MAX_ROWS   8
+#define BLOCK      16
+
+typedef enum row_kind { ROW_RAYSTREAM, ROW_PEER } row_kind;
+
+typedef struct row {
+    const char *label;
+    row_kind kind;
+    /* raystream */
+    rs_sampler sampler;
+    int megakernel;
+    /* a peer: bench/peers/SCRIPT SCENE VARIANT SAMPLER ... */
+    const char *script, *scene_file, *variant, *mi_sampler, *name;
+    /* results */
+    int ref_row; /* whose reference it is measured against (the same renderer's) */
+    double secs[MAX_LEVELS][MAX_RUNS], err2[MAX_LEVELS];
+    double done[MAX_LEVELS]; /* the samples per pixel taken, mean over rounds (LuxCore overshoots) */
+    int ok;
+} row;
+
+typedef struct reference {
+    float *img;     /* the mean of the two halves */
+    float *a, *b;   /* the halves */
+    double var_ref; /* mean over pixels and channels of the reference's own noise variance */
+} reference;
+
+static const char *prog = "peers_bench";
+static uint32_t W = 256, H = 256;
+static char tmp_dir[512];
+static char python[1100];
+
+/* ---- small helpers ---------------------------------------------------------------------- */
+
+static double sq_dist(const float *a, const float *b, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        s += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+    return s / (double)n;
+}
+
+static int pin_to_one_core(int on)
+{
+    cpu_set_t set;
+    static cpu_set_t all;
+    static int saved = 0;
+    if (!saved) {
+        if (sched_getaffinity(0, sizeof all, &all) != 0)
+            return -1;
+        saved = 1;
+    }
+    if (!on)
+        return sched_setaffinity(0, sizeof all, &all);
+    /* the last allowed core: core 0 takes most interrupts */
+    CPU_ZERO(&set);
+    for (int c = CPU_SETSIZE - 1; c >= 0; --c)
+        if (CPU_ISSET(c, &all)) {
+            CPU_SET(c, &set);
+            break;
+        }
+    return sched_setaffinity(0, sizeof set, &set);
+}
+
+/* Runs argv with stdout to a pipe; calls line(ctx, text) for each line.  Returns the exit code
+ * (-1 when it could not be started or was killed). */
+static int run_child(char *const argv[], void (*line)(void *, const char *), void *ctx)
+{
+    int fds[2], status;
+    pid_t pid;
+    FILE *f;
+    char buf[512];
+    if (pipe(fds) != 0)
+        return -1;
+    pid = fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        dup2(fds[1], 1);
+        close(fds[0]);
+        close(fds[1]);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    close(fds[1]);
+    f = fdopen(fds[0], "r");
+    while (f && fgets(buf, sizeof buf, f))
+        if (line)
+            line(ctx, buf);
+    if (f)
+        fclose(f);
+    if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status))
+        return -1;
+    return WEXITSTATUS(status);
+}
+
+/* ---- the scene, as Mitsuba reads it ----------------------------------------------------- */
+
+static void obj_vertex(FILE *f, rs_vec3 p) { fprintf(f, "v %.9g %.9g %.9g\n", p.x, p.y, p.z); }
+
+/* Writes tmp_dir/mat<K>.obj for every material K with geometry and tmp_dir/scene.xml.  Only
+ * what the Cornell box needs is exported: quads and triangles, Lambertian surfaces (two-sided in
+ * raystream, so wrapped in `twosided`) and one-sided diffuse lights, a pinhole camera. */
+static int export_mitsuba(const rs_scene *s, const char *path_xml, const char *path_json)
+{
+    FILE *x = fopen(path_xml, "w"), *js = fopen(path_json, "w");
+    int first_mesh = 1;
+    uint32_t m, i;
+    const rs_camera_desc *c = &s->camera;
+    if (!x || !js) {
+        fprintf(stderr, "%s: cannot write %s: %s\n", prog, x ? path_json : path_xml,
+                strerror(errno));
+        return 0;
+    }
+    /* the same for LuxCore's script, which builds its scene in Python */
+    fprintf(js,
+            "{\"width\": %u, \"height\": %u, \"vfov\": %.9g, \"max_depth\": 50,\n"
+            " \"from\": [%.9g, %.9g, %.9g], \"at\": [%.9g, %.9g, %.9g], \"up\": [%.9g, %.9g, "
+            "%.9g],\n \"meshes\": [",
+            W, H, c->vfov_deg, c->from.x, c->from.y, c->from.z, c->at.x, c->at.y, c->at.z,
+            c->up.x, c->up.y, c->up.z);
+    if (s->n_spheres > 0) {
+        fprintf(stderr, "%s: %s: spheres are not exported\n", prog, s->name);
+        fclose(x);
+        fclose(js);
+        return 0;
+    }
+    fprintf(x, "<scene version=\"3.0.0\">\n"
+               "  <default name=\"sampler\" value=\"independent\"/>\n"
+               "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"50\"/>"
+               "</integrator>\n"
+               "  <sensor type=\"perspective\">\n"
+               "    <float name=\"fov\" value=\"%.9g\"/><string name=\"fov_axis\" value=\"y\"/>\n"
+               "    <transform name=\"to_world\"><lookat origin=\"%.9g,%.9g,%.9g\" "
+               "target=\"%.9g,%.9g,%.9g\" up=\"%.9g,%.9g,%.9g\"/></transform>\n"
+               "    <sampler type=\"$sampler\"><integer name=\"sample_count\" value=\"4\"/>"
+               "</sampler>\n"
+               "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"%u\"/>"
+               "<integer name=\"height\" value=\"%u\"/>"
+               "<string name=\"component_format\" value=\"float32\"/>"
+               "<rfilter type=\"box\"/></film>\n"
+               "  </sensor>\n",
+            c->vfov_deg, c->from.x, c->from.y, c->from.z, c->at.x, c->at.y, c->at.z, c->up.x,
+            c->up.y, c->up.z, W, H);
+    for (m = 0; m < s->n_materials; ++m) {
+        const rs_material *mat = &s->materials[m];
+        char path[600];
+        FILE *o;
+        uint32_t nv = 0;
+        int any = 0;
+        for (i = 0; i < s->n_quads && !any; ++i)
+            any = s->quad_mat[i] == m;
+        for (i = 0; i < s->n_tris && !any; ++i)
+            any = s->tri_mat[i] == m;
+        if (!any)
+            continue;
+        if (mat->type == RS_MAT_LAMBERTIAN && mat->albedo_tex == RS_NO_TEXTURE) {
+            fprintf(x,
+                    "  <shape type=\"obj\"><string name=\"filename\" value=\"mat%u.obj\"/>"
+                    "<boolean name=\"face_normals\" value=\"true\"/>\n"
+                    "    <bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" "
+                    "value=\"%.9g,%.9g,%.9g\"/></bsdf></bsdf></shape>\n",
+                    m, mat->albedo.x, mat->albedo.y, mat->albedo.z);
+            fprintf(js, "%s\n  {\"obj\": \"mat%u.obj\", \"kind\": \"diffuse\", \"rgb\": [%.9g, %.9g, %.9g]}",
+                    first_mesh ? "" : ",", m, mat->albedo.x, mat->albedo.y, mat->albedo.z);
+            first_mesh = 0;
+        } else if (mat->type == RS_MAT_DIFFUSE_LIGHT && !(mat->flags & RS_MAT_TWO_SIDED)) {
+            /* emits on the side its winding faces (u x v, as raystream's quads) and reflects
+             * nothing, as raystream's lights */
+            fprintf(x,
+                    "  <shape type=\"obj\"><string name=\"filename\" value=\"mat%u.obj\"/>"
+                    "<boolean name=\"face_normals\" value=\"true\"/>\n"
+                    "    <bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0,0,0\"/></bsdf>\n"
+                    "    <emitter type=\"area\"><rgb name=\"radiance\" value=\"%.9g,%.9g,%.9g\"/>"
+                    "</emitter></shape>\n",
+                    m, mat->emission.x, mat->emission.y, mat->emission.z);
+            fprintf(js, "%s\n  {\"obj\": \"mat%u.obj\", \"kind\": \"light\", \"rgb\": [%.9g, %.9g, %.9g]}",
+                    first_mesh ? "" : ",", m, mat->emission.x, mat->emission.y, mat->emission.z);
+            first_mesh = 0;
+        } else {
+            fprintf(stderr, "%s: %s: material %u is not exported (only Lambertian surfaces and "
+                            "one-sided diffuse lights)\n",
+                    prog, s->name, m);
+            fclose(x);
+            fclose(js);
+            return 0;
+        }
+        snprintf(path, sizeof path, "%s/mat%u.obj", tmp_dir, m);
+        o = fopen(path, "w");
+        if (!o) {
+            fprintf(stderr, "%s: cannot write %s: %s\n", prog, path, strerror(errno));
+            fclose(x);
+            fclose(js);
+            return 0;
+        }
+        for (i = 0; i < s->n_quads; ++i) {
+            const rs_quad *q = &s->quads[i];
+            if (s->quad_mat[i] != m)
+                continue;
+            obj_vertex(o, q->q);
+            obj_vertex(o, rs_v3_add(q->q, q->u));
+            obj_vertex(o, rs_v3_add(rs_v3_add(q->q, q->u), q->v));
+            obj_vertex(o, rs_v3_add(q->q, q->v));
+            fprintf(o, "f %u %u %u\nf %u %u %u\n", nv + 1, nv + 2, nv + 3, nv + 1, nv + 3, nv + 4);
+            nv += 4;
+        }
+        for (i = 0; i < s->n_tris; ++i) {
+            const rs_tri *t = &s->tris[i];
+            if (s->tri_mat[i] != m)
+                continue;
+            obj_vertex(o, t->v0);
+            obj_vertex(o, t->v1);
+            obj_vertex(o, t->v2);
+            fprintf(o, "f %u %u %u\n", nv + 1, nv + 2, nv + 3);
+            nv += 3;
+        }
+        if (fclose(o) != 0) {
+            fprintf(stderr, "%s: cannot write %s\n", prog, path);
+            fclose(x);
+            fclose(js);
+            return 0;
+        }
+    }
+    fprintf(x, "</scene>\n");
+    fprintf(js, "\n]}\n");
+    if (fclose(js) != 0 || fclose(x) != 0) {
+        fprintf(stderr, "%s: cannot write %s\n", prog, path_xml);
+        return 0;
+    }
+    return 1;
+}
+
+/* ---- renders ------------------------------------------------------------------------------ */
+
+static float *render_raystream(const rs_scene *scene, const row *r, uint32_t spp, uint64_t seed,
+                               int threads, double *secs)
+{
+    rt_args a = rt_defaults("cornell", W, spp);
+    rs_render_stats st;
+    float *img;
+    a.height = H;
+    a.seed = seed;
+    a.threads = threads;
+    a.sampler = r->sampler;
+    a.megakernel = r->megakernel;
+    a.bvh = RS_BVH_SAH;
+    img = rt_render_scene(scene, &a, &st);
+    if (img && secs)
+        *secs = st.seconds;
+    return img;
+}
+
+typedef struct mi_lines {
+    double secs[MAX_LEVELS], done[MAX_LEVELS];
+    uint32_t spp[MAX_LEVELS];
+    int n;
+} mi_lines;
+
+static void mi_line(void *ctx, const char *text)
+{
+    mi_lines *l = (mi_lines *)ctx;
+    unsigned spp;
+    double s, done;
+    int got = l->n < MAX_LEVELS ? sscanf(text, "%u %lf %lf", &spp, &s, &done) : 0;
+    if (got >= 2) {
+        l->spp[l->n] = spp;
+        l->done[l->n] = got == 3 ? done : spp;
+        l->secs[l->n++] = s;
+    }
+}
+
+/* Renders every level in one Mitsuba process; fills secs[] and, when imgs is not NULL, reads
+ * the images.  Returns 0 after printing why. */
+static int render_peer(const row *r, const uint32_t *levels, int n_levels, uint64_t seed,
+                       int threads, int warmup, double *secs, double *done, float **imgs)
+{
+    char script[1024], xml[600], out[600], thr[16], sd[32], spps[256] = "", *argv[12];
+    mi_lines got;
+    int i, n = 0, rc;
+    snprintf(script, sizeof script, "%s/bench/peers/%s", RS_SOURCE_DIR, r->script);
+    snprintf(xml, sizeof xml, "%s/%s", tmp_dir, r->scene_file);
+    snprintf(out, sizeof out, "%s/mi", tmp_dir);
+    snprintf(thr, sizeof thr, "%d", threads);
+    snprintf(sd, sizeof sd, "%llu", (unsigned long long)seed);
+    for (i = 0; i < n_levels; ++i)
+        snprintf(spps + strlen(spps), sizeof spps - strlen(spps), "%s%u", i ? "," : "",
+                 levels[i]);
+    argv[n++] = python;
+    argv[n++] = script;
+    argv[n++] = xml;
+    argv[n++] = (char *)r->variant;
+    argv[n++] = (char *)r->mi_sampler;
+    argv[n++] = thr;
+    argv[n++] = sd;
+    argv[n++] = out;
+    argv[n++] = spps;
+    if (!warmup && strstr(r->script, "mitsuba"))
+        argv[n++] = (char *)"--no-warmup";
+    argv[n] = NULL;
+    memset(&got, 0, sizeof got);
+    rc = run_child(argv, mi_line, &got);
+    if (rc != 0 || got.n != n_levels) {
+        fprintf(stderr, "%s: %s: %s failed (exit %d, %d of %d renders)\n", prog, r->label,
+                r->script, rc, got.n, n_levels);
+        return 0;
+    }
+    for (i = 0; i < n_levels; ++i) {
+        secs[i] = got.secs[i];
+        if (done)
+            done[i] = got.done[i];
+        if (imgs) {
+            char path[700];
+            FILE *f;
+            size_t nf = (size_t)W * H * 3, got_n = 0;
+            snprintf(path, sizeof path, "%s_%u.f32", out, levels[i]);
+            imgs[i] = (float *)malloc(nf * sizeof(float));
+            f = fopen(path, "rb");
+            if (f) {
+                got_n = imgs[i] ? fread(imgs[i], sizeof(float), nf, f) : 0;
+                if (fgetc(f) != EOF)
+                    got_n = 0;
+                fclose(f);
+            }
+            if (got_n != nf) {
+                fprintf(stderr, "%s: %s: %s is not a %ux%u RGB float image\n", prog, r->label,
+                        path, W, H);
+                free(imgs[i]);
+                imgs[i] = NULL;
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+/* The reference of a row: two halves of ref_spp / 2 with different seeds, every core. */
+static int make_reference(const rs_scene *scene, const row *r, uint32_t ref_spp, reference *ref)
+{
+    size_t nf = (size_t)W * H * 3, i;
+    uint32_t half = ref_spp / 2 ? ref_spp / 2 : 1;
+    double t;
+    if (r->kind == ROW_RAYSTREAM) {
+        ref->a = render_raystream(scene, r, half, 90001, rs_cpu_count(), NULL);
+        ref->b = render_raystream(scene, r, half, 90002, rs_cpu_count(), NULL);
+    } else {
+        float *img[1] = {NULL};
+        if (!render_peer(r, &half, 1, 90001, rs_cpu_count(), 0, &t, NULL, img))
+            return 0;
+        ref->a = img[0];
+        if (!render_peer(r, &half, 1, 90002, rs_cpu_count(), 0, &t, NULL, img))
+            return 0;
+        ref->b = img[0];
+    }
+    if (!ref->a || !ref->b)
+        return 0;
+    ref->img = (float *)malloc(nf * sizeof *ref->img);
+    if (!ref->img)
+        return 0;
+    for (i = 0; i < nf; ++i) {
+        if (!isfinite(ref->a[i]) || !isfinite(ref->b[i])) {
+            fprintf(stderr, "%s: %s: non-finite reference pixel\n", prog, r->label);
+            return 0;
+        }
+        ref->img[i] = 0.5f * (ref->a[i] + ref->b[i]);
+    }
+    ref->var_ref = sq_dist(ref->a, ref->b, nf) / 4.0;
+    return 1;
+}
+
+/* Block-mean z-test of two references: per 16x16 block and channel, the difference of the block
+ * means over its standard error (each reference's from its halves' per-pixel differences).
+ * Prints the result; returns 1 when no more than 1% of the blocks have |z| > 3 (0.27% expected
+ * by chance) and the image means agree within 1%. */
+static int same_picture(const char *label, const reference *x, const reference *y)
+{
+    uint32_t bx, by, px, py, nb = 0, over = 0;
+    int c;
+    double zmax = 0.0, mx = 0.0, my = 0.0;
+    for (by = 0; by + BLOCK <= H; by += BLOCK)
+        for (bx = 0; bx + BLOCK <= W; bx += BLOCK)
+            for (c = 0; c < 3; ++c) {
+                double sx = 0, sy = 0, vx = 0, vy = 0, z, n = 0;
+                for (py = by; py < by + BLOCK; ++py)
+                    for (px = bx; px < bx + BLOCK; ++px) {
+                        if (py == 0 || px == 0 || py == H - 1 || px == W - 1)
+                            continue; /* the image's edge (LuxCore's bottom row is made up) */
+                        size_t i = ((size_t)py * W + px) * 3 + (size_t)c;
+                        double dx = (double)x->a[i] - x->b[i], dy = (double)y->a[i] - y->b[i];
+                        sx += x->img[i];
+                        sy += y->img[i];
+                        vx += dx * dx / 4.0;
+                        vy += dy * dy / 4.0;
+                        n += 1;
+                    }
+                mx += sx;
+                my += sy;
+                z = (sx / n - sy / n) / sqrt((vx + vy) / (n * n) + 1e-30);
+                if (fabs(z) > zmax)
+                    zmax = fabs(z);
+                over += fabs(z) > 3.0;
+                nb++;
+            }
+    printf("same picture (%s against raystream, %ux%u-pixel blocks x 3 channels): %u of %u "
+           "blocks |z| > 3 (%.2f%%; 0.27%% by chance), max |z| %.1f, mean ratio %.4f\n",
+           label, BLOCK, BLOCK, over, nb, 100.0 * over / nb, zmax, mx / my);
+    return over <= nb / 100 && fabs(mx / my - 1.0) < 0.01;
+}
+
+/* ---- fit and table -------------------------------------------------------------------------- */
+
+/* Least squares of log err = a + b log spp over the levels whose error is measurable. */
+static int fit(const row *r, int n_levels, double *a, double *b)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0, l;
+    for (l = 0; l < n_levels; ++l)
+        if (r->err2[l] > 0.0) {
+            double lx = log(r->done[l]), ly = 0.5 * log(r->err2[l]);
+            sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
+            n++;
+        }
+    if (n < 2 || sxx * n - sx * sx <= 0.0)
+        return 0;
+    *b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    *a = (sy - *b * sx) / n;
+    return *b < 0.0;
+}
+
+static double median_secs(const row *r, int l, int runs)
+{
+    double v[MAX_RUNS];
+    memcpy(v, r->secs[l], sizeof(double) * (size_t)runs);
+    return rs_bench_median(v, runs);
+}
+
+/* Seconds to reach `target`: the spp the fit needs at the seconds per spp of the top level. */
+static double time_to(const row *r, int n_levels, int runs, double target, double *spp_out)
+{
+    double a, b, spp, per_spp;
+    if (!fit(r, n_levels, &a, &b))
+        return -1.0;
+    spp = exp((log(target) - a) / b);
+    per_spp = median_secs(r, n_levels - 1, runs) / r->done[n_levels - 1];
+    if (spp_out)
+        *spp_out = spp;
+    return spp * per_spp;
+}
+
+static void print_table(row *rows, int n_rows, const uint32_t *levels, int n_levels, int runs)
+{
+    int k, l;
+    double base01 = -1.0;
+    printf("\n| renderer | samples/s (1 thread) |");
+    for (l = 0; l < n_levels; ++l)
+        printf(" RMSE %u spp |", levels[l]);
+    printf(" slope | time to RMSE 0.02 | time to RMSE 0.01 | vs raystream at 0.01 |\n|---|---:|");
+    for (l = 0; l < n_levels; ++l)
+        printf("---:|");
+    printf("---:|---:|---:|---:|\n");
+    for (k = 0; k < n_rows; ++k) {
+        row *r = &rows[k];
+        double t02, t01, a, b, sps;
+        if (!r->ok)
+            continue;
+        sps = (double)W * H * r->done[n_levels - 1] / median_secs(r, n_levels - 1, runs);
+        t02 = time_to(r, n_levels, runs, 0.02, NULL);
+        t01 = time_to(r, n_levels, runs, 0.01, NULL);
+        if (k == 0)
+            base01 = t01;
+        printf("| %s | %.2f M |", r->label, sps / 1e6);
+        for (l = 0; l < n_levels; ++l)
+            printf(" %.4f |", sqrt(r->err2[l] > 0 ? r->err2[l] : 0));
+        if (fit(r, n_levels, &a, &b))
+            printf(" %.2f |", b);
+        else
+            printf(" — |");
+        if (t02 > 0)
+            printf(" %.2f s |", t02);
+        else
+            printf(" — |");
+        if (t01 > 0 && base01 > 0)
+            printf(" %.2f s | %.2fx %s |\n", t01, t01 > base01 ? t01 / base01 : base01 / t01,
+                   k == 0 ? "(baseline)" : t01 > base01 ? "slower" : "faster");
+        else
+            printf(" — | — |\n");
+    }
+    printf("\nslope: d log RMSE / d log spp over the levels (-0.5 for independent samples); times "
+           "from that fit at the median seconds per spp of the %u-spp renders\n",
+           levels[n_levels - 1]);
+}
+
+/* ---- main ------------------------------------------------------------------------------------ */
+
+static int parse_levels(const char *s, uint32_t *levels, int *n)
+{
+    *n = 0;
+    while (*s && *n < MAX_LEVELS) {
+        char *end;
+        long v = strtol(s, &end, 10);
+        if (end == s || v < 1 || (*n > 0 && (uint32_t)v <= levels[*n - 1]))
+            return 0;
+        levels[(*n)++] = (uint32_t)v;
+        s = *end == ',' ? end + 1 : end;
+        if (end == s && *s)
+            return 0;
+    }
+    return *n >= 2 && !*s;
+}
+
+/* Whether the venv's Python imports `module` (python[] is set to the venv's interpreter). */
+static int peer_available(const char *venv, const char *module)
+{
+    char *argv[4];
+    char code[128];
+    struct stat sb;
+    snprintf(python, sizeof python, "%s/bin/python", venv);
+    if (stat(python, &sb) != 0)
+        return 0;
+    snprintf(code, sizeof code, "import %s", module);
+    argv[0] = python;
+    argv[1] = (char *)"-c";
+    argv[2] = code;
+    argv[3] = NULL;
+    return run_child(argv, NULL, NULL) == 0;
+}
+
+static row *add_peer(row *rows, int *n_rows, const char *label, const char *name,
+                     const char *script, const char *scene_file, const char *variant,
+                     const char *sampler)
+{
+    row *r = &rows[(*n_rows)++];
+    r->label = label;
+    r->name = name;
+    r->kind = ROW_PEER;
+    r->script = script;
+    r->scene_file = scene_file;
+    r->variant = variant;
+    r->mi_sampler = sampler;
+    r->ref_row = *n_rows - 1;
+    return r;
+}
+
+int main(int argc, char **argv)
+{
+    uint32_t levels[MAX_LEVELS] = {4, 16, 64, 256}, ref_spp = 1024;
+    int n_levels = 4, runs = 3, quick = 0, peers = 1, i, k, l, round, n_rows = 0, n_ray;
+    const char *venv = getenv("RS_PEERS_VENV"), *keep = NULL;
+    char default_venv[1024], xml[600], json[600];
+    size_t nf;
+    rs_scene *scene = NULL;
+    row rows[MAX_ROWS];
+    reference refs[MAX_ROWS];
+    snprintf(default_venv, sizeof default_venv, "%s/peers-venv", RS_BINARY_DIR);
+    if (!venv || !*venv)
+        venv = default_venv;
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--quick") == 0) {
+            quick = 1;
+        } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
+            W = H = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--levels") == 0 && i + 1 < argc) {
+            if (!parse_levels(argv[++i], levels, &n_levels)) {
+                fprintf(stderr, "%s: --levels takes two or more increasing counts: 4,16,64\n",
+                        prog);
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--ref-spp") == 0 && i + 1 < argc) {
+            ref_spp = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
+            runs = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--venv") == 0 && i + 1 < argc) {
+            venv = argv[++i];
+        } else if (strcmp(argv[i], "--no-peers") == 0) {
+            peers = 0;
+        } else if (strcmp(argv[i], "--keep") == 0 && i + 1 < argc) {
+            keep = argv[++i];
+        } else {
+            fprintf(stderr, "usage: peers_bench [--quick] [--size N] [--levels A,B,...] "
+                            "[--ref-spp N] [--runs N] [--venv DIR] [--no-peers] [--keep DIR]\n");
+            return 2;
+        }
+    }
+    if (quick) {
+        W = H = 32;
+        levels[0] = 1, levels[1] = 4, n_levels = 2;
+        ref_spp = 64;
+        runs = 1;
+        peers = 0;
+    }
+    if (W < BLOCK || W > 4096 || ref_spp < 2 || runs < 1 || runs > MAX_RUNS) {
+        fprintf(stderr, "%s: --size %u..4096, --ref-spp >= 2, --runs 1..%d\n", prog, BLOCK,
+                MAX_RUNS);
+        return 2;
+    }
+    nf = (size_t)W * H * 3;
+
+    /* the rows: raystream's first (the baseline), then the peers */
+    memset(rows, 0, sizeof rows);
+    memset(refs, 0, sizeof refs);
+    rows[n_rows].label = "raystream stream, sobol (default)";
+    rows[n_rows++].sampler = RS_SAMPLER_SOBOL;
+    rows[n_rows].label = "raystream megakernel, sobol";
+    rows[n_rows].sampler = RS_SAMPLER_SOBOL;
+    rows[n_rows++].megakernel = 1;
+    rows[n_rows].label = "raystream stream, zsobol";
+    rows[n_rows++].sampler = RS_SAMPLER_ZSOBOL;
+    rows[n_rows].label = "raystream stream, independent";
+    rows[n_rows++].sampler = RS_SAMPLER_INDEPENDENT;
+    n_ray = n_rows;
+
+    if (keep) {
+        if (mkdir(keep, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "%s: cannot make %s: %s\n", prog, keep, strerror(errno));
+            return 1;
+        }
+        snprintf(tmp_dir, sizeof tmp_dir, "%s", keep);
+    } else {
+        snprintf(tmp_dir, sizeof tmp_dir, "%s/peers_bench.XXXXXX",
+                 getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+        if (!mkdtemp(tmp_dir)) {
+            fprintf(stderr, "%s: cannot make a temporary folder: %s\n", prog, strerror(errno));
+            return 1;
+        }
+    }
+    if (rs_builtin_create("cornell", &scene) != RS_OK) {
+        fprintf(stderr, "%s: %s\n", prog, rs_error_message());
+        return 1;
+    }
+    snprintf(xml, sizeof xml, "%s/scene.xml", tmp_dir);
+    snprintf(json, sizeof json, "%s/peers.json", tmp_dir);
+    if (!export_mitsuba(scene, xml, json))
+        return 1;
+
+    rs_bench_print_machine(stdout);
+    printf("settings: builtin:cornell %ux%u, max depth 50, 1-pixel box filter, MIS (power "
+           "heuristic) everywhere; one thread pinned to one core, %d interleaved rounds; "
+           "references %u spp (two halves, every core)\n",
+           W, H, runs, ref_spp);
+    if (!peers)
+        printf("peers: skipped (%s)\n", quick ? "--quick" : "--no-peers");
+    if (peers && !peer_available(venv, "mitsuba")) {
+        printf("Mitsuba 3: skipped: %s/bin/python cannot import mitsuba (make the venv with `sh "
+               "scripts/install-peers.sh %s`)\n",
+               venv, venv);
+    } else if (peers) {
+        const char *llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so";
+        struct stat sb;
+        int have_llvm = getenv("DRJIT_LIBLLVM_PATH") != NULL || stat(llvm, &sb) == 0, first;
+        if (!getenv("DRJIT_LIBLLVM_PATH") && have_llvm)
+            setenv("DRJIT_LIBLLVM_PATH", llvm, 1);
+        first = n_rows;
+        add_peer(rows, &n_rows, "Mitsuba 3 scalar_rgb, independent", "Mitsuba 3",
+                 "mitsuba_peer.py", "scene.xml", "scalar_rgb", "independent");
+        if (have_llvm) {
+            add_peer(rows, &n_rows, "Mitsuba 3 llvm_ad_rgb, independent", "Mitsuba 3",
+                     "mitsuba_peer.py", "scene.xml", "llvm_ad_rgb", "independent");
+            add_peer(rows, &n_rows, "Mitsuba 3 llvm_ad_rgb, ldsampler", "Mitsuba 3",
+                     "mitsuba_peer.py", "scene.xml", "llvm_ad_rgb", "ldsampler");
+            /* the JIT renders the reference 3x faster than scalar_rgb */
+            for (k = first; k < n_rows; ++k)
+                rows[k].ref_row = first + 1;
+        } else {
+            printf("Mitsuba 3 llvm_ad_rgb: skipped: no %s (Debian's libllvm19) and no "
+                   "DRJIT_LIBLLVM_PATH\n",
+                   llvm);
+        }
+    }
+    if (peers && !peer_available(venv, "pyluxcore"))
+        printf("LuxCoreRender: skipped: %s/bin/python cannot import pyluxcore (`sh "
+               "scripts/install-peers.sh %s` installs it)\n",
+               venv, venv);
+    else if (peers)
+        add_peer(rows, &n_rows, "LuxCoreRender 2.11 PATHCPU, sobol", "LuxCoreRender",
+                 "luxcore_peer.py", "peers.json", "PATHCPU", "SOBOL");
+    fflush(stdout);
+
+    /* references, every core, one per renderer (its other rows converge to the same image);
+     * the same-picture check */
+    for (k = 0; k < n_rows; ++k) {
+        row *r = &rows[k];
+        if (r->ref_row != k)
+            continue;
+        r->ok = make_reference(scene, r, ref_spp, &refs[k]);
+        if (!r->ok) {
+            if (k < n_ray)
+                return 1;
+            printf("%s: skipped: its reference could not be made\n", r->label);
+            continue;
+        }
+        if (k >= n_ray && !same_picture(r->name, &refs[k], &refs[0])) {
+            printf("%s: skipped: it does not render the same picture\n", r->name);
+            r->ok = 0;
+        }
+    }
+    for (k = 0; k < n_rows; ++k)
+        rows[k].ok = rows[rows[k].ref_row].ok;
+    fflush(stdout);
+
+    /* the timed rounds: one core, renderers interleaved */
+    if (pin_to_one_core(1) != 0)
+        printf("(could not pin to one core: %s)\n", strerror(errno));
+    for (round = 0; round < runs; ++round)
+        for (k = 0; k < n_rows; ++k) {
+            row *r = &rows[k];
+            uint64_t seed = 1 + (uint64_t)round * 1000;
+            if (!r->ok)
+                continue;
+            if (r->kind == ROW_RAYSTREAM) {
+                for (l = 0; l < n_levels; ++l) {
+                    float *img = render_raystream(scene, r, levels[l], seed + (uint64_t)l, 1,
+                                                  &r->secs[l][round]);
+                    if (!img)
+                        return 1;
+                    r->done[l] += (double)levels[l] / runs;
+                    r->err2[l] += (sq_dist(img, refs[r->ref_row].img, nf) - refs[r->ref_row].var_ref) / runs;
+                    free(img);
+                }
+            } else {
+                float *imgs[MAX_LEVELS];
+                double secs[MAX_LEVELS], done[MAX_LEVELS];
+                if (!render_peer(r, levels, n_levels, seed, 1, 1, secs, done, imgs)) {
+                    r->ok = 0;
+                    continue;
+                }
+                for (l = 0; l < n_levels; ++l) {
+                    r->secs[l][round] = secs[l];
+                    r->done[l] += done[l] / runs;
+                    r->err2[l] += (sq_dist(imgs[l], refs[r->ref_row].img, nf) -
+                                  refs[r->ref_row].var_ref) / runs;
+                    free(imgs[l]);
+                }
+            }
+        }
+    pin_to_one_core(0);
+    print_table(rows, n_rows, levels, n_levels, runs);
+
+    for (k = 0; k < n_rows; ++k) {
+        if (rows[k].ref_row != k)
+            continue;
+        free(refs[k].img);
+        free(refs[k].a);
+        free(refs[k].b);
+    }
+    rs_scene_destroy(scene);
+    if (!keep) {
+        char cmd[700];
+        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
+        if (system(cmd) != 0)
+            fprintf(stderr, "%s: could not remove %s\n", prog, tmp_dir);
+    }
+    return 0;
+}
