@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 
 namespace
 {
@@ -147,6 +148,11 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
 {
     *rgb = nullptr;
     try {
+        // OpenImageIO gets regular files of a sane size only: its format probing keeps reading
+        // a /dev/zero, and opening a FIFO blocks until someone writes to it
+        rs_status st = rs_file_check(path, RS_FILE_MAX_IMAGE_BYTES, nullptr);
+        if (st != RS_OK)
+            return st;
         auto in = OIIO::ImageInput::open(path);
         if (!in)
             return rs_error_set(RS_ERR_IO, "%s: cannot open image: %s", path,
@@ -154,14 +160,21 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
         const OIIO::ImageSpec &spec = in->spec();
         if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
             return rs_error_set(RS_ERR_IO, "%s: empty image", path);
+        // a header may claim any size: bound it before allocating (a small file can decode
+        // to gigabytes)
+        if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE ||
+            (uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
+            return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d is too large (at most %llu pixels)",
+                                path, spec.width, spec.height,
+                                (unsigned long long)RS_IMAGE_MAX_PIXELS);
         size_t npix = (size_t)spec.width * (size_t)spec.height;
-        std::vector<float> all(npix * (size_t)spec.nchannels);
-        if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+        int nc = spec.nchannels < 3 ? spec.nchannels : 3; // only RGB is kept
+        std::vector<float> all(npix * (size_t)nc);
+        if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
             return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
         float *o = (float *)rs_alloc(npix * 3, sizeof(float));
         if (!o)
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
-        int nc = spec.nchannels;
         bool decode = linear && !spec.format.is_floating_point();
         for (size_t i = 0; i < npix; ++i)
             for (int c = 0; c < 3; ++c) {

@@ -23,6 +23,11 @@ rs_status rs_image_check_output(const char *path);
 /* Writes width x height RGB (3 floats a pixel, row-major from the top-left, linear). */
 rs_status rs_image_write(const char *path, uint32_t width, uint32_t height, const float *rgb);
 
+/* Read images are bounded: the file must be a regular file of at most RS_FILE_MAX_IMAGE_BYTES
+ * (core/file.h) and the image at most this many pixels, each side at most RS_IMAGE_MAX_SIDE. */
+#define RS_IMAGE_MAX_SIDE   65536
+#define RS_IMAGE_MAX_PIXELS ((uint64_t)1 << 28)
+
 /* Reads any image OpenImageIO knows as RGB floats in the file's own encoding (8-bit files give
  * their code values / 255, not decoded).  *rgb is allocated with rs_alloc; free with rs_free. */
 rs_status rs_image_read(const char *path, uint32_t *width, uint32_t *height, float **rgb);

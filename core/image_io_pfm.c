@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 #include "core/image_io.h"
 
 static int is_pfm(const char *path)
@@ -57,16 +58,20 @@ rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, const float *
 
 rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f;
     unsigned ww, hh;
     float scale;
     uint32_t y;
     int ok;
+    rs_status st;
     *rgb = NULL;
-    if (!f)
-        return rs_error_set(RS_ERR_IO, "%s: cannot open", path);
+    /* a regular file of a sane size only (a FIFO would block, /dev/zero never end) */
+    st = rs_file_open(path, RS_FILE_MAX_IMAGE_BYTES, &f, NULL);
+    if (st != RS_OK)
+        return st;
     ok = fscanf(f, "PF %u %u %f", &ww, &hh, &scale) == 3 && fgetc(f) != EOF && scale < 0.0f &&
-         ww > 0 && hh > 0 && ww < 65536 && hh < 65536;
+         ww > 0 && hh > 0 && ww < 65536 && hh < 65536 &&
+         (uint64_t)ww * hh <= RS_IMAGE_MAX_PIXELS;
     if (ok)
         ok = (*rgb = (float *)rs_alloc((size_t)ww * hh * 3, sizeof(float))) != NULL;
     for (y = hh; ok && y-- > 0;)

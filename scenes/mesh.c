@@ -1,18 +1,201 @@
 /* scenes/mesh.c — see mesh.h. */
 #include "scenes/mesh.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
-#include <errno.h>
+#include <ctype.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
+
+/* ---- every file Assimp opens goes through core/file.h ------------------------------------ */
+
+/* Assimp's own file system would open whatever a mesh names (an OBJ's mtllib, a glTF's
+ * buffers): a FIFO blocks the open for ever, /dev/zero never ends.  These callbacks open only
+ * regular files of a sane size.  A file refused for its kind or size is remembered and fails
+ * the whole import, even where Assimp would carry on without it; a missing file is left to
+ * Assimp (an OBJ without its MTL still imports, with default materials). */
+typedef struct mesh_io {
+    struct aiFileIO io;  /* first: Assimp hands this pointer back */
+    rs_status refused;   /* RS_OK, or the code of the first refusal */
+    char why[1200];      /* its message, "FILE: not a regular file" */
+} mesh_io;
+
+typedef struct mesh_file {
+    struct aiFile file;  /* first: Assimp hands this pointer back */
+    FILE *fp;
+    uint64_t size;
+} mesh_file;
+
+static size_t mf_read(struct aiFile *f, char *buf, size_t size, size_t count)
+{
+    return fread(buf, size, count, ((mesh_file *)f)->fp);
+}
+
+static size_t mf_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+    (void)f, (void)buf, (void)size, (void)count;
+    return 0; /* opened for reading only */
+}
+
+static size_t mf_tell(struct aiFile *f)
+{
+    off_t at = ftello(((mesh_file *)f)->fp);
+    return at < 0 ? 0 : (size_t)at;
+}
+
+static size_t mf_size(struct aiFile *f) { return (size_t)((mesh_file *)f)->size; }
+
+static enum aiReturn mf_seek(struct aiFile *f, size_t offset, enum aiOrigin origin)
+{
+    /* Assimp passes a backwards relative seek as a wrapped-around size_t */
+    int whence = origin == aiOrigin_CUR ? SEEK_CUR : origin == aiOrigin_END ? SEEK_END : SEEK_SET;
+    return fseeko(((mesh_file *)f)->fp, (off_t)(ptrdiff_t)offset, whence) == 0 ? aiReturn_SUCCESS
+                                                                             : aiReturn_FAILURE;
+}
+
+static void mf_flush(struct aiFile *f) { (void)f; }
+
+static struct aiFile *mio_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    mesh_io *m = (mesh_io *)io;
+    mesh_file *mf;
+    char msg[1200];
+    uint64_t size;
+    int fd;
+    rs_status st;
+    if (!path || !mode || strpbrk(mode, "wa+"))
+        return NULL; /* an import never writes */
+    st = rs_file_open_quiet(path, RS_FILE_MAX_MESH_BYTES, &fd, &size, msg, sizeof msg);
+    if (st != RS_OK) {
+        if (st == RS_ERR_ARG && m->refused == RS_OK) {
+            m->refused = st;
+            snprintf(m->why, sizeof m->why, "%s", msg);
+        }
+        return NULL;
+    }
+    mf = (mesh_file *)rs_calloc(1, sizeof *mf);
+    if (!mf || !(mf->fp = fdopen(fd, "rb"))) {
+        rs_free(mf);
+        close(fd);
+        return NULL;
+    }
+    mf->size = size;
+    mf->file.ReadProc = mf_read;
+    mf->file.WriteProc = mf_write;
+    mf->file.TellProc = mf_tell;
+    mf->file.FileSizeProc = mf_size;
+    mf->file.SeekProc = mf_seek;
+    mf->file.FlushProc = mf_flush;
+    return &mf->file;
+}
+
+static void mio_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (f) {
+        fclose(((mesh_file *)f)->fp);
+        rs_free(f);
+    }
+}
+
+/* ---- PLY headers ------------------------------------------------------------------------- */
+
+/* Assimp's PLY reader spins for ever on a header that stops before end_header.  A file that
+ * says it is PLY (by its first line or its extension) must reach end_header within this many
+ * bytes, and may not declare more elements than its bytes after the header could hold (each
+ * instance of an element with a property takes at least one byte, ascii or binary). */
+#define PLY_MAX_HEADER (64u << 10)
+
+static int ext_is(const char *path, const char *ext)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    size_t i;
+    if (!dot || (slash && dot < slash) || strlen(dot + 1) != strlen(ext))
+        return 0;
+    for (i = 0; ext[i]; ++i)
+        if (tolower((unsigned char)dot[1 + i]) != ext[i])
+            return 0;
+    return 1;
+}
+
+static rs_status check_ply_header(const char *path)
+{
+    FILE *f;
+    uint64_t size, total = 0, count = 0;
+    char *buf;
+    size_t n, hdr = 0;
+    const char *p, *end;
+    int is_ply, has_prop = 0, found = 0;
+    rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
+    if (st != RS_OK)
+        return st;
+    buf = (char *)rs_alloc(PLY_MAX_HEADER + 1, 1);
+    if (!buf) {
+        fclose(f);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    }
+    n = fread(buf, 1, PLY_MAX_HEADER, f);
+    fclose(f);
+    buf[n] = '\0';
+    is_ply = n >= 4 && memcmp(buf, "ply", 3) == 0 && (buf[3] == '\n' || buf[3] == '\r');
+    if (!is_ply) {
+        rs_free(buf);
+        if (ext_is(path, "ply"))
+            return rs_error_set(RS_ERR_ARG, "%s: not a PLY file (its first line is not 'ply')",
+                                path);
+        return RS_OK;
+    }
+    for (p = buf, end = buf + n; p < end;) {
+        const char *eol = (const char *)memchr(p, '\n', (size_t)(end - p));
+        int is_elem, is_end;
+        if (!eol)
+            break; /* the header's last line is cut */
+        is_elem = strncmp(p, "element", 7) == 0 && (p[7] == ' ' || p[7] == '\t');
+        is_end = strncmp(p, "end_header", 10) == 0 && (p + 10 == eol || isspace((unsigned char)p[10]));
+        if (is_elem || is_end) {
+            if (has_prop)
+                total = total + count < total ? UINT64_MAX : total + count;
+            has_prop = 0;
+            count = 0;
+        }
+        if (is_elem) {
+            const char *q = p + 7;
+            while (q < eol && (*q == ' ' || *q == '\t'))
+                ++q;
+            while (q < eol && *q != ' ' && *q != '\t')
+                ++q; /* the element's name */
+            count = strtoull(q, NULL, 10);
+        } else if (strncmp(p, "property", 8) == 0) {
+            has_prop = 1;
+        } else if (is_end) {
+            found = 1;
+            hdr = (size_t)(eol + 1 - buf);
+            break;
+        }
+        p = eol + 1;
+    }
+    rs_free(buf);
+    if (!found)
+        return rs_error_set(RS_ERR_ARG, "%s: PLY header has no end_header (within its first %u KiB)",
+                            path, PLY_MAX_HEADER >> 10);
+    if (total > size - hdr)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: PLY header declares %llu elements, more than its %llu bytes of "
+                            "data could hold",
+                            path, (unsigned long long)total, (unsigned long long)(size - hdr));
+    return RS_OK;
+}
 
 /* Rotation about x, then y, then z (right-handed, degrees). */
 static rs_vec3 rotate_xyz(rs_vec3 p, rs_vec3 deg)
@@ -29,8 +212,8 @@ static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinit
 
 /* A scene material for an Assimp material: an emitter if it emits, Phong if it has a specular
  * colour and shininess, else Lambertian; a diffuse texture file becomes an image texture. */
-static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, const char *dir,
-                                   uint32_t *id)
+static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, const char *mesh,
+                                   const char *dir, uint32_t *id)
 {
     struct aiColor4D kd = {0.7f, 0.7f, 0.7f, 1}, ks = {0, 0, 0, 1}, ke = {0, 0, 0, 1};
     ai_real shininess = 0;
@@ -62,10 +245,20 @@ static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, con
             char path[2048];
             uint32_t image, t;
             rs_texture tx;
+            char why[1200];
+            int fd;
+            rs_status st;
             if (tex.data[0] == '/')
                 snprintf(path, sizeof path, "%s", tex.data);
             else
                 snprintf(path, sizeof path, "%s/%s", dir, tex.data);
+            /* a texture that is not a regular file of a sane size (a FIFO, /dev/zero, a
+             * folder) is refused outright; only a missing or unreadable one is a warning */
+            st = rs_file_open_quiet(path, RS_FILE_MAX_IMAGE_BYTES, &fd, NULL, why, sizeof why);
+            if (st == RS_ERR_ARG)
+                return rs_error_set(st, "%s: %s", mesh, why);
+            if (st == RS_OK)
+                close(fd);
             if (rs_scene_load_image(s, path, &image) == RS_OK) {
                 memset(&tx, 0, sizeof tx);
                 tx.type = RS_TEX_IMAGE;
@@ -108,7 +301,8 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
 {
     const struct aiScene *as;
     struct aiPropertyStore *props;
-    struct stat sb;
+    mesh_io mio;
+    uint64_t size;
     placement pl;
     uint32_t *mat_of = NULL, mi, k;
     char dir[1024];
@@ -116,16 +310,21 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     rs_status st = RS_OK;
     rs_aabb raw;
     memset(info, 0, sizeof *info);
-    if (stat(path, &sb) != 0)
-        return rs_error_set(RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    if (!S_ISREG(sb.st_mode))
-        return rs_error_set(RS_ERR_IO, "%s: not a regular file", path);
-    if (sb.st_size == 0)
+    st = rs_file_check(path, RS_FILE_MAX_MESH_BYTES, &size);
+    if (st != RS_OK)
+        return st;
+    if (size == 0)
         return rs_error_set(RS_ERR_ARG, "%s: empty file", path);
+    st = check_ply_header(path);
+    if (st != RS_OK)
+        return st;
     if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !finite3(o->scale))
         return rs_error_set(RS_ERR_ARG, "%s: scale must be finite and non-zero", path);
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
 
+    memset(&mio, 0, sizeof mio);
+    mio.io.OpenProc = mio_open;
+    mio.io.CloseProc = mio_close;
     props = aiCreatePropertyStore();
     /* Drop points and lines (a truncated OBJ face is a line); keep triangles.  Assimp's own
      * structure validation is off: it rejects a whole file for one bad face, while the loop
@@ -137,8 +336,16 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
                                           aiProcess_SortByPType | aiProcess_PreTransformVertices |
                                           aiProcess_GenSmoothNormals |
                                           aiProcess_ValidateDataStructure,
-                                      NULL, props);
+                                      &mio.io, props);
     aiReleasePropertyStore(props);
+    if (mio.refused != RS_OK) {
+        /* a file the mesh names was refused: fail even if Assimp carried on without it */
+        if (as)
+            aiReleaseImport(as);
+        if (strncmp(mio.why, path, strlen(path)) == 0 && mio.why[strlen(path)] == ':')
+            return rs_error_set(mio.refused, "%s", mio.why);
+        return rs_error_set(mio.refused, "%s: %s", path, mio.why);
+    }
     if (!as || !as->mRootNode) {
         st = rs_error_set(RS_ERR_ARG, "%s: cannot import mesh: %s", path, aiGetErrorString());
         if (as)
@@ -192,7 +399,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
         }
         for (k = 0; k < as->mNumMaterials && st == RS_OK; ++k) {
-            st = add_file_material(s, as->mMaterials[k], dir, &mat_of[k]);
+            st = add_file_material(s, as->mMaterials[k], path, dir, &mat_of[k]);
             info->materials++;
         }
         if (st == RS_OK && as->mNumMaterials == 0) {

@@ -3,8 +3,12 @@
  * (smooth normals are generated where it has none); the mesh is placed by scale, rotations about
  * x, y, z, and a translation, in that order (the thesis's transforms), or fitted into a box.
  *
- * Bad data never crashes the import: a file Assimp cannot read is an RS_ERR_ARG naming it; faces
- * with non-finite or out-of-range vertices, or of zero area, are dropped and counted. */
+ * Bad data never crashes or hangs the import: a file Assimp cannot read is an RS_ERR_ARG naming
+ * it; faces with non-finite or out-of-range vertices, or of zero area, are dropped and counted.
+ * Assimp reads every file through core/file.h (the mesh, its MTL, a glTF's buffers), and so do
+ * the textures a mesh names: one that is not a regular file of a sane size (a FIFO, /dev/zero, a
+ * folder) fails the import, naming it; one that is merely missing does not.  A PLY file must
+ * reach end_header within 64 KiB (Assimp's reader spins for ever on a cut header). */
 #ifndef RS_SCENES_MESH_H
 #define RS_SCENES_MESH_H
 

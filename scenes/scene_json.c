@@ -5,15 +5,15 @@
 #include "scenes/scene_json.h"
 
 #include <cjson/cJSON.h>
-#include <errno.h>
+#include <float.h>
 #include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/file.h"
 
-#define MAX_SCENE_BYTES (256u << 20)
 #define MAX_NAMES       4096
 
 typedef struct named {
@@ -39,14 +39,24 @@ static rs_status field_error(const ctx *c, const char *path, const char *fmt, ..
 #endif
     ;
 
+/* Control characters (a key may hold an escaped newline) print as '?': one line, always. */
+static void one_line(char *s)
+{
+    for (; *s; ++s)
+        if ((unsigned char)*s < 0x20 || *s == 0x7f)
+            *s = '?';
+}
+
 static rs_status field_error(const ctx *c, const char *path, const char *fmt, ...)
 {
-    char msg[384];
+    char msg[384], all[1600];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    return rs_error_set(RS_ERR_ARG, "%s: %s: %s", c->label, path, msg);
+    snprintf(all, sizeof all, "%s: %s: %s", c->label, path, msg);
+    one_line(all);
+    return rs_error_set(RS_ERR_ARG, "%s", all);
 }
 
 /* Fails on any key of `obj` that is not in the NULL-terminated list `keys`. */
@@ -140,6 +150,18 @@ static rs_status get_color(const ctx *c, const cJSON *obj, const char *path, con
     return st;
 }
 
+/* A reflectance (or transmittance): a colour with every component in [0, 1]. */
+static rs_status get_reflectance(const ctx *c, const cJSON *obj, const char *path,
+                                 const char *key, int required, rs_vec3 def, rs_vec3 *out)
+{
+    char p[256];
+    rs_status st = get_color(c, obj, path, key, required, def, out);
+    subpath(p, sizeof p, path, key);
+    if (st == RS_OK && (out->x > 1 || out->y > 1 || out->z > 1))
+        return FAIL(c, p, "reflectance must be in [0, 1]");
+    return st;
+}
+
 static rs_status get_bool(const ctx *c, const cJSON *obj, const char *path, const char *key,
                           int def, int *out)
 {
@@ -211,8 +233,10 @@ static rs_status read_camera(ctx *c, const cJSON *cam)
     if (sh) {
         if (!cJSON_IsArray(sh) || cJSON_GetArraySize(sh) != 2 ||
             !cJSON_IsNumber(cJSON_GetArrayItem(sh, 0)) ||
-            !cJSON_IsNumber(cJSON_GetArrayItem(sh, 1)))
-            return FAIL(c, "camera.shutter", "expected [open, close]");
+            !cJSON_IsNumber(cJSON_GetArrayItem(sh, 1)) ||
+            fabs(cJSON_GetArrayItem(sh, 0)->valuedouble) > 1e30 ||
+            fabs(cJSON_GetArrayItem(sh, 1)->valuedouble) > 1e30)
+            return FAIL(c, "camera.shutter", "expected [open, close], two finite numbers");
         d->shutter_open = (float)cJSON_GetArrayItem(sh, 0)->valuedouble;
         d->shutter_close = (float)cJSON_GetArrayItem(sh, 1)->valuedouble;
         if (!(d->shutter_close >= d->shutter_open))
@@ -280,12 +304,12 @@ static rs_status read_texture(ctx *c, const cJSON *t, const char *path, const ch
     if (strcmp(type, "solid") == 0) {
         TRY(check_keys(c, t, path, k_solid));
         tex.type = RS_TEX_SOLID;
-        TRY(get_color(c, t, path, "color", 1, rs_v3(0, 0, 0), &tex.a));
+        TRY(get_reflectance(c, t, path, "color", 1, rs_v3(0, 0, 0), &tex.a));
     } else if (strcmp(type, "checker") == 0 || strcmp(type, "stripes") == 0) {
         TRY(check_keys(c, t, path, k_two));
         tex.type = type[0] == 'c' ? RS_TEX_CHECKER : RS_TEX_STRIPES;
-        TRY(get_color(c, t, path, "a", 1, rs_v3(0, 0, 0), &tex.a));
-        TRY(get_color(c, t, path, "b", 1, rs_v3(0, 0, 0), &tex.b));
+        TRY(get_reflectance(c, t, path, "a", 1, rs_v3(0, 0, 0), &tex.a));
+        TRY(get_reflectance(c, t, path, "b", 1, rs_v3(0, 0, 0), &tex.b));
         TRY(get_num(c, t, path, "scale", 0, type[0] == 'c' ? 1.0 : 10.0, 1e-6, 1e6, &tex.scale));
     } else if (strcmp(type, "image") == 0) {
         const char *file = "";
@@ -330,13 +354,7 @@ static rs_status read_albedo(ctx *c, const cJSON *m, const char *path, const cha
         mat->albedo = rs_v3_splat(1.0f);
         return RS_OK;
     }
-    TRY(get_color(c, m, path, key, 0, rs_v3(.5f, .5f, .5f), &mat->albedo));
-    if (mat->albedo.x > 1 || mat->albedo.y > 1 || mat->albedo.z > 1) {
-        char p[256];
-        subpath(p, sizeof p, path, key);
-        return FAIL(c, p, "reflectance must be in [0, 1]");
-    }
-    return RS_OK;
+    return get_reflectance(c, m, path, key, 0, rs_v3(.5f, .5f, .5f), &mat->albedo);
 }
 
 static rs_status read_material(ctx *c, const cJSON *m, const char *path, const char *name)
@@ -371,18 +389,18 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
         mat = rs_mat_phong(rs_v3_splat(.5f), rs_v3_splat(.5f), 50.0f);
         TRY(check_keys(c, m, path, k_phong));
         TRY(read_albedo(c, m, path, "kd", &mat));
-        TRY(get_color(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat.specular));
+        TRY(get_reflectance(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat.specular));
         TRY(get_num(c, m, path, "exponent", 0, 50.0, 0.0, 1e6, &mat.exponent));
     } else if (strcmp(type, "metal") == 0) {
         mat = rs_mat_metal(rs_v3_splat(.8f), 0.0f);
         TRY(check_keys(c, m, path, k_metal));
-        TRY(get_color(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat.albedo));
+        TRY(get_reflectance(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat.albedo));
         TRY(get_num(c, m, path, "fuzz", 0, 0.0, 0.0, 1.0, &mat.fuzz));
     } else if (strcmp(type, "dielectric") == 0) {
         mat = rs_mat_dielectric(1.5f);
         TRY(check_keys(c, m, path, k_glass));
         TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat.ior));
-        TRY(get_color(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+        TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
     } else if (strcmp(type, "light") == 0) {
         mat = rs_mat_light(rs_v3_splat(1.0f), 0);
         TRY(check_keys(c, m, path, k_light));
@@ -475,8 +493,8 @@ static rs_status read_object(ctx *c, const cJSON *o, const char *path)
             return FAIL(c, sp, "expected 6 numbers (u0, v0, u1, v1, u2, v2)");
         for (i = 0; i < 6; ++i) {
             const cJSON *e = cJSON_GetArrayItem(uv, i);
-            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
-                return FAIL(c, sp, "expected 6 numbers (u0, v0, u1, v1, u2, v2)");
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
+                return FAIL(c, sp, "expected 6 finite numbers (u0, v0, u1, v1, u2, v2)");
             uvs[i] = (float)e->valuedouble;
         }
         return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
@@ -523,6 +541,36 @@ static rs_status read_map(ctx *c, const cJSON *root, const char *key,
     return RS_OK;
 }
 
+/* Checks the whole tree before it is read: no key twice in one object (cJSON would keep both
+ * and the reader see only the first) and no number that is not finite (cJSON reads 1e999 as
+ * inf) or beyond a float's range, wherever they are. */
+static rs_status check_tree(const ctx *c, const cJSON *it, const char *path)
+{
+    const cJSON *a, *b;
+    int i = 0;
+    if (cJSON_IsNumber(it)) {
+        if (!isfinite(it->valuedouble) || fabs(it->valuedouble) > FLT_MAX)
+            return FAIL(c, *path ? path : "(top level)", "number out of range (not finite)");
+        return RS_OK;
+    }
+    if (!cJSON_IsObject(it) && !cJSON_IsArray(it))
+        return RS_OK;
+    for (a = it->child; a; a = a->next, ++i) {
+        char p[256];
+        if (cJSON_IsObject(it)) {
+            for (b = it->child; b != a; b = b->next)
+                if (strcmp(a->string, b->string) == 0)
+                    return FAIL(c, *path ? path : "(top level)", "key '%s' appears twice",
+                                a->string);
+            subpath(p, sizeof p, path, a->string);
+        } else {
+            snprintf(p, sizeof p, "%s[%d]", path, i);
+        }
+        TRY(check_tree(c, a, p));
+    }
+    return RS_OK;
+}
+
 static rs_status build(ctx *c, const cJSON *root)
 {
     static const char *const keys[] = {"camera",    "image",   "background", "textures",
@@ -531,6 +579,7 @@ static rs_status build(ctx *c, const cJSON *root)
     int i = 0;
     if (!cJSON_IsObject(root))
         return rs_error_set(RS_ERR_ARG, "%s: the scene must be a JSON object", c->label);
+    TRY(check_tree(c, root, ""));
     TRY(check_keys(c, root, "(top level)", keys));
     if (!cJSON_GetObjectItemCaseSensitive(root, "camera"))
         return FAIL(c, "(top level)", "missing 'camera'");
@@ -571,6 +620,20 @@ rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, c
             line += text[i] == '\n';
         return rs_error_set(RS_ERR_ARG, "%s:%zu: JSON syntax error", label, line);
     }
+    if (end && end >= text && end <= text + len) {
+        /* one JSON value and nothing after it but white space */
+        const char *p = end;
+        while (p < text + len && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r'))
+            ++p;
+        if (p < text + len) {
+            size_t line = 1, i;
+            for (i = 0; i < (size_t)(p - text); ++i)
+                line += text[i] == '\n';
+            cJSON_Delete(root);
+            return rs_error_set(RS_ERR_ARG, "%s:%zu: unexpected content after the JSON value",
+                                label, line);
+        }
+    }
     c = (ctx *)rs_calloc(1, sizeof *c);
     if (!c) {
         cJSON_Delete(root);
@@ -602,41 +665,21 @@ rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, c
 
 rs_status rs_scene_load_json(const char *path, rs_scene **out)
 {
-    FILE *f = fopen(path, "rb");
     char *text, dir[1024];
     const char *slash;
-    long n;
-    size_t got;
+    size_t n;
     rs_status st;
     *out = NULL;
-    if (!f)
-        return rs_error_set(RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        fclose(f);
-        return rs_error_set(RS_ERR_IO, "%s: cannot read (not a regular file?)", path);
-    }
-    if ((unsigned long)n > MAX_SCENE_BYTES) {
-        fclose(f);
-        return rs_error_set(RS_ERR_ARG, "%s: larger than %u MiB", path, MAX_SCENE_BYTES >> 20);
-    }
-    text = (char *)rs_alloc((size_t)n + 1, 1);
-    if (!text) {
-        fclose(f);
-        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
-    }
-    got = fread(text, 1, (size_t)n, f);
-    fclose(f);
-    if (got != (size_t)n) {
-        rs_free(text);
-        return rs_error_set(RS_ERR_IO, "%s: read error", path);
-    }
-    text[n] = '\0';
+    /* a regular file of a sane size only: a FIFO or /dev/zero would never end */
+    st = rs_file_read(path, RS_FILE_MAX_SCENE_BYTES, &text, &n);
+    if (st != RS_OK)
+        return st;
     slash = strrchr(path, '/');
     if (slash)
         snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     else
         snprintf(dir, sizeof dir, ".");
-    st = rs_scene_parse_json(text, (size_t)n, path, dir, out);
+    st = rs_scene_parse_json(text, n, path, dir, out);
     rs_free(text);
     return st;
 }

@@ -1147,6 +1147,36 @@ static void test_scene_files_and_meshes(void **state)
     path_in(f, "y.png", path, sizeof path);
     EXPECT(&p, !file_exists(path), "no image for a bad scene");
     proc_free(&p);
+    {
+        /* a scene file that is a FIFO (whose open would block) and a PLY whose header is cut
+         * (Assimp's reader spins on it): at once, exit 1, one line naming the file */
+        static const char *const fifo_scene[] = {"render", "f.json", "-q", "-o", "z.png", NULL};
+        static const char *const cut_ply[] = {"render", "--mesh", "cut.ply", "--width", "16",
+                                              "--spp",  "1",      "-q",      "-o",      "z.png",
+                                              NULL};
+        path_in(f, "f.json", path, sizeof path);
+        assert_int_equal(mkfifo(path, 0600), 0);
+        run(&p, f->dir, 30.0, fifo_scene);
+        EXPECT(&p,
+               exited_with(&p, 1) && one_line(&p.err) && strstr(p.err.data, "f.json") &&
+                   strstr(p.err.data, "not a regular file"),
+               "a FIFO as the scene: exit 1, one line naming it");
+        proc_free(&p);
+        path_in(f, "cut.ply", path, sizeof path);
+        fp = fopen(path, "w");
+        assert_non_null(fp);
+        fputs("ply\nformat ascii 1.0\n", fp);
+        fclose(fp);
+        run(&p, f->dir, 30.0, cut_ply);
+        EXPECT(&p,
+               exited_with(&p, 1) && one_line(&p.err) && strstr(p.err.data, "cut.ply") &&
+                   strstr(p.err.data, "no end_header"),
+               "a PLY whose header is cut: exit 1, one line naming it");
+        proc_free(&p);
+        path_in(f, "z.png", path, sizeof path);
+        if (file_exists(path))
+            fail_msg("z.png was written for a refused input");
+    }
 }
 
 int main(void)

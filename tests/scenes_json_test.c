@@ -13,6 +13,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include "core/image_io.h"
@@ -112,6 +116,45 @@ static const bad_case g_bad[] = {
     {"{" CAM "," MAT ",\"objects\":[{\"type\":\"box\",\"min\":[1,1,1],\"max\":[0,2,2],"
      "\"material\":\"m\"}]}",
      {"objects[0]", "'max' must exceed 'min'"}},
+    /* non-finite numbers anywhere (cJSON reads 1e999 as inf) */
+    {"{\"camera\":{\"from\":[0,0,5],\"at\":[0,0,0],\"shutter\":[-1e999,1e999]}," MAT
+     ",\"objects\":[]}",
+     {"camera.shutter[0]", "not finite"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1e999,"
+     "\"material\":\"m\"}]}",
+     {"objects[0].radius", "not finite"}},
+    {"{\"camera\":{\"from\":[0,0,5],\"at\":[0,0,0],\"shutter\":[0,1e300]}," MAT
+     ",\"objects\":[]}",
+     {"camera.shutter", "finite"}},
+    /* trailing content after the one JSON value */
+    {"{" CAM "," MAT ",\"objects\":[]} x", {"t.json:1", "after the JSON value"}},
+    {"{" CAM "," MAT ",\"objects\":[]}\n\n{}", {"t.json:3", "after the JSON value"}},
+    /* duplicate keys, named with their object's path */
+    {"{" CAM "," CAM "," MAT ",\"objects\":[]}", {"(top level)", "'camera' appears twice"}},
+    {"{" CAM ",\"materials\":{\"m\":{\"type\":\"lambertian\",\"albedo\":[0.5,0.5,0.5],"
+     "\"albedo\":[1,1,1]}},\"objects\":[]}",
+     {"materials.m", "'albedo' appears twice"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1,"
+     "\"radius\":2,\"material\":\"m\"}]}",
+     {"objects[0]", "'radius' appears twice"}},
+    {"{" CAM ",\"materials\":{\"m\":{\"type\":\"lambertian\"},\"m\":{\"type\":\"metal\"}},"
+     "\"objects\":[]}",
+     {"materials", "'m' appears twice"}},
+    /* every reflectance in [0, 1] */
+    {"{" CAM ",\"materials\":{\"m\":{\"type\":\"metal\",\"albedo\":[5,5,5]}},\"objects\":[]}",
+     {"materials.m.albedo", "[0, 1]"}},
+    {"{" CAM ",\"materials\":{\"p\":{\"type\":\"phong\",\"ks\":[5,5,5]}},\"objects\":[]}",
+     {"materials.p.ks", "[0, 1]"}},
+    {"{" CAM ",\"materials\":{\"g\":{\"type\":\"dielectric\",\"tint\":[1,2,1]}},"
+     "\"objects\":[]}",
+     {"materials.g.tint", "[0, 1]"}},
+    {"{" CAM ",\"textures\":{\"t\":{\"type\":\"solid\",\"color\":[3,0,0]}},\"objects\":[]}",
+     {"textures.t.color", "[0, 1]"}},
+    {"{" CAM ",\"textures\":{\"t\":{\"type\":\"checker\",\"a\":[0,0,0],\"b\":[0,1.5,0]}},"
+     "\"objects\":[]}",
+     {"textures.t.b", "[0, 1]"}},
+    /* a key with a newline in it still gives one line */
+    {"{" CAM "," MAT ",\"objects\":[],\"a\\nb\":1}", {"unknown key 'a?b'"}},
 };
 
 static void test_bad_inputs(void **state)
@@ -135,6 +178,15 @@ static void test_bad_inputs(void **state)
                 fail_msg("case %zu: message '%s' lacks '%s'", k, msg, g_bad[k].words[w]);
     }
     rs_error_clear();
+    {
+        /* a NUL byte after the value is content too */
+        static const char nul[] = "{" CAM "," MAT ",\"objects\":[]}\n\0";
+        rs_scene *s = (rs_scene *)0x1;
+        assert_int_equal(rs_scene_parse_json(nul, sizeof nul - 1, "t.json", NULL, &s), RS_ERR_ARG);
+        assert_null(s);
+        assert_non_null(strstr(rs_error_message(), "t.json:2: unexpected content after"));
+        rs_error_clear();
+    }
 }
 
 /* An image texture next to the scene file, named relatively: loaded and sRGB-decoded. */
@@ -168,6 +220,96 @@ static void test_image_texture_relative(void **state)
     rs_scene_destroy(s);
     remove(png);
     remove(scene_path);
+    rmdir(dir);
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Loads `scene` (a file) and expects a failure whose one-line message has `a` and `b`. */
+static void expect_load_error(const char *scene, const char *a, const char *b)
+{
+    rs_scene *s = (rs_scene *)0x1;
+    rs_status st;
+    rs_error_clear();
+    st = rs_scene_load_json(scene, &s);
+    if (st == RS_OK)
+        fail_msg("%s loaded without an error", scene);
+    assert_true(st == RS_ERR_ARG || st == RS_ERR_IO);
+    assert_null(s);
+    print_message("%s -> %s\n", scene, rs_error_message());
+    assert_null(strchr(rs_error_message(), '\n'));
+    if (!strstr(rs_error_message(), a) || (b && !strstr(rs_error_message(), b)))
+        fail_msg("message '%s' lacks '%s' or '%s'", rs_error_message(), a, b ? b : "");
+    rs_error_clear();
+}
+
+/* Scene files and textures that are not regular files of a sane size are refused by name,
+ * without being read: a FIFO (opening one for reading blocks until a writer comes), /dev/zero
+ * (never ends), a folder, a socket, a sparse file of 300 MiB.  alarm() turns a regression (a
+ * hang) into a failed test instead of a stuck one. */
+static void test_file_kinds(void **state)
+{
+    char dir[] = "/tmp/rs_json_XXXXXX", fifo[256], sub[256], sock[256], big[256], scene[256];
+    char json[1024];
+    static const char *const tex_files[] = {"fifo.png", "/dev/zero", "sub"};
+    static const char *const tex_words[] = {"not a regular file", "not a regular file",
+                                            "is a folder"};
+    struct sockaddr_un addr;
+    int fd, k;
+    (void)state;
+    alarm(60);
+    assert_non_null(mkdtemp(dir));
+    snprintf(fifo, sizeof fifo, "%s/fifo.json", dir);
+    snprintf(sub, sizeof sub, "%s/sub", dir);
+    snprintf(sock, sizeof sock, "%s/sock.json", dir);
+    snprintf(big, sizeof big, "%s/big.json", dir);
+    snprintf(scene, sizeof scene, "%s/scene.json", dir);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    assert_int_equal(mkdir(sub, 0700), 0);
+    fd = socket(AF_UNIX, SOCK_STREAM, 0);
+    assert_true(fd >= 0);
+    memset(&addr, 0, sizeof addr);
+    addr.sun_family = AF_UNIX;
+    assert_true(strlen(sock) < sizeof addr.sun_path);
+    memcpy(addr.sun_path, sock, strlen(sock) + 1);
+    assert_int_equal(bind(fd, (const struct sockaddr *)&addr, sizeof addr), 0);
+    close(fd);
+    fd = open(big, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    assert_true(fd >= 0);
+    assert_int_equal(ftruncate(fd, (off_t)300 << 20), 0); /* sparse: no disk used */
+    close(fd);
+
+    expect_load_error(fifo, fifo, "not a regular file");
+    expect_load_error("/dev/zero", "/dev/zero", "not a regular file");
+    expect_load_error(sub, sub, "is a folder");
+    expect_load_error(sock, sock, "not a regular file");
+    expect_load_error(big, big, "larger than 256 MiB");
+
+    /* the same for an image texture the scene names */
+    snprintf(fifo, sizeof fifo, "%s/fifo.png", dir);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    for (k = 0; k < 3; ++k) {
+        snprintf(json, sizeof json,
+                 "{" CAM ",\"textures\":{\"t\":{\"type\":\"image\",\"file\":\"%s\"}},"
+                 "\"objects\":[]}",
+                 tex_files[k]);
+        write_file(scene, json);
+        expect_load_error(scene, tex_files[k], tex_words[k]);
+    }
+    alarm(0);
+    remove(fifo);
+    snprintf(fifo, sizeof fifo, "%s/fifo.json", dir);
+    remove(fifo);
+    remove(sock);
+    remove(big);
+    remove(scene);
+    rmdir(sub);
     rmdir(dir);
 }
 
@@ -225,6 +367,7 @@ int main(void)
         cmocka_unit_test(test_example_equals_builtin),
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_image_texture_relative),
+        cmocka_unit_test(test_file_kinds),
         cmocka_unit_test(test_mutations_never_crash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -14,7 +14,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "accel/bvh.h"
 #include "scenes/builtin.h"
@@ -141,6 +143,146 @@ static void test_malformed(void **state)
     rs_error_clear();
     assert_int_equal(rs_scene_finalize(s), RS_OK);
     rs_scene_destroy(s);
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Imports `path` with the file's own materials and expects an error whose one-line message
+ * has `a` and `b`. */
+static void expect_mesh_error(const char *path, const char *a, const char *b)
+{
+    rs_scene *s;
+    rs_mesh_opts o = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
+    rs_mesh_info info;
+    rs_status st;
+    assert_int_equal(rs_scene_create("kinds", &s), RS_OK);
+    rs_error_clear();
+    st = rs_scene_add_mesh(s, path, &o, &info);
+    if (st == RS_OK)
+        fail_msg("%s imported without an error", path);
+    assert_true(st == RS_ERR_ARG || st == RS_ERR_IO);
+    print_message("  %s -> %s\n", path, rs_error_message());
+    assert_null(strchr(rs_error_message(), '\n'));
+    if (!strstr(rs_error_message(), a) || (b && !strstr(rs_error_message(), b)))
+        fail_msg("message '%s' lacks '%s' or '%s'", rs_error_message(), a, b ? b : "");
+    rs_error_clear();
+    rs_scene_destroy(s);
+}
+
+#define TRI_OBJ "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl mat\nf 1/1 2/2 3/3\n"
+
+/* Every file an import opens is a regular file of a sane size, or the import fails naming it:
+ * the mesh itself, an OBJ's mtllib and its map_Kd texture, each as a FIFO (its open would
+ * block), /dev/zero (through a symlink: never ends), a folder; a sparse 5 GiB mesh.  A missing
+ * MTL or texture is still only a default material or a warning, as before.  alarm() turns a
+ * regression (a hang) into a failure. */
+static void test_file_kinds(void **state)
+{
+    char dir[] = "/tmp/rs_mesh_XXXXXX", p[256], obj[256], mtl[256];
+    static const struct {
+        const char *mtllib, *words;
+    } libs[] = {{"fifo.mtl", "not a regular file"},
+                {"zero.mtl", "not a regular file"},
+                {"sub", "is a folder"}};
+    static const struct {
+        const char *map, *words;
+    } maps[] = {{"fifo.png", "not a regular file"},
+                {"/dev/zero", "not a regular file"},
+                {"sub", "is a folder"}};
+    rs_scene *s;
+    rs_mesh_opts o = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
+    static const char *const names[] = {"fifo.mtl", "fifo.png", "fifo.obj", "zero.mtl",
+                                        "zero.obj", "big.obj",  "m.obj",    "m.mtl"};
+    rs_mesh_info info;
+    char text[512];
+    int fd;
+    size_t k;
+    (void)state;
+    alarm(120);
+    assert_non_null(mkdtemp(dir));
+#define IN(name) (snprintf(p, sizeof p, "%s/%s", dir, (name)), p)
+    assert_int_equal(mkfifo(IN("fifo.mtl"), 0600), 0);
+    assert_int_equal(mkfifo(IN("fifo.png"), 0600), 0);
+    assert_int_equal(mkfifo(IN("fifo.obj"), 0600), 0);
+    assert_int_equal(symlink("/dev/zero", IN("zero.mtl")), 0);
+    assert_int_equal(symlink("/dev/zero", IN("zero.obj")), 0);
+    assert_int_equal(mkdir(IN("sub"), 0700), 0);
+    fd = open(IN("big.obj"), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    assert_true(fd >= 0);
+    assert_int_equal(ftruncate(fd, (off_t)5 << 30), 0); /* sparse: no disk used */
+    close(fd);
+    snprintf(obj, sizeof obj, "%s/m.obj", dir);
+    snprintf(mtl, sizeof mtl, "%s/m.mtl", dir);
+
+    expect_mesh_error(IN("fifo.obj"), "fifo.obj", "not a regular file");
+    expect_mesh_error(IN("zero.obj"), "zero.obj", "not a regular file");
+    expect_mesh_error(IN("sub"), "sub", "is a folder");
+    expect_mesh_error(IN("big.obj"), "big.obj", "larger than 4 GiB");
+    for (k = 0; k < sizeof libs / sizeof libs[0]; ++k) {
+        snprintf(text, sizeof text, "mtllib %s\n" TRI_OBJ, libs[k].mtllib);
+        write_file(obj, text);
+        expect_mesh_error(obj, libs[k].mtllib, libs[k].words);
+    }
+    for (k = 0; k < sizeof maps / sizeof maps[0]; ++k) {
+        snprintf(text, sizeof text, "newmtl mat\nKd 0.5 0.5 0.5\nmap_Kd %s\n", maps[k].map);
+        write_file(mtl, text);
+        write_file(obj, "mtllib m.mtl\n" TRI_OBJ);
+        expect_mesh_error(obj, maps[k].map, maps[k].words);
+    }
+    /* a missing MTL or texture: imported (default material, or the colour and a warning) */
+    assert_int_equal(rs_scene_create("kinds", &s), RS_OK);
+    remove(mtl); /* Assimp falls back to m.mtl for a missing MTL */
+    write_file(obj, "mtllib none.mtl\n" TRI_OBJ);
+    assert_int_equal(rs_scene_add_mesh(s, obj, &o, &info), RS_OK);
+    write_file(mtl, "newmtl mat\nKd 0.5 0.5 0.5\nmap_Kd none.png\n");
+    write_file(obj, "mtllib m.mtl\n" TRI_OBJ);
+    assert_int_equal(rs_scene_add_mesh(s, obj, &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    rs_scene_destroy(s);
+    rs_error_clear();
+    alarm(0);
+    for (k = 0; k < sizeof names / sizeof names[0]; ++k)
+        remove(IN(names[k]));
+    rmdir(IN("sub"));
+#undef IN
+    rmdir(dir);
+}
+
+/* A PLY whose header is cut before end_header (Assimp's reader spins on it for ever), one
+ * that declares more elements than its bytes could hold, and a .ply that is not PLY: each an
+ * error naming the file, at once. */
+static void test_ply_headers(void **state)
+{
+    static const struct {
+        const char *text, *words;
+    } cases[] = {
+        {"ply\nformat ascii 1.0\n", "PLY header has no end_header"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n", "no end_header"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_hea", "no end_header"},
+        {"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+         "property float z\nend_header\n0 0 0\n",
+         "declares 4000000000 elements"},
+        {"solid cube\nendsolid\n", "not a PLY file"},
+    };
+    char dir[] = "/tmp/rs_ply_XXXXXX", path[256];
+    size_t k;
+    (void)state;
+    alarm(60);
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/cut.ply", dir);
+    for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        write_file(path, cases[k].text);
+        expect_mesh_error(path, path, cases[k].words);
+    }
+    alarm(0);
+    remove(path);
+    rmdir(dir);
 }
 
 static const char *models_dir(void)
@@ -284,6 +426,8 @@ int main(void)
         cmocka_unit_test(test_ply_and_gltf),
         cmocka_unit_test(test_fit),
         cmocka_unit_test(test_malformed),
+        cmocka_unit_test(test_file_kinds),
+        cmocka_unit_test(test_ply_headers),
         cmocka_unit_test(test_shared_models),
         cmocka_unit_test(test_obj_mtl_materials),
         cmocka_unit_test(test_builtin_mesh_scenes),
