@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "app/options.h"
+#include "app/outputs.h"
 #include "app/progress.h"
 #include "core/alloc.h"
 #include "core/image_io.h"
@@ -30,23 +31,53 @@
 #  define RS_VERSION "0.0.0"
 #endif
 
+/* The stop signals (SIGINT, SIGTERM, SIGHUP).  The first one asks for a clean stop: g_cancel,
+ * which the render loop polls, and g_signal, its number, for the exit status (128 + it).  A
+ * second one stops at once: the files being written (app/outputs.h, tracked before the first is
+ * created) are removed and the program dies of that signal, as it would without a handler.
+ * The handler may run on any thread; it touches only lock-free atomics and calls only
+ * async-signal-safe functions (unlink, signal, raise). */
 static atomic_int g_cancel;
+static atomic_int g_signal;
 
-static void on_sigint(int sig)
+static void on_stop_signal(int sig)
 {
-    (void)sig;
-    atomic_store(&g_cancel, 1);
+    int none = 0;
+    if (atomic_compare_exchange_strong(&g_signal, &none, sig)) {
+        atomic_store(&g_cancel, 1);
+        return;
+    }
+    rs_outputs_remove_tracked();
+    signal(sig, SIG_DFL);
+    raise(sig); /* pending until the handler returns (the signal is blocked in it), then fatal */
 }
 
-static void install_sigint(void)
+static const int k_stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
+
+/* A signal the caller ignores (nohup, a background job of a script) stays ignored. */
+static void install_stop_signals(void)
 {
-    struct sigaction sa;
+    struct sigaction sa, old;
+    size_t i;
     memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_sigint;
+    sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);
-    /* the first Ctrl-C asks for a clean stop; a second one kills as usual */
-    sa.sa_flags = SA_RESETHAND;
-    sigaction(SIGINT, &sa, NULL);
+    for (i = 0; i < sizeof k_stop_signals / sizeof k_stop_signals[0]; ++i)
+        sigaddset(&sa.sa_mask, k_stop_signals[i]); /* one handler at a time */
+    sa.sa_flags = SA_RESTART;
+    for (i = 0; i < sizeof k_stop_signals / sizeof k_stop_signals[0]; ++i)
+        if (sigaction(k_stop_signals[i], NULL, &old) == 0 && old.sa_handler != SIG_IGN)
+            sigaction(k_stop_signals[i], &sa, NULL);
+}
+
+static const char *signal_name(int sig)
+{
+    switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+    }
 }
 
 static int fail(int code, const char *what)
@@ -103,20 +134,17 @@ static void human(double v, char *buf, size_t n)
  * device).  A gpu that cannot be used becomes the CPU fallback device (one warning line).  The
  * cores are shared out without oversubscription: each fallback takes one thread when a cpu
  * device is beside it (every core when it is alone), and a cpu device without an explicit
- * thread count gets the rest.  RS_FAULT (scheduler/fault.h) wraps devices that should fail.
+ * thread count gets the rest.  `fault` (RS_FAULT, scheduler/fault.h) wraps devices that should
+ * fail.
  * Returns the count, or -1 after printing an error. */
-static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores, rs_device **devs)
+static int create_devices(const rs_cli_options *o, const rs_fault_spec *fault, int threads,
+                          rs_cores *cores, rs_device **devs)
 {
     rs_device_spec specs[RS_MAX_DEVICES];
     int usable[RS_MAX_DEVICES];
     int i, n = 0, n_specs = 0, n_gpus, has_cpu = 0, fallback_threads = 0;
     const char *why = "";
-    rs_fault_spec fault;
 
-    if (rs_fault_parse(getenv("RS_FAULT"), &fault) != RS_OK) {
-        fail(RS_EXIT_USAGE, NULL);
-        return -1;
-    }
     n_gpus = rs_gpu_count(&why);
     if (o->devices_auto) {
         memset(&specs[0], 0, sizeof specs[0]);
@@ -163,7 +191,7 @@ static int create_devices(const rs_cli_options *o, int threads, rs_cores *cores,
             }
         }
         if (st == RS_OK) {
-            int after = d->is_gpu ? fault.gpu_after : fault.cpu_after;
+            int after = d->is_gpu ? fault->gpu_after : fault->cpu_after;
             if (after >= 0)
                 st = rs_fault_wrap(&devs[n], after);
             if (st != RS_OK)
@@ -240,6 +268,11 @@ typedef struct render_run {
     char name[64]; /* the scene's stem: default output name */
     char out_default[96];
     const char *out;
+    rs_fault_spec fault;            /* RS_FAULT */
+    rs_output outs[RS_OUTPUTS_MAX]; /* the image, then --stats-json and --timeline if asked */
+    int n_outs;
+    rs_output *stats_out, *timeline_out; /* into outs, or NULL */
+    int interrupted;                     /* the signal that stopped the render, or 0 */
 } render_run;
 
 static void run_release(render_run *r)
@@ -271,6 +304,11 @@ static int load_scene(const rs_cli_options *o, render_run *r)
     if (strncmp(o->scene, "builtin:", 8) == 0) {
         rs_builtin_opts bo;
         rs_status bst;
+        struct stat sb;
+        if (o->mesh && stat(o->mesh, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+            fprintf(stderr, "raystream: --mesh %s: is a folder, not a mesh file\n", o->mesh);
+            return RS_EXIT_USAGE;
+        }
         bo.models_dir = o->models;
         bo.mesh_file = o->mesh;
         bst = rs_builtin_create_ex(o->scene + 8, &bo, &r->scene);
@@ -289,6 +327,10 @@ static int load_scene(const rs_cli_options *o, render_run *r)
                     "raystream: %s: no such scene file (built-in scenes are named "
                     "builtin:NAME; see 'raystream scenes')\n",
                     o->scene);
+            return RS_EXIT_USAGE;
+        }
+        if (S_ISDIR(sb.st_mode)) {
+            fprintf(stderr, "raystream: %s: is a folder, not a scene file\n", o->scene);
             return RS_EXIT_USAGE;
         }
     }
@@ -393,37 +435,41 @@ static void make_settings(const rs_cli_options *o, render_run *r)
     st->strategy = o->strategy;
 }
 
-/* 1 if the folder of `path` exists and is writable; else prints why (naming `option`). */
-static int folder_writable(const char *option, const char *path)
-{
-    char dir[4096];
-    const char *slash = strrchr(path, '/');
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1,
-             slash ? (slash == path ? "/" : path) : ".");
-    if (access(dir, W_OK) == 0)
-        return 1;
-    fprintf(stderr, "raystream: %s %s: the folder %s does not exist or is not writable\n", option,
-            path, dir);
-    return 0;
-}
-
-/* Every output is checked before any work.  Returns an exit code. */
+/* Every output is checked before any work (app/outputs.h): a folder, a file that cannot be
+ * written, a missing or read-only folder, two outputs on one file, an output over an input; then
+ * the image's format.  Returns an exit code: RS_EXIT_USAGE, nothing written, for all of them. */
 static int check_outputs(const rs_cli_options *o, render_run *r)
 {
-    rs_status rst;
+    const char *inputs[2];
+    rs_output *out = r->outs;
+    int n = 0, rc;
     if (o->output) {
         r->out = o->output;
     } else {
         snprintf(r->out_default, sizeof r->out_default, "%s.png", r->name);
         r->out = r->out_default;
     }
-    rst = rs_image_check_output(r->out);
-    if (rst != RS_OK)
-        return fail(rst == RS_ERR_ARG ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
-    if (o->stats_json && !folder_writable("--stats-json", o->stats_json))
-        return RS_EXIT_USAGE;
-    if (o->timeline && !folder_writable("--timeline", o->timeline))
-        return RS_EXIT_USAGE;
+    memset(r->outs, 0, sizeof r->outs);
+    out[n].option = o->output ? "-o" : "the image";
+    out[n++].path = r->out;
+    if (o->stats_json) {
+        out[n].option = "--stats-json";
+        out[n].path = o->stats_json;
+        out[n].may_be_special = 1; /* /dev/stdout */
+        r->stats_out = &out[n++];
+    }
+    if (o->timeline) {
+        out[n].option = "--timeline";
+        out[n].path = o->timeline;
+        r->timeline_out = &out[n++];
+    }
+    r->n_outs = n;
+    inputs[0] = strncmp(o->scene, "builtin:", 8) == 0 ? NULL : o->scene;
+    inputs[1] = o->mesh;
+    if ((rc = rs_outputs_check(out, n, inputs, 2)) != RS_EXIT_OK)
+        return rc;
+    if (rs_image_check_output(r->out) != RS_OK)
+        return fail(RS_EXIT_USAGE, NULL);
     return RS_EXIT_OK;
 }
 
@@ -466,7 +512,7 @@ static int start_devices(const rs_cli_options *o, render_run *r)
             return RS_EXIT_RUNTIME;
         n = 1;
     } else {
-        n = create_devices(o, r->threads, &r->cores, r->devs);
+        n = create_devices(o, &r->fault, r->threads, &r->cores, r->devs);
         if (n < 0)
             return RS_EXIT_RUNTIME;
         r->n_devs = n;
@@ -500,13 +546,15 @@ static int start_devices(const rs_cli_options *o, render_run *r)
     return RS_EXIT_OK;
 }
 
-/* The render itself, with the progress bar and Ctrl-C.  Returns an exit code. */
+/* The render itself, with the progress bar and the stop signals (which stay caught until the
+ * program ends: a second one while the outputs are written removes their temporary files).
+ * Returns an exit code: 128 + the signal for an interrupted render. */
 static int run_render(const rs_cli_options *o, render_run *r)
 {
     rs_render_hooks hooks;
     rs_progress progress;
     rs_status rst;
-    install_sigint();
+    install_stop_signals();
     rs_progress_begin(&progress, !o->quiet);
     hooks.progress = rs_progress_update;
     hooks.user = &progress;
@@ -516,10 +564,10 @@ static int run_render(const rs_cli_options *o, render_run *r)
     else
         rst = rs_render(r->scene, r->sched, &r->st, &hooks, r->film, &r->stats);
     rs_progress_end(&progress);
-    signal(SIGINT, SIG_DFL);
     if (rst == RS_ERR_CANCELLED) {
         rs_error_clear();
-        return RS_EXIT_INTERRUPTED;
+        r->interrupted = atomic_load(&g_signal) ? atomic_load(&g_signal) : SIGINT;
+        return RS_EXIT_SIGNALLED(r->interrupted);
     }
     if (rst != RS_OK)
         return fail(RS_EXIT_RUNTIME, "render failed");
@@ -592,14 +640,16 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
-/* Returns 0 after printing why the file could not be written. */
-static int write_stats_json(const char *path, const render_run *r, const device_rows *t)
+/* Writes the --stats-json text to `path` (named `shown` in messages).  Returns 0 after printing
+ * why the file could not be written. */
+static int write_stats_json(const char *path, const char *shown, const render_run *r,
+                            const device_rows *t)
 {
     double wall = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
     FILE *f = fopen(path, "w");
-    int i;
+    int i, ok;
     if (!f) {
-        fprintf(stderr, "raystream: %s: cannot write the stats\n", path);
+        fprintf(stderr, "raystream: %s: cannot write the stats (%s)\n", shown, strerror(errno));
         return 0;
     }
     fprintf(f, "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"stages\": {", wall,
@@ -625,15 +675,18 @@ static int write_stats_json(const char *path, const render_run *r, const device_
                 i + 1 < t->n ? "," : "");
     }
     fprintf(f, "  ]\n}\n");
-    if (fclose(f) != 0) {
-        fprintf(stderr, "raystream: %s: cannot write the stats\n", path);
+    ok = !ferror(f);
+    if (fclose(f) != 0 || !ok) {
+        fprintf(stderr, "raystream: %s: cannot write the stats (%s)\n", shown, strerror(errno));
         return 0;
     }
     return 1;
 }
 
-/* The --timeline picture: a lane per device, then the render thread's.  0 after printing why. */
-static int write_timeline(const rs_cli_options *o, const render_run *r, const device_rows *t)
+/* The --timeline picture, a lane per device, then the render thread's, into `path`.  0 after
+ * printing why. */
+static int write_timeline(const char *path, const rs_cli_options *o, const render_run *r,
+                          const device_rows *t)
 {
     char lanes[RS_MAX_DEVICES + 1][96], title[160];
     const char *names[RS_MAX_DEVICES + 1];
@@ -650,7 +703,7 @@ static int write_timeline(const rs_cli_options *o, const render_run *r, const de
     names[t->n] = lanes[t->n];
     snprintf(title, sizeof title, "raystream render %s, %ux%u, %u spp, %s integrator", o->scene,
              r->st.width, r->st.height, r->st.spp, o->megakernel ? "megakernel" : "stream");
-    if (rs_timeline_write_svg(o->timeline, r->timeline, names, t->n + 1, title) != RS_OK) {
+    if (rs_timeline_write_svg(path, r->timeline, names, t->n + 1, title) != RS_OK) {
         fail(RS_EXIT_RUNTIME, NULL);
         return 0;
     }
@@ -658,7 +711,7 @@ static int write_timeline(const rs_cli_options *o, const render_run *r, const de
 }
 
 /* The summary line on stderr (or, with --quiet, only a word on an interruption). */
-static void print_summary(const rs_cli_options *o, const render_run *r, int code)
+static void print_summary(const rs_cli_options *o, const render_run *r)
 {
     char sps[32], rps[32], rays[32], bvh_name[64];
     double secs = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
@@ -666,10 +719,11 @@ static void print_summary(const rs_cli_options *o, const render_run *r, int code
     const rs_render_settings *st = &r->st;
     int i;
     if (o->quiet) {
-        if (code == RS_EXIT_INTERRUPTED)
+        if (r->interrupted)
             fprintf(stderr,
-                    "raystream: interrupted; wrote a partial image (%llu of %llu samples) to %s\n",
-                    (unsigned long long)r->stats.paths_done,
+                    "raystream: interrupted by %s; wrote a partial image (%llu of %llu samples) "
+                    "to %s\n",
+                    signal_name(r->interrupted), (unsigned long long)r->stats.paths_done,
                     (unsigned long long)r->stats.paths_total, r->out);
         return;
     }
@@ -680,11 +734,10 @@ static void print_summary(const rs_cli_options *o, const render_run *r, int code
             "%s %s at %ux%u, %u spp (%s sampling, %s sampler, max depth %u, seed %llu) in %.2f s: "
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
             "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
-            code == RS_EXIT_INTERRUPTED ? "Partial render (interrupted):" : "Rendered", o->scene,
-            st->width, st->height, st->spp, rs_sampling_name(st->sampling),
-            rs_sampler_name(st->sampler), st->max_depth, (unsigned long long)st->seed,
-            r->stats.seconds, sps, rps, rays, (unsigned long long)r->stats.rays_closest,
-            (unsigned long long)r->stats.rays_shadow,
+            r->interrupted ? "Partial render (interrupted):" : "Rendered", o->scene, st->width,
+            st->height, st->spp, rs_sampling_name(st->sampling), rs_sampler_name(st->sampler),
+            st->max_depth, (unsigned long long)st->seed, r->stats.seconds, sps, rps, rays,
+            (unsigned long long)r->stats.rays_closest, (unsigned long long)r->stats.rays_shadow,
             rs_bvh_builder_name(&r->bvh->builder, bvh_name, sizeof bvh_name),
             rs_bvh_sah_cost(r->bvh), r->bvh->n_nodes, r->bvh->n_prims, r->bvh_ms);
     for (i = 0; i < r->n_devs; ++i) {
@@ -709,7 +762,7 @@ static void print_summary(const rs_cli_options *o, const render_run *r, int code
     if (r->film->nonfinite)
         fprintf(stderr, "%llu non-finite samples were dropped. ",
                 (unsigned long long)r->film->nonfinite);
-    if (code == RS_EXIT_INTERRUPTED)
+    if (r->interrupted)
         fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", r->out,
                 (unsigned long long)r->stats.paths_done, (unsigned long long)r->stats.paths_total,
                 rs_film_min_count(r->film));
@@ -717,21 +770,49 @@ static void print_summary(const rs_cli_options *o, const render_run *r, int code
         fprintf(stderr, "Wrote %s.\n", r->out);
 }
 
-/* The image, then the reports that were asked for.  Returns the exit code. */
+/* The outputs, all or none: the stats JSON and the timeline to their staged names, then the
+ * image (rs_image_write: its own temporary file, renamed into place), then the staged files
+ * renamed.  A failure before the image is in place replaces nothing; a --stats-json that is a
+ * special file (/dev/stdout) is written last, in place.  Every name is tracked first, so a second
+ * signal removes whichever exist.  Returns the exit code: `code`, or RS_EXIT_RUNTIME. */
 static int write_outputs(const rs_cli_options *o, render_run *r, int code)
 {
     device_rows rows;
+    char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
+    int i, ok = 1, replaced = 0;
     rs_film_resolve(r->film, r->rgb);
-    if (rs_image_write(r->out, r->st.width, r->st.height, r->rgb) != RS_OK)
-        return fail(RS_EXIT_RUNTIME, NULL);
     collect_rows(r, &rows);
     if (o->stats)
         print_stats_table(r, &rows);
-    if (o->stats_json && !write_stats_json(o->stats_json, r, &rows))
-        code = RS_EXIT_RUNTIME;
-    if (o->timeline && !write_timeline(o, r, &rows))
-        code = RS_EXIT_RUNTIME;
-    print_summary(o, r, code);
+    for (i = 0; i < r->n_outs; ++i)
+        if (!r->outs[i].in_place)
+            rs_outputs_track(r->outs[i].staged); /* outs[0]'s is the core's image temporary */
+    if (r->timeline_out) {                       /* rs_timeline_write_svg's own temporary name */
+        snprintf(timeline_inner, sizeof timeline_inner, "%s.tmp", r->timeline_out->staged);
+        rs_outputs_track(timeline_inner);
+    }
+    if (r->stats_out && !r->stats_out->in_place)
+        ok = write_stats_json(r->stats_out->staged, r->stats_out->path, r, &rows);
+    if (ok && r->timeline_out)
+        ok = write_timeline(r->timeline_out->staged, o, r, &rows);
+    if (ok && rs_image_write(r->out, r->st.width, r->st.height, r->rgb) != RS_OK) {
+        fail(0, NULL);
+        ok = 0;
+    }
+    replaced = ok;
+    for (i = 1; ok && i < r->n_outs; ++i)
+        if (!r->outs[i].in_place)
+            ok = rs_output_commit(&r->outs[i]);
+    if (ok && r->stats_out && r->stats_out->in_place)
+        ok = write_stats_json(r->stats_out->path, r->stats_out->path, r, &rows);
+    rs_outputs_remove_tracked(); /* what was not renamed */
+    rs_outputs_untrack();
+    if (!ok) {
+        fprintf(stderr, "raystream: the run failed; %s\n",
+                replaced ? "some outputs were already replaced" : "no output was replaced");
+        return RS_EXIT_RUNTIME;
+    }
+    print_summary(o, r);
     return code;
 }
 
@@ -741,13 +822,16 @@ static int cmd_render(const rs_cli_options *o)
     render_run r;
     int code;
     memset(&r, 0, sizeof r);
+    /* RS_FAULT is input like the options: a bad value is a usage error, before any work */
+    if (rs_fault_parse(getenv("RS_FAULT"), &r.fault) != RS_OK)
+        return fail(RS_EXIT_USAGE, NULL);
     if ((code = load_scene_bounded(o, &r)) == RS_EXIT_OK) {
         make_settings(o, &r);
         if ((code = check_outputs(o, &r)) == RS_EXIT_OK &&
             (code = build_bvh(o, &r)) == RS_EXIT_OK &&
             (code = start_devices(o, &r)) == RS_EXIT_OK) {
             code = run_render(o, &r);
-            if (code == RS_EXIT_OK || code == RS_EXIT_INTERRUPTED)
+            if (code == RS_EXIT_OK || r.interrupted)
                 code = write_outputs(o, &r, code);
         }
     }
@@ -758,7 +842,11 @@ static int cmd_render(const rs_cli_options *o)
 int main(int argc, char **argv)
 {
     rs_cli_options o;
-    int rc = rs_cli_parse(argc, argv, &o);
+    int rc;
+    /* A reader that goes away (`raystream render ... 2>&1 | head -1`) must not kill the render:
+     * writes to stdout or stderr then fail with EPIPE, which nothing here treats as fatal. */
+    signal(SIGPIPE, SIG_IGN);
+    rc = rs_cli_parse(argc, argv, &o);
     if (rc != RS_EXIT_OK)
         return rc;
     switch (o.command) {

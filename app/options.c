@@ -166,8 +166,21 @@ void rs_cli_print_help(const char *command)
             "  -q, --quiet         no progress bar and no summary\n"
             "  -h, --help          this text\n"
             "\n"
-            "Ctrl-C writes the samples finished so far and exits with status 130.\n"
-            "Exit status: 0 done, 1 runtime error, 2 usage error, 130 interrupted.\n");
+            "Every output (-o, --stats-json, --timeline) is checked before the render: a\n"
+            "folder, a file that cannot be written or a missing or read-only folder is a\n"
+            "usage error.  Outputs are written to FILE.tmp-PID and renamed into place only\n"
+            "when all of them are written: a run that fails replaces no file.\n"
+            "\n"
+            "Ctrl-C (SIGINT), SIGTERM or SIGHUP writes the samples finished so far and exits\n"
+            "with 128 + the signal: 130, 143, 129.  A second signal stops at once, also\n"
+            "while the outputs are written: their temporary files are removed.\n"
+            "\n"
+            "Environment: RS_FAULT=cpu:after=N,gpu:after=N makes those devices fail after N\n"
+            "chunks (to test recovery; a bad value is a usage error); RS_MODELS_DIR is the\n"
+            "default --models.\n"
+            "\n"
+            "Exit status: 0 done, 1 runtime error, 2 usage error (nothing written),\n"
+            "130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP.\n");
         return;
     }
     printf("usage: raystream COMMAND [options]\n"

@@ -10,7 +10,10 @@
 #define RS_EXIT_OK          0
 #define RS_EXIT_RUNTIME     1
 #define RS_EXIT_USAGE       2
-#define RS_EXIT_INTERRUPTED 130
+#define RS_EXIT_INTERRUPTED 130 /* SIGINT (Ctrl-C): RS_EXIT_SIGNALLED(SIGINT) */
+/* A render stopped by a signal (SIGINT, SIGTERM, SIGHUP) exits with 128 + its number, as a shell
+ * reports a command the signal killed: 130, 143, 129. */
+#define RS_EXIT_SIGNALLED(sig) (128 + (sig))
 
 #define RS_MAX_DEVICES 16
 

@@ -7,14 +7,20 @@
  *     unknown built-in scene, sampling mode or device, an unsupported extension, a missing scene
  *     file) exit with 2, print exactly one line on stderr naming the problem, nothing on stdout,
  *     and write nothing;
- *   - an output that cannot be written (missing folder; read-only folder when not root) exits
- *     with 1 before any rendering, with one line naming the path, and writes nothing;
+ *   - an output that cannot be written (missing folder; read-only folder when not root; a
+ *     folder, a read-only file or a missing folder for -o, --stats-json or --timeline; two
+ *     outputs on one file) exits with 2 before any rendering, with one line naming the path, and
+ *     writes nothing; a scene file that is a folder and a bad RS_FAULT are usage errors too;
  *   - --help, render --help, --version and scenes exit 0 and print to stdout;
  *   - a small render writes a PNG of the requested size that is not black and prints a summary
  *     with samples/s and rays/s; .exr and .hdr work and hold finite, non-negative linear values;
  *     without -o the image goes to cornell.png in the working folder; no temporary file is left;
- *   - a failing run leaves an existing output byte for byte as it was;
- *   - SIGINT during a long render exits with 130 and writes the partial image at full size;
+ *   - a failing run leaves an existing output byte for byte as it was, also when it fails
+ *     writing --stats-json after the render (the image is not replaced either);
+ *   - SIGINT, SIGTERM and SIGHUP during a long render exit with 128 + the signal and write the
+ *     partial image at full size; a second SIGINT while the image is being written kills the
+ *     program and leaves no temporary file and every old output as it was;
+ *   - a reader of stderr that goes away (`2>&1 | head -1`) does not stop the render;
  *   - --threads, --chunk-size and --wave-size change nothing in the pixels (bit-identical .exr).
  *
  * Every test gets its own folder from mkdtemp under /tmp, removed afterwards, so nothing is
@@ -152,6 +158,8 @@ static void proc_start(proc *p, const char *cwd, const char *const *args)
         sigemptyset(&none);
         sigprocmask(SIG_SETMASK, &none, NULL);
         signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        signal(SIGHUP, SIG_DFL);
         signal(SIGPIPE, SIG_DFL);
         if (devnull < 0 || dup2(devnull, STDIN_FILENO) < 0 ||
             dup2(out_pipe[1], STDOUT_FILENO) < 0 || dup2(err_pipe[1], STDERR_FILENO) < 0 ||
@@ -530,6 +538,12 @@ static void test_usage_errors(void **state)
         {{"render", "--width", "8", "--spp", "1", "-o", "out.xyz", NULL}, {"out.xyz"}},
         {{"render", "no-such-scene.rss", "-o", "out.png", "--spp", "1", NULL},
          {"no-such-scene.rss"}},
+        {{"render", RS_SOURCE_DIR "/scenes", "-o", "out.png", "--spp", "1", NULL},
+         {"/scenes", "is a folder"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--stats-json", "/nonexistent-dir/s.json", NULL},
+         {"--stats-json", "/nonexistent-dir"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--stats-json", "out.png", NULL},
+         {"--stats-json", "out.png", "same file"}},
         {{"render", "-o", "out.png", "--spp", "1", "--timeline", "t.png", NULL},
          {"--timeline", "t.png", ".svg"}},
         {{"render", "-o", "out.png", "--spp", "1", "--timeline", "/nonexistent-dir/t.svg", NULL},
@@ -567,7 +581,7 @@ static void test_usage_errors(void **state)
 /* ---- 2. an output that cannot be written ----------------------------------------------------- */
 
 /* Runs a render that would take an hour into `out`, which cannot be written, and checks that it
- * stops at once with status 1 and one line naming `out`, leaving `n_files` entries in the
+ * stops at once with status 2 and one line naming `out`, leaving `n_files` entries in the
  * working folder. */
 static void expect_unwritable(const fixture *f, const char *out, int n_files)
 {
@@ -579,7 +593,7 @@ static void expect_unwritable(const fixture *f, const char *out, int n_files)
     EXPECT(&p, !p.timed_out && p.seconds < EARLY_FAIL_LIMIT_S,
            "an unwritable output must be reported before rendering (within %.0f s)",
            EARLY_FAIL_LIMIT_S);
-    EXPECT(&p, exited_with(&p, 1), "an unwritable output is a runtime error: status 1");
+    EXPECT(&p, exited_with(&p, 2), "an unwritable output is a usage error: status 2");
     EXPECT(&p, one_line(&p.err), "expected exactly one line on stderr");
     EXPECT(&p, strstr(p.err.data, out) != NULL, "the error line should name '%s'", out);
     EXPECT(&p, list_dir(f->dir, names, sizeof names) == n_files,
@@ -788,31 +802,39 @@ static void test_failed_run_keeps_output(void **state)
 
 /* ---- 6. Ctrl-C ------------------------------------------------------------------------------- */
 
-/* One long render (args) interrupted after ~1.5 s must exit within limit_s. */
-static void sigint_case(const fixture *f, const char *const *args, double limit_s)
+/* Lets run `p` (just started) set up and install its handlers for ~1.5 s (setup takes
+ * milliseconds; a progress line cannot be awaited, as the first one comes after 10% of the
+ * work); fails if it ended meanwhile. */
+static void let_it_render(proc *p)
+{
+    int i;
+    for (i = 0; i < 15; ++i) {
+        proc_pump(p, 100);
+        if (waitpid(p->pid, &p->status, WNOHANG) == p->pid) {
+            p->reaped = 1;
+            p->seconds = now_s() - p->start;
+            EXPECT(p, 0, "the long render ended before the signal was sent");
+        }
+    }
+}
+
+/* One long render (args, into partial.png) stopped by `sig` after ~1.5 s must exit within
+ * limit_s with 128 + sig and leave the partial image, full size, and nothing else. */
+static void signal_case(const fixture *f, const char *const *args, int sig, double limit_s)
 {
     char names[512];
     double sent;
     proc p;
     image im;
-    int i;
 
     proc_start(&p, f->dir, args);
-    /* Give it time to set up and install its handler (setup takes milliseconds); a progress line
-     * cannot be awaited, as the first one comes after 10% of the work. */
-    for (i = 0; i < 15; ++i) {
-        proc_pump(&p, 100);
-        if (waitpid(p.pid, &p.status, WNOHANG) == p.pid) {
-            p.reaped = 1;
-            p.seconds = now_s() - p.start;
-            EXPECT(&p, 0, "the long render ended before SIGINT was sent");
-        }
-    }
+    let_it_render(&p);
     sent = now_s();
-    assert_int_equal(kill(p.pid, SIGINT), 0);
+    assert_int_equal(kill(p.pid, sig), 0);
     proc_finish(&p, (sent - p.start) + limit_s);
-    EXPECT(&p, !p.timed_out, "SIGINT should end the render within %.0f s", limit_s);
-    EXPECT(&p, exited_with(&p, 130), "SIGINT should end the render with status 130");
+    EXPECT(&p, !p.timed_out, "signal %d should end the render within %.0f s", sig, limit_s);
+    EXPECT(&p, exited_with(&p, 128 + sig), "signal %d should end the render with status %d", sig,
+           128 + sig);
     EXPECT(&p, contains_ci(p.err.data, "partial") || contains_ci(p.err.data, "interrupted"),
            "stderr should say the image is partial");
     EXPECT(&p, list_dir(f->dir, names, sizeof names) == 1 && strcmp(names, "partial.png") == 0,
@@ -823,6 +845,11 @@ static void sigint_case(const fixture *f, const char *const *args, double limit_
     proc_free(&p);
     snprintf(names, sizeof names, "%s/partial.png", f->dir); /* the next case starts clean */
     unlink(names);
+}
+
+static void sigint_case(const fixture *f, const char *const *args, double limit_s)
+{
+    signal_case(f, args, SIGINT, limit_s);
 }
 
 static void test_sigint_writes_partial_image(void **state)
@@ -851,6 +878,285 @@ static void test_sigint_megakernel(void **state)
     sigint_case(f, cpu, 5.0);
     if (rs_gpu_count(&why) == 0) /* with a GPU its passes are milliseconds: nothing to see */
         sigint_case(f, gpu, 5.0);
+}
+
+/* SIGTERM (a supervisor, `kill`) and SIGHUP (the terminal went away) stop like Ctrl-C: the
+ * samples so far are written, and the status is 128 + the signal. */
+static void test_sigterm_sighup_write_partial_image(void **state)
+{
+    static const char *const args[] = {"render", "--width", "256", "--height",    "256",
+                                       "--spp",  "100000",  "-o",  "partial.png", NULL};
+    const fixture *f = (const fixture *)*state;
+    signal_case(f, args, SIGTERM, SIGINT_EXIT_LIMIT_S);
+    signal_case(f, args, SIGHUP, SIGINT_EXIT_LIMIT_S);
+}
+
+/* Writes `text` to the file `name` in the test folder. */
+static void put_file(const fixture *f, const char *name, const char *text)
+{
+    char path[256];
+    FILE *fp;
+    path_in(f, name, path, sizeof path);
+    fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs(text, fp);
+    assert_int_equal(fclose(fp), 0);
+}
+
+/* 1 if the file `name` in the test folder holds exactly `len` bytes `want`. */
+static int file_is(const fixture *f, const char *name, const char *want, size_t len)
+{
+    char path[256];
+    size_t n = 0;
+    char *got;
+    int same;
+    path_in(f, name, path, sizeof path);
+    got = read_bytes(path, &n);
+    same = got && n == len && memcmp(got, want, len) == 0;
+    free(got);
+    return same;
+}
+
+/* A second SIGINT while the image is being written: the program dies of it at once, the
+ * temporary file the image was going into (OUT.tmp-PID, core/image_io's name) is removed, and
+ * the old image, stats and timeline are as they were.  The image is 2048x2048 EXR, so writing it
+ * takes a good fraction of a second; the test watches for the temporary file and then signals.
+ * Should the write end before the signal lands (the program then exits 130), it tries again. */
+#define OLD_JSON "{\"old\": true}\n"
+#define OLD_SVG  "<svg>old</svg>\n"
+static void test_second_signal_removes_temp_file(void **state)
+{
+    static const char *const good_args[] = {"render", "--width", "16",          "--spp", "1",
+                                            "-q",     "-o",      "partial.exr", NULL};
+    static const char *const args[] = {"render",  "--width",     "2048",   "--height",
+                                       "2048",    "--spp",       "100000", "--stats-json",
+                                       "st.json", "--timeline",  "t.svg",  "-q",
+                                       "-o",      "partial.exr", NULL};
+    const fixture *f = (const fixture *)*state;
+    char path[256], tmp[300], names[512];
+    char *good;
+    size_t n_good = 0;
+    int attempt, caught = 0;
+    proc p;
+
+    render_ok(&p, f, good_args, "partial.exr");
+    proc_free(&p);
+    path_in(f, "partial.exr", path, sizeof path);
+    good = read_bytes(path, &n_good);
+    assert_non_null(good);
+    put_file(f, "st.json", OLD_JSON);
+    put_file(f, "t.svg", OLD_SVG);
+    for (attempt = 0; attempt < 3 && !caught; ++attempt) {
+        double deadline;
+        int seen = 0;
+        proc_start(&p, f->dir, args);
+        snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)p.pid);
+        let_it_render(&p);
+        assert_int_equal(kill(p.pid, SIGINT), 0);
+        deadline = now_s() + SIGINT_EXIT_LIMIT_S;
+        while (!seen && now_s() < deadline) {
+            if (file_exists(tmp)) {
+                seen = 1;
+                kill(p.pid, SIGINT);
+            } else if (waitpid(p.pid, &p.status, WNOHANG) == p.pid) {
+                p.reaped = 1;
+                break;
+            } else {
+                sleep_s(0.0005);
+            }
+        }
+        proc_finish(&p, (now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
+        EXPECT(&p, seen || !exited_with(&p, 130),
+               "the image was written without %s ever existing: is core/image_io's temporary "
+               "name still OUT.tmp-PID?",
+               tmp);
+        EXPECT(&p, seen, "the render did not stop and write within %.0f s", SIGINT_EXIT_LIMIT_S);
+        caught = WIFSIGNALED(p.status) && WTERMSIG(p.status) == SIGINT;
+        EXPECT(&p, caught || exited_with(&p, 130),
+               "a second SIGINT while writing should kill the program (or come too late)");
+        EXPECT(&p, list_dir(f->dir, names, sizeof names) == 3,
+               "the folder should hold partial.exr, st.json and t.svg only, it holds: %s", names);
+        EXPECT(&p, caught || file_exists(path), "partial.exr is gone");
+        if (caught) {
+            EXPECT(&p, file_is(f, "partial.exr", good, n_good),
+                   "the old partial.exr was replaced by a killed run");
+            EXPECT(&p, file_is(f, "st.json", OLD_JSON, strlen(OLD_JSON)),
+                   "the old st.json was replaced by a killed run");
+            EXPECT(&p, file_is(f, "t.svg", OLD_SVG, strlen(OLD_SVG)),
+                   "the old t.svg was replaced by a killed run");
+        } else { /* the write won the race: put the old files back and try again */
+            FILE *fp = fopen(path, "wb");
+            assert_non_null(fp);
+            assert_int_equal(fwrite(good, 1, n_good, fp), n_good);
+            assert_int_equal(fclose(fp), 0);
+            put_file(f, "st.json", OLD_JSON);
+            put_file(f, "t.svg", OLD_SVG);
+        }
+        proc_free(&p);
+    }
+    free(good);
+    if (!caught)
+        fail_msg("three times the image was written before the second SIGINT landed");
+}
+
+/* `raystream render ... 2>&1 | head -1`: the reader takes one line and goes away.  The render
+ * must go on (SIGPIPE ignored, EPIPE on stderr harmless) and write its image. */
+static void test_reader_gone_keeps_rendering(void **state)
+{
+    static const char *const args[] = {"render", "--width", "160",      "--spp",
+                                       "64",     "-o",      "pipe.png", NULL};
+    const fixture *f = (const fixture *)*state;
+    proc p;
+    image im;
+    double deadline;
+    proc_start(&p, f->dir, args);
+    deadline = now_s() + DEFAULT_TIMEOUT_S;
+    while (!strchr(p.err.data, '\n') && p.err_fd >= 0 && now_s() < deadline)
+        proc_pump(&p, 20);
+    EXPECT(&p, strchr(p.err.data, '\n') != NULL, "expected a progress line on stderr");
+    if (p.out_fd >= 0)
+        close(p.out_fd);
+    if (p.err_fd >= 0)
+        close(p.err_fd);
+    p.out_fd = p.err_fd = -1;
+    proc_finish(&p, DEFAULT_TIMEOUT_S);
+    EXPECT(&p, exited_with(&p, 0), "the render should go on after its reader went away");
+    im = read_image(&p, f, "pipe.png");
+    EXPECT(&p, im.w == 160 && im.h == 160 && image_mean(&im) > 0.01,
+           "pipe.png is %ux%u with mean %g", im.w, im.h, image_mean(&im));
+    rs_free(im.rgb);
+    proc_free(&p);
+}
+
+/* Every output is checked before the render: a folder, a missing folder, a read-only file or
+ * folder, for -o, --stats-json and --timeline, is refused at once (status 2, one line naming it),
+ * and the good image already at -o stays byte for byte. */
+static void test_outputs_checked_first(void **state)
+{
+    static const char *const good_args[] = {"render", "--width", "16",       "--spp", "1",
+                                            "-q",     "-o",      "good.png", NULL};
+    typedef struct out_case {
+        const char *opt, *path, *word;
+        int needs_non_root;
+    } out_case;
+    static const out_case cases[] = {
+        {"-o", "dir.png", "folder", 0},
+        {"--stats-json", "dir.png", "folder", 0},
+        {"--timeline", "dir.svg", "folder", 0},
+        {"--stats-json", "missing/st.json", "missing", 0},
+        {"--timeline", "missing/t.svg", "missing", 0},
+        {"--stats-json", "good.png/st.json", "not a folder", 0},
+        {"--stats-json", "ro.json", "not writable", 1},
+        {"-o", "ro.png", "not writable", 1},
+        {"--timeline", "rodir/t.svg", "not writable", 1},
+    };
+    const fixture *f = (const fixture *)*state;
+    char path[256], before[512], after[512];
+    char *good;
+    size_t n_good = 0, c;
+    int n_before;
+    proc p;
+
+    render_ok(&p, f, good_args, "good.png");
+    proc_free(&p);
+    path_in(f, "good.png", path, sizeof path);
+    good = read_bytes(path, &n_good);
+    assert_non_null(good);
+    path_in(f, "dir.png", path, sizeof path);
+    assert_int_equal(mkdir(path, 0755), 0);
+    path_in(f, "dir.svg", path, sizeof path);
+    assert_int_equal(mkdir(path, 0755), 0);
+    put_file(f, "ro.json", "{}\n");
+    put_file(f, "ro.png", "not really a png\n");
+    path_in(f, "ro.json", path, sizeof path);
+    assert_int_equal(chmod(path, 0444), 0);
+    path_in(f, "ro.png", path, sizeof path);
+    assert_int_equal(chmod(path, 0444), 0);
+    path_in(f, "rodir", path, sizeof path);
+    assert_int_equal(mkdir(path, 0555), 0);
+    n_before = list_dir(f->dir, before, sizeof before);
+    for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        const char *args[] = {"render", "--width", "256",      "--height", "256", "--spp",
+                              "100000", "-o",      "good.png", NULL,       NULL,  NULL};
+        if (cases[c].needs_non_root && geteuid() == 0)
+            continue; /* root writes whatever it likes */
+        if (strcmp(cases[c].opt, "-o") == 0) {
+            args[8] = cases[c].path;
+        } else {
+            args[9] = cases[c].opt;
+            args[10] = cases[c].path;
+        }
+        run(&p, f->dir, 4 * EARLY_FAIL_LIMIT_S, args);
+        EXPECT(&p, !p.timed_out && p.seconds < EARLY_FAIL_LIMIT_S,
+               "a bad output must be refused before rendering (within %.0f s)", EARLY_FAIL_LIMIT_S);
+        EXPECT(&p, exited_with(&p, 2), "a bad output is a usage error: status 2");
+        EXPECT(&p, one_line(&p.err), "expected exactly one line on stderr");
+        EXPECT(&p, strstr(p.err.data, cases[c].path) && strstr(p.err.data, cases[c].word),
+               "the line should name %s and say '%s'", cases[c].path, cases[c].word);
+        EXPECT(&p, file_is(f, "good.png", good, n_good), "good.png changed");
+        EXPECT(&p, list_dir(f->dir, after, sizeof after) == n_before && strcmp(before, after) == 0,
+               "the folder changed: %s, was %s", after, before);
+        proc_free(&p);
+    }
+    free(good);
+}
+
+/* A run that fails after the render replaces nothing: here --stats-json's folder disappears
+ * while it renders, so the stats cannot be written at the end; the good image at -o must stay
+ * (it used to be replaced first) and no temporary file is left. */
+static void test_failed_stats_keeps_image(void **state)
+{
+    static const char *const good_args[] = {"render", "--width", "16",       "--spp", "1",
+                                            "-q",     "-o",      "good.png", NULL};
+    static const char *const args[] = {"render", "--width",  "256", "--height",     "256",
+                                       "--spp",  "100000",   "-q",  "--stats-json", "sub/st.json",
+                                       "-o",     "good.png", NULL};
+    const fixture *f = (const fixture *)*state;
+    char path[256], names[512];
+    char *good;
+    size_t n_good = 0;
+    proc p;
+
+    render_ok(&p, f, good_args, "good.png");
+    proc_free(&p);
+    path_in(f, "good.png", path, sizeof path);
+    good = read_bytes(path, &n_good);
+    assert_non_null(good);
+    path_in(f, "sub", path, sizeof path);
+    assert_int_equal(mkdir(path, 0755), 0);
+    proc_start(&p, f->dir, args);
+    let_it_render(&p);
+    EXPECT(&p, rmdir(path) == 0, "cannot remove %s: %s", path, strerror(errno));
+    assert_int_equal(kill(p.pid, SIGINT), 0);
+    proc_finish(&p, (now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
+    EXPECT(&p, file_is(f, "good.png", good, n_good), "good.png was replaced by a failed run");
+    EXPECT(&p, exited_with(&p, 1), "failing to write the stats is a runtime error: status 1");
+    EXPECT(&p, strstr(p.err.data, "st.json") && strstr(p.err.data, "no output was replaced"),
+           "stderr should name st.json and say that nothing was replaced");
+    EXPECT(&p, list_dir(f->dir, names, sizeof names) == 1,
+           "only good.png should be in the folder, found: %s", names);
+    free(good);
+    proc_free(&p);
+}
+
+/* A malformed RS_FAULT is a usage error (status 2, one line naming it), whatever the devices. */
+static void test_bad_fault_env(void **state)
+{
+    static const char *const args[] = {"render", "--width", "8",       "--spp",
+                                       "1",      "-o",      "bad.png", NULL};
+    const fixture *f = (const fixture *)*state;
+    char names[512];
+    proc p;
+    setenv("RS_FAULT", "gpu:sometimes", 1);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, args);
+    unsetenv("RS_FAULT");
+    EXPECT(&p, exited_with(&p, 2), "a malformed RS_FAULT is a usage error: status 2");
+    EXPECT(&p,
+           one_line(&p.err) && strstr(p.err.data, "RS_FAULT") &&
+               strstr(p.err.data, "gpu:sometimes"),
+           "expected one line naming RS_FAULT and its bad part");
+    EXPECT(&p, list_dir(f->dir, names, sizeof names) == 0, "files were written: %s", names);
+    proc_free(&p);
 }
 
 /* ---- 7. scheduling does not show in the pixels ----------------------------------------------- */
@@ -1018,8 +1324,8 @@ static void test_device_fault_and_stats(void **state)
            strstr(json, "\"name\": \"gpu-fallback:0\"") && strstr(json, "\"failed\": true") &&
                strstr(json, "\"name\": \"cpu\"") && strstr(json, "\"failed\": false"),
            "stats.json should list both devices and the failure: %s", json);
-    EXPECT(&r, !exited_with(&r, 0) && strstr(r.err.data, "RS_FAULT") != NULL,
-           "a malformed RS_FAULT should be an error naming it");
+    EXPECT(&r, exited_with(&r, 2) && one_line(&r.err) && strstr(r.err.data, "RS_FAULT") != NULL,
+           "a malformed RS_FAULT should be a usage error naming it");
     proc_free(&p);
     proc_free(&q);
     proc_free(&r);
@@ -1192,6 +1498,12 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_failed_run_keeps_output, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sigint_writes_partial_image, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sigint_megakernel, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_sigterm_sighup_write_partial_image, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_second_signal_removes_temp_file, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_reader_gone_keeps_rendering, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_outputs_checked_first, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_failed_stats_keeps_image, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_bad_fault_env, setup, teardown),
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_device_fault_and_stats, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
