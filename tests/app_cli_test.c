@@ -690,6 +690,20 @@ static void render_ok(proc *p, const fixture *f, const char *const *args, const 
            names);
 }
 
+/* render_ok, then the bytes of the image it wrote (the "good output" a later run must keep). */
+static char *render_good(const fixture *f, const char *const *args, const char *name, size_t *n)
+{
+    char path[256];
+    char *bytes;
+    proc p;
+    render_ok(&p, f, args, name);
+    proc_free(&p);
+    path_in(f, name, path, sizeof path);
+    bytes = read_bytes(path, n);
+    assert_non_null(bytes);
+    return bytes;
+}
+
 static void test_render_png(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -939,11 +953,8 @@ static void test_second_signal_removes_temp_file(void **state)
     int attempt, caught = 0;
     proc p;
 
-    render_ok(&p, f, good_args, "partial.exr");
-    proc_free(&p);
+    good = render_good(f, good_args, "partial.exr", &n_good);
     path_in(f, "partial.exr", path, sizeof path);
-    good = read_bytes(path, &n_good);
-    assert_non_null(good);
     put_file(f, "st.json", OLD_JSON);
     put_file(f, "t.svg", OLD_SVG);
     for (attempt = 0; attempt < 3 && !caught; ++attempt) {
@@ -1057,11 +1068,7 @@ static void test_outputs_checked_first(void **state)
     int n_before;
     proc p;
 
-    render_ok(&p, f, good_args, "good.png");
-    proc_free(&p);
-    path_in(f, "good.png", path, sizeof path);
-    good = read_bytes(path, &n_good);
-    assert_non_null(good);
+    good = render_good(f, good_args, "good.png", &n_good);
     path_in(f, "dir.png", path, sizeof path);
     assert_int_equal(mkdir(path, 0755), 0);
     path_in(f, "dir.svg", path, sizeof path);
@@ -1117,11 +1124,7 @@ static void test_failed_stats_keeps_image(void **state)
     size_t n_good = 0;
     proc p;
 
-    render_ok(&p, f, good_args, "good.png");
-    proc_free(&p);
-    path_in(f, "good.png", path, sizeof path);
-    good = read_bytes(path, &n_good);
-    assert_non_null(good);
+    good = render_good(f, good_args, "good.png", &n_good);
     path_in(f, "sub", path, sizeof path);
     assert_int_equal(mkdir(path, 0755), 0);
     proc_start(&p, f->dir, args);

@@ -29,9 +29,8 @@
 
 #include "core/sobol.h"
 #include "test_rand.h"
+#include "test_sampler.h"
 
-/* Chi-square critical value for 99 degrees of freedom at significance 0.01 (upper tail). */
-#define CHI2_99DOF_P01 134.642
 
 /* Dimension `dim` (0 or 1) of point `index` from the direction numbers themselves. */
 static uint32_t sobol_reference(uint32_t index, int dim)
@@ -91,26 +90,6 @@ static void test_shuffle_keeps_blocks(void **state)
     }
 }
 
-/* Exactly one of the n = 2^m points in every elementary interval 2^-a x 2^-b, a + b = m. */
-static void expect_net(const float *x, const float *y, int m, const char *what)
-{
-    static unsigned char cell[1u << 10];
-    uint32_t n = 1u << m, i;
-    int a;
-    for (a = 0; a <= m; ++a) {
-        memset(cell, 0, n);
-        for (i = 0; i < n; ++i) {
-            uint32_t cx = (uint32_t)(x[i] * (float)(1u << a)),
-                     cy = (uint32_t)(y[i] * (float)(1u << (m - a)));
-            uint32_t c = (cx << (m - a)) | cy;
-            if (cell[c])
-                fail_msg("%s: 2^%d points, intervals 2^-%d x 2^-%d: two points in one", what, m, a,
-                         m - a);
-            cell[c] = 1;
-        }
-    }
-}
-
 static void test_pairs_are_nets(void **state)
 {
     static float p[4][1u << 10];
@@ -158,63 +137,15 @@ static void test_uniform_chi_square(void **state)
     }
 }
 
-/* 10 x 10 histogram of 10^5 pairs (a, b) from `pair`; chi-square against independence. */
-static double pair_chi_square(void (*pair)(uint32_t i, float *a, float *b))
+static rs_rng_f4 sobol5(uint32_t pixel, uint32_t sample, uint32_t bounce, uint32_t group)
 {
-    double h[100];
-    uint32_t i;
-    memset(h, 0, sizeof h);
-    for (i = 0; i < 100000; ++i) {
-        float a, b;
-        pair(i, &a, &b);
-        h[(int)(a * 10.0f) * 10 + (int)(b * 10.0f)] += 1.0;
-    }
-    return chi_square(h, 100, 1000.0);
-}
-
-/* the first number of each pair of one call */
-static void lanes_0_2(uint32_t i, float *a, float *b)
-{
-    rs_rng_f4 f = rs_sobol_float4(5, i / 64, i % 64, 0, 1);
-    *a = f.v[0];
-    *b = f.v[2];
-}
-
-/* the same lane of two groups of one sample */
-static void groups_1_2(uint32_t i, float *a, float *b)
-{
-    *a = rs_sobol_float4(5, i / 64, i % 64, 3, 1).v[0];
-    *b = rs_sobol_float4(5, i / 64, i % 64, 3, 2).v[0];
-}
-
-/* neighbouring pixels, same sample */
-static void pixels(uint32_t i, float *a, float *b)
-{
-    *a = rs_sobol_float4(5, 2 * (i / 64), i % 64, 0, 0).v[1];
-    *b = rs_sobol_float4(5, 2 * (i / 64) + 1, i % 64, 0, 0).v[1];
-}
-
-/* the same lane at two bounces */
-static void bounces(uint32_t i, float *a, float *b)
-{
-    *a = rs_sobol_float4(5, i / 64, i % 64, 1, 1).v[0];
-    *b = rs_sobol_float4(5, i / 64, i % 64, 2, 1).v[0];
+    return rs_sobol_float4(5, pixel, sample, bounce, group);
 }
 
 static void test_independence(void **state)
 {
-    static void (*const fns[])(uint32_t, float *, float *) = {lanes_0_2, groups_1_2, pixels,
-                                                              bounces};
-    static const char *const names[] = {"two pairs of a call", "two groups", "two pixels",
-                                        "two bounces"};
-    size_t k;
     (void)state;
-    for (k = 0; k < sizeof fns / sizeof fns[0]; ++k) {
-        double c = pair_chi_square(fns[k]);
-        print_message("%s: chi-square %.1f (99 dof, 0.01 critical %.1f)\n", names[k], c,
-                      CHI2_99DOF_P01);
-        assert_true(c < CHI2_99DOF_P01);
-    }
+    expect_independent_decisions(sobol5);
 }
 
 /* f(x, y) = x e^y + sin(pi x y): its integral over the unit square, by series:

@@ -38,9 +38,8 @@
 
 #include "core/zsobol.h"
 #include "test_rand.h"
+#include "test_sampler.h"
 
-/* Chi-square critical values at significance 0.01 (upper tail). */
-#define CHI2_99DOF_P01 134.642
 #define CHI2_23DOF_P01 41.638
 
 static void test_helpers(void **state)
@@ -153,26 +152,6 @@ static void test_index_hierarchy(void **state)
         }
 }
 
-/* Exactly one of the n = 2^m points in every elementary interval 2^-a x 2^-b, a + b = m. */
-static void expect_net(const float *x, const float *y, int m, const char *what)
-{
-    static unsigned char cell[1u << 12];
-    uint32_t n = 1u << m, i;
-    int a;
-    for (a = 0; a <= m; ++a) {
-        memset(cell, 0, n);
-        for (i = 0; i < n; ++i) {
-            uint32_t cx = (uint32_t)(x[i] * (float)(1u << a)),
-                     cy = (uint32_t)(y[i] * (float)(1u << (m - a)));
-            uint32_t c = (cx << (m - a)) | cy;
-            if (cell[c])
-                fail_msg("%s: 2^%d points, intervals 2^-%d x 2^-%d: two points in one", what, m, a,
-                         m - a);
-            cell[c] = 1;
-        }
-    }
-}
-
 static void test_pixels_and_quads_are_nets(void **state)
 {
     static float p[4][1u << 12];
@@ -253,69 +232,15 @@ static void test_uniform_chi_square(void **state)
     }
 }
 
-/* 10 x 10 histogram of 10^5 pairs (a, b) from `pair`; chi-square against independence.  Pair i:
- * pixel (i / 64) of a 256x256 image (row-major), sample i % 64, at 64 spp. */
-static double pair_chi_square(void (*pair)(uint32_t i, float *a, float *b))
-{
-    double h[100];
-    uint32_t i;
-    memset(h, 0, sizeof h);
-    for (i = 0; i < 100000; ++i) {
-        float a, b;
-        pair(i, &a, &b);
-        h[(int)(a * 10.0f) * 10 + (int)(b * 10.0f)] += 1.0;
-    }
-    return chi_square(h, 100, 1000.0);
-}
-
 static rs_rng_f4 z4(uint32_t pixel, uint32_t sample, uint32_t bounce, uint32_t group)
 {
     return rs_zsobol_float4(5, pixel % 256, pixel / 256, sample, 6, 8, bounce, group);
 }
 
-/* the first number of each pair of one call */
-static void lanes_0_2(uint32_t i, float *a, float *b)
-{
-    rs_rng_f4 f = z4(i / 64, i % 64, 0, 1);
-    *a = f.v[0];
-    *b = f.v[2];
-}
-
-/* the same lane of two groups of one sample */
-static void groups_1_2(uint32_t i, float *a, float *b)
-{
-    *a = z4(i / 64, i % 64, 3, 1).v[0];
-    *b = z4(i / 64, i % 64, 3, 2).v[0];
-}
-
-/* neighbouring pixels (one Morton quad), same sample */
-static void pixels(uint32_t i, float *a, float *b)
-{
-    *a = z4(2 * (i / 64), i % 64, 0, 0).v[1];
-    *b = z4(2 * (i / 64) + 1, i % 64, 0, 0).v[1];
-}
-
-/* the same lane at two bounces */
-static void bounces(uint32_t i, float *a, float *b)
-{
-    *a = z4(i / 64, i % 64, 1, 1).v[0];
-    *b = z4(i / 64, i % 64, 2, 1).v[0];
-}
-
 static void test_independence(void **state)
 {
-    static void (*const fns[])(uint32_t, float *, float *) = {lanes_0_2, groups_1_2, pixels,
-                                                              bounces};
-    static const char *const names[] = {"two pairs of a call", "two groups", "two pixels",
-                                        "two bounces"};
-    size_t k;
     (void)state;
-    for (k = 0; k < sizeof fns / sizeof fns[0]; ++k) {
-        double c = pair_chi_square(fns[k]);
-        print_message("%s: chi-square %.1f (99 dof, 0.01 critical %.1f)\n", names[k], c,
-                      CHI2_99DOF_P01);
-        assert_true(c < CHI2_99DOF_P01);
-    }
+    expect_independent_decisions(z4);
 }
 
 static int cmp_u64(const void *a, const void *b)
