@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "app/options.h"
+#include "core/file.h"
 
 #define TRACK_MAX 8
 
@@ -35,12 +36,6 @@ void rs_outputs_remove_tracked(void)
     int i, n = atomic_load_explicit(&g_n_tracked, memory_order_acquire);
     for (i = 0; i < n && i < TRACK_MAX; ++i)
         unlink(g_tracked[i]);
-}
-
-int rs_outputs_temp_name(const char *name, char *buf, size_t n)
-{
-    int k = snprintf(buf, n, "%s.tmp-%ld", name, (long)getpid());
-    return k > 0 && (size_t)k < n;
 }
 
 /* One line "raystream: OPTION PATH: what" and RS_EXIT_USAGE. */
@@ -117,7 +112,7 @@ int rs_outputs_check(rs_output *out, int n, const char *const *inputs, int n_inp
     int i, j, rc;
     for (i = 0; i < n; ++i) {
         rs_output *o = &out[i];
-        if (!rs_outputs_temp_name(o->path, o->staged, sizeof o->staged))
+        if (!rs_file_temp_name(o->path, o->staged, sizeof o->staged))
             return refuse(o, "the name is too long", NULL);
         for (j = 0; j < i; ++j)
             if (same_file(o->path, out[j].path)) {

@@ -35,9 +35,6 @@ typedef struct rs_output {
  * (RS_EXIT_OK) or RS_EXIT_USAGE after printing one line. */
 int rs_outputs_check(rs_output *out, int n, const char *const *inputs, int n_inputs);
 
-/* Writes `name` + ".tmp-PID" into buf (n bytes); 0 if it does not fit. */
-int rs_outputs_temp_name(const char *name, char *buf, size_t n);
-
 /* Renames o->staged to o->path.  Returns 1, or 0 after printing why. */
 int rs_output_commit(const rs_output *o);
 

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdarg.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -141,4 +142,10 @@ rs_status rs_file_read(const char *path, uint64_t max_bytes, char **text, size_t
     *text = buf;
     *len = (size_t)n;
     return RS_OK;
+}
+
+int rs_file_temp_name(const char *path, char *buf, size_t n)
+{
+    int k = snprintf(buf, n, "%s.tmp-%ld", path, (long)getpid());
+    return k > 0 && (size_t)k < n;
 }

@@ -42,6 +42,10 @@ rs_status rs_file_open(const char *path, uint64_t max_bytes, FILE **f, uint64_t 
 rs_status rs_file_check(const char *path, uint64_t max_bytes, uint64_t *size);
 /* Reads the whole file into an rs_alloc'd buffer with a NUL after its *len bytes. */
 rs_status rs_file_read(const char *path, uint64_t max_bytes, char **text, size_t *len);
+/* The temporary file beside `path` that an output is written to before it is renamed over
+ * `path` ("PATH.tmp-PID"; the image writers and the CLI's staged outputs use it, and the CLI
+ * removes it on a second signal).  Returns 0 when it does not fit in n bytes. */
+int rs_file_temp_name(const char *path, char *buf, size_t n);
 #ifdef __cplusplus
 }
 #endif

@@ -52,7 +52,10 @@ std::string dir_of(const char *path)
 
 std::string temp_name(const char *path)
 {
-    return std::string(path) + ".tmp-" + std::to_string((long)getpid());
+    char buf[4200];
+    if (!rs_file_temp_name(path, buf, sizeof buf))
+        return std::string(path) + ".tmp";
+    return buf;
 }
 
 } // namespace

@@ -42,7 +42,8 @@ rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, const float *
     rs_status st = rs_image_check_output(path);
     if (st != RS_OK)
         return st;
-    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()); /* as image_io.cpp */
+    if (!rs_file_temp_name(path, tmp, sizeof tmp))
+        return rs_error_set(RS_ERR_ARG, "%s: path too long", path);
     if (!(f = fopen(tmp, "wb")))
         return rs_error_set(RS_ERR_IO, "%s: cannot write", path);
     ok = fprintf(f, "PF\n%u %u\n-1.0\n", w, h) > 0; /* negative scale: little-endian floats */
