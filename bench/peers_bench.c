@@ -190,35 +190,35 @@ static int export_mitsuba(const rs_scene *s, const char *path_xml, const char *p
         char path[600];
         FILE *o;
         uint32_t nv = 0;
-        int any = 0;
+        int any = 0, lambert;
         for (i = 0; i < s->n_quads && !any; ++i)
             any = s->quad_mat[i] == m;
         for (i = 0; i < s->n_tris && !any; ++i)
             any = s->tri_mat[i] == m;
         if (!any)
             continue;
-        if (mat->type == RS_MAT_LAMBERTIAN && mat->albedo_tex == RS_NO_TEXTURE) {
+        lambert = mat->type == RS_MAT_LAMBERTIAN && mat->albedo_tex == RS_NO_TEXTURE;
+        if (lambert || (mat->type == RS_MAT_DIFFUSE_LIGHT && !(mat->flags & RS_MAT_TWO_SIDED))) {
+            rs_vec3 rgb = lambert ? mat->albedo : mat->emission;
             fprintf(x,
                     "  <shape type=\"obj\"><string name=\"filename\" value=\"mat%u.obj\"/>"
-                    "<boolean name=\"face_normals\" value=\"true\"/>\n"
-                    "    <bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" "
-                    "value=\"%.9g,%.9g,%.9g\"/></bsdf></bsdf></shape>\n",
-                    m, mat->albedo.x, mat->albedo.y, mat->albedo.z);
-            fprintf(js, "%s\n  {\"obj\": \"mat%u.obj\", \"kind\": \"diffuse\", \"rgb\": [%.9g, %.9g, %.9g]}",
-                    first_mesh ? "" : ",", m, mat->albedo.x, mat->albedo.y, mat->albedo.z);
-            first_mesh = 0;
-        } else if (mat->type == RS_MAT_DIFFUSE_LIGHT && !(mat->flags & RS_MAT_TWO_SIDED)) {
-            /* emits on the side its winding faces (u x v, as raystream's quads) and reflects
-             * nothing, as raystream's lights */
-            fprintf(x,
-                    "  <shape type=\"obj\"><string name=\"filename\" value=\"mat%u.obj\"/>"
-                    "<boolean name=\"face_normals\" value=\"true\"/>\n"
-                    "    <bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0,0,0\"/></bsdf>\n"
-                    "    <emitter type=\"area\"><rgb name=\"radiance\" value=\"%.9g,%.9g,%.9g\"/>"
-                    "</emitter></shape>\n",
-                    m, mat->emission.x, mat->emission.y, mat->emission.z);
-            fprintf(js, "%s\n  {\"obj\": \"mat%u.obj\", \"kind\": \"light\", \"rgb\": [%.9g, %.9g, %.9g]}",
-                    first_mesh ? "" : ",", m, mat->emission.x, mat->emission.y, mat->emission.z);
+                    "<boolean name=\"face_normals\" value=\"true\"/>\n",
+                    m);
+            if (lambert)
+                fprintf(x,
+                        "    <bsdf type=\"twosided\"><bsdf type=\"diffuse\"><rgb "
+                        "name=\"reflectance\" value=\"%.9g,%.9g,%.9g\"/></bsdf></bsdf>\n",
+                        rgb.x, rgb.y, rgb.z);
+            else /* emits on the side its winding faces (u x v, as raystream's quads) and
+                    reflects nothing, as raystream's lights */
+                fprintf(x,
+                        "    <bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0,0,0\"/>"
+                        "</bsdf>\n    <emitter type=\"area\"><rgb name=\"radiance\" "
+                        "value=\"%.9g,%.9g,%.9g\"/></emitter>\n",
+                        rgb.x, rgb.y, rgb.z);
+            fprintf(x, "  </shape>\n");
+            fprintf(js, "%s\n  {\"obj\": \"mat%u.obj\", \"kind\": \"%s\", \"rgb\": [%.9g, %.9g, %.9g]}",
+                    first_mesh ? "" : ",", m, lambert ? "diffuse" : "light", rgb.x, rgb.y, rgb.z);
             first_mesh = 0;
         } else {
             fprintf(stderr, "%s: %s: material %u is not exported (only Lambertian surfaces and "
