@@ -43,8 +43,9 @@ typedef struct rs_render_settings {
     uint64_t seed;
     rs_sampling sampling;
     rs_sampler sampler;       /* independent (zeroed), sobol or zsobol */
-    uint32_t wave_paths;      /* paths in flight; 0: auto (RS_RENDER_DEFAULT_WAVE with a GPU,
-                                 RS_RENDER_HOST_WAVE per thread without) */
+    uint32_t wave_paths;      /* paths in flight; 0: auto (RS_RENDER_HOST_WAVE per thread on one
+                                 CPU device, RS_RENDER_DEFAULT_WAVE with a GPU or several
+                                 devices) */
     uint32_t waves_in_flight; /* 1..RS_RENDER_MAX_WAVES; 0: auto (below) */
     int threads;              /* OpenMP threads for the shading stages (at most) */
     rs_cores *cores;          /* the budget shared with the CPU devices; NULL: none */
