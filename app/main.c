@@ -42,7 +42,7 @@ static atomic_int g_signal;
 
 static void on_stop_signal(int sig)
 {
-    int none = 0;
+    int none = 0, saved_errno = errno; /* unlink may set it under the interrupted code's feet */
     if (atomic_compare_exchange_strong(&g_signal, &none, sig)) {
         atomic_store(&g_cancel, 1);
         return;
@@ -50,6 +50,7 @@ static void on_stop_signal(int sig)
     rs_outputs_remove_tracked();
     signal(sig, SIG_DFL);
     raise(sig); /* pending until the handler returns (the signal is blocked in it), then fatal */
+    errno = saved_errno;
 }
 
 static const int k_stop_signals[] = {SIGINT, SIGTERM, SIGHUP};
