@@ -294,24 +294,6 @@ static void test_distinct_and_deterministic(void **state)
     assert_true(b.v[0] >= 0.0f && b.v[0] < 1.0f && b.v[0] != a.v[0]);
 }
 
-/* f(x, y) = x e^y + sin(pi x y): its integral over the unit square, by series:
- * (e - 1) / 2 + sum_k (-1)^k pi^(2k+1) / ((2k+1)! (2k+2)^2). */
-static double smooth(double x, double y) { return x * exp(y) + sin(3.14159265358979 * x * y); }
-
-static double smooth_integral(void)
-{
-    double s = 0.0, term = 3.14159265358979, fact = 1.0;
-    int k;
-    for (k = 0; k < 20; ++k) {
-        if (k > 0) {
-            term *= -3.14159265358979 * 3.14159265358979;
-            fact *= (double)(2 * k) * (double)(2 * k + 1);
-        }
-        s += term / fact / ((2.0 * k + 2.0) * (2.0 * k + 2.0));
-    }
-    return (exp(1.0) - 1.0) / 2.0 + s;
-}
-
 #define IMG 64
 
 /* Per-pixel n-sample estimates of the integral over a 64x64 image (zsobol or sobol, lane pair

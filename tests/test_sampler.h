@@ -4,6 +4,7 @@
 #ifndef RS_TESTS_TEST_SAMPLER_H
 #define RS_TESTS_TEST_SAMPLER_H
 
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -94,6 +95,25 @@ static void expect_independent_decisions(ts_draw_fn draw)
                       CHI2_99DOF_P01);
         assert_true(c < CHI2_99DOF_P01);
     }
+}
+
+/* A smooth integrand for the convergence checks. */
+/* f(x, y) = x e^y + sin(pi x y): its integral over the unit square, by series:
+ * (e - 1) / 2 + sum_k (-1)^k pi^(2k+1) / ((2k+1)! (2k+2)^2). */
+static double smooth(double x, double y) { return x * exp(y) + sin(3.14159265358979 * x * y); }
+
+static double smooth_integral(void)
+{
+    double s = 0.0, term = 3.14159265358979, fact = 1.0;
+    int k;
+    for (k = 0; k < 20; ++k) {
+        if (k > 0) {
+            term *= -3.14159265358979 * 3.14159265358979;
+            fact *= (double)(2 * k) * (double)(2 * k + 1);
+        }
+        s += term / fact / ((2.0 * k + 2.0) * (2.0 * k + 2.0));
+    }
+    return (exp(1.0) - 1.0) / 2.0 + s;
 }
 
 #endif
