@@ -1,5 +1,9 @@
 /* core/cores.c — see cores.h. */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include "core/cores.h"
+
+#include <sched.h>
+#include <unistd.h>
 
 void rs_cores_init(rs_cores *c, int total)
 {
@@ -25,4 +29,17 @@ void rs_cores_release(rs_cores *c, int n)
 {
     if (c)
         atomic_fetch_add(&c->free, n);
+}
+
+int rs_cores_allowed(void)
+{
+#ifdef __linux__
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+        return CPU_COUNT(&set);
+#endif
+    {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        return n > 0 ? (int)n : 1;
+    }
 }

@@ -25,4 +25,8 @@ int rs_cores_acquire(rs_cores *c, int want);
 /* Gives back what rs_cores_acquire returned. */
 void rs_cores_release(rs_cores *c, int n);
 
+/* The processors the calling thread may run on now (its affinity mask, read at each call: a
+ * `taskset` or a later sched_setaffinity counts). */
+int rs_cores_allowed(void);
+
 #endif

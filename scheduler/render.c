@@ -6,6 +6,7 @@
 #include <time.h>
 
 #include "core/alloc.h"
+#include "core/cores.h"
 #include "streams/wave.h"
 
 /* SLOT_IDLE: the slot holds no wave.  Otherwise its `stage` is an rs_stage. */
@@ -326,9 +327,15 @@ static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint
     if (st->threads < 1)
         st->threads = 1;
     if (st->wave_paths == 0) {
-        /* cache-sized waves for one CPU device; several devices need the big wave to share out
-         * (with 16384-path waves cpu:1 + the fallback lost 10-30% of its load balance) */
-        uint64_t host = (uint64_t)RS_RENDER_HOST_WAVE * (uint32_t)st->threads;
+        /* One CPU device: waves the caches hold when the render thread and the device's
+         * dispatch thread share one core (RS_RENDER_HOST_WAVE per thread), bigger ones when the
+         * dispatch thread has a core of its own to trace on while the stages run
+         * (RS_RENDER_HOST_WAVE_FREE: 16384 was 16-27% slower there, docs/performance.md).
+         * Several devices need the big wave to share out (with 16384-path waves cpu:1 + the
+         * fallback lost 10-30% of its load balance). */
+        uint64_t host = (uint64_t)(rs_cores_allowed() > 1 ? RS_RENDER_HOST_WAVE_FREE
+                                                          : RS_RENDER_HOST_WAVE) *
+                        (uint32_t)st->threads;
         st->wave_paths = gpu || n_dev > 1 || host > RS_RENDER_DEFAULT_WAVE
                              ? RS_RENDER_DEFAULT_WAVE
                              : (uint32_t)host;

@@ -43,8 +43,9 @@ typedef struct rs_render_settings {
     uint64_t seed;
     rs_sampling sampling;
     rs_sampler sampler;       /* independent (zeroed), sobol or zsobol */
-    uint32_t wave_paths;      /* paths in flight; 0: auto (RS_RENDER_HOST_WAVE per thread on one
-                                 CPU device, RS_RENDER_DEFAULT_WAVE with a GPU or several
+    uint32_t wave_paths;      /* paths in flight; 0: auto (one CPU device: RS_RENDER_HOST_WAVE
+                                 per thread on one core, RS_RENDER_HOST_WAVE_FREE per thread
+                                 on more; RS_RENDER_DEFAULT_WAVE with a GPU or several
                                  devices) */
     uint32_t waves_in_flight; /* 1..RS_RENDER_MAX_WAVES; 0: auto (below) */
     int threads;              /* OpenMP threads for the shading stages (at most) */
@@ -61,6 +62,10 @@ typedef struct rs_render_settings {
  * every 4 KB of its buffers once.  Cornell 256x256 16 spp on one thread: 0.76 s of stages
  * against 0.96 s (docs/performance.md). */
 #define RS_RENDER_HOST_WAVE    16384u
+/* The same when the process may use more than one core, so that the CPU device's dispatch thread
+ * traces beside the stages: larger waves keep it busy (Cornell 300x300 16 spp, unpinned: 1.13 s
+ * against 1.31 s at one thread, 0.68 s against 0.85 s at two). */
+#define RS_RENDER_HOST_WAVE_FREE 131072u
 #define RS_RENDER_MAX_WAVES    4u
 
 typedef struct rs_render_stats {
