@@ -305,7 +305,7 @@ static rs_status lbvh_order(const rs_bvh_build_opts *opts, uint32_t n, int threa
  * s->slots (the root at slot 0), ids is reordered into the leaves' ranges.  Returns the root's
  * report. */
 static rec_out build_tree(const scratch *s, uint32_t *ids, uint32_t n, uint32_t max_leaf,
-                          const rs_bvh_builder *builder, int threads)
+                          uint32_t leaf_block, const rs_bvh_builder *builder, int threads)
 {
     rs_bvh_ctx c;
     frame f;
@@ -315,6 +315,7 @@ static rec_out build_tree(const scratch *s, uint32_t *ids, uint32_t n, uint32_t 
     c.centroid = s->centroid;
     c.ids = ids;
     c.max_leaf = max_leaf;
+    c.leaf_block = leaf_block ? leaf_block : 1;
     c.builder = *builder;
     c.pairs = s->pairs;
     c.pairs2 = s->pairs2;
@@ -381,7 +382,8 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
         st = builder.method == RS_BVH_LBVH ? lbvh_order(opts, n, threads, &s, b->prim_ids) : RS_OK;
         if (st == RS_OK)
             st = finish_tree(b, s.slots,
-                             build_tree(&s, b->prim_ids, n, max_leaf, &builder, threads));
+                             build_tree(&s, b->prim_ids, n, max_leaf,
+                                        opts ? opts->leaf_block : 0, &builder, threads));
     }
     free_scratch(&s); /* success and a failed lbvh_sort too: the scratch goes either way */
     if (st != RS_OK) {

@@ -10,7 +10,10 @@
  *     C_split = C_trav + C_isect (A_L N_L + A_R N_R) / A,      C_leaf = C_isect N,
  *
  * with C_trav = RS_BVH_COST_TRAV and C_isect = RS_BVH_COST_ISECT, the constants rs_bvh_sah_cost
- * uses (both 1).  The cheapest plane of the three axes wins (ties: lower axis, lower plane).
+ * uses (both 1).  With rs_bvh_build_opts.leaf_block = B > 1, every N above counts blocks,
+ * ceil(N / B): a leaf test that takes B primitives at once (the wide trees' tri4 blocks) costs
+ * the same for 1 and for B of them, so ranges are no longer split down to one or two primitives
+ * (Embree's SAH counts its leaves in blocks the same way).  The cheapest plane of the three axes wins (ties: lower axis, lower plane).
  *
  * Leaves.  max_leaf caps the leaf size: a range with more than max_leaf primitives is always
  * split, even where the SAH says a leaf would be cheaper; a range of at most max_leaf becomes a
@@ -26,6 +29,12 @@
  * bins hold integer counts and min/max boxes, which merge exactly, so the result is the same for
  * any thread count. */
 #include "accel/internal.h"
+
+/* n primitives in leaf-test blocks (rs_bvh_build_opts.leaf_block) */
+static double blocks(const rs_bvh_ctx *c, uint32_t n)
+{
+    return (double)((n + c->leaf_block - 1) / c->leaf_block);
+}
 
 typedef struct sah_bin {
     rs_aabb box;
@@ -196,7 +205,8 @@ uint32_t rs_bvh_split_sah(const rs_bvh_ctx *c, uint32_t first, uint32_t count, u
             if (right_n[i] == 0)
                 continue;
             cost = RS_BVH_COST_TRAV * area +
-                   RS_BVH_COST_ISECT * (area_of(&acc) * n_acc + right_area[i] * right_n[i]);
+                   RS_BVH_COST_ISECT * (area_of(&acc) * blocks(c, n_acc) +
+                                        right_area[i] * blocks(c, right_n[i]));
             if (cost < best) {
                 best = cost;
                 best_axis = a;
@@ -212,7 +222,7 @@ uint32_t rs_bvh_split_sah(const rs_bvh_ctx *c, uint32_t first, uint32_t count, u
         *fallback = 1;
         return count / 2;
     }
-    if (count <= c->max_leaf && RS_BVH_COST_ISECT * (double)count * area <= best)
+    if (count <= c->max_leaf && RS_BVH_COST_ISECT * blocks(c, count) * area <= best)
         return 0;
     /* partition: bins 0 .. best_plane to the left */
     i = first;

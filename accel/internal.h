@@ -18,6 +18,7 @@
 #define RS_ACCEL_INTERNAL_H
 
 #include "accel/bvh.h"
+#include "accel/bvh4.h"
 
 /* A sort key and the primitive it belongs to (8 bytes). */
 typedef struct rs_bvh_key_id {
@@ -30,6 +31,7 @@ typedef struct rs_bvh_ctx {
     const rs_vec3 *centroid; /* per primitive: the centre of its box */
     uint32_t *ids;           /* the permutation under construction; becomes prim_ids */
     uint32_t max_leaf;
+    uint32_t leaf_block; /* SAH: primitives per block of the leaf cost (>= 1) */
     rs_bvh_builder builder; /* validated, bins filled in */
     rs_bvh_key_id *pairs;   /* n scratch pairs (grid builders and the median fallback) */
     rs_bvh_key_id *pairs2;  /* n more for the merge sort (RS_BVH_PART_SORT only) */
@@ -62,5 +64,34 @@ uint32_t rs_bvh_split_median(const rs_bvh_ctx *c, uint32_t first, uint32_t count
  * (ties in ascending primitive order) and codes[i] is the code of ids[i]. */
 void rs_bvh_lbvh_sort(const rs_vec3 *centroid, uint32_t n, uint32_t *ids, uint32_t *codes,
                       uint32_t *codes_tmp, uint32_t *ids_tmp, int threads);
+
+/* ---- collapsing into wide trees (accel/wide.c; used by accel/bvh4.c and accel/bvh8.c) ---- */
+
+/* The binary nodes a wide node of up to `width` lanes holds, starting from binary node `src`: its
+ * two children, then opening the interior lane of largest surface area until there are `width`
+ * or none is left (for a tree that is one leaf, that leaf alone).  Returns the count. */
+uint32_t rs_bvh_wide_lanes(const rs_bvh_node *bn, uint32_t src, uint32_t width, uint32_t *lanes);
+
+/* Copies triangle leaves into tri4 blocks (accel/bvh4.h): only in SSE builds with the
+ * Möller-Trumbore triangle test, whose arithmetic the blocks' test repeats. */
+typedef struct rs_tri4_packer {
+    const rs_geom *g;
+    const uint32_t *prim_ids;
+    rs_bvh4_tri4 *tri4; /* cap_tri4 blocks, allocated by the caller */
+    uint32_t n_tri4, cap_tri4;
+    int pack;
+} rs_tri4_packer;
+
+void rs_tri4_packer_init(rs_tri4_packer *p, const rs_bvh *b, const rs_geom *g);
+/* Whether binary leaf `n` is packed: packing is on and every primitive is a triangle. */
+int rs_tri4_packable(const rs_tri4_packer *p, const rs_bvh_node *n);
+/* Packs leaf `n` (rs_tri4_packable) into the next blocks; returns the first block's index. */
+uint32_t rs_tri4_pack(rs_tri4_packer *p, const rs_bvh_node *n);
+
+/* Checks that `b` fits a wide tree (`what` names it in the message) of at most `max_nodes` nodes
+ * and leaves of at most 32767 primitives; sets p->cap_tri4 and *cap_nodes, the blocks and nodes
+ * to allocate. */
+rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_tri4_packer *p, const char *what,
+                           uint32_t max_nodes, uint32_t *cap_nodes);
 
 #endif

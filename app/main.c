@@ -488,6 +488,8 @@ static int build_bvh(const rs_cli_options *o, render_run *r)
     bo.threads = (uint32_t)r->threads;
     if (o->no_bvh) /* one leaf holding everything: each ray tests every primitive */
         bo.max_leaf = UINT32_MAX;
+    else if (o->bvh_width != 2 && r->geom.tri_algo == RS_ISECT_TRI_MOLLER)
+        bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE; /* the CPU's wide trees test triangles 4 at once */
     if (o->bvh_on_gpu) {
         const char *why = "";
         if (rs_gpu_count(&why) > 0)

@@ -149,8 +149,9 @@ void rs_cli_print_help(const char *command)
             "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
             "  --bvh-device D      where --bvh lbvh computes and sorts its Morton codes: cpu\n"
             "                      (default) or gpu (CUDA device 0; the tree is the same)\n"
-            "  --bvh-width W       the CPU's traversal: 4 (default; the binary BVH collapsed to\n"
-            "                      4-wide nodes, SSE box tests) or 2 (the binary BVH, as on\n"
+            "  --bvh-width W       the CPU's traversal: 8 (the default where the CPU has AVX2;\n"
+            "                      the binary BVH collapsed to 8-wide nodes), 4 (4-wide nodes,\n"
+            "                      SSE; the default elsewhere) or 2 (the binary BVH, as on\n"
             "                      the GPU).  Same image either way.\n"
             "  --isect-sphere A    algebraic (default) or geometric\n"
             "  --isect-tri A       moller (default), snyder-barr or watertight\n"
@@ -367,8 +368,8 @@ static int parse_accel_option(opt_arg *x, rs_cli_options *o)
         o->bvh_on_gpu = v[0] == 'g';
     } else if (strcmp(name, "--bvh-width") == 0) {
         NEEDS_VALUE();
-        if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0)
-            return usage_error("--bvh-width must be 2 or 4, not '%s'%s", v, "");
+        if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0 && strcmp(v, "8") != 0)
+            return usage_error("--bvh-width must be 2, 4 or 8, not '%s'%s", v, "");
         o->bvh_width = (uint32_t)(v[0] - '0');
     } else if (strcmp(name, "--isect-sphere") == 0) {
         NEEDS_VALUE();

@@ -52,7 +52,8 @@ typedef struct rs_cli_options {
     uint32_t isect_sphere; /* --isect-sphere: rs_isect_sphere_algo */
     uint32_t isect_tri;    /* --isect-tri: rs_isect_tri_algo */
     uint32_t isect_aabb;   /* --isect-aabb: rs_isect_aabb_algo */
-    uint32_t bvh_width;    /* --bvh-width 2|4: the CPU device's traversal (default 4) */
+    uint32_t bvh_width;    /* --bvh-width 2|4|8: the CPU device's traversal (0: the widest
+                              this CPU runs, 8 with AVX2) */
     int devices_auto;      /* --devices auto (the default): the CPU and every CUDA device */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];

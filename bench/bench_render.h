@@ -52,6 +52,7 @@ static inline int br_load_scene(const char *prog, const char *spec, const char *
     *g = rs_scene_geom(*scene);
     memset(&bo, 0, sizeof bo);
     bo.builder.method = RS_BVH_SAH;
+    bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE; /* as the CLI builds it */
     if (rs_bvh_build(g, &bo, bvh) != RS_OK) {
         fprintf(stderr, "%s: %s\n", prog, rs_error_message());
         rs_scene_destroy(*scene);

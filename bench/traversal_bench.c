@@ -3,16 +3,17 @@
  * For each scene (bench/bench_scene.h; by default the teapot+bunny Cornell box, the bunny and the
  * dragon from the shared models) it builds our BVH (binned SAH by default, --bvh) and traces the
  * three ray sets, primary, diffuse-bounce and shadow, with both queries, closest hit and any hit,
- * on 1 thread and on all threads (an OpenMP loop, dynamic chunks of 256 rays), with both of our
- * kernels: the binary traversal every device shares (rs_bvh_closest / rs_bvh_occluded, what the
- * CUDA kernels and the GPU fallback run) and the 4-wide SSE traversal the CPU device runs
- * (accel/bvh4.h).  Each figure is Mrays/s, the median of --runs runs.  The two kernels must give
- * the same answers bit for bit (same prim, same t); the run fails otherwise.
+ * with our kernels: the binary traversal every device shares (rs_bvh_closest / rs_bvh_occluded,
+ * what the CUDA kernels and the GPU fallback run), the 4-wide SSE traversal (accel/bvh4.h) and the
+ * 8-wide AVX2 one (accel/bvh8.h; where the CPU has AVX2), on one thread, and the CPU device's
+ * kernel (the widest of them) on all threads too (an OpenMP loop, dynamic chunks of 256 rays).
+ * Each figure is Mrays/s, the median of --runs runs, the kernels' runs taken in turn.  Our kernels
+ * must give the same answers bit for bit (same prim, same t); the run fails otherwise.
  *
  * Built with Embree 3 (libembree-dev; optional, found by CMake), the same program puts the same
  * primitives in an Embree scene (triangles, quads, spheres as RTC_GEOMETRY_TYPE_SPHERE_POINT;
  * build quality MEDIUM, the default) and traces the same rays with rtcIntersect1 / rtcOccluded1
- * in the same loops, prints the 4-wide kernel's ratio to Embree, and checks that both find the
+ * in the same loops, prints our widest kernel's ratio to Embree, and checks that both find the
  * same answers: the same occlusion, and the same closest primitive or a hit at the same distance
  * (relative 1e-4: a tie between neighbours).  A disagreement on more than 0.1% of any set fails the
  * run.
@@ -27,6 +28,7 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh4.h"
+#include "accel/bvh8.h"
 #include "bench_scene.h"
 #include "core/parallel.h"
 #include "machine.h"
@@ -40,7 +42,7 @@
 #define CHUNK      256
 
 enum { Q_CLOSEST = 0, Q_ANY = 1 };
-enum { ENGINE_BIN = 0, ENGINE_BVH4 = 1, ENGINE_EMBREE = 2, N_ENGINES = 3 };
+enum { ENGINE_BIN = 0, ENGINE_BVH4 = 1, ENGINE_BVH8 = 2, ENGINE_EMBREE = 3, N_ENGINES = 4 };
 
 /* Answers of one engine on one set: the closest hit's prim and t, or occlusion. */
 typedef struct answers {
@@ -59,9 +61,16 @@ typedef struct settings {
 
 /* ---- our kernel ---------------------------------------------------------------------------- */
 
-/* Our kernels over the set: the 4-wide one when b4 is not NULL, else the binary one. */
-static double trace_ours(const rs_bvh_view *v, const rs_bvh4 *b4, const rs_geom *g,
-                         const bs_rays *s, int q, int threads, answers *a)
+typedef struct ours_ctx {
+    rs_bvh_view v;
+    const rs_bvh4 *b4;
+    const rs_bvh8 *b8;
+    const rs_geom *g;
+} ours_ctx;
+
+/* Our kernel `e` (ENGINE_BIN, _BVH4, _BVH8) over the set. */
+static double trace_ours(const ours_ctx *c, int e, const bs_rays *s, int q, int threads,
+                         answers *a)
 {
     double t0 = rs_bench_now();
     (void)threads; /* read only by the OpenMP clauses (compiled out under ThreadSanitizer) */
@@ -70,18 +79,21 @@ static double trace_ours(const rs_bvh_view *v, const rs_bvh4 *b4, const rs_geom 
 #pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
         for (i = 0; i < n; ++i) {
             rs_hit h;
-            if (b4)
-                rs_bvh4_closest(b4, g, s->rays[i], &h);
+            if (e == ENGINE_BVH8)
+                rs_bvh8_closest(c->b8, c->g, s->rays[i], &h);
+            else if (e == ENGINE_BVH4)
+                rs_bvh4_closest(c->b4, c->g, s->rays[i], &h);
             else
-                rs_bvh_closest(v, g, s->rays[i], &h);
+                rs_bvh_closest(&c->v, c->g, s->rays[i], &h);
             a->prim[i] = h.prim;
             a->t[i] = h.t;
         }
     } else {
 #pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
         for (i = 0; i < n; ++i)
-            a->occluded[i] = (uint8_t)(b4 ? rs_bvh4_occluded(b4, g, s->rays[i])
-                                          : rs_bvh_occluded(v, g, s->rays[i]));
+            a->occluded[i] = (uint8_t)(e == ENGINE_BVH8   ? rs_bvh8_occluded(c->b8, c->g, s->rays[i])
+                                       : e == ENGINE_BVH4 ? rs_bvh4_occluded(c->b4, c->g, s->rays[i])
+                                                          : rs_bvh_occluded(&c->v, c->g, s->rays[i]));
     }
     return rs_bench_now() - t0;
 }
@@ -276,22 +288,19 @@ static uint32_t disagreements(const answers *x, const answers *y, uint32_t n, in
 
 typedef double (*trace_fn)(const void *ctx, const bs_rays *s, int q, int threads, answers *a);
 
-typedef struct ours_ctx {
-    rs_bvh_view v;
-    const rs_bvh4 *b4;
-    const rs_geom *g;
-} ours_ctx;
-
 static double run_bin(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
 {
-    const ours_ctx *c = (const ours_ctx *)ctx;
-    return trace_ours(&c->v, NULL, c->g, s, q, threads, a);
+    return trace_ours((const ours_ctx *)ctx, ENGINE_BIN, s, q, threads, a);
 }
 
 static double run_bvh4(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
 {
-    const ours_ctx *c = (const ours_ctx *)ctx;
-    return trace_ours(&c->v, c->b4, c->g, s, q, threads, a);
+    return trace_ours((const ours_ctx *)ctx, ENGINE_BVH4, s, q, threads, a);
+}
+
+static double run_bvh8(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
+{
+    return trace_ours((const ours_ctx *)ctx, ENGINE_BVH8, s, q, threads, a);
 }
 
 /* The same answers bit for bit: 0, else the index of the first difference + 1. */
@@ -312,33 +321,45 @@ static double run_embree(const void *ctx, const bs_rays *s, int q, int threads, 
 }
 #endif
 
-static double mrays(trace_fn f, const void *ctx, const bs_rays *s, int q, int threads, int runs,
-                    answers *a)
+/* Mrays/s of each engine e with on[e] set: the median of `runs` runs, the engines' runs taken in
+ * turn (run 1 of each, then run 2 of each, ...) so that drift of the machine's speed is shared.
+ * Each engine's answers of its last run are left in a[e]. */
+static void mrays(trace_fn const *f, const void *const *ctx, const int *on, const bs_rays *s, int q,
+                  int threads, int runs, answers *a, double *out)
 {
-    double t[MAX_RUNS];
-    int k;
+    double t[N_ENGINES][MAX_RUNS];
+    int k, e;
     for (k = 0; k < runs; ++k)
-        t[k] = f(ctx, s, q, threads, a);
-    return (double)s->n / rs_bench_median(t, runs) / 1e6;
+        for (e = 0; e < N_ENGINES; ++e)
+            if (on[e])
+                t[e][k] = f[e](ctx[e], s, q, threads, &a[e]);
+    for (e = 0; e < N_ENGINES; ++e)
+        out[e] = on[e] ? (double)s->n / rs_bench_median(t[e], runs) / 1e6 : 0.0;
 }
 
 static int bench_scene(const bs_scene *sc, const void *ctx)
 {
     const settings *st = (const settings *)ctx;
     static const char *const QNAME[2] = {"closest", "any"};
+    static const char *const ENAME[3] = {"binary", "4-wide", "8-wide"};
     bs_rays sets[BS_N_SETS];
     rs_bvh_build_opts bo;
     rs_bvh *bvh = NULL;
     rs_bvh4 *bvh4 = NULL;
+    rs_bvh8 *bvh8 = NULL;
     ours_ctx ours;
     answers ans[N_ENGINES];
+    trace_fn fns[N_ENGINES] = {run_bin, run_bvh4, run_bvh8, NULL};
+    const void *ctxs[N_ENGINES];
+    int on1[N_ENGINES] = {1, 1, 0, 0}, onn[N_ENGINES] = {0, 0, 0, 0};
     double m[BS_N_SETS][2][N_ENGINES][2]; /* [set][query][engine][1 thread, all threads] */
     uint32_t bad[BS_N_SETS][2], hits[BS_N_SETS][2];
     double build_s, embree_build_s = 0.0;
-    int k, q, e, n_engines = 2, ok = 0;
+    int k, q, e, best, embree = 0, ok = 0;
 #ifdef RS_HAVE_EMBREE
     embree_scene es;
     memset(&es, 0, sizeof es);
+    fns[ENGINE_EMBREE] = run_embree;
 #endif
     memset(ans, 0, sizeof ans);
     memset(bad, 0, sizeof bad);
@@ -347,20 +368,28 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
         return 0;
     memset(&bo, 0, sizeof bo);
     bo.builder = st->builder;
+    bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE; /* as the CLI builds it for the CPU device */
     build_s = rs_bench_now();
     if (rs_bvh_build(&sc->g, &bo, &bvh) != RS_OK) {
         fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
         goto out;
     }
     build_s = rs_bench_now() - build_s;
-    if (rs_bvh4_build(bvh, &sc->g, &bvh4) != RS_OK) {
+    if (rs_bvh4_build(bvh, &sc->g, &bvh4) != RS_OK || rs_bvh8_build(bvh, &sc->g, &bvh8) != RS_OK) {
         fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
         goto out;
     }
     ours.v = rs_bvh_view_of(bvh);
     ours.b4 = bvh4;
+    ours.b8 = bvh8;
     ours.g = &sc->g;
+    on1[ENGINE_BVH8] = rs_bvh8_supported();
+    best = on1[ENGINE_BVH8] ? ENGINE_BVH8 : ENGINE_BVH4; /* what the CPU device runs */
+    onn[best] = 1;
+    for (e = 0; e < N_ENGINES; ++e)
+        ctxs[e] = &ours;
 #ifdef RS_HAVE_EMBREE
+    ctxs[ENGINE_EMBREE] = &es;
     if (st->embree) {
         if (sc->g.sphere_motion) {
             printf("\n(Embree left out on %s: it has moving spheres)\n", sc->label);
@@ -372,33 +401,29 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
                 goto out;
             }
             embree_build_s = rs_bench_now() - embree_build_s;
-            n_engines = 3;
+            embree = 1;
+            on1[ENGINE_EMBREE] = onn[ENGINE_EMBREE] = 1;
         }
     }
 #endif
     {
         uint32_t most =
             sets[BS_PRIMARY].n > sets[BS_DIFFUSE].n ? sets[BS_PRIMARY].n : sets[BS_DIFFUSE].n;
-        if (!answers_alloc(&ans[0], most) || !answers_alloc(&ans[1], most) ||
-            !answers_alloc(&ans[2], most)) {
-            fprintf(stderr, "traversal_bench: out of memory\n");
-            goto out;
-        }
+        for (e = 0; e < N_ENGINES; ++e)
+            if (!answers_alloc(&ans[e], most)) {
+                fprintf(stderr, "traversal_bench: out of memory\n");
+                goto out;
+            }
     }
 
     for (k = 0; k < BS_N_SETS; ++k)
         for (q = 0; q < 2; ++q) {
-            for (e = 0; e < n_engines; ++e) {
-                trace_fn f = e == ENGINE_BIN ? run_bin : run_bvh4;
-                const void *ctx = &ours;
-#ifdef RS_HAVE_EMBREE
-                if (e == ENGINE_EMBREE) {
-                    f = run_embree;
-                    ctx = &es;
-                }
-#endif
-                m[k][q][e][0] = mrays(f, ctx, &sets[k], q, 1, st->runs, &ans[e]);
-                m[k][q][e][1] = mrays(f, ctx, &sets[k], q, st->threads, st->runs, &ans[e]);
+            double r1[N_ENGINES], rn[N_ENGINES];
+            mrays(fns, ctxs, on1, &sets[k], q, 1, st->runs, ans, r1);
+            mrays(fns, ctxs, onn, &sets[k], q, st->threads, st->runs, ans, rn);
+            for (e = 0; e < N_ENGINES; ++e) {
+                m[k][q][e][0] = r1[e];
+                m[k][q][e][1] = rn[e];
             }
             {
                 uint32_t i, h = 0;
@@ -406,18 +431,18 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
                     h += q == Q_ANY ? ans[0].occluded[i] : ans[0].prim[i] != RS_NO_HIT;
                 hits[k][q] = h;
             }
-            {
-                uint32_t d = first_difference(&ans[ENGINE_BIN], &ans[ENGINE_BVH4], sets[k].n, q);
+            for (e = ENGINE_BVH4; e <= ENGINE_BVH8; ++e) {
+                uint32_t d = on1[e] ? first_difference(&ans[ENGINE_BIN], &ans[e], sets[k].n, q) : 0;
                 if (d) {
                     fprintf(stderr,
-                            "traversal_bench: %s: the binary and 4-wide kernels answer %s ray %u "
+                            "traversal_bench: %s: the binary and %s kernels answer %s ray %u "
                             "(%s) differently\n",
-                            sc->label, sets[k].name, d - 1, QNAME[q]);
+                            sc->label, ENAME[e], sets[k].name, d - 1, QNAME[q]);
                     goto out;
                 }
             }
-            if (n_engines == 3) {
-                bad[k][q] = disagreements(&ans[ENGINE_BVH4], &ans[ENGINE_EMBREE], sets[k].n, q);
+            if (embree) {
+                bad[k][q] = disagreements(&ans[best], &ans[ENGINE_EMBREE], sets[k].n, q);
                 if (bad[k][q] > sets[k].n / 1000) {
                     fprintf(stderr,
                             "traversal_bench: %s: Embree and raystream disagree on %u of %u %s "
@@ -431,39 +456,41 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     printf("\n### %s: %u primitives; %u primary rays (%ux%u), %u diffuse and %u shadow rays\n\n",
            sc->label, rs_geom_prim_count(&sc->g), sets[0].n, st->size, st->size, sets[1].n,
            sets[2].n);
-    printf("BVH %s: %u nodes, SAH cost %.2f, built in %.1f ms; 4-wide: %u nodes, depth %u (binary "
-           "%u)",
+    printf("BVH %s: %u nodes, SAH cost %.2f, built in %.1f ms; 4-wide: %u nodes, depth %u; 8-wide: "
+           "%u nodes, depth %u (binary %u)",
            st->bvh_name, bvh->n_nodes, rs_bvh_sah_cost(bvh), 1e3 * build_s, bvh4->n_nodes,
-           bvh4->depth, bvh->depth);
-    if (n_engines == 3)
+           bvh4->depth, bvh8->n_nodes, bvh8->depth, bvh->depth);
+    if (embree)
         printf("; Embree scene committed in %.1f ms", 1e3 * embree_build_s);
+    if (!on1[ENGINE_BVH8])
+        printf("; this CPU has no AVX2: the 8-wide kernel is left out");
     printf("\n\n");
-    printf("| rays | query | hit %% | binary Mrays/s 1 thr | binary %d thr | 4-wide 1 thr | 4-wide "
-           "%d thr | 4-wide vs binary 1 thr",
-           st->threads, st->threads);
-    if (n_engines == 3)
+    printf("| rays | query | hit %% | binary Mrays/s 1 thr | 4-wide 1 thr | 8-wide 1 thr | %s %d thr "
+           "| %s vs binary 1 thr",
+           ENAME[best], st->threads, ENAME[best]);
+    if (embree)
         printf(" | Embree 1 thr | Embree %d thr | ours/Embree 1 thr | ours/Embree %d thr | "
                "answers differ",
                st->threads, st->threads);
     printf(" |\n|---|---|---:|---:|---:|---:|---:|---:|%s\n",
-           n_engines == 3 ? "---:|---:|---:|---:|---:|" : "");
+           embree ? "---:|---:|---:|---:|---:|" : "");
     for (k = 0; k < BS_N_SETS; ++k)
         for (q = 0; q < 2; ++q) {
             double hp = sets[k].n ? 100.0 * hits[k][q] / sets[k].n : 0.0;
             printf("| %s | %s | %.1f | %.2f | %.2f | %.2f | %.2f | %.2fx", sets[k].name, QNAME[q],
-                   hp, m[k][q][ENGINE_BIN][0], m[k][q][ENGINE_BIN][1], m[k][q][ENGINE_BVH4][0],
-                   m[k][q][ENGINE_BVH4][1], m[k][q][ENGINE_BVH4][0] / m[k][q][ENGINE_BIN][0]);
-            if (n_engines == 3)
+                   hp, m[k][q][ENGINE_BIN][0], m[k][q][ENGINE_BVH4][0], m[k][q][ENGINE_BVH8][0],
+                   m[k][q][best][1], m[k][q][best][0] / m[k][q][ENGINE_BIN][0]);
+            if (embree)
                 printf(" | %.2f | %.2f | %.2fx | %.2fx | %u", m[k][q][ENGINE_EMBREE][0],
                        m[k][q][ENGINE_EMBREE][1],
-                       m[k][q][ENGINE_BVH4][0] / m[k][q][ENGINE_EMBREE][0],
-                       m[k][q][ENGINE_BVH4][1] / m[k][q][ENGINE_EMBREE][1], bad[k][q]);
+                       m[k][q][best][0] / m[k][q][ENGINE_EMBREE][0],
+                       m[k][q][best][1] / m[k][q][ENGINE_EMBREE][1], bad[k][q]);
             printf(" |\n");
             if (st->csv)
                 fprintf(st->csv, "%s,%s,%s,%s,%u,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u\n", sc->label,
-                        st->bvh_name, sets[k].name, QNAME[q], sets[k].n, m[k][q][0][0],
-                        m[k][q][0][1], m[k][q][1][0], m[k][q][1][1], m[k][q][2][0], m[k][q][2][1],
-                        bad[k][q]);
+                        st->bvh_name, sets[k].name, QNAME[q], sets[k].n, m[k][q][ENGINE_BIN][0],
+                        m[k][q][ENGINE_BVH4][0], m[k][q][ENGINE_BVH8][0], m[k][q][best][1],
+                        m[k][q][ENGINE_EMBREE][0], m[k][q][ENGINE_EMBREE][1], bad[k][q]);
         }
     ok = 1;
 out:
@@ -472,6 +499,7 @@ out:
 #endif
     for (e = 0; e < N_ENGINES; ++e)
         answers_free(&ans[e]);
+    rs_bvh8_destroy(bvh8);
     rs_bvh4_destroy(bvh4);
     rs_bvh_destroy(bvh);
     bs_rays_free(sets, BS_N_SETS);
@@ -541,8 +569,8 @@ int main(int argc, char **argv)
     }
     if (csv) {
         st.csv = rs_bench_csv_open("traversal_bench", csv,
-                                   "scene,bvh,rays,query,n,binary_mrays_1thr,binary_mrays_nthr,"
-                                   "bvh4_mrays_1thr,bvh4_mrays_nthr,embree_mrays_1thr,"
+                                   "scene,bvh,rays,query,n,binary_mrays_1thr,bvh4_mrays_1thr,"
+                                   "bvh8_mrays_1thr,cpu_kernel_mrays_nthr,embree_mrays_1thr,"
                                    "embree_mrays_nthr,answers_differ\n");
         if (!st.csv)
             return 1;
@@ -558,9 +586,9 @@ int main(int argc, char **argv)
 #else
     printf("Embree: not built in (install libembree-dev and re-run CMake to compare)\n");
 #endif
-    printf("settings: our BVH %s (max leaf 4); median of %d run%s; %d threads in the "
+    printf("settings: our BVH %s (max leaf 4, leaf cost in blocks of %u); median of %d run%s; %d threads in the "
            "multi-threaded columns (OpenMP, dynamic chunks of %d rays)\n",
-           st.bvh_name, st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
+           st.bvh_name, RS_BVH_LEAF_BLOCK_WIDE, st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
 
     if (n_scenes == 0) {
         const char *dir = bs_models_dir(models);

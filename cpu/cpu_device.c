@@ -1,5 +1,5 @@
 /* cpu/cpu_device.c — see cpu_device.h.  Borrows the host scene and BVH arrays (no copy); owns
- * only the 4-wide tree it collapses from the BVH.  Its megakernel is cpu/cpu_megakernel.c. */
+ * only the wide tree it collapses from the BVH.  Its megakernel is cpu/cpu_megakernel.c. */
 #include "cpu/cpu_device.h"
 
 #include <stdio.h>
@@ -15,8 +15,14 @@ static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     c->geom = *g;
     c->bvh = rs_bvh_view_of(bvh);
     rs_bvh4_destroy(c->bvh4);
+    rs_bvh8_destroy(c->bvh8);
     c->bvh4 = NULL;
-    if (c->width == 4 && g->aabb_algo == RS_ISECT_AABB_SLAB) {
+    c->bvh8 = NULL;
+    if (c->width == 8 && g->aabb_algo == RS_ISECT_AABB_SLAB) {
+        rs_status st = rs_bvh8_build(bvh, g, &c->bvh8);
+        if (st != RS_OK)
+            return st;
+    } else if (c->width == 4 && g->aabb_algo == RS_ISECT_AABB_SLAB) {
         rs_status st = rs_bvh4_build(bvh, g, &c->bvh4);
         if (st != RS_OK)
             return st;
@@ -36,6 +42,18 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
         return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
     threads = rs_cores_acquire(c->cores, d->threads);
     (void)threads; /* read only by the OpenMP clauses */
+    if (c->bvh8) {
+        /* the 8-wide kernel is a function of its own (compiled for AVX2): called on runs of
+         * 64 rays, 4 runs to a dynamic chunk as below */
+        long runs = ((long)(end - begin) + 63) / 64;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (threads > 1 && end - begin >= 512u)
+        for (i = 0; i < runs; ++i) {
+            uint32_t b0 = begin + (uint32_t)i * 64u;
+            rs_bvh8_trace(c->bvh8, g, batch, b0, end - b0 < 64u ? end : b0 + 64u);
+        }
+        rs_cores_release(c->cores, threads);
+        return RS_OK;
+    }
     /* dynamic schedule: ray costs vary a lot (a miss of the root box vs a deep traversal).
      * A chunk too small to feed every thread runs on the dispatch thread alone: waking a team
      * costs more than it saves. */
@@ -54,8 +72,10 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
 static void cpu_destroy(rs_device *d)
 {
     cpu_impl *c = (cpu_impl *)d->impl;
-    if (c)
+    if (c) {
         rs_bvh4_destroy(c->bvh4);
+        rs_bvh8_destroy(c->bvh8);
+    }
     rs_free(c);
     rs_free(d);
 }
@@ -86,12 +106,18 @@ rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out
         rs_free(c);
         return rs_error_set(RS_ERR_NOMEM, "out of memory creating the CPU device");
     }
-    if (o->bvh_width != 0 && o->bvh_width != 2 && o->bvh_width != 4) {
+    if (o->bvh_width != 0 && o->bvh_width != 2 && o->bvh_width != 4 && o->bvh_width != 8) {
         rs_free(d);
         rs_free(c);
-        return rs_error_set(RS_ERR_ARG, "BVH width %u: 2 or 4", o->bvh_width);
+        return rs_error_set(RS_ERR_ARG, "BVH width %u: 2, 4 or 8", o->bvh_width);
     }
-    c->width = o->bvh_width ? o->bvh_width : 4;
+    if (o->bvh_width == 8 && !rs_bvh8_supported()) {
+        rs_free(d);
+        rs_free(c);
+        return rs_error_set(RS_ERR_ARG, "BVH width 8 needs a CPU with AVX2 (this one has none; "
+                                        "use 4)");
+    }
+    c->width = o->bvh_width ? o->bvh_width : rs_bvh8_supported() ? 8 : 4;
     c->cores = o->cores;
     c->strategy = o->strategy;
     d->ops = &cpu_ops;

@@ -70,6 +70,7 @@ rs_status rs_cpu_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, 
     c.tracer.geom = impl->geom;
     c.tracer.bvh = impl->bvh;
     c.tracer.bvh4 = impl->bvh4;
+    c.tracer.bvh8 = impl->bvh8;
     c.s0 = s0;
     c.n = n;
     c.width = job->it->width;

@@ -3,12 +3,14 @@
 #define RS_CPU_INTERNAL_H
 
 #include "accel/bvh4.h"
+#include "accel/bvh8.h"
 #include "cpu/cpu_device.h"
 
 typedef struct cpu_impl {
     rs_geom geom; /* the caller's arrays, borrowed */
     rs_bvh_view bvh;
-    rs_bvh4 *bvh4; /* NULL: the binary kernel */
+    rs_bvh4 *bvh4; /* width 4 */
+    rs_bvh8 *bvh8; /* width 8 (AVX2); neither: the binary kernel */
     uint32_t width;
     rs_cores *cores;
     rs_par_strategy strategy;

@@ -87,6 +87,7 @@ rs_status rs_device_copy_scene(const rs_scene *s, const rs_device_geom *geom,
 #undef RS_TAKE_ARRAY
     out->tracer.bvh = geom->bvh;
     out->tracer.bvh4 = NULL;
+    out->tracer.bvh8 = NULL;
     return RS_OK;
 }
 

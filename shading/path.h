@@ -37,6 +37,7 @@
 #include "streams/paths.h"
 #if !defined(__CUDACC__)
 #  include "accel/bvh4.h" /* SSE: the host's megakernel may trace with the 4-wide BVH */
+#  include "accel/bvh8.h" /* or, with AVX2, the 8-wide one */
 #endif
 
 typedef enum rs_sampling {
@@ -463,11 +464,12 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
 }
 
 /* What a megakernel traces with: the binary BVH over `geom` (device pointers on the GPU), or on
- * the host the 4-wide one where `bvh4` is set. */
+ * the host the 8-wide one where `bvh8` is set, the 4-wide one where `bvh4` is. */
 typedef struct rs_path_tracer {
     rs_bvh_view bvh;
     rs_geom geom;
     const void *bvh4; /* const rs_bvh4 * (accel/bvh4.h), host only; NULL: the binary BVH */
+    const void *bvh8; /* const rs_bvh8 * (accel/bvh8.h), host only, AVX2; before bvh4 */
 } rs_path_tracer;
 
 /* Rays a megakernel traced. */
@@ -479,6 +481,10 @@ typedef struct rs_path_counts {
 RS_HD void rs_path_closest(const rs_path_tracer *tr, rs_ray r, rs_hit *h)
 {
 #if !defined(__CUDACC__)
+    if (tr->bvh8) {
+        rs_bvh8_closest((const rs_bvh8 *)tr->bvh8, &tr->geom, r, h);
+        return;
+    }
     if (tr->bvh4) {
         rs_bvh4_closest((const rs_bvh4 *)tr->bvh4, &tr->geom, r, h);
         return;
@@ -490,6 +496,8 @@ RS_HD void rs_path_closest(const rs_path_tracer *tr, rs_ray r, rs_hit *h)
 RS_HD int rs_path_occluded(const rs_path_tracer *tr, rs_ray r)
 {
 #if !defined(__CUDACC__)
+    if (tr->bvh8)
+        return rs_bvh8_occluded((const rs_bvh8 *)tr->bvh8, &tr->geom, r);
     if (tr->bvh4)
         return rs_bvh4_occluded((const rs_bvh4 *)tr->bvh4, &tr->geom, r);
 #endif

@@ -38,6 +38,7 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh4.h"
+#include "accel/bvh8.h"
 #include "core/alloc.h"
 
 #include "test_rand.h"
@@ -133,35 +134,96 @@ static rs_bvh *build(const rs_geom *g, uint32_t max_leaf)
     return b;
 }
 
+/* The binned SAH tree with leaf costs counted in blocks of `block` (what the CLI builds for the
+ * CPU's wide trees with block RS_BVH_LEAF_BLOCK_WIDE). */
+static rs_bvh *build_sah_blocks(const rs_geom *g, uint32_t max_leaf, uint32_t block)
+{
+    rs_bvh_build_opts o = {0};
+    rs_bvh *b = NULL;
+    rs_status st;
+    o.max_leaf = max_leaf;
+    o.builder.method = RS_BVH_SAH;
+    o.leaf_block = block;
+    st = rs_bvh_build(g, &o, &b);
+    if (st != RS_OK)
+        fail_msg("rs_bvh_build (sah, blocks of %u) failed: %d (%s)", block, (int)st,
+                 rs_error_message());
+    assert_non_null(b);
+    return b;
+}
+
 static void describe_ray(char *buf, size_t n, const rs_ray *r)
 {
     snprintf(buf, n, "o (%.9g %.9g %.9g) d (%.9g %.9g %.9g) t (%.9g, %.9g)", r->o.x, r->o.y, r->o.z,
              r->d.x, r->d.y, r->d.z, r->tmin, r->tmax);
 }
 
-/* The 4-wide tree of `b`, or a test failure. */
-static rs_bvh4 *collapse4(const rs_bvh *b, const rs_geom *g)
+/* The wide trees of a binary tree, what the CPU device runs: the 4-wide one and the 8-wide one
+ * (built anywhere; its AVX2 traversal is tested where the CPU has AVX2). */
+typedef struct wide {
+    rs_bvh4 *b4;
+    rs_bvh8 *b8;
+} wide;
+
+/* The wide trees of `b`, or a test failure. */
+static wide collapse(const rs_bvh *b, const rs_geom *g)
 {
-    rs_bvh4 *b4 = NULL;
-    rs_status st = rs_bvh4_build(b, g, &b4);
+    wide w = {NULL, NULL};
+    rs_status st = rs_bvh4_build(b, g, &w.b4);
     if (st != RS_OK)
         fail_msg("rs_bvh4_build failed: %d (%s)", (int)st, rs_error_message());
-    assert_non_null(b4);
-    return b4;
+    st = rs_bvh8_build(b, g, &w.b8);
+    if (st != RS_OK)
+        fail_msg("rs_bvh8_build failed: %d (%s)", (int)st, rs_error_message());
+    assert_non_null(w.b4);
+    assert_non_null(w.b8);
+    /* the same leaves, packed the same way */
+    assert_int_equal(w.b8->n_packed, w.b4->n_packed);
+    assert_int_equal(w.b8->n_tri4, w.b4->n_tri4);
+    return w;
 }
 
-/* Compares the queries of the binary tree and, if b4 is not NULL, of the 4-wide one against the
+static void wide_free(wide *w)
+{
+    rs_bvh4_destroy(w->b4);
+    rs_bvh8_destroy(w->b8);
+    w->b4 = NULL;
+    w->b8 = NULL;
+}
+
+/* Wide kernels to test: the 4-wide one (0) and, with AVX2, the 8-wide one (1). */
+static int n_wide_kernels(void)
+{
+    static int said = 0;
+    if (!rs_bvh8_supported() && !said++)
+        print_message("this CPU has no AVX2: the 8-wide traversal is not tested\n");
+    return rs_bvh8_supported() ? 2 : 1;
+}
+
+static const char *wide_name(int k) { return k ? "8-wide" : "4-wide"; }
+
+static int wide_closest(const wide *w, int k, const rs_geom *g, rs_ray r, rs_hit *h)
+{
+    return k ? rs_bvh8_closest(w->b8, g, r, h) : rs_bvh4_closest(w->b4, g, r, h);
+}
+
+static int wide_occluded(const wide *w, int k, const rs_geom *g, rs_ray r)
+{
+    return k ? rs_bvh8_occluded(w->b8, g, r) : rs_bvh4_occluded(w->b4, g, r);
+}
+
+/* Compares the queries of the binary tree and, if w is not NULL, of the wide ones against the
  * brute-force answer for ray r: the same hit bit for bit, and the same occlusion. */
-static void expect_same_hit(const rs_bvh *bvh, const rs_bvh4 *b4, const rs_geom *g, const rs_ray *r,
+static void expect_same_hit(const rs_bvh *bvh, const wide *w, const rs_geom *g, const rs_ray *r,
                             const rs_hit *ref, int ref_hit, const char *what, long index)
 {
-    static const char *const kernel[2] = {"binary", "4-wide"};
+    static const char *const kernel[3] = {"binary", "4-wide", "8-wide"};
     rs_bvh_view view = rs_bvh_view_of(bvh);
     int k;
-    for (k = 0; k < (b4 ? 2 : 1); ++k) {
+    for (k = 0; k < (w ? 1 + n_wide_kernels() : 1); ++k) {
         rs_hit h;
-        int got = k ? rs_bvh4_closest(b4, g, *r, &h) : rs_bvh_closest(&view, g, *r, &h);
-        int occ = k ? rs_bvh4_occluded(b4, g, *r) : rs_bvh_occluded(&view, g, *r);
+        int got = k ? wide_closest(w, k - 1, g, *r, &h) : rs_bvh_closest(&view, g, *r, &h);
+        int occ = k ? wide_occluded(w, k - 1, g, *r) : rs_bvh_occluded(&view, g, *r);
         char ray[256];
         if (got != ref_hit || h.prim != ref->prim ||
             (got && (h.t != ref->t || h.u != ref->u || h.v != ref->v))) {
@@ -415,21 +477,23 @@ static int brute_ties(const rs_geom *g, const rs_ray *r, const rs_hit *ref)
     return ties;
 }
 
-/* n rays (from the soup's generator, or the grid's when grid > 0) against brute force, for trees
- * with max_leaf 1, 4 and 8 and both kernels.  Returns the hits; *ties counts the rays whose
+/* n rays (from the soup's generator, or the grid's when grid > 0) against brute force, for median
+ * trees with max_leaf 1, 4 and 8 and the SAH tree with leaf costs in blocks of 4 (max_leaf 8), and
+ * every kernel.  Returns the hits; *ties counts the rays whose
  * closest t several primitives share. */
 static long check_vs_brute_force(const soup *s, const char *name, long n, uint32_t grid, long *ties)
 {
-    static const uint32_t leaf_sizes[] = {1, 4, 8};
-    rs_bvh *trees[3];
-    rs_bvh4 *wide[3];
+    static const uint32_t leaf_sizes[] = {1, 4, 8, 8};
+    rs_bvh *trees[4];
+    wide wides[4];
     uint64_t rs = 0xbeef;
     long i, hits = 0;
     size_t k;
     *ties = 0;
-    for (k = 0; k < 3; ++k) {
-        trees[k] = build(&s->g, leaf_sizes[k]);
-        wide[k] = collapse4(trees[k], &s->g);
+    for (k = 0; k < 4; ++k) {
+        trees[k] = k < 3 ? build(&s->g, leaf_sizes[k])
+                         : build_sah_blocks(&s->g, leaf_sizes[k], RS_BVH_LEAF_BLOCK_WIDE);
+        wides[k] = collapse(trees[k], &s->g);
     }
     for (i = 0; i < n; ++i) {
         rs_ray r = grid ? grid_ray(&rs, i, grid, s) : soup_ray(&rs, i);
@@ -438,14 +502,15 @@ static long check_vs_brute_force(const soup *s, const char *name, long n, uint32
         hits += ref_hit;
         if (ref_hit && grid)
             *ties += brute_ties(&s->g, &r, &ref) > 0;
-        for (k = 0; k < 3; ++k) {
+        for (k = 0; k < 4; ++k) {
             char what[64];
-            snprintf(what, sizeof what, "%s, max_leaf %u", name, leaf_sizes[k]);
-            expect_same_hit(trees[k], wide[k], &s->g, &r, &ref, ref_hit, what, i);
+            snprintf(what, sizeof what, "%s, %s max_leaf %u", name, k < 3 ? "median" : "sah blocks",
+                     leaf_sizes[k]);
+            expect_same_hit(trees[k], &wides[k], &s->g, &r, &ref, ref_hit, what, i);
         }
     }
-    for (k = 0; k < 3; ++k) {
-        rs_bvh4_destroy(wide[k]);
+    for (k = 0; k < 4; ++k) {
+        wide_free(&wides[k]);
         rs_bvh_destroy(trees[k]);
     }
     return hits;
@@ -475,17 +540,17 @@ static void test_shared_vertices_vs_brute_force(void **state)
     soup s;
     long hits, ties;
     rs_bvh *b;
-    rs_bvh4 *b4;
+    wide w;
     (void)state;
     soup_grid(&s, GRID, 0x9e1d);
-    /* a triangles-only scene: with Möller-Trumbore every 4-wide leaf is packed */
+    /* a triangles-only scene: with Möller-Trumbore every wide leaf is packed */
     b = build(&s.g, 4);
-    b4 = collapse4(b, &s.g);
+    w = collapse(b, &s.g);
 #ifdef RS_BVH4_SSE
-    assert_true(b4->n_packed > 0);
-    assert_true(b4->n_tri4 >= (s.g.n_tris + 3) / 4);
+    assert_true(w.b4->n_packed > 0);
+    assert_true(w.b4->n_tri4 >= (s.g.n_tris + 3) / 4);
 #endif
-    rs_bvh4_destroy(b4);
+    wide_free(&w);
     rs_bvh_destroy(b);
     hits = check_vs_brute_force(&s, "grid", N_RAYS, GRID, &ties);
     print_message("grid: %d rays, %ld hit, %ld at a t that several triangles share\n", N_RAYS, hits,
@@ -522,13 +587,17 @@ static void test_empty(void **state)
         assert_int_equal(rs_bvh_occluded(&v, &g, r), 0);
     }
     {
-        rs_bvh4 *b4 = collapse4(b, &g);
+        wide w = collapse(b, &g);
         rs_ray r = mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, 1), 0.0f, T_INF);
-        assert_int_equal(b4->n_nodes, 0);
-        assert_int_equal(rs_bvh4_closest(b4, &g, r, &h), 0);
-        assert_int_equal(h.prim, RS_NO_HIT);
-        assert_int_equal(rs_bvh4_occluded(b4, &g, r), 0);
-        rs_bvh4_destroy(b4);
+        int k;
+        assert_int_equal(w.b4->n_nodes, 0);
+        assert_int_equal(w.b8->n_nodes, 0);
+        for (k = 0; k < n_wide_kernels(); ++k) {
+            assert_int_equal(wide_closest(&w, k, &g, r, &h), 0);
+            assert_int_equal(h.prim, RS_NO_HIT);
+            assert_int_equal(wide_occluded(&w, k, &g, r), 0);
+        }
+        wide_free(&w);
     }
     rs_bvh_destroy(b);
 }
@@ -573,19 +642,24 @@ static void test_single_primitive(void **state)
         assert_int_equal(
             rs_bvh_occluded(&v, &s.g, mk_ray(rs_v3(5, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF)), 0);
         {
-            /* a tree that is one leaf: a 4-wide root with one leaf lane */
-            rs_bvh4 *b4 = collapse4(b, &s.g);
-            rs_ray down = mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF);
-            assert_int_equal(b4->n_nodes, 1);
-            assert_int_equal(b4->nodes[0].n_lanes, 1);
-            assert_int_equal(rs_bvh4_closest(b4, &s.g, down, &h), 1);
-            assert_int_equal(h.prim, 0);
-            assert_true(h.t == (kind == 0 ? 4.0f : 5.0f));
-            assert_int_equal(rs_bvh4_occluded(b4, &s.g, down), 1);
-            down.tmax = 3.5f;
-            assert_int_equal(rs_bvh4_closest(b4, &s.g, down, &h), 0);
-            assert_int_equal(rs_bvh4_occluded(b4, &s.g, down), 0);
-            rs_bvh4_destroy(b4);
+            /* a tree that is one leaf: a wide root with one leaf lane */
+            wide w = collapse(b, &s.g);
+            int k;
+            assert_int_equal(w.b4->n_nodes, 1);
+            assert_int_equal(w.b4->nodes[0].n_lanes, 1);
+            assert_int_equal(w.b8->n_nodes, 1);
+            assert_int_equal(w.b8->nodes[0].n_lanes, 1);
+            for (k = 0; k < n_wide_kernels(); ++k) {
+                rs_ray down = mk_ray(rs_v3(0, 0, 0), rs_v3(0, 0, -1), 0.0f, T_INF);
+                assert_int_equal(wide_closest(&w, k, &s.g, down, &h), 1);
+                assert_int_equal(h.prim, 0);
+                assert_true(h.t == (kind == 0 ? 4.0f : 5.0f));
+                assert_int_equal(wide_occluded(&w, k, &s.g, down), 1);
+                down.tmax = 3.5f;
+                assert_int_equal(wide_closest(&w, k, &s.g, down, &h), 0);
+                assert_int_equal(wide_occluded(&w, k, &s.g, down), 0);
+            }
+            wide_free(&w);
         }
         rs_bvh_destroy(b);
         soup_free(&s);
@@ -613,7 +687,7 @@ static void test_identical_centroids(void **state)
     }
     for (k = 0; k < 3; ++k) {
         rs_bvh *b = build(&s.g, leaf_sizes[k]);
-        rs_bvh4 *b4 = collapse4(b, &s.g);
+        wide w = collapse(b, &s.g);
         check_structure(b, &s.g, leaf_sizes[k]);
         for (j = 0; j < 5000; ++j) {
             rs_ray r = mk_ray(rs_v3_add(c, rnd_box(&seed, 12.0f)), rnd_unit(&seed), 0.0f, T_INF);
@@ -622,9 +696,9 @@ static void test_identical_centroids(void **state)
             if (j % 2)
                 r.d = rs_v3_sub(rs_v3_add(c, rnd_box(&seed, 2.0f)), r.o);
             ref_hit = brute_closest(&s.g, &r, &ref);
-            expect_same_hit(b, b4, &s.g, &r, &ref, ref_hit, "identical centroids", j);
+            expect_same_hit(b, &w, &s.g, &r, &ref, ref_hit, "identical centroids", j);
         }
-        rs_bvh4_destroy(b4);
+        wide_free(&w);
         rs_bvh_destroy(b);
     }
     soup_free(&s);
@@ -648,14 +722,14 @@ static void test_nan_inf_rays_terminate(void **state)
     const int n_special = (int)(sizeof specials / sizeof specials[0]);
     soup s;
     rs_bvh *b;
-    rs_bvh4 *b4;
+    wide w;
     rs_bvh_view v;
     uint64_t seed = 0x7a7;
     int a, c, e, f, n = 0;
     (void)state;
     soup_random(&s, 0x5eed);
     b = build(&s.g, 0);
-    b4 = collapse4(b, &s.g);
+    w = collapse(b, &s.g);
     v = rs_bvh_view_of(b);
     signal(SIGALRM, on_alarm);
     alarm(20);
@@ -669,25 +743,26 @@ static void test_nan_inf_rays_terminate(void **state)
                     rs_hit h;
                     int hit = rs_bvh_closest(&v, &s.g, r, &h);
                     int occ = rs_bvh_occluded(&v, &s.g, r);
-                    rs_hit h4;
-                    int hit4 = rs_bvh4_closest(b4, &s.g, r, &h4);
-                    int occ4 = rs_bvh4_occluded(b4, &s.g, r);
+                    int k;
                     assert_true(hit == 0 || hit == 1);
                     assert_true(occ == 0 || occ == 1);
                     if (hit)
                         assert_true(h.prim < rs_geom_prim_count(&s.g));
                     else
                         assert_int_equal(h.prim, RS_NO_HIT);
-                    /* the 4-wide kernel: the same answer, whatever it is */
-                    assert_int_equal(hit4, hit);
-                    assert_int_equal(occ4, occ);
-                    assert_int_equal(h4.prim, h.prim);
+                    /* the wide kernels: the same answer, whatever it is */
+                    for (k = 0; k < n_wide_kernels(); ++k) {
+                        rs_hit hw;
+                        assert_int_equal(wide_closest(&w, k, &s.g, r, &hw), hit);
+                        assert_int_equal(wide_occluded(&w, k, &s.g, r), occ);
+                        assert_int_equal(hw.prim, h.prim);
+                    }
                     ++n;
                 }
     alarm(0);
     signal(SIGALRM, SIG_DFL);
     print_message("%d NaN/Inf rays returned\n", n);
-    rs_bvh4_destroy(b4);
+    wide_free(&w);
     rs_bvh_destroy(b);
     soup_free(&s);
 }
@@ -740,27 +815,30 @@ static void test_ray_in_bounding_plane(void **state)
     if (!rs_bvh_occluded(&v, &s.g, r))
         ++failures, print_message("ray in the plane x = 0 along -y: not occluded\n");
     {
-        /* the 4-wide kernel on both rays */
-        rs_bvh4 *b4 = collapse4(b, &s.g);
+        /* the wide kernels on both rays */
+        wide w = collapse(b, &s.g);
         rs_ray rays[2];
-        int k;
+        int k, kw;
         rays[0] = mk_ray(rs_v3(0, 0, -5), rs_v3(0, 0, 1), 0.0f, T_INF);
         rays[1] = mk_ray(rs_v3(0, 2, 2), rs_v3(0, -2, 0), 0.0f, T_INF);
-        for (k = 0; k < 2; ++k) {
-            brute_closest(&s.g, &rays[k], &ref);
-            if (!rs_bvh4_closest(b4, &s.g, rays[k], &h) || h.prim != ref.prim || h.t != ref.t)
-                ++failures, print_message("4-wide, ray %d in the plane x = 0: prim %u t %g, "
-                                          "brute force prim %u t %g\n",
-                                          k, h.prim, h.t, ref.prim, ref.t);
-            if (!rs_bvh4_occluded(b4, &s.g, rays[k]))
-                ++failures, print_message("4-wide, ray %d in the plane x = 0: not occluded\n", k);
-        }
-        rs_bvh4_destroy(b4);
+        for (kw = 0; kw < n_wide_kernels(); ++kw)
+            for (k = 0; k < 2; ++k) {
+                brute_closest(&s.g, &rays[k], &ref);
+                if (!wide_closest(&w, kw, &s.g, rays[k], &h) || h.prim != ref.prim ||
+                    h.t != ref.t)
+                    ++failures, print_message("%s, ray %d in the plane x = 0: prim %u t %g, "
+                                              "brute force prim %u t %g\n",
+                                              wide_name(kw), k, h.prim, h.t, ref.prim, ref.t);
+                if (!wide_occluded(&w, kw, &s.g, rays[k]))
+                    ++failures, print_message("%s, ray %d in the plane x = 0: not occluded\n",
+                                              wide_name(kw), k);
+            }
+        wide_free(&w);
     }
     rs_bvh_destroy(b);
     soup_free(&s);
     if (failures)
-        fail_msg("%d of 8 queries along the scene's bounding plane disagree with brute force",
+        fail_msg("%d queries along the scene's bounding plane disagree with brute force",
                  failures);
 }
 
@@ -812,6 +890,26 @@ static void test_build_out_of_memory(void **state)
             } else {
                 assert_int_equal(st, RS_ERR_NOMEM);
                 assert_null(b4);
+            }
+        }
+        rs_error_clear();
+        assert_true(succeeded);
+        assert_true(k > 1);
+        /* and to 8-wide nodes */
+        for (succeeded = 0, k = 0; k < 8 && !succeeded; ++k) {
+            rs_bvh8 *b8 = (rs_bvh8 *)(uintptr_t)1;
+            rs_status st;
+            rs_alloc_fail_after(k);
+            st = rs_bvh8_build(b, &s.g, &b8);
+            rs_alloc_fail_after(-1);
+            if (st == RS_OK) {
+                assert_non_null(b8);
+                assert_true(b8->n_nodes >= 1 && b8->depth <= b->depth);
+                rs_bvh8_destroy(b8);
+                succeeded = 1;
+            } else {
+                assert_int_equal(st, RS_ERR_NOMEM);
+                assert_null(b8);
             }
         }
         rs_error_clear();

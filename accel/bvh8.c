@@ -1,0 +1,112 @@
+/* accel/bvh8.c — collapsing a binary BVH into the 8-wide one (see accel/bvh8.h), and whether
+ * its AVX2 traversal (accel/bvh8_avx2.c) can run here. */
+#include "accel/bvh8.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "accel/internal.h"
+#include "core/alloc.h"
+
+typedef struct collapse {
+    const rs_bvh *bin;
+    rs_bvh8 *out;
+    rs_tri4_packer pk;
+    uint32_t cap;
+} collapse;
+
+/* Fills 8-wide node `dst` from binary node `src` and recurses into its interior lanes, as
+ * accel/bvh4.c does for four.  Unused lanes get an empty box (lo +inf, hi -inf), which no ray
+ * enters.  Returns the depth below, in nodes. */
+static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
+{
+    const rs_bvh_node *bn = c->bin->nodes;
+    uint32_t lanes[8], n = rs_bvh_wide_lanes(bn, src, 8, lanes), i, a, depth = 0;
+    rs_bvh8_node *d = &c->out->nodes[dst];
+    memset(d, 0, sizeof *d);
+    d->n_lanes = n;
+    for (i = 0; i < 8; ++i)
+        for (a = 0; a < 3; ++a) {
+            d->b[a][i] = INFINITY;
+            d->b[a + 3][i] = -INFINITY;
+        }
+    for (i = 0; i < n; ++i) {
+        const rs_bvh_node *l = &bn[lanes[i]];
+        d->b[0][i] = l->lo.x;
+        d->b[1][i] = l->lo.y;
+        d->b[2][i] = l->lo.z;
+        d->b[3][i] = l->hi.x;
+        d->b[4][i] = l->hi.y;
+        d->b[5][i] = l->hi.z;
+        d->count[i] = (uint16_t)l->count;
+        d->child[i] = l->left_first; /* a leaf's first entry; interior lanes below */
+        if (l->count > 0 && rs_tri4_packable(&c->pk, l)) {
+            d->child[i] = rs_tri4_pack(&c->pk, l);
+            d->count[i] = (uint16_t)(RS_BVH4_PACKED | (l->count + 3) / 4);
+            c->out->n_packed++;
+        }
+    }
+    for (i = 0; i < n; ++i) {
+        if (bn[lanes[i]].count == 0) {
+            uint32_t child = c->out->n_nodes++, below;
+            RS_ASSERT(child < c->cap);
+            c->out->nodes[dst].child[i] = child;
+            below = collapse_node(c, lanes[i], child);
+            if (below > depth)
+                depth = below;
+        }
+    }
+    return depth + 1;
+}
+
+rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out)
+{
+    rs_bvh8 *t;
+    collapse c;
+    rs_status st;
+    *out = NULL;
+    memset(&c, 0, sizeof c);
+    c.bin = b;
+    rs_tri4_packer_init(&c.pk, b, g);
+    st = rs_bvh_wide_plan(b, &c.pk, "8-wide BVH", RS_BVH8_MAX_NODES, &c.cap);
+    if (st != RS_OK)
+        return st;
+    t = (rs_bvh8 *)rs_calloc(1, sizeof *t);
+    if (!t)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for the 8-wide BVH");
+    t->prim_ids = b->prim_ids;
+    if (c.cap > 0) {
+        t->nodes = (rs_bvh8_node *)rs_alloc_aligned(c.cap, sizeof *t->nodes);
+        if (c.pk.cap_tri4 > 0)
+            t->tri4 = (rs_bvh4_tri4 *)rs_alloc_aligned(c.pk.cap_tri4, sizeof *t->tri4);
+        if (!t->nodes || (c.pk.cap_tri4 > 0 && !t->tri4)) {
+            rs_bvh8_destroy(t);
+            return rs_error_set(RS_ERR_NOMEM, "out of memory for the 8-wide BVH (%u nodes)", c.cap);
+        }
+        c.out = t;
+        c.pk.tri4 = t->tri4;
+        t->n_nodes = 1;
+        t->depth = collapse_node(&c, 0, 0);
+        t->n_tri4 = c.pk.n_tri4;
+    }
+    *out = t;
+    return RS_OK;
+}
+
+void rs_bvh8_destroy(rs_bvh8 *b)
+{
+    if (!b)
+        return;
+    rs_free(b->nodes);
+    rs_free(b->tri4);
+    rs_free(b);
+}
+
+int rs_bvh8_supported(void)
+{
+#if defined(__x86_64__) && defined(__GNUC__) && defined(RS_BVH4_SSE)
+    return __builtin_cpu_supports("avx2");
+#else
+    return 0;
+#endif
+}

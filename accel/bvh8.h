@@ -1,0 +1,80 @@
+/* accel/bvh8.h — the CPU's 8-wide BVH: the binary tree collapsed so that each node holds up to
+ * eight children's boxes side by side, tested against one ray with AVX2 (Embree's BVH8; Wald et
+ * al. 2014).  Host only, like the 4-wide tree (accel/bvh4.h) it extends: the CUDA kernels and the
+ * GPU fallback keep the binary tree.  The traversal (accel/bvh8_avx2.c) is compiled for AVX2 alone
+ * and chosen at run time: rs_bvh8_supported() says whether this machine and build can run it;
+ * where it cannot, the CPU device uses the 4-wide tree.
+ *
+ * Same answers as the binary and 4-wide traversals, bit for bit, for the reasons accel/bvh4.h
+ * gives: the nodes hold the binary tree's own boxes, the leaves its primitive ranges (triangle
+ * leaves packed into the 4-wide tree's tri4 blocks and tested by the same SSE code), and the
+ * closest hit follows rs_hit_better.  The box test picks each axis's near and far plane by the sign
+ * of the ray's direction instead of taking min / max of the two slab distances: for a finite
+ * 1 / d the rounded (bound - o) * (1 / d) is monotone in the bound, so the near plane's distance
+ * is exactly the min the slab test takes and the far plane's the max, and each box passes exactly
+ * when rs_bvh_slab passes it.  Rays with a zero (or NaN, or denormal) direction component, whose
+ * 1 / d is not finite, take the slab test's min / max form with its NaN rule.
+ *
+ * Node layout (256 bytes, four cache lines, 64-byte aligned):
+ *   b[6][8]     the children's boxes by plane: lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of all eight
+ *               lanes (so the near plane of axis a is row a or a + 3)
+ *   child[8]    interior lane: index of the child node; leaf lane: first prim_ids entry, or for a
+ *               packed leaf the first of its tri4 blocks
+ *   count[8]    0 for an interior lane, else the leaf's primitive count, or for a packed leaf
+ *               RS_BVH4_PACKED | its number of tri4 blocks
+ *   n_lanes     lanes in use (1 to 8), packed from lane 0; unused lanes hold an empty box */
+#ifndef RS_ACCEL_BVH8_H
+#define RS_ACCEL_BVH8_H
+
+#include "accel/bvh4.h"
+
+typedef struct rs_bvh8_node {
+    float b[6][8];
+    uint32_t child[8];
+    uint16_t count[8];
+    uint32_t n_lanes;
+    uint32_t pad_[3];
+} rs_bvh8_node;
+
+typedef struct rs_bvh8 {
+    rs_bvh8_node *nodes;      /* node 0 is the root; none for an empty scene */
+    rs_bvh4_tri4 *tri4;       /* the packed leaves' triangles */
+    const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
+    uint32_t n_nodes, n_tri4;
+    uint32_t depth;    /* in nodes; at most the binary tree's */
+    uint32_t n_packed; /* leaves packed as tri4 blocks */
+} rs_bvh8;
+
+/* A traversal stack entry: an interior node's index, or RS_BVH8_LEAF | node << 3 | lane. */
+#define RS_BVH8_LEAF      0x80000000u
+#define RS_BVH8_MAX_NODES (1u << 28)
+/* Each level pushes at most 7 entries (closest) or 8 (any hit). */
+#define RS_BVH8_STACK (8 * RS_BVH_STACK)
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* Collapses `b`, built over `g`, into an 8-wide tree (each node opens the interior child of
+ * largest surface area until it has eight; triangle leaves packed as rs_bvh4_build packs them).
+ * RS_ERR_ARG for a leaf of more than 32767 primitives or a tree of more than 2^28 nodes,
+ * RS_ERR_NOMEM when memory runs out (*out is NULL then).  Builds on any machine. */
+rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out);
+void rs_bvh8_destroy(rs_bvh8 *b);
+
+/* Whether the traversal below can run here: built for x86-64 with GCC or Clang, and the CPU has
+ * AVX2.  The functions below must not be called where it says 0. */
+int rs_bvh8_supported(void);
+
+/* Closest hit, as rs_bvh_closest (1 and *hit on a hit, else hit->prim = RS_NO_HIT and 0), and any
+ * hit inside (tmin, tmax), as rs_bvh_occluded. */
+int rs_bvh8_closest(const rs_bvh8 *b, const rs_geom *g, rs_ray ray, rs_hit *hit);
+int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray);
+
+/* rs_trace_one (accel/trace.h) on rays [begin, end) of `batch`. */
+void rs_bvh8_trace(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
+                   uint32_t begin, uint32_t end);
+#ifdef __cplusplus
+}
+#endif
+
+#endif
