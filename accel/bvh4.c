@@ -9,7 +9,7 @@
 typedef struct collapse {
     const rs_bvh *bin;
     rs_bvh4 *out;
-    rs_tri4_packer pk;
+    rs_leaf_packer pk;
     uint32_t cap;
 } collapse;
 
@@ -30,13 +30,10 @@ static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
         d->hi[0][i] = l->hi.x;
         d->hi[1][i] = l->hi.y;
         d->hi[2][i] = l->hi.z;
-        d->count[i] = (uint16_t)l->count;
-        d->child[i] = l->left_first; /* a leaf's first entry; interior lanes below */
-        if (l->count > 0 && rs_tri4_packable(&c->pk, l)) {
-            d->child[i] = rs_tri4_pack(&c->pk, l);
-            d->count[i] = (uint16_t)(RS_BVH4_PACKED | (l->count + 3) / 4);
-            c->out->n_packed++;
-        }
+        d->count[i] = 0;
+        d->child[i] = 0; /* interior lanes: set below */
+        if (l->count > 0)
+            c->out->n_packed += (uint32_t)rs_leaf_lane(&c->pk, l, &d->child[i], &d->count[i]);
     }
     for (i = 0; i < n; ++i) {
         if (bn[lanes[i]].count == 0) {
@@ -59,7 +56,7 @@ rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)
     *out = NULL;
     memset(&c, 0, sizeof c);
     c.bin = b;
-    rs_tri4_packer_init(&c.pk, b, g);
+    rs_leaf_packer_init(&c.pk, b, g);
     st = rs_bvh_wide_plan(b, &c.pk, "4-wide BVH", RS_BVH4_MAX_NODES, &c.cap);
     if (st != RS_OK)
         return st;
@@ -71,15 +68,19 @@ rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)
         t->nodes = (rs_bvh4_node *)rs_alloc_aligned(c.cap, sizeof *t->nodes);
         if (c.pk.cap_tri4 > 0)
             t->tri4 = (rs_bvh4_tri4 *)rs_alloc_aligned(c.pk.cap_tri4, sizeof *t->tri4);
-        if (!t->nodes || (c.pk.cap_tri4 > 0 && !t->tri4)) {
+        if (c.pk.cap_quad4 > 0)
+            t->quad4 = (rs_bvh4_quad4 *)rs_alloc_aligned(c.pk.cap_quad4, sizeof *t->quad4);
+        if (!t->nodes || (c.pk.cap_tri4 > 0 && !t->tri4) || (c.pk.cap_quad4 > 0 && !t->quad4)) {
             rs_bvh4_destroy(t);
             return rs_error_set(RS_ERR_NOMEM, "out of memory for the 4-wide BVH (%u nodes)", c.cap);
         }
         c.out = t;
         c.pk.tri4 = t->tri4;
+        c.pk.quad4 = t->quad4;
         t->n_nodes = 1;
         t->depth = collapse_node(&c, 0, 0);
         t->n_tri4 = c.pk.n_tri4;
+        t->n_quad4 = c.pk.n_quad4;
     }
     *out = t;
     return RS_OK;
@@ -91,5 +92,6 @@ void rs_bvh4_destroy(rs_bvh4 *b)
         return;
     rs_free(b->nodes);
     rs_free(b->tri4);
+    rs_free(b->quad4);
     rs_free(b);
 }

@@ -14,15 +14,17 @@
  * Node layout (128 bytes, two cache lines, 64-byte aligned):
  *   lo[3][4], hi[3][4]  the children's boxes, axis-major (x of all four lanes, then y, then z)
  *   child[4]            interior lane: index of the child node; leaf lane: first prim_ids entry,
- *                       or for a packed leaf the first of its tri4 blocks
+ *                       or for a packed leaf the first of its tri4 or quad4 blocks
  *   count[4]            0 for an interior lane, else the leaf's primitive count, or for a packed
- *                       leaf RS_BVH4_PACKED | its number of tri4 blocks
+ *                       leaf RS_BVH4_PACKED | its number of blocks, with RS_BVH4_QUADS for quad4
  *   n_lanes             lanes in use (1 to 4), packed from lane 0
  *
- * Packed leaves (SSE builds, Möller-Trumbore geometry): a leaf of triangles only keeps copies of
- * them, four to a block, as v0 and the edges e1 = v1 - v0, e2 = v2 - v0 side by side, and tests
- * the four at once with the scalar rs_isect_tri's operations in its order (unused lanes are all
- * zero: det = 0, never a hit), so that t, u and v come out the same bit for bit. */
+ * Packed leaves (SSE builds): a leaf of triangles only (with Möller-Trumbore geometry) keeps
+ * copies of them, four to a block, as v0 and the edges e1 = v1 - v0, e2 = v2 - v0 side by side,
+ * and tests the four at once with the scalar rs_isect_tri's operations in its order (unused lanes
+ * are all zero: det = 0, never a hit); a leaf of parallelograms only keeps their q, u, v, w the
+ * same way and repeats rs_isect_quad (unused lanes: w = 0, denominator 0, never a hit).  So t, u
+ * and v come out the same bit for bit. */
 #ifndef RS_ACCEL_BVH4_H
 #define RS_ACCEL_BVH4_H
 
@@ -48,19 +50,27 @@ typedef struct rs_bvh4_tri4 {
     uint32_t prim[4]; /* global primitive numbers; RS_NO_HIT in unused lanes */
 } rs_bvh4_tri4;
 
+typedef struct rs_bvh4_quad4 {
+    float q[3][4], u[3][4], v[3][4], w[3][4];
+    uint32_t prim[4]; /* global primitive numbers; RS_NO_HIT in unused lanes */
+} rs_bvh4_quad4;
+
 typedef struct rs_bvh4 {
     rs_bvh4_node *nodes;      /* node 0 is the root; none for an empty scene */
     rs_bvh4_tri4 *tri4;       /* the packed leaves' triangles */
+    rs_bvh4_quad4 *quad4;     /* the packed leaves' parallelograms */
     const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
-    uint32_t n_nodes, n_tri4;
+    uint32_t n_nodes, n_tri4, n_quad4;
     uint32_t depth;    /* in nodes; at most the binary tree's */
-    uint32_t n_packed; /* leaves packed as tri4 blocks */
+    uint32_t n_packed; /* leaves packed as tri4 or quad4 blocks */
 } rs_bvh4;
 
 /* A traversal stack entry refers to an interior node (its index) or to one leaf lane of a node
  * (RS_BVH4_LEAF | node << 2 | lane). */
 #define RS_BVH4_LEAF      0x80000000u
 #define RS_BVH4_PACKED    0x8000u
+#define RS_BVH4_QUADS     0x4000u /* with RS_BVH4_PACKED: the blocks are quad4 */
+#define RS_BVH4_BLOCKS    0x3fffu /* a packed count's number of blocks (at most 8192) */
 #define RS_BVH4_MAX_NODES (1u << 29)
 /* Each level of the tree pushes at most 3 entries (closest) or 4 (any hit), and the tree is at
  * most RS_BVH_MAX_DEPTH deep. */
@@ -71,7 +81,8 @@ extern "C" {
 #endif
 /* Collapses `b`, built over `g`, into a 4-wide tree: each node takes its binary node's two
  * children and then keeps opening the interior child of largest surface area until it has four;
- * leaves of triangles are packed when g->tri_algo is Möller-Trumbore.  RS_ERR_ARG for a leaf of
+ * leaves of triangles are packed when g->tri_algo is Möller-Trumbore, leaves of parallelograms
+ * always (SSE builds).  RS_ERR_ARG for a leaf of
  * more than 32767 primitives or a tree of more than 2^29 nodes, RS_ERR_NOMEM when memory runs out
  * (*out is NULL then). */
 rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out);
@@ -205,6 +216,104 @@ static inline uint32_t rs_bvh4_tri4_hit(const rs_bvh4_tri4 *b, const rs_bvh4_ray
 }
 #endif
 
+#ifdef RS_BVH4_SSE
+/* rs_isect_quad on the four parallelograms of a block: the mask of lanes hit inside (tmin, tmax),
+ * and their t and planar coordinates a, b. */
+static inline uint32_t rs_bvh4_quad4_hit(const rs_bvh4_quad4 *b, const rs_bvh4_ray *r, float tmin,
+                                         float tmax, float t[4], float a[4], float bb[4])
+{
+#  define RS_LD(x) _mm_load_ps(x)
+    __m128 wx = RS_LD(b->w[0]), wy = RS_LD(b->w[1]), wz = RS_LD(b->w[2]);
+    __m128 qx = RS_LD(b->q[0]), qy = RS_LD(b->q[1]), qz = RS_LD(b->q[2]);
+    __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    /* denom = w . d, t = w . (q - o) / denom */
+    __m128 denom = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, r->d[0]), _mm_mul_ps(wy, r->d[1])),
+                              _mm_mul_ps(wz, r->d[2]));
+    __m128 num = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, _mm_sub_ps(qx, r->o[0])),
+                                       _mm_mul_ps(wy, _mm_sub_ps(qy, r->o[1]))),
+                            _mm_mul_ps(wz, _mm_sub_ps(qz, r->o[2])));
+    __m128 tt = _mm_div_ps(num, denom);
+    __m128 ok = _mm_and_ps(_mm_cmpneq_ps(denom, zero),
+                           _mm_and_ps(_mm_cmpgt_ps(tt, _mm_set1_ps(tmin)),
+                                      _mm_cmplt_ps(tt, _mm_set1_ps(tmax))));
+    if (_mm_movemask_ps(ok) == 0)
+        return 0;
+    {
+        /* ph = (o + d t) - q; alpha = w . (ph x v), beta = w . (u x ph) */
+        __m128 ux = RS_LD(b->u[0]), uy = RS_LD(b->u[1]), uz = RS_LD(b->u[2]);
+        __m128 vx = RS_LD(b->v[0]), vy = RS_LD(b->v[1]), vz = RS_LD(b->v[2]);
+        __m128 hx = _mm_sub_ps(_mm_add_ps(r->o[0], _mm_mul_ps(r->d[0], tt)), qx);
+        __m128 hy = _mm_sub_ps(_mm_add_ps(r->o[1], _mm_mul_ps(r->d[1], tt)), qy);
+        __m128 hz = _mm_sub_ps(_mm_add_ps(r->o[2], _mm_mul_ps(r->d[2], tt)), qz);
+        __m128 cx = _mm_sub_ps(_mm_mul_ps(hy, vz), _mm_mul_ps(hz, vy));
+        __m128 cy = _mm_sub_ps(_mm_mul_ps(hz, vx), _mm_mul_ps(hx, vz));
+        __m128 cz = _mm_sub_ps(_mm_mul_ps(hx, vy), _mm_mul_ps(hy, vx));
+        __m128 al = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, cx), _mm_mul_ps(wy, cy)),
+                               _mm_mul_ps(wz, cz));
+        __m128 dx = _mm_sub_ps(_mm_mul_ps(uy, hz), _mm_mul_ps(uz, hy));
+        __m128 dy = _mm_sub_ps(_mm_mul_ps(uz, hx), _mm_mul_ps(ux, hz));
+        __m128 dz = _mm_sub_ps(_mm_mul_ps(ux, hy), _mm_mul_ps(uy, hx));
+        __m128 be = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, dx), _mm_mul_ps(wy, dy)),
+                               _mm_mul_ps(wz, dz));
+        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(al, zero), _mm_cmple_ps(al, one)));
+        ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpge_ps(be, zero), _mm_cmple_ps(be, one)));
+        _mm_storeu_ps(t, tt);
+        _mm_storeu_ps(a, al);
+        _mm_storeu_ps(bb, be);
+    }
+#  undef RS_LD
+    return (uint32_t)_mm_movemask_ps(ok);
+}
+
+/* A packed leaf (`count` has RS_BVH4_PACKED) for closest hit: each block's hits taken as
+ * rs_bvh_leaf_closest takes them (rs_hit_better; the ray cut just past the best). */
+static inline void rs_bvh4_packed_closest(const rs_bvh4_tri4 *tri4, const rs_bvh4_quad4 *quad4,
+                                          uint32_t first, uint32_t count, const rs_bvh4_ray *r,
+                                          rs_ray *ray, rs_hit *hit)
+{
+    uint32_t i, n = count & RS_BVH4_BLOCKS;
+    for (i = 0; i < n; ++i) {
+        float t[4], u[4], v[4];
+        const uint32_t *prim;
+        uint32_t m;
+        if (count & RS_BVH4_QUADS) {
+            m = rs_bvh4_quad4_hit(&quad4[first + i], r, ray->tmin, ray->tmax, t, u, v);
+            prim = quad4[first + i].prim;
+        } else {
+            m = rs_bvh4_tri4_hit(&tri4[first + i], r, ray->tmin, ray->tmax, t, u, v);
+            prim = tri4[first + i].prim;
+        }
+        while (m) {
+            uint32_t l = (uint32_t)__builtin_ctz(m);
+            m &= m - 1;
+            if (rs_hit_better(t[l], prim[l], hit)) {
+                ray->tmax = rs_float_next_up(t[l]);
+                hit->t = t[l];
+                hit->u = u[l];
+                hit->v = v[l];
+                hit->prim = prim[l];
+            }
+        }
+    }
+}
+
+/* A packed leaf for any hit: 1 when some primitive is hit inside (tmin, tmax). */
+static inline int rs_bvh4_packed_occluded(const rs_bvh4_tri4 *tri4, const rs_bvh4_quad4 *quad4,
+                                          uint32_t first, uint32_t count, const rs_bvh4_ray *r,
+                                          const rs_ray *ray)
+{
+    uint32_t i, n = count & RS_BVH4_BLOCKS;
+    for (i = 0; i < n; ++i) {
+        float t[4], u[4], v[4];
+        if (count & RS_BVH4_QUADS
+                ? rs_bvh4_quad4_hit(&quad4[first + i], r, ray->tmin, ray->tmax, t, u, v)
+                : rs_bvh4_tri4_hit(&tri4[first + i], r, ray->tmin, ray->tmax, t, u, v))
+            return 1;
+    }
+    return 0;
+}
+#endif
+
 /* The stack entry for lane `lane` of node `node`. */
 static inline uint32_t rs_bvh4_ref(const rs_bvh4_node *n, uint32_t node, uint32_t lane)
 {
@@ -265,22 +374,7 @@ static inline int rs_bvh4_closest(const rs_bvh4 *b, const rs_geom *g, rs_ray ray
             uint32_t lane = ref & 3u, first = n->child[lane], count = n->count[lane], i;
 #ifdef RS_BVH4_SSE
             if (count & RS_BVH4_PACKED) {
-                for (i = 0; i < (count & ~RS_BVH4_PACKED); ++i) {
-                    const rs_bvh4_tri4 *blk = &b->tri4[first + i];
-                    float t[4], u[4], v[4];
-                    uint32_t m = rs_bvh4_tri4_hit(blk, &r, ray.tmin, ray.tmax, t, u, v);
-                    while (m) {
-                        uint32_t l = (uint32_t)rs_bvh4_lowest_bit(m);
-                        m &= m - 1;
-                        if (rs_hit_better(t[l], blk->prim[l], hit)) {
-                            ray.tmax = rs_float_next_up(t[l]);
-                            hit->t = t[l];
-                            hit->u = u[l];
-                            hit->v = v[l];
-                            hit->prim = blk->prim[l];
-                        }
-                    }
-                }
+                rs_bvh4_packed_closest(b->tri4, b->quad4, first, count, &r, &ray, hit);
                 count = 0;
             }
 #endif
@@ -325,11 +419,8 @@ static inline int rs_bvh4_occluded(const rs_bvh4 *b, const rs_geom *g, rs_ray ra
             uint32_t lane = ref & 3u, first = n->child[lane], count = n->count[lane], i;
 #ifdef RS_BVH4_SSE
             if (count & RS_BVH4_PACKED) {
-                for (i = 0; i < (count & ~RS_BVH4_PACKED); ++i) {
-                    float t[4], u[4], v[4];
-                    if (rs_bvh4_tri4_hit(&b->tri4[first + i], &r, ray.tmin, ray.tmax, t, u, v))
-                        return 1;
-                }
+                if (rs_bvh4_packed_occluded(b->tri4, b->quad4, first, count, &r, &ray))
+                    return 1;
                 continue;
             }
 #endif

@@ -7,7 +7,8 @@
  *
  * Same answers as the binary and 4-wide traversals, bit for bit, for the reasons accel/bvh4.h
  * gives: the nodes hold the binary tree's own boxes, the leaves its primitive ranges (triangle
- * leaves packed into the 4-wide tree's tri4 blocks and tested by the same SSE code), and the
+ * and parallelogram leaves packed into the 4-wide tree's tri4 and quad4 blocks and tested by the
+ * same SSE code), and the
  * closest hit follows rs_hit_better.  The box test picks each axis's near and far plane by the sign
  * of the ray's direction instead of taking min / max of the two slab distances: for a finite
  * 1 / d the rounded (bound - o) * (1 / d) is monotone in the bound, so the near plane's distance
@@ -19,9 +20,9 @@
  *   b[6][8]     the children's boxes by plane: lo.x, lo.y, lo.z, hi.x, hi.y, hi.z of all eight
  *               lanes (so the near plane of axis a is row a or a + 3)
  *   child[8]    interior lane: index of the child node; leaf lane: first prim_ids entry, or for a
- *               packed leaf the first of its tri4 blocks
+ *               packed leaf the first of its blocks
  *   count[8]    0 for an interior lane, else the leaf's primitive count, or for a packed leaf
- *               RS_BVH4_PACKED | its number of tri4 blocks
+ *               RS_BVH4_PACKED | its number of blocks (with RS_BVH4_QUADS for quad4 blocks)
  *   n_lanes     lanes in use (1 to 8), packed from lane 0; unused lanes hold an empty box */
 #ifndef RS_ACCEL_BVH8_H
 #define RS_ACCEL_BVH8_H
@@ -39,10 +40,11 @@ typedef struct rs_bvh8_node {
 typedef struct rs_bvh8 {
     rs_bvh8_node *nodes;      /* node 0 is the root; none for an empty scene */
     rs_bvh4_tri4 *tri4;       /* the packed leaves' triangles */
+    rs_bvh4_quad4 *quad4;     /* the packed leaves' parallelograms */
     const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
-    uint32_t n_nodes, n_tri4;
+    uint32_t n_nodes, n_tri4, n_quad4;
     uint32_t depth;    /* in nodes; at most the binary tree's */
-    uint32_t n_packed; /* leaves packed as tri4 blocks */
+    uint32_t n_packed; /* leaves packed as tri4 or quad4 blocks */
 } rs_bvh8;
 
 /* A traversal stack entry: an interior node's index, or RS_BVH8_LEAF | node << 3 | lane. */
@@ -55,7 +57,7 @@ typedef struct rs_bvh8 {
 extern "C" {
 #endif
 /* Collapses `b`, built over `g`, into an 8-wide tree (each node opens the interior child of
- * largest surface area until it has eight; triangle leaves packed as rs_bvh4_build packs them).
+ * largest surface area until it has eight; triangle and parallelogram leaves packed as rs_bvh4_build packs them).
  * RS_ERR_ARG for a leaf of more than 32767 primitives or a tree of more than 2^28 nodes,
  * RS_ERR_NOMEM when memory runs out (*out is NULL then).  Builds on any machine. */
 rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out);

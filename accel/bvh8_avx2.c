@@ -20,7 +20,7 @@ typedef struct ray8 {
     size_t near[3], far[3]; /* offsets in floats into rs_bvh8_node.b: each axis's near and far
                                plane's row */
     int general;              /* some 1 / d is not finite: the slab test's min / max form */
-    rs_bvh4_ray r4;           /* for the tri4 leaves */
+    rs_bvh4_ray r4;           /* for the packed leaves */
 } ray8;
 
 static void ray8_init(ray8 *r, const rs_ray *ray)
@@ -175,22 +175,7 @@ int rs_bvh8_closest(const rs_bvh8 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
             const rs_bvh8_node *n = &b->nodes[(ref & ~RS_BVH8_LEAF) >> 3];
             uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane], i;
             if (count & RS_BVH4_PACKED) {
-                for (i = 0; i < (count & ~RS_BVH4_PACKED); ++i) {
-                    const rs_bvh4_tri4 *blk = &b->tri4[first + i];
-                    float t[4], u[4], v[4];
-                    uint32_t m = rs_bvh4_tri4_hit(blk, &r.r4, ray.tmin, ray.tmax, t, u, v);
-                    while (m) {
-                        uint32_t l = lowest(m);
-                        m &= m - 1;
-                        if (rs_hit_better(t[l], blk->prim[l], hit)) {
-                            ray.tmax = rs_float_next_up(t[l]);
-                            hit->t = t[l];
-                            hit->u = u[l];
-                            hit->v = v[l];
-                            hit->prim = blk->prim[l];
-                        }
-                    }
-                }
+                rs_bvh4_packed_closest(b->tri4, b->quad4, first, count, &r.r4, &ray, hit);
                 count = 0;
             }
             for (i = 0; i < count; ++i)
@@ -233,11 +218,8 @@ int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray)
             const rs_bvh8_node *n = &b->nodes[(ref & ~RS_BVH8_LEAF) >> 3];
             uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane], i;
             if (count & RS_BVH4_PACKED) {
-                for (i = 0; i < (count & ~RS_BVH4_PACKED); ++i) {
-                    float t[4], u[4], v[4];
-                    if (rs_bvh4_tri4_hit(&b->tri4[first + i], &r.r4, ray.tmin, ray.tmax, t, u, v))
-                        return 1;
-                }
+                if (rs_bvh4_packed_occluded(b->tri4, b->quad4, first, count, &r.r4, &ray))
+                    return 1;
                 continue;
             }
             for (i = 0; i < count; ++i) {

@@ -1,6 +1,7 @@
 /* accel/wide.c — what collapsing a binary BVH into a wide one takes, whatever the width: the
- * choice of each wide node's lanes, the size checks, and packing triangle leaves into tri4
- * blocks (accel/bvh4.h, accel/bvh8.h; declared in accel/internal.h). */
+ * choice of each wide node's lanes, the size checks, and packing leaves of triangles into tri4
+ * blocks and leaves of parallelograms into quad4 blocks (accel/bvh4.h, accel/bvh8.h; declared in
+ * accel/internal.h). */
 #include <string.h>
 
 #include "accel/internal.h"
@@ -37,28 +38,36 @@ uint32_t rs_bvh_wide_lanes(const rs_bvh_node *bn, uint32_t src, uint32_t width, 
     return n;
 }
 
-void rs_tri4_packer_init(rs_tri4_packer *p, const rs_bvh *b, const rs_geom *g)
+void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g)
 {
     memset(p, 0, sizeof *p);
     p->g = g;
     p->prim_ids = b->prim_ids;
 #ifdef RS_BVH4_SSE
-    p->pack = g->tri_algo == RS_ISECT_TRI_MOLLER;
+    p->pack_tris = g->tri_algo == RS_ISECT_TRI_MOLLER;
+    p->pack_quads = 1;
 #endif
 }
 
-int rs_tri4_packable(const rs_tri4_packer *p, const rs_bvh_node *n)
+/* How binary leaf `n` is packed: RS_BVH4_PACKED for tri4 blocks, RS_BVH4_PACKED | RS_BVH4_QUADS
+ * for quad4 blocks, 0 when it is not (a mix of kinds, spheres, or packing off). */
+static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
 {
-    uint32_t i, first_tri = p->g->n_spheres + p->g->n_quads;
-    if (!p->pack)
-        return 0;
-    for (i = 0; i < n->count; ++i)
-        if (p->prim_ids[n->left_first + i] < first_tri)
-            return 0;
-    return 1;
+    uint32_t i, first_quad = p->g->n_spheres, first_tri = first_quad + p->g->n_quads;
+    uint32_t tris = 0, quads = 0;
+    for (i = 0; i < n->count; ++i) {
+        uint32_t prim = p->prim_ids[n->left_first + i];
+        tris += prim >= first_tri;
+        quads += prim >= first_quad && prim < first_tri;
+    }
+    if (p->pack_tris && tris == n->count)
+        return RS_BVH4_PACKED;
+    if (p->pack_quads && quads == n->count)
+        return RS_BVH4_PACKED | RS_BVH4_QUADS;
+    return 0;
 }
 
-uint32_t rs_tri4_pack(rs_tri4_packer *p, const rs_bvh_node *n)
+static uint32_t pack_tris(rs_leaf_packer *p, const rs_bvh_node *n)
 {
     uint32_t first = p->n_tri4, i, a;
     uint32_t first_tri = p->g->n_spheres + p->g->n_quads;
@@ -86,18 +95,61 @@ uint32_t rs_tri4_pack(rs_tri4_packer *p, const rs_bvh_node *n)
     return first;
 }
 
-rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_tri4_packer *p, const char *what,
+static uint32_t pack_quads(rs_leaf_packer *p, const rs_bvh_node *n)
+{
+    uint32_t first = p->n_quad4, i, a;
+    for (i = 0; i < n->count; ++i) {
+        uint32_t prim = p->prim_ids[n->left_first + i];
+        const rs_quad *q = &p->g->quads[prim - p->g->n_spheres];
+        rs_bvh4_quad4 *blk = &p->quad4[first + i / 4];
+        uint32_t l = i % 4;
+        if (l == 0) {
+            memset(blk, 0, sizeof *blk);
+            blk->prim[0] = blk->prim[1] = blk->prim[2] = blk->prim[3] = RS_NO_HIT;
+        }
+        for (a = 0; a < 3; ++a) {
+            blk->q[a][l] = rs_v3_get(q->q, (int)a);
+            blk->u[a][l] = rs_v3_get(q->u, (int)a);
+            blk->v[a][l] = rs_v3_get(q->v, (int)a);
+            blk->w[a][l] = rs_v3_get(q->w, (int)a);
+        }
+        blk->prim[l] = prim;
+    }
+    p->n_quad4 += (n->count + 3) / 4;
+    RS_ASSERT(p->n_quad4 <= p->cap_quad4);
+    return first;
+}
+
+int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint16_t *count)
+{
+    uint32_t kind = pack_kind(p, l);
+    if (kind == 0) {
+        *child = l->left_first;
+        *count = (uint16_t)l->count;
+        return 0;
+    }
+    *child = kind & RS_BVH4_QUADS ? pack_quads(p, l) : pack_tris(p, l);
+    *count = (uint16_t)(kind | (l->count + 3) / 4);
+    return 1;
+}
+
+rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
                            uint32_t max_nodes, uint32_t *cap_nodes)
 {
     uint32_t i, interior = 0;
-    p->cap_tri4 = 0;
+    p->cap_tri4 = p->cap_quad4 = 0;
     for (i = 0; i < b->n_nodes; ++i) {
         if (b->nodes[i].count > 0x7fffu)
             return rs_error_set(RS_ERR_ARG, "%s: a leaf of %u primitives (at most 32767 fit a lane)",
                                 what, b->nodes[i].count);
         interior += b->nodes[i].count == 0;
-        if (b->nodes[i].count > 0 && rs_tri4_packable(p, &b->nodes[i]))
-            p->cap_tri4 += (b->nodes[i].count + 3) / 4;
+        if (b->nodes[i].count > 0) {
+            uint32_t kind = pack_kind(p, &b->nodes[i]), blocks = (b->nodes[i].count + 3) / 4;
+            if (kind & RS_BVH4_QUADS)
+                p->cap_quad4 += blocks;
+            else if (kind)
+                p->cap_tri4 += blocks;
+        }
     }
     if (interior + 1 > max_nodes)
         return rs_error_set(RS_ERR_ARG, "%s: %u nodes are more than the %u it can index", what,

@@ -180,6 +180,7 @@ static wide collapse(const rs_bvh *b, const rs_geom *g)
     /* the same leaves, packed the same way */
     assert_int_equal(w.b8->n_packed, w.b4->n_packed);
     assert_int_equal(w.b8->n_tri4, w.b4->n_tri4);
+    assert_int_equal(w.b8->n_quad4, w.b4->n_quad4);
     return w;
 }
 
@@ -527,10 +528,29 @@ static void test_random_rays_vs_brute_force(void **state)
     print_message("soup: %d rays, %ld hit\n", N_RAYS, hits);
     /* both outcomes well represented, or the comparison says little */
     assert_true(hits > N_RAYS / 5 && hits < N_RAYS - N_RAYS / 5);
-    /* the same soup with the watertight triangle test: the 4-wide tree packs no leaves then */
+    /* the same soup with the watertight triangle test: the wide trees pack no triangles then */
     s.g.tri_algo = RS_ISECT_TRI_WATERTIGHT;
     hits = check_vs_brute_force(&s, "soup, watertight", N_RAYS / 4, 0, &ties);
     assert_true(hits > N_RAYS / 20);
+    {
+        /* its parallelograms alone: every wide leaf a quad4 block */
+        soup q = s;
+        rs_bvh *b;
+        wide w;
+        q.g.n_spheres = 0;
+        q.g.n_tris = 0;
+        b = build(&q.g, 4);
+        w = collapse(b, &q.g);
+#ifdef RS_BVH4_SSE
+        assert_int_equal(w.b4->n_packed, b->n_leaves);
+        assert_true(w.b4->n_quad4 >= (q.g.n_quads + 3) / 4 && w.b4->n_tri4 == 0);
+#endif
+        wide_free(&w);
+        rs_bvh_destroy(b);
+        hits = check_vs_brute_force(&q, "parallelograms", N_RAYS / 4, 0, &ties);
+        print_message("parallelograms: %d rays, %ld hit\n", N_RAYS / 4, hits);
+        assert_true(hits > N_RAYS / 100);
+    }
     soup_free(&s);
 }
 
