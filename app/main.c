@@ -871,6 +871,53 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
         fprintf(stderr, "Wrote %s.\n", r->out);
 }
 
+/* What the image's header records of the render (.exr only, core/image_io.h): the scene, the
+ * spp every pixel has and the spp asked for, seed, sampling, sampler, max depth, devices,
+ * integrator, version.  Strings into `text` (which must outlive meta). */
+enum { META_N = 10 };
+typedef struct image_meta {
+    rs_image_meta meta[META_N];
+    char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];
+} image_meta;
+
+static void make_image_meta(const rs_cli_options *o, const render_run *r, image_meta *m)
+{
+    static const char *const keys[META_N] = {
+        "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
+        "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
+        "raystream:integrator", "raystream:version"};
+    const char *values[META_N];
+    size_t used = 0;
+    int i;
+    snprintf(m->spp, sizeof m->spp, "%u", rs_film_min_count(r->film));
+    snprintf(m->spp_requested, sizeof m->spp_requested, "%u", r->st.spp);
+    snprintf(m->seed, sizeof m->seed, "%llu", (unsigned long long)r->st.seed);
+    snprintf(m->depth, sizeof m->depth, "%u", r->st.max_depth);
+    m->devices[0] = '\0';
+    for (i = 0; i < (r->mk ? 1 : r->n_devs); ++i) {
+        const rs_device *d = r->mk ? r->mk : r->devs[i];
+        int k =
+            snprintf(m->devices + used, sizeof m->devices - used, "%s%s", i ? "," : "", d->name);
+        if (k < 0 || (size_t)k >= sizeof m->devices - used)
+            break;
+        used += (size_t)k;
+    }
+    values[0] = o->scene;
+    values[1] = m->spp;
+    values[2] = m->spp_requested;
+    values[3] = m->seed;
+    values[4] = rs_sampling_name(r->st.sampling);
+    values[5] = rs_sampler_name(r->st.sampler);
+    values[6] = m->depth;
+    values[7] = m->devices;
+    values[8] = o->megakernel ? "megakernel" : "stream";
+    values[9] = RS_VERSION;
+    for (i = 0; i < META_N; ++i) {
+        m->meta[i].key = keys[i];
+        m->meta[i].value = values[i];
+    }
+}
+
 /* The outputs, all or none: the stats JSON and the timeline to their staged names, then the
  * image (rs_image_write: its own temporary file, renamed into place), then the staged files
  * renamed.  A failure before the image is in place replaces nothing; a --stats-json that is a
@@ -879,6 +926,7 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
 static int write_outputs(const rs_cli_options *o, render_run *r, int code)
 {
     device_rows rows;
+    image_meta meta;
     char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
     int i, ok = 1, replaced = 0;
     rs_film_resolve(r->film, r->rgb);
@@ -899,7 +947,9 @@ static int write_outputs(const rs_cli_options *o, render_run *r, int code)
     if (ok && r->ckpt_out) /* renamed below with the others */
         ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 0, &r->key, r->film,
                                  r->on_film);
-    if (ok && rs_image_write(r->out, r->st.width, r->st.height, r->rgb) != RS_OK) {
+    make_image_meta(o, r, &meta);
+    if (ok && rs_image_write_meta(r->out, r->st.width, r->st.height, r->rgb, meta.meta, META_N) !=
+                  RS_OK) {
         fail(0, NULL);
         ok = 0;
     }

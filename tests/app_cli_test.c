@@ -1591,6 +1591,15 @@ static void test_time_limit(void **state)
         snprintf(spp_text, sizeof spp_text, "%lld", spp);
         EXPECT(&p, strstr(p.err.data, spp_text) && strstr(p.err.data, "of 1000000 spp"),
                "the summary should say %s of 1000000 spp", spp_text);
+        {
+            char meta[64];
+            path_in(f, "t.exr", path, sizeof path);
+            EXPECT(&p,
+                   rs_image_read_meta(path, "raystream:spp", meta, sizeof meta) == RS_OK &&
+                       strcmp(meta, spp_text) == 0,
+                   "t.exr's header should give raystream:spp %s", spp_text);
+            rs_error_clear();
+        }
         run_expect(f, ref, 0, &q);
         expect_same_image(&q, f, "t.exr", "ref.exr");
         proc_free(&p);
@@ -1756,6 +1765,53 @@ static void test_resume_after_signal(void **state)
     proc_free(&q);
 }
 
+/* The EXR header records the render: scene, spp done and asked for, seed, sampling, sampler,
+ * max depth, devices, integrator, version. */
+static void test_exr_metadata(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render",      "builtin:materials",
+                                       "--width",     "24",
+                                       "--spp",       "3",
+                                       "--seed",      "42",
+                                       "--sampler",   "independent",
+                                       "--max-depth", "7",
+                                       "--devices",   "cpu:1,gpu",
+                                       "-q",          "-o",
+                                       "m.exr",       NULL};
+    static const struct {
+        const char *key, *want;
+    } fields[] = {
+        {"raystream:scene", "builtin:materials"},
+        {"raystream:spp", "3"},
+        {"raystream:spp_requested", "3"},
+        {"raystream:seed", "42"},
+        {"raystream:sampling", "mis"},
+        {"raystream:sampler", "independent"},
+        {"raystream:max_depth", "7"},
+        {"raystream:devices", "cpu,gpu-fallback:0"},
+        {"raystream:integrator", "stream"},
+    };
+    char path[256], value[256];
+    size_t k;
+    proc p;
+    run_expect(f, args, 0, &p);
+    path_in(f, "m.exr", path, sizeof path);
+    for (k = 0; k < sizeof fields / sizeof fields[0]; ++k) {
+        value[0] = '\0';
+        EXPECT(&p, rs_image_read_meta(path, fields[k].key, value, sizeof value) == RS_OK,
+               "m.exr has no %s", fields[k].key);
+        EXPECT(&p, strcmp(value, fields[k].want) == 0, "m.exr's %s is '%s', not '%s'",
+               fields[k].key, value, fields[k].want);
+    }
+    EXPECT(&p,
+           rs_image_read_meta(path, "raystream:version", value, sizeof value) == RS_OK &&
+               strspn(value, "0123456789.") > 0,
+           "m.exr's raystream:version is '%s'", value);
+    rs_error_clear();
+    proc_free(&p);
+}
+
 /* Copies the first `len` bytes of file `from` to `to` (the test folder's), byte `flip` (if >= 0)
  * inverted. */
 static void copy_cut(const fixture *f, const char *from, const char *to, size_t len, long flip)
@@ -1892,6 +1948,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_checkpoint_resume, setup, teardown),
         cmocka_unit_test_setup_teardown(test_resume_after_signal, setup, teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_refused, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_exr_metadata, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
