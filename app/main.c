@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "app/checkpoint.h"
 #include "app/options.h"
 #include "app/outputs.h"
 #include "app/progress.h"
@@ -273,7 +274,14 @@ typedef struct render_run {
     rs_output outs[RS_OUTPUTS_MAX]; /* the image, then --stats-json and --timeline if asked */
     int n_outs;
     rs_output *stats_out, *timeline_out; /* into outs, or NULL */
+    rs_output *ckpt_out;                 /* --checkpoint, into outs, or NULL */
     int interrupted;                     /* the signal that stopped the render, or 0 */
+    rs_checkpoint_key key;               /* what decides the image, for --checkpoint/--resume */
+    uint64_t resumed;                    /* paths the --resume file held */
+    uint64_t on_film;                    /* the film holds paths [0, on_film) */
+    double last_ckpt;                    /* when the last checkpoint was written (rs_now_s) */
+    double ckpt_every_s;                 /* --checkpoint-interval */
+    rs_progress progress;
 } render_run;
 
 static void run_release(render_run *r)
@@ -441,7 +449,7 @@ static void make_settings(const rs_cli_options *o, render_run *r)
  * the image's format.  Returns an exit code: RS_EXIT_USAGE, nothing written, for all of them. */
 static int check_outputs(const rs_cli_options *o, render_run *r)
 {
-    const char *inputs[2];
+    const char *inputs[3];
     rs_output *out = r->outs;
     int n = 0, rc;
     if (o->output) {
@@ -464,13 +472,62 @@ static int check_outputs(const rs_cli_options *o, render_run *r)
         out[n].path = o->timeline;
         r->timeline_out = &out[n++];
     }
+    if (o->checkpoint) {
+        out[n].option = "--checkpoint";
+        out[n].path = o->checkpoint;
+        out[n].may_replace = o->resume; /* checkpointing on into the file it continues */
+        r->ckpt_out = &out[n++];
+    }
     r->n_outs = n;
     inputs[0] = strncmp(o->scene, "builtin:", 8) == 0 ? NULL : o->scene;
     inputs[1] = o->mesh;
-    if ((rc = rs_outputs_check(out, n, inputs, 2)) != RS_EXIT_OK)
+    inputs[2] = o->resume;
+    if ((rc = rs_outputs_check(out, n, inputs, 3)) != RS_EXIT_OK)
         return rc;
     if (rs_image_check_output(r->out) != RS_OK)
         return fail(RS_EXIT_USAGE, NULL);
+    return RS_EXIT_OK;
+}
+
+/* The film: a fresh one, or with --resume the checkpoint's (app/checkpoint.h), checked against
+ * these settings before any work; the render then starts at the first path it does not hold.
+ * --resume without --spp continues to the spp the checkpoint was started with.  Returns an exit
+ * code. */
+static int make_film(const rs_cli_options *o, render_run *r)
+{
+    rs_checkpoint_key *k = &r->key;
+    int rc;
+    memset(k, 0, sizeof *k);
+    k->scene_hash = rs_checkpoint_scene_hash(r->scene);
+    k->seed = r->st.seed;
+    k->width = r->st.width;
+    k->height = r->st.height;
+    k->spp = r->st.spp;
+    k->max_depth = r->st.max_depth;
+    k->rr_depth = r->st.rr_depth ? r->st.rr_depth : 3;
+    k->sampling = (uint32_t)r->st.sampling;
+    k->sampler = (uint32_t)r->st.sampler;
+    k->isect_sphere = o->isect_sphere;
+    k->isect_tri = o->isect_tri;
+    k->isect_aabb = o->isect_aabb;
+    k->scene = o->scene;
+    if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "starting the render");
+    if (!o->resume)
+        return RS_EXIT_OK;
+    if (!o->spp_given)
+        k->spp = 0; /* the file's */
+    if ((rc = rs_checkpoint_read(o->resume, k, r->film, &r->resumed)) != RS_EXIT_OK)
+        return rc;
+    r->st.spp = k->spp;
+    r->st.path_begin = r->resumed;
+    if (o->megakernel && r->resumed % ((uint64_t)r->st.width * r->st.height) != 0) {
+        fprintf(stderr,
+                "raystream: --resume %s: stopped within a pass (%llu samples of %ux%u pixels); "
+                "the megakernel continues whole passes only (use --integrator stream)\n",
+                o->resume, (unsigned long long)r->resumed, r->st.width, r->st.height);
+        return RS_EXIT_USAGE;
+    }
     return RS_EXIT_OK;
 }
 
@@ -539,8 +596,6 @@ static int start_devices(const rs_cli_options *o, render_run *r)
         if (rs_sched_create(r->devs, n, &cfg, &r->sched) != RS_OK)
             return fail(RS_EXIT_RUNTIME, "starting the render");
     }
-    if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK)
-        return fail(RS_EXIT_RUNTIME, "starting the render");
     r->rgb = (float *)rs_alloc((size_t)r->st.width * r->st.height * 3, sizeof *r->rgb);
     if (!r->rgb) {
         fprintf(stderr, "raystream: out of memory for a %ux%u image\n", r->st.width, r->st.height);
@@ -552,21 +607,48 @@ static int start_devices(const rs_cli_options *o, render_run *r)
 /* The render itself, with the progress bar and the stop signals (which stay caught until the
  * program ends: a second one while the outputs are written removes their temporary files).
  * Returns an exit code: 128 + the signal for an interrupted render. */
+static void on_progress(void *user, uint64_t done, uint64_t total)
+{
+    rs_progress_update(&((render_run *)user)->progress, done, total);
+}
+
+/* The render thread, whenever the film holds a prefix of the paths: a periodic checkpoint.  A
+ * failed one is reported and the render goes on (the last good file stays). */
+static void on_film_ready(void *user, const rs_film *film, uint64_t paths)
+{
+    render_run *r = (render_run *)user;
+    double now;
+    r->on_film = paths;
+    if (!r->ckpt_out || (now = rs_now_s()) - r->last_ckpt < r->ckpt_every_s ||
+        paths == (uint64_t)r->st.width * r->st.height * r->st.spp) /* the last: at the end */
+        return;
+    r->last_ckpt = now;
+    (void)rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 1, &r->key, film, paths);
+}
+
 static int run_render(const rs_cli_options *o, render_run *r)
 {
     rs_render_hooks hooks;
-    rs_progress progress;
     rs_status rst;
     install_stop_signals();
-    rs_progress_begin(&progress, !o->quiet);
-    hooks.progress = rs_progress_update;
-    hooks.user = &progress;
+    rs_progress_begin(&r->progress, !o->quiet);
+    memset(&hooks, 0, sizeof hooks);
+    hooks.progress = on_progress;
+    hooks.user = r;
     hooks.cancel = &g_cancel;
+    hooks.time_limit_s = o->time_limit_s;
+    r->ckpt_every_s = o->ckpt_every_s;
+    r->on_film = r->st.path_begin;
+    r->last_ckpt = rs_now_s();
+    if (r->ckpt_out) {
+        hooks.film_ready = on_film_ready;
+        rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
+    }
     if (o->megakernel)
         rst = rs_render_passes(r->scene, r->mk, &r->st, &hooks, r->film, &r->stats);
     else
         rst = rs_render(r->scene, r->sched, &r->st, &hooks, r->film, &r->stats);
-    rs_progress_end(&progress);
+    rs_progress_end(&r->progress);
     if (rst == RS_ERR_CANCELLED) {
         rs_error_clear();
         r->interrupted = atomic_load(&g_signal) ? atomic_load(&g_signal) : SIGINT;
@@ -655,8 +737,14 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
         fprintf(stderr, "raystream: %s: cannot write the stats (%s)\n", shown, strerror(errno));
         return 0;
     }
-    fprintf(f, "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"stages\": {", wall,
-            (unsigned long long)t->total);
+    /* spp: what every pixel has (the image's samples per pixel); samples: the film's total */
+    fprintf(f,
+            "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"spp\": %u,\n  \"spp_requested\": %u,\n"
+            "  \"samples\": %llu,\n  \"resumed_samples\": %llu,\n  \"time_limited\": %s,\n"
+            "  \"interrupted\": %s,\n  \"stages\": {",
+            wall, (unsigned long long)t->total, rs_film_min_count(r->film), r->st.spp,
+            (unsigned long long)(r->resumed + r->stats.paths_done), (unsigned long long)r->resumed,
+            r->stats.time_limited ? "true" : "false", r->interrupted ? "true" : "false");
     for (i = 0; i < RS_STAGE_COUNT; ++i)
         fprintf(f, "%s\"%s\": %.6f", i ? ", " : "", rs_stage_name((rs_stage)i),
                 r->stats.stage_s[i]);
@@ -716,7 +804,7 @@ static int write_timeline(const char *path, const rs_cli_options *o, const rende
 /* The summary line on stderr (or, with --quiet, only a word on an interruption). */
 static void print_summary(const rs_cli_options *o, const render_run *r)
 {
-    char sps[32], rps[32], rays[32], bvh_name[64];
+    char sps[32], rps[32], rays[32], bvh_name[64], spp[96];
     double secs = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
     uint64_t rays_total = r->stats.rays_closest + r->stats.rays_shadow;
     const rs_render_settings *st = &r->st;
@@ -733,12 +821,17 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
     human((double)r->stats.paths_done / secs, sps, sizeof sps);
     human((double)rays_total / secs, rps, sizeof rps);
     human((double)rays_total, rays, sizeof rays);
+    if (r->stats.time_limited)
+        snprintf(spp, sizeof spp, "%u of %u spp (stopped at the --time-limit of %g s)",
+                 rs_film_min_count(r->film), st->spp, o->time_limit_s);
+    else
+        snprintf(spp, sizeof spp, "%u spp", st->spp);
     fprintf(stderr,
-            "%s %s at %ux%u, %u spp (%s sampling, %s sampler, max depth %u, seed %llu) in %.2f s: "
+            "%s %s at %ux%u, %s (%s sampling, %s sampler, max depth %u, seed %llu) in %.2f s: "
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
             "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
             r->interrupted ? "Partial render (interrupted):" : "Rendered", o->scene, st->width,
-            st->height, st->spp, rs_sampling_name(st->sampling), rs_sampler_name(st->sampler),
+            st->height, spp, rs_sampling_name(st->sampling), rs_sampler_name(st->sampler),
             st->max_depth, (unsigned long long)st->seed, r->stats.seconds, sps, rps, rays,
             (unsigned long long)r->stats.rays_closest, (unsigned long long)r->stats.rays_shadow,
             rs_bvh_builder_name(&r->bvh->builder, bvh_name, sizeof bvh_name),
@@ -765,12 +858,66 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
     if (r->film->nonfinite)
         fprintf(stderr, "%llu non-finite samples were dropped. ",
                 (unsigned long long)r->film->nonfinite);
+    if (o->resume)
+        fprintf(stderr, "Continued from %s (%llu samples). ", o->resume,
+                (unsigned long long)r->resumed);
+    if (r->ckpt_out)
+        fprintf(stderr, "Checkpoint %s holds %llu samples. ", r->ckpt_out->path,
+                (unsigned long long)r->on_film);
     if (r->interrupted)
         fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", r->out,
-                (unsigned long long)r->stats.paths_done, (unsigned long long)r->stats.paths_total,
+                (unsigned long long)(r->stats.paths_done + r->resumed),
+                (unsigned long long)(r->stats.paths_total + r->resumed),
                 rs_film_min_count(r->film));
     else
         fprintf(stderr, "Wrote %s.\n", r->out);
+}
+
+/* What the image's header records of the render (.exr only, core/image_io.h): the scene, the
+ * spp every pixel has and the spp asked for, seed, sampling, sampler, max depth, devices,
+ * integrator, version.  Strings into `text` (which must outlive meta). */
+enum { META_N = 10 };
+typedef struct image_meta {
+    rs_image_meta meta[META_N];
+    char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];
+} image_meta;
+
+static void make_image_meta(const rs_cli_options *o, const render_run *r, image_meta *m)
+{
+    static const char *const keys[META_N] = {
+        "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
+        "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
+        "raystream:integrator", "raystream:version"};
+    const char *values[META_N];
+    size_t used = 0;
+    int i;
+    snprintf(m->spp, sizeof m->spp, "%u", rs_film_min_count(r->film));
+    snprintf(m->spp_requested, sizeof m->spp_requested, "%u", r->st.spp);
+    snprintf(m->seed, sizeof m->seed, "%llu", (unsigned long long)r->st.seed);
+    snprintf(m->depth, sizeof m->depth, "%u", r->st.max_depth);
+    m->devices[0] = '\0';
+    for (i = 0; i < (r->mk ? 1 : r->n_devs); ++i) {
+        const rs_device *d = r->mk ? r->mk : r->devs[i];
+        int k =
+            snprintf(m->devices + used, sizeof m->devices - used, "%s%s", i ? "," : "", d->name);
+        if (k < 0 || (size_t)k >= sizeof m->devices - used)
+            break;
+        used += (size_t)k;
+    }
+    values[0] = o->scene;
+    values[1] = m->spp;
+    values[2] = m->spp_requested;
+    values[3] = m->seed;
+    values[4] = rs_sampling_name(r->st.sampling);
+    values[5] = rs_sampler_name(r->st.sampler);
+    values[6] = m->depth;
+    values[7] = m->devices;
+    values[8] = o->megakernel ? "megakernel" : "stream";
+    values[9] = RS_VERSION;
+    for (i = 0; i < META_N; ++i) {
+        m->meta[i].key = keys[i];
+        m->meta[i].value = values[i];
+    }
 }
 
 /* The outputs, all or none: the stats JSON and the timeline to their staged names, then the
@@ -781,6 +928,7 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
 static int write_outputs(const rs_cli_options *o, render_run *r, int code)
 {
     device_rows rows;
+    image_meta meta;
     char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
     int i, ok = 1, replaced = 0;
     rs_film_resolve(r->film, r->rgb);
@@ -798,7 +946,12 @@ static int write_outputs(const rs_cli_options *o, render_run *r, int code)
         ok = write_stats_json(r->stats_out->staged, r->stats_out->path, r, &rows);
     if (ok && r->timeline_out)
         ok = write_timeline(r->timeline_out->staged, o, r, &rows);
-    if (ok && rs_image_write(r->out, r->st.width, r->st.height, r->rgb) != RS_OK) {
+    if (ok && r->ckpt_out) /* renamed below with the others */
+        ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 0, &r->key, r->film,
+                                 r->on_film);
+    make_image_meta(o, r, &meta);
+    if (ok && rs_image_write_meta(r->out, r->st.width, r->st.height, r->rgb, meta.meta, META_N) !=
+                  RS_OK) {
         fail(0, NULL);
         ok = 0;
     }
@@ -831,7 +984,7 @@ static int cmd_render(const rs_cli_options *o)
     if ((code = load_scene_bounded(o, &r)) == RS_EXIT_OK) {
         make_settings(o, &r);
         if ((code = check_outputs(o, &r)) == RS_EXIT_OK &&
-            (code = build_bvh(o, &r)) == RS_EXIT_OK &&
+            (code = make_film(o, &r)) == RS_EXIT_OK && (code = build_bvh(o, &r)) == RS_EXIT_OK &&
             (code = start_devices(o, &r)) == RS_EXIT_OK) {
             code = run_render(o, &r);
             if (code == RS_EXIT_OK || r.interrupted)

@@ -46,6 +46,33 @@ bad:
     return usage_error("%s: '%s' is not a whole number", opt, text);
 }
 
+/* A number of seconds: a positive, finite decimal number (1, 0.5, 2.5e3) up to 10^9, nothing
+ * around it. */
+static int parse_seconds(const char *opt, const char *text, double *out)
+{
+    char *end;
+    double v;
+    if (!text || !*text)
+        return usage_error("%s needs a value%s", opt, "");
+    /* strtod also takes "inf", "nan" and hex: only digits, a point, an exponent */
+    if (strspn(text, "0123456789.eE+-") != strlen(text) || text[0] == '+' || text[0] == 'e' ||
+        text[0] == 'E')
+        return usage_error("%s: '%s' is not a number of seconds", opt, text);
+    errno = 0;
+    v = strtod(text, &end);
+    if (*end != '\0' || end == text)
+        return usage_error("%s: '%s' is not a number of seconds", opt, text);
+    if (errno || !(v > 0.0) || v > 1e9) {
+        fprintf(stderr,
+                "raystream: %s %s: must be a number of seconds above 0 and at most 1e9 (see "
+                "'raystream --help')\n",
+                opt, text);
+        return RS_EXIT_USAGE;
+    }
+    *out = v;
+    return RS_EXIT_OK;
+}
+
 static int parse_u32(const char *opt, const char *text, uint32_t lo, uint32_t hi, uint32_t *out)
 {
     uint64_t v;
@@ -165,13 +192,28 @@ void rs_cli_print_help(const char *command)
             "                      trace another (default auto: 2 with a GPU, else 1)\n"
             "  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
             "                      spans coloured by stage, idle gaps, waves labelled\n"
+            "  --time-limit S      stop after S seconds (a decimal number > 0), at the end of\n"
+            "                      the sample pass under way: every pixel gets the same\n"
+            "                      number of samples; the summary and --stats-json say how\n"
+            "                      many (checked when a wave of paths starts, so the render\n"
+            "                      may run over by one wave; at least one pass is done)\n"
+            "  --checkpoint FILE   save the film to FILE every --checkpoint-interval, when a\n"
+            "                      signal stops the render and at the end (FILE.tmp-PID,\n"
+            "                      then renamed: the last good one stays until then)\n"
+            "  --checkpoint-interval S  seconds between checkpoints (default 60)\n"
+            "  --resume FILE       continue the render saved in FILE to --spp samples (default:\n"
+            "                      the spp it was started with); the image is the one an\n"
+            "                      uninterrupted render gives, bit for bit, on any devices.\n"
+            "                      The scene, size, seed, sampling, sampler, max depth and\n"
+            "                      intersection tests must be the same (and for zsobol the\n"
+            "                      spp): a mismatch is refused with the field named\n"
             "  -q, --quiet         no progress bar and no summary\n"
             "  -h, --help          this text\n"
             "\n"
-            "Every output (-o, --stats-json, --timeline) is checked before the render: a\n"
-            "folder, a file that cannot be written or a missing or read-only folder is a\n"
-            "usage error.  Outputs are written to FILE.tmp-PID and renamed into place only\n"
-            "when all of them are written: a run that fails replaces no file.\n"
+            "Every output (-o, --stats-json, --timeline, --checkpoint) is checked before the\n"
+            "render: a folder, a file that cannot be written or a missing or read-only folder\n"
+            "is a usage error.  Outputs are written to FILE.tmp-PID and renamed into place\n"
+            "only when all of them are written: a run that fails replaces no file.\n"
             "\n"
             "Ctrl-C (SIGINT), SIGTERM or SIGHUP writes the samples finished so far and exits\n"
             "with 128 + the signal: 130, 143, 129.  A second signal stops at once, also\n"
@@ -250,6 +292,7 @@ static int parse_image_option(opt_arg *x, rs_cli_options *o)
     } else if (strcmp(name, "--spp") == 0) {
         NEEDS_VALUE();
         rc = parse_u32(name, v, 1, 1u << 20, &o->spp);
+        o->spp_given = 1;
     } else if (strcmp(name, "--max-depth") == 0) {
         NEEDS_VALUE();
         rc = parse_u32(name, v, 1, 10000, &o->max_depth);
@@ -321,6 +364,22 @@ static int parse_engine_option(opt_arg *x, rs_cli_options *o)
         if (n < 5 || strcmp(v + n - 4, ".svg") != 0)
             return usage_error("--timeline writes an SVG picture: '%s'%s must end in .svg", v, "");
         o->timeline = v;
+    } else if (strcmp(name, "--time-limit") == 0) {
+        NEEDS_VALUE();
+        rc = parse_seconds(name, v, &o->time_limit_s);
+    } else if (strcmp(name, "--checkpoint") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a file name%s", name, "");
+        o->checkpoint = v;
+    } else if (strcmp(name, "--checkpoint-interval") == 0) {
+        NEEDS_VALUE();
+        rc = parse_seconds(name, v, &o->ckpt_every_s);
+    } else if (strcmp(name, "--resume") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a file name%s", name, "");
+        o->resume = v;
     } else if (strcmp(name, "--chunk-size") == 0) {
         NEEDS_VALUE();
         if (strcmp(v, "auto") == 0)
@@ -433,6 +492,10 @@ static int check_render_options(rs_cli_options *o)
         return usage_error("--integrator megakernel runs on one device%s%s (use --devices cpu or "
                            "--devices gpu[:INDEX])",
                            "", "");
+    if (o->ckpt_every_s > 0 && !o->checkpoint)
+        return usage_error("--checkpoint-interval needs --checkpoint FILE%s%s", "", "");
+    if (o->ckpt_every_s == 0)
+        o->ckpt_every_s = 60.0;
     if (o->bvh_on_gpu && o->bvh.method != RS_BVH_LBVH)
         return usage_error("--bvh-device gpu builds the lbvh only (add --bvh lbvh)%s%s", "", "");
     if (o->mesh) {

@@ -63,6 +63,11 @@ typedef struct rs_cli_options {
     int stats;                /* --stats: a per-device table after the render */
     const char *stats_json;   /* --stats-json FILE */
     const char *timeline;     /* --timeline FILE.svg */
+    int spp_given;            /* --spp was on the command line (--resume takes the file's) */
+    double time_limit_s;      /* --time-limit SECONDS; 0: none */
+    const char *checkpoint;   /* --checkpoint FILE */
+    double ckpt_every_s;      /* --checkpoint-interval SECONDS (default 60) */
+    const char *resume;       /* --resume FILE */
 } rs_cli_options;
 
 /* Parses argv.  Returns RS_EXIT_OK, or RS_EXIT_USAGE after printing one line naming the

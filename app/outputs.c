@@ -121,7 +121,8 @@ int rs_outputs_check(rs_output *out, int n, const char *const *inputs, int n_inp
                 return refuse(o, what, NULL);
             }
         for (j = 0; j < n_inputs; ++j)
-            if (inputs[j] && same_file(o->path, inputs[j]))
+            if (inputs[j] && same_file(o->path, inputs[j]) &&
+                !(o->may_replace && same_file(o->may_replace, inputs[j])))
                 return refuse(o, "would replace an input file", NULL);
         if ((rc = check_target(o)) != RS_EXIT_OK)
             return rc;

@@ -7,7 +7,8 @@
  *   - rs_outputs_check refuses, with one line on stderr naming the option and the file, an output
  *     that is a folder, an existing file that cannot be written, a folder that is missing or does
  *     not accept new files (probed by creating and removing the staged name), two outputs naming
- *     the same file, and an output that is one of the input files.  It leaves no file behind.
+ *     the same file, and an output that is one of the input files (but its own may_replace).
+ *     It leaves no file behind.
  *   - A staged file is named PATH.tmp-PID, beside PATH.  That is also the name core/image_io's
  *     rs_image_write gives its own temporary file (image_io.cpp: temp_name), so the image's entry
  *     names the file the core is writing.
@@ -26,6 +27,8 @@ typedef struct rs_output {
     const char *option; /* "-o", "--stats-json", "--timeline", or "the image" (the default name) */
     const char *path;   /* the file the user asked for */
     int may_be_special; /* input: an existing non-regular file (/dev/stdout, a pipe) is allowed */
+    const char *may_replace; /* input: an input file this output may replace (the checkpoint
+                                over the --resume file it continues), or NULL */
     int in_place;       /* output: path is such a file; written directly, after everything else */
     char staged[RS_OUTPUT_PATH_MAX]; /* output: "path.tmp-PID" */
 } rs_output;

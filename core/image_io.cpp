@@ -93,6 +93,13 @@ extern "C" rs_status rs_image_check_output(const char *path)
 
 extern "C" rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, const float *rgb)
 {
+    return rs_image_write_meta(path, w, h, rgb, nullptr, 0);
+}
+
+extern "C" rs_status rs_image_write_meta(const char *path, uint32_t w, uint32_t h,
+                                         const float *rgb, const rs_image_meta *meta,
+                                         size_t n_meta)
+{
     std::string tmp = temp_name(path);
     try {
         std::string e = lower_ext(path);
@@ -104,6 +111,9 @@ extern "C" rs_status rs_image_write(const char *path, uint32_t w, uint32_t h, co
         if (is_float_format(e)) {
             OIIO::ImageSpec spec((int)w, (int)h, 3, OIIO::TypeDesc::FLOAT);
             spec.attribute("oiio:ColorSpace", "Linear");
+            if (e == "exr")
+                for (size_t i = 0; i < n_meta; ++i)
+                    spec.attribute(meta[i].key, meta[i].value);
             ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb);
         } else {
             std::vector<unsigned char> px(n);
@@ -192,6 +202,28 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
         return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
     } catch (...) {
         return rs_error_set(RS_ERR_IO, "%s: unknown error reading the image", path);
+    }
+}
+
+extern "C" rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n)
+{
+    try {
+        rs_status st = rs_file_check(path, RS_FILE_MAX_IMAGE_BYTES, nullptr);
+        if (st != RS_OK)
+            return st;
+        auto in = OIIO::ImageInput::open(path);
+        if (!in)
+            return rs_error_set(RS_ERR_ARG, "%s: cannot open image: %s", path,
+                                OIIO::geterror().c_str());
+        const OIIO::ParamValue *p = in->spec().find_attribute(key, OIIO::TypeDesc::STRING);
+        if (!p)
+            return rs_error_set(RS_ERR_ARG, "%s: no attribute %s", path, key);
+        std::snprintf(value, n, "%s", p->get_string().c_str());
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        return rs_error_set(RS_ERR_ARG, "%s: %s", path, ex.what());
+    } catch (...) {
+        return rs_error_set(RS_ERR_ARG, "%s: unknown error reading the image", path);
     }
 }
 

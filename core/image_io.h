@@ -8,6 +8,7 @@
 #ifndef RS_CORE_IMAGE_IO_H
 #define RS_CORE_IMAGE_IO_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/status.h"
@@ -22,6 +23,20 @@ rs_status rs_image_check_output(const char *path);
 
 /* Writes width x height RGB (3 floats a pixel, row-major from the top-left, linear). */
 rs_status rs_image_write(const char *path, uint32_t width, uint32_t height, const float *rgb);
+
+/* A string attribute of an image file's header ("raystream:spp" = "64"). */
+typedef struct rs_image_meta {
+    const char *key, *value;
+} rs_image_meta;
+
+/* rs_image_write with n_meta header attributes, kept where the format has a header for them
+ * (.exr only: the other formats are written as rs_image_write writes them, byte for byte). */
+rs_status rs_image_write_meta(const char *path, uint32_t width, uint32_t height, const float *rgb,
+                              const rs_image_meta *meta, size_t n_meta);
+
+/* The string attribute `key` of image `path` into value[n] (NUL-terminated, cut to fit).
+ * RS_ERR_ARG when the file has no such attribute or cannot be read. */
+rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n);
 
 /* Read images are bounded: the file must be a regular file of at most RS_FILE_MAX_IMAGE_BYTES
  * (core/file.h) and the image at most this many pixels, each side at most RS_IMAGE_MAX_SIDE. */

@@ -71,8 +71,7 @@ rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
     if (st != RS_OK)
         return st;
     ok = fscanf(f, "PF %u %u %f", &ww, &hh, &scale) == 3 && fgetc(f) != EOF && scale < 0.0f &&
-         ww > 0 && hh > 0 && ww < 65536 && hh < 65536 &&
-         (uint64_t)ww * hh <= RS_IMAGE_MAX_PIXELS;
+         ww > 0 && hh > 0 && ww < 65536 && hh < 65536 && (uint64_t)ww * hh <= RS_IMAGE_MAX_PIXELS;
     if (ok)
         ok = (*rgb = (float *)rs_alloc((size_t)ww * hh * 3, sizeof(float))) != NULL;
     for (y = hh; ok && y-- > 0;)
@@ -92,6 +91,22 @@ rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
 rs_status rs_image_read_linear(const char *path, uint32_t *w, uint32_t *h, float **rgb)
 {
     return rs_image_read(path, w, h, rgb); /* PFM is linear */
+}
+
+rs_status rs_image_write_meta(const char *path, uint32_t w, uint32_t h, const float *rgb,
+                              const rs_image_meta *meta, size_t n_meta)
+{
+    (void)meta; /* a .pfm has no header for them */
+    (void)n_meta;
+    return rs_image_write(path, w, h, rgb);
+}
+
+rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n)
+{
+    (void)value;
+    (void)n;
+    return rs_error_set(RS_ERR_ARG, "%s: no attribute %s (this build has no OpenImageIO)", path,
+                        key);
 }
 
 const char *rs_image_library_version(void) { return "none (PFM only)"; }

@@ -7,7 +7,12 @@
  * whose pixel loop adds each pixel's samples one after the other; a few per call for a GPU,
  * which runs one pass over every pixel per sample), checks Ctrl-C and reports progress between
  * calls.  Each pixel gets its samples in sample order, so the image is the wavefront's bit for
- * bit on the host devices (and up to the GPU's arithmetic on CUDA). */
+ * bit on the host devices (and up to the GPU's arithmetic on CUDA).
+ *
+ * With a time limit or a film_ready hook (render.h) the film must end every call on whole
+ * samples: the CPU device then gets one sample per call and is not told of a cancel (it would
+ * stop within a sample), which the loop checks between calls instead.  settings->path_begin
+ * must be a whole number of passes. */
 #ifndef RS_SCHEDULER_PASSES_H
 #define RS_SCHEDULER_PASSES_H
 

@@ -34,6 +34,11 @@ typedef struct render_ctx {
     rs_film *film;
     slot slots[RS_RENDER_MAX_WAVES];
     uint32_t n_slots;
+    uint64_t next_path;       /* the first path no wave has started yet */
+    uint64_t end_path;        /* paths [next_path, end_path) are still to start: the render's
+                                 end, or the end of the pass under way once the time is up */
+    uint64_t on_film;         /* the film holds paths [0, on_film) */
+    double t_start;           /* when rs_render began (now_s) */
     uint64_t ended;           /* paths ended in waves not yet on the film */
     rs_host_allocator pinned; /* a device's host_alloc for the wave buffers, if one has it */
     int have_pinned;
@@ -172,7 +177,10 @@ static uint8_t stage_film(render_ctx *c, slot *sl, rs_status *status)
     c->stats->paths_done += sl->count;
     c->ended -= sl->count;
     c->stats->waves++;
+    c->on_film = sl->start + sl->count;
     report(c);
+    if (c->hooks && c->hooks->film_ready)
+        c->hooks->film_ready(c->hooks->user, c->film, c->on_film);
     return SLOT_IDLE;
 }
 
@@ -214,12 +222,14 @@ static rs_status run_stage(render_ctx *c, slot *sl)
     return status;
 }
 
+/* Starts the next wave: paths [next_path, next_path + wave_paths), cut at end_path. */
 static rs_status slot_start(render_ctx *c, slot *sl, uint64_t wave)
 {
-    uint64_t total = c->stats->paths_total, per = c->st.wave_paths;
+    uint64_t left = c->end_path - c->next_path, per = c->st.wave_paths;
     sl->wave = wave;
-    sl->start = wave * per;
-    sl->count = (uint32_t)(total - sl->start < per ? total - sl->start : per);
+    sl->start = c->next_path;
+    sl->count = (uint32_t)(left < per ? left : per);
+    c->next_path += sl->count;
     sl->alive = sl->count;
     sl->bounce = 0;
     sl->cur = 0;
@@ -271,6 +281,10 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     if (npix > UINT32_MAX)
         return rs_error_set(RS_ERR_ARG, "image too large: %ux%u at %u spp", st->width, st->height,
                             st->spp);
+    if (st->path_begin > npix * st->spp)
+        return rs_error_set(RS_ERR_ARG,
+                            "the film already holds %llu samples, more than %ux%u at %u spp",
+                            (unsigned long long)st->path_begin, st->width, st->height, st->spp);
     memset(it, 0, sizeof *it);
     it->scene = scene;
     it->camera = rs_camera_make(scene->camera.from, scene->camera.at, scene->camera.up,
@@ -348,9 +362,28 @@ static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint
         st->wave_paths = (uint32_t)total;
 }
 
+/* Once the time limit is reached: no path past the end of the pass that holds the last path
+ * started (at least the first pass this call adds to), so the film ends on a whole pass. */
+static void apply_time_limit(render_ctx *c)
+{
+    uint64_t npix = c->it.npix, end, first_pass_end;
+    const rs_render_hooks *h = c->hooks;
+    if (!h || h->time_limit_s <= 0 || c->stats->time_limited ||
+        now_s() - c->t_start < h->time_limit_s)
+        return;
+    end = (c->next_path + npix - 1) / npix * npix;
+    first_pass_end = (c->st.path_begin / npix + 1) * npix;
+    if (end < first_pass_end)
+        end = first_pass_end;
+    if (end < c->end_path) {
+        c->end_path = end;
+        c->stats->time_limited = 1;
+    }
+}
+
 /* Round robin over the slots: each visit runs a slot up to its next submission, so the devices
  * trace the other slots' rays meanwhile; finished waves go to the film in wave order. */
-static rs_status run_waves(render_ctx *c, uint64_t n_waves)
+static rs_status run_waves(render_ctx *c)
 {
     uint64_t next_wave = 0, next_flush = 0;
     rs_status status = RS_OK;
@@ -359,10 +392,12 @@ static rs_status run_waves(render_ctx *c, uint64_t n_waves)
         busy = 0;
         for (k = 0; k < c->n_slots && status == RS_OK; ++k) {
             slot *sl = &c->slots[k];
-            if (sl->stage == SLOT_IDLE && next_wave < n_waves) {
+            if (sl->stage == SLOT_IDLE && c->next_path < c->end_path) {
                 if (cancelled(c->hooks))
                     break;
-                status = slot_start(c, sl, next_wave++);
+                apply_time_limit(c);
+                if (c->next_path < c->end_path)
+                    status = slot_start(c, sl, next_wave++);
             } else if (sl->stage == RS_STAGE_TRACE_CLOSEST || sl->stage == RS_STAGE_TRACE_SHADOW) {
                 if (cancelled(c->hooks))
                     break;
@@ -370,7 +405,7 @@ static rs_status run_waves(render_ctx *c, uint64_t n_waves)
             }
             if (status == RS_OK)
                 status = flush_in_order(c, &next_flush);
-            busy |= sl->stage != SLOT_IDLE || next_wave < n_waves;
+            busy |= sl->stage != SLOT_IDLE || c->next_path < c->end_path;
         }
         if (status == RS_OK && cancelled(c->hooks))
             status = rs_error_set(RS_ERR_CANCELLED, "render interrupted");
@@ -397,17 +432,20 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
     c = (render_ctx *)rs_calloc(1, sizeof *c);
     if (!c)
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the render loop");
-    total = (uint64_t)it.npix * st_in->spp;
+    total = (uint64_t)it.npix * st_in->spp - st_in->path_begin; /* this call's paths */
     c->it = it;
     c->st = *st_in;
     c->sched = sched;
     c->hooks = hooks;
     c->stats = stats;
     c->film = film;
+    c->next_path = c->on_film = st_in->path_begin;
+    c->end_path = st_in->path_begin + total;
+    c->t_start = t_start;
     resolve_settings(&c->st, sched, total);
     c->ex.threads = c->st.threads;
     c->ex.strategy = c->st.strategy;
-    n_waves = (total + c->st.wave_paths - 1) / c->st.wave_paths;
+    n_waves = total ? (total + c->st.wave_paths - 1) / c->st.wave_paths : 0;
     c->n_slots = n_waves < c->st.waves_in_flight ? (uint32_t)n_waves : c->st.waves_in_flight;
     stats->paths_total = total;
     choose_host_memory(c);
@@ -422,8 +460,8 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
             status = rs_wave_buffers_create(c->st.wave_paths, NULL, &c->slots[k].b);
         }
     }
-    if (status == RS_OK)
-        status = run_waves(c, n_waves);
+    if (status == RS_OK && total > 0)
+        status = run_waves(c);
     /* on a failure or an interruption, take back what is still with the scheduler before the
      * buffers go: the render thread owns them */
     for (k = 0; k < c->n_slots; ++k) {

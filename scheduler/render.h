@@ -53,6 +53,9 @@ typedef struct rs_render_settings {
     rs_par_strategy strategy; /* how the shade stage splits a wave among threads */
     rs_timeline *timeline;    /* stage spans on lane `timeline_lane`; NULL: none */
     uint16_t timeline_lane;   /* the render thread's lane: the number of devices */
+    uint64_t path_begin;      /* the film already holds paths [0, path_begin) of this render
+                                 (a resumed checkpoint, app/checkpoint.h); the render adds the
+                                 rest, [path_begin, width * height * spp).  0: a fresh film */
 } rs_render_settings;
 
 #define RS_RENDER_DEFAULT_WAVE (1u << 20)
@@ -77,6 +80,7 @@ typedef struct rs_render_stats {
     uint64_t rays_closest, rays_shadow;
     uint32_t waves;
     uint32_t max_bounce; /* deepest segment reached */
+    int time_limited;    /* the time limit stopped it before paths_total (at a whole pass) */
 } rs_render_stats;
 
 typedef struct rs_render_hooks {
@@ -86,14 +90,27 @@ typedef struct rs_render_hooks {
     /* When non-NULL and set, the render stops at the next stage boundary: the current wave is
      * dropped, the film keeps every finished wave, and RS_ERR_CANCELLED is returned. */
     const atomic_int *cancel;
+    /* > 0: once this many seconds of the render have passed, no new pass is begun: the paths up
+     * to the end of the pass under way (sample-major numbering: a pass is npix paths) are
+     * finished, so every pixel has the same number of samples, and RS_OK is returned with
+     * stats->time_limited set.  At least one pass is always finished. */
+    double time_limit_s;
+    /* May be NULL.  Called from the render thread whenever the film holds exactly the paths
+     * [0, paths_on_film) (after each wave is added; for the megakernel after each call of
+     * render_pass); the film may be read, not written, during the call. */
+    void (*film_ready)(void *user, const rs_film *film, uint64_t paths_on_film);
 } rs_render_hooks;
 
-/* Renders `scene` into `film` (whose size must match settings).  `hooks` may be NULL. */
+/* Renders `scene` into `film` (whose size must match settings).  `hooks` may be NULL.  With
+ * settings->path_begin > 0 the film must hold exactly paths [0, path_begin) of a render with
+ * the same settings; the result is then the uninterrupted render's bit for bit, since each
+ * pixel sums its samples in path order whatever the waves (stats count this call's paths). */
 rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_settings *settings,
                     const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats);
 
 /* What both integrators check and share: the settings against the film (RS_ERR_ARG with a
- * message when a size is 0, the film does not match, or the image has 2^32 pixels or more), and
+ * message when a size is 0, the film does not match, the image has 2^32 pixels or more, or
+ * path_begin lies past the render's paths), and
  * the render's device-safe constants *it (camera, seed, sizes, depths, sampling). */
 rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *settings,
                               const rs_film *film, rs_integrator *it);

@@ -549,6 +549,34 @@ static void test_usage_errors(void **state)
          {"--timeline", "t.png", ".svg"}},
         {{"render", "-o", "out.png", "--spp", "1", "--timeline", "/nonexistent-dir/t.svg", NULL},
          {"--timeline", "/nonexistent-dir"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "0", NULL},
+         {"--time-limit", "0"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "-1", NULL},
+         {"--time-limit", "-1"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "abc", NULL},
+         {"--time-limit", "abc"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "inf", NULL},
+         {"--time-limit", "inf"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "nan", NULL},
+         {"--time-limit", "nan"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "1e999", NULL},
+         {"--time-limit", "1e999"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", "0x10", NULL},
+         {"--time-limit", "0x10"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--time-limit", NULL}, {"--time-limit"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--checkpoint-interval", "5", NULL},
+         {"--checkpoint-interval", "--checkpoint"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--checkpoint", "c.ckpt",
+          "--checkpoint-interval", "0", NULL},
+         {"--checkpoint-interval", "0"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--checkpoint", "/nonexistent-dir/c.ckpt", NULL},
+         {"--checkpoint", "/nonexistent-dir"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--checkpoint", "out.png", NULL},
+         {"--checkpoint", "out.png", "same file"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--resume", "no-such.ckpt", NULL},
+         {"--resume", "no-such.ckpt"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--resume", RS_SOURCE_DIR "/scenes", NULL},
+         {"--resume", "/scenes", "folder"}},
     };
     char known[256], names[512];
     size_t c;
@@ -1489,6 +1517,410 @@ static void test_scene_files_and_meshes(void **state)
     }
 }
 
+/* ---- 9. bounded and resumable renders -------------------------------------------------------- */
+
+/* The unsigned number after "KEY": in the file `name` of the test folder, or -1. */
+static long long json_number(const fixture *f, const char *name, const char *key)
+{
+    char path[256], text[8192], pat[64];
+    const char *at;
+    path_in(f, name, path, sizeof path);
+    if (!slurp(path, text, sizeof text))
+        return -1;
+    snprintf(pat, sizeof pat, "\"%s\": ", key);
+    at = strstr(text, pat);
+    return at ? strtoll(at + strlen(pat), NULL, 10) : -1;
+}
+
+/* Runs args (NULL-terminated) in the test folder; it must exit with `code`. */
+static void run_expect(const fixture *f, const char *const *args, int code, proc *p)
+{
+    run(p, f->dir, DEFAULT_TIMEOUT_S, args);
+    EXPECT(p, exited_with(p, code), "expected exit status %d", code);
+}
+
+/* The images `a` and `b` of the test folder are the same bit for bit (`p`: the run to show). */
+static void expect_same_image(const proc *p, const fixture *f, const char *a, const char *b)
+{
+    image x = read_image(p, f, a), y = read_image(p, f, b);
+    size_t i = 0, n = (size_t)x.w * x.h * 3;
+    if (x.w == y.w && x.h == y.h)
+        for (i = 0; i < n && memcmp(&x.rgb[i], &y.rgb[i], sizeof(float)) == 0; ++i)
+            ;
+    if (!(x.w == y.w && x.h == y.h && i == n)) {
+        float va = i < n ? x.rgb[i] : 0.0f, vb = i < n && y.w == x.w ? y.rgb[i] : 0.0f;
+        rs_free(x.rgb);
+        rs_free(y.rgb);
+        EXPECT(p, 0, "%s (%ux%u) and %s (%ux%u) differ at value %zu: %.9g against %.9g", a, x.w,
+               x.h, b, y.w, y.h, i, (double)va, (double)vb);
+    }
+    rs_free(x.rgb);
+    rs_free(y.rgb);
+}
+
+/* --time-limit: a render that would take minutes stops on a whole pass, says how many spp it
+ * did (summary, --stats-json), and its image is the one `--spp THAT` gives, bit for bit: every
+ * pixel has that many samples and the image is divided by them.  Stream and megakernel. */
+static void test_time_limit(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const integrators[][4] = {
+        {"--devices", "cpu", NULL}, {"--integrator", "megakernel", "--devices", "cpu"}};
+    size_t k;
+    for (k = 0; k < 2; ++k) {
+        const char *args[MAX_ARGS] = {
+            "render",       "--width", "32",           "--height", "24", "--spp", "1000000",
+            "--time-limit", "0.3",     "--stats-json", "s.json",   "-o", "t.exr"};
+        char spp_text[32], path[256];
+        const char *ref[] = {"render", "--width", "32", "--height", "24", "--spp",
+                             spp_text, "-q",      "-o", "ref.exr",  NULL};
+        int n = 13, i;
+        long long spp;
+        proc p, q;
+        for (i = 0; i < 4 && integrators[k][i]; ++i)
+            args[n++] = integrators[k][i];
+        args[n] = NULL;
+        run(&p, f->dir, 60.0, args);
+        EXPECT(&p, !p.timed_out && exited_with(&p, 0),
+               "a time-limited render should end by itself with status 0");
+        spp = json_number(f, "s.json", "spp");
+        EXPECT(&p, spp >= 1 && spp < 1000000, "s.json should give the spp done, not %lld", spp);
+        EXPECT(&p, json_number(f, "s.json", "spp_requested") == 1000000,
+               "s.json should give the spp asked for");
+        EXPECT(&p, json_number(f, "s.json", "samples") == spp * 32 * 24,
+               "s.json: every pixel should have %lld samples", spp);
+        snprintf(spp_text, sizeof spp_text, "%lld", spp);
+        EXPECT(&p, strstr(p.err.data, spp_text) && strstr(p.err.data, "of 1000000 spp"),
+               "the summary should say %s of 1000000 spp", spp_text);
+        {
+            char meta[64];
+            path_in(f, "t.exr", path, sizeof path);
+            EXPECT(&p,
+                   rs_image_read_meta(path, "raystream:spp", meta, sizeof meta) == RS_OK &&
+                       strcmp(meta, spp_text) == 0,
+                   "t.exr's header should give raystream:spp %s", spp_text);
+            rs_error_clear();
+        }
+        run_expect(f, ref, 0, &q);
+        expect_same_image(&q, f, "t.exr", "ref.exr");
+        proc_free(&p);
+        proc_free(&q);
+        for (i = 0; i < 3; ++i) {
+            static const char *const names[] = {"t.exr", "ref.exr", "s.json"};
+            path_in(f, names[i], path, sizeof path);
+            unlink(path);
+        }
+    }
+}
+
+/* --checkpoint then --resume to more samples: the image of the uninterrupted render bit for
+ * bit, on the CPU, CPU + GPU (the fallback here), the megakernel, and checkpointing on into the
+ * file it continues; the resumed run traces only the samples it adds. */
+static void test_checkpoint_resume(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+#define SMALL "--width", "40", "--height", "30", "-q", "--stats-json"
+    static const char *const full[] = {"render",    SMALL, "full.json", "--spp",    "8",
+                                       "--devices", "cpu", "-o",        "full.exr", NULL};
+    static const char *const part[] = {"render", SMALL,       "part.json", "--spp",
+                                       "3",      "--devices", "cpu",       "--checkpoint",
+                                       "c.ckpt", "-o",        "part.exr",  NULL};
+    static const char *const resumes[][24] = {
+        {"render", SMALL, "r1.json", "--resume", "c.ckpt", "--spp", "8", "--devices", "cpu", "-o",
+         "r1.exr", NULL},
+        {"render", SMALL, "r2.json", "--resume", "c.ckpt", "--spp", "8", "--devices", "cpu,gpu",
+         "-o", "r2.exr", NULL},
+        {"render", SMALL, "r3.json", "--resume", "c.ckpt", "--spp", "8", "--integrator",
+         "megakernel", "--devices", "cpu", "-o", "r3.exr", NULL},
+        {"render", SMALL, "r4.json", "--resume", "c.ckpt", "--spp", "8", "--integrator",
+         "megakernel", "--devices", "gpu", "-o", "r4.exr", NULL},
+    };
+    /* on into the same file: 3 -> 5 spp, then (no --spp: the file's 5) nothing to add, then 8 */
+    static const char *const chain[][24] = {
+        {"render", SMALL, "c1.json", "--resume", "c.ckpt", "--checkpoint", "c.ckpt", "--spp", "5",
+         "--devices", "cpu:1,gpu", "--wave-size", "777", "-o", "c5.exr", NULL},
+        {"render", SMALL, "c2.json", "--resume", "c.ckpt", "-o", "c5b.exr", NULL},
+        {"render", SMALL, "c3.json", "--resume", "c.ckpt", "--spp", "8", "-o", "c8.exr", NULL},
+    };
+    static const char *const five[] = {"render", SMALL, "five.json", "--spp",
+                                       "5",      "-o",  "five.exr",  NULL};
+#undef SMALL
+    long long rays_full, rays;
+    size_t k;
+    proc p;
+
+    run_expect(f, full, 0, &p);
+    proc_free(&p);
+    rays_full = json_number(f, "full.json", "rays");
+    run_expect(f, part, 0, &p);
+    proc_free(&p);
+    for (k = 0; k < sizeof resumes / sizeof resumes[0]; ++k) {
+        char name[16];
+        run_expect(f, resumes[k], 0, &p);
+        snprintf(name, sizeof name, "r%zu.exr", k + 1);
+        expect_same_image(&p, f, name, "full.exr");
+        snprintf(name, sizeof name, "r%zu.json", k + 1);
+        EXPECT(&p,
+               json_number(f, name, "resumed_samples") == 3 * 1200 &&
+                   json_number(f, name, "samples") == 8 * 1200,
+               "%s should say 3 spp resumed, 8 in all", name);
+        rays = json_number(f, name, "rays");
+        /* 5 of 8 spp traced: about 5/8 of the rays */
+        EXPECT(&p, rays > 0 && rays < rays_full * 3 / 4,
+               "the resumed render traced %lld rays, the whole one %lld: it should add only the "
+               "missing samples",
+               rays, rays_full);
+        proc_free(&p);
+    }
+    run_expect(f, five, 0, &p);
+    proc_free(&p);
+    for (k = 0; k < sizeof chain / sizeof chain[0]; ++k) {
+        run_expect(f, chain[k], 0, &p);
+        if (k == 0)
+            expect_same_image(&p, f, "c5.exr", "five.exr");
+        if (k == 1) {
+            expect_same_image(&p, f, "c5b.exr", "five.exr");
+            EXPECT(&p, json_number(f, "c2.json", "rays") == 0,
+                   "a checkpoint that holds every sample asked for needs no rays");
+        }
+        if (k == 2)
+            expect_same_image(&p, f, "c8.exr", "full.exr");
+        proc_free(&p);
+    }
+}
+
+/* A stop in the middle of a pass (SIGINT: the checkpoint written on the way out), and a render
+ * killed outright (SIGKILL: the last periodic checkpoint), each resumed on another device set:
+ * the uninterrupted render's image bit for bit. */
+static void test_resume_after_signal(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const sig_run[] = {
+        "render",       "--width", "40",        "--height", "30", "--spp",        "1000000",
+        "--wave-size",  "1000",    "--devices", "cpu",      "-q", "--checkpoint", "s.ckpt",
+        "--stats-json", "s.json",  "-o",        "p.exr",    NULL};
+    static const char *const kill_run[] = {"render",
+                                           "--width",
+                                           "40",
+                                           "--height",
+                                           "30",
+                                           "--spp",
+                                           "1000000",
+                                           "--devices",
+                                           "cpu:1,gpu",
+                                           "-q",
+                                           "--checkpoint",
+                                           "k.ckpt",
+                                           "--checkpoint-interval",
+                                           "0.1",
+                                           "-o",
+                                           "k.exr",
+                                           NULL};
+    char spp_text[32];
+    const char *resume[] = {"render",   "--width", "40",    "--height", "30",
+                            "--resume", "s.ckpt",  "--spp", spp_text,   "--devices",
+                            "cpu,gpu",  "-q",      "-o",    "rs.exr",   NULL};
+    const char *ref[] = {"render", "--width",   "40",  "--height", "30",      "--spp", spp_text,
+                         "-q",     "--devices", "cpu", "-o",       "ref.exr", NULL};
+    static const char *const resume_k[] = {
+        "render",       "--width", "40",           "--height", "30",        "--resume", "k.ckpt",
+        "--spp",        "1000000", "--time-limit", "0.2",      "--devices", "cpu",      "-q",
+        "--stats-json", "k.json",  "-o",           "rk.exr",   NULL};
+    char path[256];
+    long long samples, spp;
+    proc p, q;
+
+    proc_start(&p, f->dir, sig_run);
+    let_it_render(&p);
+    assert_int_equal(kill(p.pid, SIGINT), 0);
+    proc_finish(&p, (now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
+    EXPECT(&p, exited_with(&p, 130), "SIGINT should stop it with status 130");
+    samples = json_number(f, "s.json", "samples");
+    EXPECT(&p, samples > 0, "s.json should count the samples done: %lld", samples);
+    fprintf(stderr, "  SIGINT after %lld samples: %lld whole passes + %lld paths\n", samples,
+            samples / 1200, samples % 1200);
+    snprintf(spp_text, sizeof spp_text, "%lld", samples / 1200 + 2);
+    run_expect(f, resume, 0, &q);
+    run_expect(f, ref, 0, &q);
+    expect_same_image(&q, f, "rs.exr", "ref.exr");
+    proc_free(&p);
+    proc_free(&q);
+    path_in(f, "ref.exr", path, sizeof path);
+    unlink(path);
+
+    proc_start(&p, f->dir, kill_run);
+    let_it_render(&p);
+    assert_int_equal(kill(p.pid, SIGKILL), 0);
+    proc_finish(&p, 10.0);
+    path_in(f, "k.ckpt", path, sizeof path);
+    EXPECT(&p, file_exists(path), "a periodic checkpoint should have been written");
+    run_expect(f, resume_k, 0, &q);
+    spp = json_number(f, "k.json", "spp");
+    EXPECT(&q, spp > 0 && json_number(f, "k.json", "resumed_samples") > 0,
+           "k.json: %lld spp after resuming", spp);
+    snprintf(spp_text, sizeof spp_text, "%lld", spp);
+    proc_free(&q);
+    run_expect(f, ref, 0, &q);
+    expect_same_image(&q, f, "rk.exr", "ref.exr");
+    proc_free(&p);
+    proc_free(&q);
+}
+
+/* The EXR header records the render: scene, spp done and asked for, seed, sampling, sampler,
+ * max depth, devices, integrator, version. */
+static void test_exr_metadata(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render",      "builtin:materials",
+                                       "--width",     "24",
+                                       "--spp",       "3",
+                                       "--seed",      "42",
+                                       "--sampler",   "independent",
+                                       "--max-depth", "7",
+                                       "--devices",   "cpu:1,gpu",
+                                       "-q",          "-o",
+                                       "m.exr",       NULL};
+    static const struct {
+        const char *key, *want;
+    } fields[] = {
+        {"raystream:scene", "builtin:materials"},
+        {"raystream:spp", "3"},
+        {"raystream:spp_requested", "3"},
+        {"raystream:seed", "42"},
+        {"raystream:sampling", "mis"},
+        {"raystream:sampler", "independent"},
+        {"raystream:max_depth", "7"},
+        {"raystream:devices", "cpu,gpu-fallback:0"},
+        {"raystream:integrator", "stream"},
+    };
+    char path[256], value[256];
+    size_t k;
+    proc p;
+    run_expect(f, args, 0, &p);
+    path_in(f, "m.exr", path, sizeof path);
+    for (k = 0; k < sizeof fields / sizeof fields[0]; ++k) {
+        value[0] = '\0';
+        EXPECT(&p, rs_image_read_meta(path, fields[k].key, value, sizeof value) == RS_OK,
+               "m.exr has no %s", fields[k].key);
+        EXPECT(&p, strcmp(value, fields[k].want) == 0, "m.exr's %s is '%s', not '%s'",
+               fields[k].key, value, fields[k].want);
+    }
+    EXPECT(&p,
+           rs_image_read_meta(path, "raystream:version", value, sizeof value) == RS_OK &&
+               strspn(value, "0123456789.") > 0,
+           "m.exr's raystream:version is '%s'", value);
+    rs_error_clear();
+    proc_free(&p);
+}
+
+/* Copies the first `len` bytes of file `from` to `to` (the test folder's), byte `flip` (if >= 0)
+ * inverted. */
+static void copy_cut(const fixture *f, const char *from, const char *to, size_t len, long flip)
+{
+    char a[256], b[256];
+    size_t n = 0;
+    char *data;
+    FILE *fp;
+    path_in(f, from, a, sizeof a);
+    path_in(f, to, b, sizeof b);
+    data = read_bytes(a, &n);
+    assert_non_null(data);
+    if (len > n)
+        len = n;
+    if (flip >= 0 && (size_t)flip < len)
+        data[flip] = (char)~data[flip];
+    fp = fopen(b, "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(data, 1, len, fp), len);
+    fclose(fp);
+    free(data);
+}
+
+/* --resume refuses, with one line naming the file (and the field), a checkpoint of other
+ * settings (status 2) and a truncated or corrupt one (status 1), and replaces no file. */
+static void test_checkpoint_refused(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const make[] = {"render", "--width",  "40", "--height",     "30",
+                                       "--spp",  "2",        "-q", "--checkpoint", "c.ckpt",
+                                       "-o",     "good.exr", NULL};
+    static const char *const make_z[] = {"render",       "--width", "40", "--height",  "30",
+                                         "--spp",        "2",       "-q", "--sampler", "zsobol",
+                                         "--checkpoint", "z.ckpt",  "-o", "z.exr",     NULL};
+    static const struct {
+        const char *args[8];
+        const char *file, *word;
+        int code;
+    } cases[] = {
+        {{"--seed", "7"}, "c.ckpt", "--seed", 2},
+        {{"--width", "20"}, "c.ckpt", "size", 2},
+        {{"--sampling", "bsdf"}, "c.ckpt", "--sampling", 2},
+        {{"--sampler", "independent"}, "c.ckpt", "--sampler", 2},
+        {{"--max-depth", "5"}, "c.ckpt", "--max-depth", 2},
+        {{"--isect-tri", "watertight"}, "c.ckpt", "--isect-tri", 2},
+        {{"builtin:materials"}, "c.ckpt", "scene", 2},
+        {{"--spp", "1"}, "c.ckpt", "--spp", 2},
+        {{"--sampler", "zsobol", "--spp", "4"}, "z.ckpt", "zsobol", 2},
+        {{NULL}, "half.ckpt", "truncated", 1},
+        {{NULL}, "flip.ckpt", "corrupt", 1},
+        {{NULL}, "head.ckpt", "corrupt", 1},
+        {{NULL}, "text.ckpt", "not a raystream checkpoint", 1},
+        {{NULL}, "empty.ckpt", "truncated", 1},
+    };
+    char good_path[256], ck_path[256], names[512];
+    char *good, *ck, *after;
+    size_t n_good = 0, n_ck = 0, n_after = 0, c, k;
+    int before;
+    proc p;
+
+    run_expect(f, make, 0, &p);
+    proc_free(&p);
+    run_expect(f, make_z, 0, &p);
+    proc_free(&p);
+    path_in(f, "good.exr", good_path, sizeof good_path);
+    path_in(f, "c.ckpt", ck_path, sizeof ck_path);
+    good = read_bytes(good_path, &n_good);
+    ck = read_bytes(ck_path, &n_ck);
+    assert_non_null(good);
+    assert_non_null(ck);
+    copy_cut(f, "c.ckpt", "half.ckpt", n_ck / 2, -1);
+    copy_cut(f, "c.ckpt", "flip.ckpt", n_ck, (long)(n_ck / 2));
+    copy_cut(f, "c.ckpt", "head.ckpt", n_ck, 32); /* the sample count in the header */
+    put_file(f, "text.ckpt",
+             "{\"not\": \"a checkpoint, but long enough to hold a header\"}\n"
+             "................................................................");
+    put_file(f, "empty.ckpt", "");
+    before = list_dir(f->dir, names, sizeof names);
+    for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        const char *args[MAX_ARGS] = {
+            "render",   "--width",     "40",           "--height", "30", "--spp",   "2",
+            "--resume", cases[c].file, "--checkpoint", "c.ckpt",   "-o", "good.exr"};
+        int n = 13;
+        for (k = 0; k < 8 && cases[c].args[k]; ++k)
+            args[n++] = cases[c].args[k];
+        args[n] = NULL;
+        if (strcmp(cases[c].file, "z.ckpt") == 0)
+            args[10] = "z2.ckpt";
+        run(&p, f->dir, DEFAULT_TIMEOUT_S, args);
+        EXPECT(&p, exited_with(&p, cases[c].code), "expected status %d", cases[c].code);
+        EXPECT(&p, one_line(&p.err), "expected exactly one line on stderr");
+        EXPECT(&p, strstr(p.err.data, cases[c].file) && strstr(p.err.data, cases[c].word),
+               "the line should name %s and '%s'", cases[c].file, cases[c].word);
+        after = read_bytes(good_path, &n_after);
+        EXPECT(&p, after && n_after == n_good && memcmp(after, good, n_good) == 0,
+               "good.exr changed");
+        free(after);
+        after = read_bytes(ck_path, &n_after);
+        EXPECT(&p, after && n_after == n_ck && memcmp(after, ck, n_ck) == 0, "c.ckpt changed");
+        free(after);
+        EXPECT(&p, list_dir(f->dir, names, sizeof names) == before,
+               "a refused resume left a file behind: %s", names);
+        proc_free(&p);
+    }
+    free(good);
+    free(ck);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1513,6 +1945,11 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_files_and_meshes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_stage_stats_and_timeline, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_time_limit, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_checkpoint_resume, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_resume_after_signal, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_checkpoint_refused, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_exr_metadata, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }

@@ -1,0 +1,67 @@
+/* app/checkpoint.h — a render's film saved to a file (--checkpoint FILE) and read back
+ * (--resume FILE), so that a render continued from it ends bit for bit as the uninterrupted one.
+ *
+ * Why that holds: paths are numbered sample-major (scheduler/render.h) and each pixel sums its
+ * samples into a double in path order, on every device set; the film only ever holds a prefix
+ * [0, paths) of the numbering (whole waves, in wave order; whole samples for the megakernel).
+ * A checkpoint stores those exact sums and counts and `paths`; the resumed render starts at path
+ * `paths` and adds the rest onto the same doubles in the same order.
+ *
+ * File format, version 1 (little-endian; a header of 92 bytes + the scene name):
+ *   off  size  field
+ *     0     8  magic "RSCKPT\r\n" (a text-mode transfer or a truncation shows)
+ *     8     4  version (1)
+ *    12     4  header bytes (from offset 0 to the first sum)
+ *    16     8  scene content hash (rs_checkpoint_scene_hash: geometry, materials, textures,
+ *              lights, camera, background; a mesh or texture file's content is in it)
+ *    24     8  seed
+ *    32     8  paths on the film
+ *    40     8  non-finite samples dropped so far
+ *    48    40  width, height, spp, max depth, rr depth, sampling, sampler, sphere test,
+ *              triangle test, box test (u32 each)
+ *    88     4  scene name bytes n (< 4096), then the name as given on the command line
+ *  hdr   24*P  the sums, 3 doubles a pixel (P = width * height)
+ *         4*P  the counts, u32 a pixel (must be paths / P, plus 1 for the first paths % P)
+ *           8  FNV-1a 64 of every byte before it
+ * Everything that decides the image is in the header; the devices, threads, chunk and wave
+ * sizes, the BVH builder and the integrator are not (they do not change the image).  spp matters
+ * only to the zsobol sampler (its point set depends on it); with the others a checkpoint may be
+ * continued to more samples. */
+#ifndef RS_APP_CHECKPOINT_H
+#define RS_APP_CHECKPOINT_H
+
+#include <stdint.h>
+
+#include "scenes/scene.h"
+#include "shading/film.h"
+
+#define RS_CHECKPOINT_VERSION 1u
+
+/* What decides the image, as the checkpoint records it. */
+typedef struct rs_checkpoint_key {
+    uint64_t scene_hash;
+    uint64_t seed;
+    uint32_t width, height, spp, max_depth, rr_depth;
+    uint32_t sampling, sampler;
+    uint32_t isect_sphere, isect_tri, isect_aabb;
+    const char *scene; /* the scene's name on the command line (messages only) */
+} rs_checkpoint_key;
+
+/* FNV-1a 64 over every array and setting of a finalized scene that shading reads. */
+uint64_t rs_checkpoint_scene_hash(const rs_scene *s);
+
+/* Writes `key` and the film, which holds paths [0, paths), to `staged` (flushed to disk) and,
+ * if `rename_now`, renames it to `path` (else the caller does, with the other outputs).  A
+ * reader never sees a partial file at `path`; on failure `staged` is removed and `path` left as
+ * it was.  Returns 1, or 0 after printing one line naming `path`. */
+int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
+                        const rs_checkpoint_key *key, const rs_film *film, uint64_t paths);
+
+/* Reads checkpoint `path` for a render with settings `want` into `film` (want's size, fresh):
+ * *paths gets the paths it holds.  want->spp == 0 takes the file's spp into want->spp.
+ * Returns 0 (RS_EXIT_OK); RS_EXIT_USAGE after one line naming the file when it is missing, not a
+ * regular file or was made with other settings (the line names the field, its value in the
+ * file and the one asked for); RS_EXIT_RUNTIME after one line when it is truncated or corrupt. */
+int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film, uint64_t *paths);
+
+#endif
