@@ -52,8 +52,6 @@ typedef enum rs_bvh_key {
  * ray/primitive test cost the same.  The binned-SAH builder and rs_bvh_sah_cost both use them. */
 #define RS_BVH_COST_TRAV  1.0
 #define RS_BVH_COST_ISECT 1.0
-/* rs_bvh_build_opts.leaf_block for trees the CPU's wide traversals run (accel/bvh4.h, bvh8.h) */
-#define RS_BVH_LEAF_BLOCK_WIDE 4u
 
 /* A builder: the method and its parameters.  Fields that the method does not use are ignored. */
 typedef struct rs_bvh_builder {
@@ -87,9 +85,9 @@ typedef struct rs_bvh_build_opts {
     uint32_t threads;       /* OpenMP threads for the build; 0: the default.  The tree does not
                                depend on it. */
     /* SAH only: a leaf's cost counts its primitives in blocks of this many, the width of the
-     * leaf test that tests them together (RS_BVH_LEAF_BLOCK_WIDE for the CPU's 4-wide and 8-wide
-     * trees, whose triangle leaves are tested four at a time); 0 or 1: one by one, as MacDonald
-     * and Booth count them.  Shapes the tree only: every tree gives the same hits. */
+     * leaf test that tests them together (the CPU's wide trees test a leaf's triangles or
+     * parallelograms 4 or 8 at a time: rs_bvh_wide_leaf_size, accel/bvh8.h); 0 or 1: one by one,
+     * as MacDonald and Booth count them.  Shapes the tree only: every tree gives the same hits. */
     uint32_t leaf_block;
     /* LBVH only: where the Morton codes are computed and sorted (the GPU: gpu/gpu_device.h's
      * rs_gpu_lbvh_sort); NULL: on the host.  It must write codes[i] = rs_morton3(centroid[i],

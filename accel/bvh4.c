@@ -56,7 +56,7 @@ rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)
     *out = NULL;
     memset(&c, 0, sizeof c);
     c.bin = b;
-    rs_leaf_packer_init(&c.pk, b, g);
+    rs_leaf_packer_init(&c.pk, b, g, 4);
     st = rs_bvh_wide_plan(b, &c.pk, "4-wide BVH", RS_BVH4_MAX_NODES, &c.cap);
     if (st != RS_OK)
         return st;
@@ -66,21 +66,21 @@ rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)
     t->prim_ids = b->prim_ids;
     if (c.cap > 0) {
         t->nodes = (rs_bvh4_node *)rs_alloc_aligned(c.cap, sizeof *t->nodes);
-        if (c.pk.cap_tri4 > 0)
-            t->tri4 = (rs_bvh4_tri4 *)rs_alloc_aligned(c.pk.cap_tri4, sizeof *t->tri4);
-        if (c.pk.cap_quad4 > 0)
-            t->quad4 = (rs_bvh4_quad4 *)rs_alloc_aligned(c.pk.cap_quad4, sizeof *t->quad4);
-        if (!t->nodes || (c.pk.cap_tri4 > 0 && !t->tri4) || (c.pk.cap_quad4 > 0 && !t->quad4)) {
+        if (c.pk.cap_tri > 0)
+            t->tri4 = (rs_bvh4_tri4 *)rs_alloc_aligned(c.pk.cap_tri, sizeof *t->tri4);
+        if (c.pk.cap_quad > 0)
+            t->quad4 = (rs_bvh4_quad4 *)rs_alloc_aligned(c.pk.cap_quad, sizeof *t->quad4);
+        if (!t->nodes || (c.pk.cap_tri > 0 && !t->tri4) || (c.pk.cap_quad > 0 && !t->quad4)) {
             rs_bvh4_destroy(t);
             return rs_error_set(RS_ERR_NOMEM, "out of memory for the 4-wide BVH (%u nodes)", c.cap);
         }
         c.out = t;
-        c.pk.tri4 = t->tri4;
-        c.pk.quad4 = t->quad4;
+        c.pk.tri = t->tri4;
+        c.pk.quad = t->quad4;
         t->n_nodes = 1;
         t->depth = collapse_node(&c, 0, 0);
-        t->n_tri4 = c.pk.n_tri4;
-        t->n_quad4 = c.pk.n_quad4;
+        t->n_tri4 = c.pk.n_tri;
+        t->n_quad4 = c.pk.n_quad;
     }
     *out = t;
     return RS_OK;

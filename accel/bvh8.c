@@ -64,7 +64,7 @@ rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out)
     *out = NULL;
     memset(&c, 0, sizeof c);
     c.bin = b;
-    rs_leaf_packer_init(&c.pk, b, g);
+    rs_leaf_packer_init(&c.pk, b, g, 8);
     st = rs_bvh_wide_plan(b, &c.pk, "8-wide BVH", RS_BVH8_MAX_NODES, &c.cap);
     if (st != RS_OK)
         return st;
@@ -74,21 +74,21 @@ rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out)
     t->prim_ids = b->prim_ids;
     if (c.cap > 0) {
         t->nodes = (rs_bvh8_node *)rs_alloc_aligned(c.cap, sizeof *t->nodes);
-        if (c.pk.cap_tri4 > 0)
-            t->tri4 = (rs_bvh4_tri4 *)rs_alloc_aligned(c.pk.cap_tri4, sizeof *t->tri4);
-        if (c.pk.cap_quad4 > 0)
-            t->quad4 = (rs_bvh4_quad4 *)rs_alloc_aligned(c.pk.cap_quad4, sizeof *t->quad4);
-        if (!t->nodes || (c.pk.cap_tri4 > 0 && !t->tri4) || (c.pk.cap_quad4 > 0 && !t->quad4)) {
+        if (c.pk.cap_tri > 0)
+            t->tri8 = (rs_bvh8_tri8 *)rs_alloc_aligned(c.pk.cap_tri, sizeof *t->tri8);
+        if (c.pk.cap_quad > 0)
+            t->quad8 = (rs_bvh8_quad8 *)rs_alloc_aligned(c.pk.cap_quad, sizeof *t->quad8);
+        if (!t->nodes || (c.pk.cap_tri > 0 && !t->tri8) || (c.pk.cap_quad > 0 && !t->quad8)) {
             rs_bvh8_destroy(t);
             return rs_error_set(RS_ERR_NOMEM, "out of memory for the 8-wide BVH (%u nodes)", c.cap);
         }
         c.out = t;
-        c.pk.tri4 = t->tri4;
-        c.pk.quad4 = t->quad4;
+        c.pk.tri = t->tri8;
+        c.pk.quad = t->quad8;
         t->n_nodes = 1;
         t->depth = collapse_node(&c, 0, 0);
-        t->n_tri4 = c.pk.n_tri4;
-        t->n_quad4 = c.pk.n_quad4;
+        t->n_tri8 = c.pk.n_tri;
+        t->n_quad8 = c.pk.n_quad;
     }
     *out = t;
     return RS_OK;
@@ -99,9 +99,16 @@ void rs_bvh8_destroy(rs_bvh8 *b)
     if (!b)
         return;
     rs_free(b->nodes);
-    rs_free(b->tri4);
-    rs_free(b->quad4);
+    rs_free(b->tri8);
+    rs_free(b->quad8);
     rs_free(b);
+}
+
+uint32_t rs_bvh_wide_leaf_size(uint32_t bvh_width, uint32_t tri_algo)
+{
+    if (bvh_width == 2 || tri_algo != RS_ISECT_TRI_MOLLER)
+        return 0;
+    return bvh_width == 8 || (bvh_width == 0 && rs_bvh8_supported()) ? 8u : 4u;
 }
 
 int rs_bvh8_supported(void)

@@ -7,8 +7,9 @@
  *
  * Same answers as the binary and 4-wide traversals, bit for bit, for the reasons accel/bvh4.h
  * gives: the nodes hold the binary tree's own boxes, the leaves its primitive ranges (triangle
- * and parallelogram leaves packed into the 4-wide tree's tri4 and quad4 blocks and tested by the
- * same SSE code), and the
+ * and parallelogram leaves packed eight to a block, tri8 and quad8, and tested eight at once with
+ * the scalar tests' operations lane by lane, as the 4-wide tree's tri4 and quad4 blocks are), and
+ * the
  * closest hit follows rs_hit_better.  The box test picks each axis's near and far plane by the sign
  * of the ray's direction instead of taking min / max of the two slab distances: for a finite
  * 1 / d the rounded (bound - o) * (1 / d) is monotone in the bound, so the near plane's distance
@@ -22,7 +23,7 @@
  *   child[8]    interior lane: index of the child node; leaf lane: first prim_ids entry, or for a
  *               packed leaf the first of its blocks
  *   count[8]    0 for an interior lane, else the leaf's primitive count, or for a packed leaf
- *               RS_BVH4_PACKED | its number of blocks (with RS_BVH4_QUADS for quad4 blocks)
+ *               RS_BVH4_PACKED | its number of blocks (with RS_BVH4_QUADS for quad8 blocks)
  *   n_lanes     lanes in use (1 to 8), packed from lane 0; unused lanes hold an empty box */
 #ifndef RS_ACCEL_BVH8_H
 #define RS_ACCEL_BVH8_H
@@ -37,14 +38,25 @@ typedef struct rs_bvh8_node {
     uint32_t pad_[3];
 } rs_bvh8_node;
 
+/* Packed leaves' blocks: rs_bvh4_tri4 and rs_bvh4_quad4 with eight lanes (320 and 416 bytes). */
+typedef struct rs_bvh8_tri8 {
+    float v0[3][8], e1[3][8], e2[3][8];
+    uint32_t prim[8]; /* global primitive numbers; RS_NO_HIT in unused lanes */
+} rs_bvh8_tri8;
+
+typedef struct rs_bvh8_quad8 {
+    float q[3][8], u[3][8], v[3][8], w[3][8];
+    uint32_t prim[8];
+} rs_bvh8_quad8;
+
 typedef struct rs_bvh8 {
     rs_bvh8_node *nodes;      /* node 0 is the root; none for an empty scene */
-    rs_bvh4_tri4 *tri4;       /* the packed leaves' triangles */
-    rs_bvh4_quad4 *quad4;     /* the packed leaves' parallelograms */
+    rs_bvh8_tri8 *tri8;       /* the packed leaves' triangles */
+    rs_bvh8_quad8 *quad8;     /* the packed leaves' parallelograms */
     const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
-    uint32_t n_nodes, n_tri4, n_quad4;
+    uint32_t n_nodes, n_tri8, n_quad8;
     uint32_t depth;    /* in nodes; at most the binary tree's */
-    uint32_t n_packed; /* leaves packed as tri4 or quad4 blocks */
+    uint32_t n_packed; /* leaves packed as tri8 or quad8 blocks */
 } rs_bvh8;
 
 /* A traversal stack entry: an interior node's index, or RS_BVH8_LEAF | node << 3 | lane. */
@@ -57,11 +69,17 @@ typedef struct rs_bvh8 {
 extern "C" {
 #endif
 /* Collapses `b`, built over `g`, into an 8-wide tree (each node opens the interior child of
- * largest surface area until it has eight; triangle and parallelogram leaves packed as rs_bvh4_build packs them).
+ * largest surface area until it has eight; triangle and parallelogram leaves packed eight to a block where rs_bvh4_build packs them four).
  * RS_ERR_ARG for a leaf of more than 32767 primitives or a tree of more than 2^28 nodes,
  * RS_ERR_NOMEM when memory runs out (*out is NULL then).  Builds on any machine. */
 rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out);
 void rs_bvh8_destroy(rs_bvh8 *b);
+
+/* The leaf size that suits the CPU device's wide tree, as rs_bvh_build_opts.leaf_block and
+ * .max_leaf: the tree's block width (8 for bvh_width 8, or 0 where rs_bvh8_supported(); 4 for
+ * width 4 or without AVX2), or 0 (the classic SAH leaves) for the binary kernel (width 2) and for
+ * a triangle test other than Möller-Trumbore, whose triangles are not packed. */
+uint32_t rs_bvh_wide_leaf_size(uint32_t bvh_width, uint32_t tri_algo);
 
 /* Whether the traversal below can run here: built for x86-64 with GCC or Clang, and the CPU has
  * AVX2.  The functions below must not be called where it says 0. */

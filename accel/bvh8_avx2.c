@@ -16,11 +16,11 @@
 #  include <immintrin.h>
 
 typedef struct ray8 {
-    __m256 o[3], inv[3];
+    __m256 o[3], d[3], inv[3];
     size_t near[3], far[3]; /* offsets in floats into rs_bvh8_node.b: each axis's near and far
                                plane's row */
     int general;              /* some 1 / d is not finite: the slab test's min / max form */
-    rs_bvh4_ray r4;           /* for the packed leaves */
+
 } ray8;
 
 static void ray8_init(ray8 *r, const rs_ray *ray)
@@ -37,23 +37,13 @@ static void ray8_init(ray8 *r, const rs_ray *ray)
     r->general = 0;
     for (a = 0; a < 3; ++a) {
         r->o[a] = _mm256_set1_ps(ov[a]);
+        r->d[a] = _mm256_set1_ps(a == 0 ? ray->d.x : a == 1 ? ray->d.y : ray->d.z);
         r->inv[a] = _mm256_set1_ps(iv[a]);
         r->near[a] = 8u * ((size_t)a + (iv[a] < 0.0f ? 3u : 0u));
         r->far[a] = 8u * ((size_t)a + (iv[a] < 0.0f ? 0u : 3u));
         /* 1 / d finite and nonzero: no 0 * inf, and the planes order as the signs say */
         r->general |= !(iv[a] - iv[a] == 0.0f) || iv[a] == 0.0f;
     }
-    /* rs_bvh4_ray_of, without dividing again */
-    r->r4.o[0] = _mm_set1_ps(ov[0]);
-    r->r4.o[1] = _mm_set1_ps(ov[1]);
-    r->r4.o[2] = _mm_set1_ps(ov[2]);
-    r->r4.d[0] = _mm_set1_ps(ray->d.x);
-    r->r4.d[1] = _mm_set1_ps(ray->d.y);
-    r->r4.d[2] = _mm_set1_ps(ray->d.z);
-    r->r4.inv[0] = _mm_set1_ps(iv[0]);
-    r->r4.inv[1] = _mm_set1_ps(iv[1]);
-    r->r4.inv[2] = _mm_set1_ps(iv[2]);
-    r->r4.axis_parallel = !(ray->d.x != 0.0f && ray->d.y != 0.0f && ray->d.z != 0.0f);
 }
 
 /* The slab test of the eight lanes of `n`: the mask of lanes hit, their entry distances in *tn. */
@@ -103,6 +93,133 @@ static inline uint32_t ref8(const rs_bvh8_node *n, uint32_t node, uint32_t lane)
 }
 
 static inline uint32_t lowest(uint32_t m) { return (uint32_t)__builtin_ctz(m); }
+
+/* AVX comparisons that match SSE's: cmpneq is unordered (true for NaN), the others ordered. */
+#  define CMP_NE(a, b) _mm256_cmp_ps(a, b, _CMP_NEQ_UQ)
+#  define CMP_GE(a, b) _mm256_cmp_ps(a, b, _CMP_GE_OQ)
+#  define CMP_GT(a, b) _mm256_cmp_ps(a, b, _CMP_GT_OQ)
+#  define CMP_LE(a, b) _mm256_cmp_ps(a, b, _CMP_LE_OQ)
+#  define CMP_LT(a, b) _mm256_cmp_ps(a, b, _CMP_LT_OQ)
+#  define LD(x)        _mm256_load_ps(x)
+#  define ADD(a, b)    _mm256_add_ps(a, b)
+#  define SUB(a, b)    _mm256_sub_ps(a, b)
+#  define MUL(a, b)    _mm256_mul_ps(a, b)
+#  define AND(a, b)    _mm256_and_ps(a, b)
+
+/* rs_bvh4_tri4_hit on eight triangles: rs_isect_tri's operations in its order. */
+static inline uint32_t tri8_hit(const rs_bvh8_tri8 *b, const ray8 *r, float tmin, float tmax,
+                                float t[8], float u[8], float v[8])
+{
+    __m256 e1x = LD(b->e1[0]), e1y = LD(b->e1[1]), e1z = LD(b->e1[2]);
+    __m256 e2x = LD(b->e2[0]), e2y = LD(b->e2[1]), e2z = LD(b->e2[2]);
+    __m256 dx = r->d[0], dy = r->d[1], dz = r->d[2];
+    __m256 px = SUB(MUL(dy, e2z), MUL(dz, e2y));
+    __m256 py = SUB(MUL(dz, e2x), MUL(dx, e2z));
+    __m256 pz = SUB(MUL(dx, e2y), MUL(dy, e2x));
+    __m256 det = ADD(ADD(MUL(e1x, px), MUL(e1y, py)), MUL(e1z, pz));
+    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    __m256 inv = _mm256_div_ps(one, det);
+    __m256 sx = SUB(r->o[0], LD(b->v0[0]));
+    __m256 sy = SUB(r->o[1], LD(b->v0[1]));
+    __m256 sz = SUB(r->o[2], LD(b->v0[2]));
+    __m256 bu = MUL(ADD(ADD(MUL(sx, px), MUL(sy, py)), MUL(sz, pz)), inv);
+    __m256 qx = SUB(MUL(sy, e1z), MUL(sz, e1y));
+    __m256 qy = SUB(MUL(sz, e1x), MUL(sx, e1z));
+    __m256 qz = SUB(MUL(sx, e1y), MUL(sy, e1x));
+    __m256 bv = MUL(ADD(ADD(MUL(dx, qx), MUL(dy, qy)), MUL(dz, qz)), inv);
+    __m256 tt = MUL(ADD(ADD(MUL(e2x, qx), MUL(e2y, qy)), MUL(e2z, qz)), inv);
+    __m256 ok = CMP_NE(det, zero);
+    ok = AND(ok, AND(CMP_GE(bu, zero), CMP_LE(bu, one)));
+    ok = AND(ok, AND(CMP_GE(bv, zero), CMP_LE(ADD(bu, bv), one)));
+    ok = AND(ok, AND(CMP_GT(tt, _mm256_set1_ps(tmin)), CMP_LT(tt, _mm256_set1_ps(tmax))));
+    _mm256_storeu_ps(t, tt);
+    _mm256_storeu_ps(u, bu);
+    _mm256_storeu_ps(v, bv);
+    return (uint32_t)_mm256_movemask_ps(ok);
+}
+
+/* rs_bvh4_quad4_hit on eight parallelograms: rs_isect_quad's operations in its order. */
+static inline uint32_t quad8_hit(const rs_bvh8_quad8 *b, const ray8 *r, float tmin, float tmax,
+                                 float t[8], float a[8], float bb[8])
+{
+    __m256 wx = LD(b->w[0]), wy = LD(b->w[1]), wz = LD(b->w[2]);
+    __m256 qx = LD(b->q[0]), qy = LD(b->q[1]), qz = LD(b->q[2]);
+    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    __m256 denom = ADD(ADD(MUL(wx, r->d[0]), MUL(wy, r->d[1])), MUL(wz, r->d[2]));
+    __m256 num = ADD(ADD(MUL(wx, SUB(qx, r->o[0])), MUL(wy, SUB(qy, r->o[1]))),
+                     MUL(wz, SUB(qz, r->o[2])));
+    __m256 tt = _mm256_div_ps(num, denom);
+    __m256 ok = AND(CMP_NE(denom, zero),
+                    AND(CMP_GT(tt, _mm256_set1_ps(tmin)), CMP_LT(tt, _mm256_set1_ps(tmax))));
+    if (_mm256_movemask_ps(ok) == 0)
+        return 0;
+    {
+        __m256 ux = LD(b->u[0]), uy = LD(b->u[1]), uz = LD(b->u[2]);
+        __m256 vx = LD(b->v[0]), vy = LD(b->v[1]), vz = LD(b->v[2]);
+        __m256 hx = SUB(ADD(r->o[0], MUL(r->d[0], tt)), qx);
+        __m256 hy = SUB(ADD(r->o[1], MUL(r->d[1], tt)), qy);
+        __m256 hz = SUB(ADD(r->o[2], MUL(r->d[2], tt)), qz);
+        __m256 cx = SUB(MUL(hy, vz), MUL(hz, vy));
+        __m256 cy = SUB(MUL(hz, vx), MUL(hx, vz));
+        __m256 cz = SUB(MUL(hx, vy), MUL(hy, vx));
+        __m256 al = ADD(ADD(MUL(wx, cx), MUL(wy, cy)), MUL(wz, cz));
+        __m256 ex = SUB(MUL(uy, hz), MUL(uz, hy));
+        __m256 ey = SUB(MUL(uz, hx), MUL(ux, hz));
+        __m256 ez = SUB(MUL(ux, hy), MUL(uy, hx));
+        __m256 be = ADD(ADD(MUL(wx, ex), MUL(wy, ey)), MUL(wz, ez));
+        ok = AND(ok, AND(CMP_GE(al, zero), CMP_LE(al, one)));
+        ok = AND(ok, AND(CMP_GE(be, zero), CMP_LE(be, one)));
+        _mm256_storeu_ps(t, tt);
+        _mm256_storeu_ps(a, al);
+        _mm256_storeu_ps(bb, be);
+    }
+    return (uint32_t)_mm256_movemask_ps(ok);
+}
+
+/* A packed leaf for closest hit, as rs_bvh4_packed_closest. */
+static inline void packed_closest(const rs_bvh8 *b, uint32_t first, uint32_t count, const ray8 *r,
+                                  rs_ray *ray, rs_hit *hit)
+{
+    uint32_t i, n = count & RS_BVH4_BLOCKS;
+    for (i = 0; i < n; ++i) {
+        float t[8], u[8], v[8];
+        const uint32_t *prim;
+        uint32_t m;
+        if (count & RS_BVH4_QUADS) {
+            m = quad8_hit(&b->quad8[first + i], r, ray->tmin, ray->tmax, t, u, v);
+            prim = b->quad8[first + i].prim;
+        } else {
+            m = tri8_hit(&b->tri8[first + i], r, ray->tmin, ray->tmax, t, u, v);
+            prim = b->tri8[first + i].prim;
+        }
+        while (m) {
+            uint32_t l = lowest(m);
+            m &= m - 1;
+            if (rs_hit_better(t[l], prim[l], hit)) {
+                ray->tmax = rs_float_next_up(t[l]);
+                hit->t = t[l];
+                hit->u = u[l];
+                hit->v = v[l];
+                hit->prim = prim[l];
+            }
+        }
+    }
+}
+
+/* A packed leaf for any hit. */
+static inline int packed_occluded(const rs_bvh8 *b, uint32_t first, uint32_t count,
+                                  const ray8 *r, const rs_ray *ray)
+{
+    uint32_t i, n = count & RS_BVH4_BLOCKS;
+    for (i = 0; i < n; ++i) {
+        float t[8], u[8], v[8];
+        if (count & RS_BVH4_QUADS
+                ? quad8_hit(&b->quad8[first + i], r, ray->tmin, ray->tmax, t, u, v)
+                : tri8_hit(&b->tri8[first + i], r, ray->tmin, ray->tmax, t, u, v))
+            return 1;
+    }
+    return 0;
+}
 
 int rs_bvh8_closest(const rs_bvh8 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
 {
@@ -175,7 +292,7 @@ int rs_bvh8_closest(const rs_bvh8 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
             const rs_bvh8_node *n = &b->nodes[(ref & ~RS_BVH8_LEAF) >> 3];
             uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane], i;
             if (count & RS_BVH4_PACKED) {
-                rs_bvh4_packed_closest(b->tri4, b->quad4, first, count, &r.r4, &ray, hit);
+                packed_closest(b, first, count, &r, &ray, hit);
                 count = 0;
             }
             for (i = 0; i < count; ++i)
@@ -218,7 +335,7 @@ int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray)
             const rs_bvh8_node *n = &b->nodes[(ref & ~RS_BVH8_LEAF) >> 3];
             uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane], i;
             if (count & RS_BVH4_PACKED) {
-                if (rs_bvh4_packed_occluded(b->tri4, b->quad4, first, count, &r.r4, &ray))
+                if (packed_occluded(b, first, count, &r, &ray))
                     return 1;
                 continue;
             }

@@ -72,25 +72,27 @@ void rs_bvh_lbvh_sort(const rs_vec3 *centroid, uint32_t n, uint32_t *ids, uint32
  * or none is left (for a tree that is one leaf, that leaf alone).  Returns the count. */
 uint32_t rs_bvh_wide_lanes(const rs_bvh_node *bn, uint32_t src, uint32_t width, uint32_t *lanes);
 
-/* Copies leaves of triangles into tri4 blocks and leaves of parallelograms into quad4 blocks
- * (accel/bvh4.h), in SSE builds only; triangles only with the Möller-Trumbore test, whose
+/* Copies leaves of triangles into triangle blocks and leaves of parallelograms into
+ * parallelogram blocks of `width` lanes (4: rs_bvh4_tri4 / quad4, accel/bvh4.h; 8: rs_bvh8_tri8 /
+ * quad8, accel/bvh8.h), in SSE builds only; triangles only with the Möller-Trumbore test, whose
  * arithmetic the blocks' test repeats. */
 typedef struct rs_leaf_packer {
     const rs_geom *g;
     const uint32_t *prim_ids;
-    rs_bvh4_tri4 *tri4;   /* cap_tri4 blocks, allocated by the caller */
-    rs_bvh4_quad4 *quad4; /* cap_quad4 blocks */
-    uint32_t n_tri4, cap_tri4, n_quad4, cap_quad4;
+    uint32_t width;
+    void *tri;  /* cap_tri triangle blocks, allocated by the caller */
+    void *quad; /* cap_quad parallelogram blocks */
+    uint32_t n_tri, cap_tri, n_quad, cap_quad;
     int pack_tris, pack_quads;
 } rs_leaf_packer;
 
-void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g);
+void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, uint32_t width);
 /* A wide node's lane for binary leaf `l`: its blocks packed where they can be, *child and *count
  * set as the node layouts say (accel/bvh4.h).  Returns 1 when the leaf was packed. */
 int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint16_t *count);
 
 /* Checks that `b` fits a wide tree (`what` names it in the message) of at most `max_nodes` nodes
- * and leaves of at most 32767 primitives; sets p->cap_tri4, p->cap_quad4 and *cap_nodes, the
+ * and leaves of at most 32767 primitives; sets p->cap_tri, p->cap_quad and *cap_nodes, the
  * blocks and nodes to allocate. */
 rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
                            uint32_t max_nodes, uint32_t *cap_nodes);

@@ -4,6 +4,7 @@
  * accel/internal.h). */
 #include <string.h>
 
+#include "accel/bvh8.h"
 #include "accel/internal.h"
 
 static float half_area(const rs_bvh_node *n)
@@ -38,19 +39,30 @@ uint32_t rs_bvh_wide_lanes(const rs_bvh_node *bn, uint32_t src, uint32_t width, 
     return n;
 }
 
-void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g)
+/* Every block type is laid out alike: `fields` vectors of 3 axes of `width` floats each, then
+ * `width` primitive numbers (rs_bvh4_tri4: v0, e1, e2; rs_bvh4_quad4: q, u, v, w; the same for the
+ * 8-wide rs_bvh8_tri8 / quad8).  The packer writes them through that layout. */
+enum { TRI_FIELDS = 3, QUAD_FIELDS = 4 };
+typedef char tri4_layout[sizeof(rs_bvh4_tri4) == (TRI_FIELDS * 3 + 1) * 4 * 4 ? 1 : -1];
+typedef char quad4_layout[sizeof(rs_bvh4_quad4) == (QUAD_FIELDS * 3 + 1) * 4 * 4 ? 1 : -1];
+typedef char tri8_layout[sizeof(rs_bvh8_tri8) == (TRI_FIELDS * 3 + 1) * 8 * 4 ? 1 : -1];
+typedef char quad8_layout[sizeof(rs_bvh8_quad8) == (QUAD_FIELDS * 3 + 1) * 8 * 4 ? 1 : -1];
+
+void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, uint32_t width)
 {
     memset(p, 0, sizeof *p);
     p->g = g;
     p->prim_ids = b->prim_ids;
+    p->width = width;
 #ifdef RS_BVH4_SSE
     p->pack_tris = g->tri_algo == RS_ISECT_TRI_MOLLER;
     p->pack_quads = 1;
 #endif
 }
 
-/* How binary leaf `n` is packed: RS_BVH4_PACKED for tri4 blocks, RS_BVH4_PACKED | RS_BVH4_QUADS
- * for quad4 blocks, 0 when it is not (a mix of kinds, spheres, or packing off). */
+/* How binary leaf `n` is packed: RS_BVH4_PACKED for triangle blocks, RS_BVH4_PACKED |
+ * RS_BVH4_QUADS for parallelogram blocks, 0 when it is not (a mix of kinds, spheres, or packing
+ * off). */
 static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
 {
     uint32_t i, first_quad = p->g->n_spheres, first_tri = first_quad + p->g->n_quads;
@@ -67,56 +79,46 @@ static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
     return 0;
 }
 
-static uint32_t pack_tris(rs_leaf_packer *p, const rs_bvh_node *n)
+/* Packs leaf `n` into the next blocks of `base` (blocks of `fields` vectors); vec(prim, f) gives
+ * the f-th vector of primitive `prim`.  Returns the first block's index. */
+static uint32_t pack(rs_leaf_packer *p, const rs_bvh_node *n, void *base, uint32_t *n_blocks,
+                     uint32_t cap, uint32_t fields, int quads)
 {
-    uint32_t first = p->n_tri4, i, a;
-    uint32_t first_tri = p->g->n_spheres + p->g->n_quads;
+    const uint32_t w = p->width, floats = fields * 3 * w;
+    const size_t block_bytes = (size_t)(floats + w) * 4;
+    uint32_t first = *n_blocks, i, f, a;
     for (i = 0; i < n->count; ++i) {
-        uint32_t prim = p->prim_ids[n->left_first + i];
-        const rs_tri *t = &p->g->tris[prim - first_tri];
-        rs_bvh4_tri4 *blk = &p->tri4[first + i / 4];
-        uint32_t l = i % 4;
-        rs_vec3 e1 = rs_v3_sub(t->v1, t->v0), e2 = rs_v3_sub(t->v2, t->v0);
-        float v0v[3] = {t->v0.x, t->v0.y, t->v0.z}, e1v[3] = {e1.x, e1.y, e1.z};
-        float e2v[3] = {e2.x, e2.y, e2.z};
+        uint32_t prim = p->prim_ids[n->left_first + i], l = i % w;
+        unsigned char *blk = (unsigned char *)base + (size_t)(first + i / w) * block_bytes;
+        float *x = (float *)(void *)blk;
+        uint32_t *ids = (uint32_t *)(void *)(blk + (size_t)floats * 4);
+        rs_vec3 v[4];
+        if (quads) {
+            const rs_quad *q = &p->g->quads[prim - p->g->n_spheres];
+            v[0] = q->q;
+            v[1] = q->u;
+            v[2] = q->v;
+            v[3] = q->w;
+        } else {
+            const rs_tri *t = &p->g->tris[prim - p->g->n_spheres - p->g->n_quads];
+            v[0] = t->v0;
+            v[1] = rs_v3_sub(t->v1, t->v0);
+            v[2] = rs_v3_sub(t->v2, t->v0);
+        }
         if (l == 0) {
-            memset(blk, 0, sizeof *blk);
-            blk->prim[0] = blk->prim[1] = blk->prim[2] = blk->prim[3] = RS_NO_HIT;
+            /* unused lanes: all zero (det or denominator 0: never a hit), no primitive */
+            memset(blk, 0, block_bytes);
+            for (a = 0; a < w; ++a)
+                ids[a] = RS_NO_HIT;
         }
-        for (a = 0; a < 3; ++a) {
-            blk->v0[a][l] = v0v[a];
-            blk->e1[a][l] = e1v[a];
-            blk->e2[a][l] = e2v[a];
-        }
-        blk->prim[l] = prim;
+        for (f = 0; f < fields; ++f)
+            for (a = 0; a < 3; ++a)
+                x[(f * 3 + a) * w + l] = rs_v3_get(v[f], (int)a);
+        ids[l] = prim;
     }
-    p->n_tri4 += (n->count + 3) / 4;
-    RS_ASSERT(p->n_tri4 <= p->cap_tri4);
-    return first;
-}
-
-static uint32_t pack_quads(rs_leaf_packer *p, const rs_bvh_node *n)
-{
-    uint32_t first = p->n_quad4, i, a;
-    for (i = 0; i < n->count; ++i) {
-        uint32_t prim = p->prim_ids[n->left_first + i];
-        const rs_quad *q = &p->g->quads[prim - p->g->n_spheres];
-        rs_bvh4_quad4 *blk = &p->quad4[first + i / 4];
-        uint32_t l = i % 4;
-        if (l == 0) {
-            memset(blk, 0, sizeof *blk);
-            blk->prim[0] = blk->prim[1] = blk->prim[2] = blk->prim[3] = RS_NO_HIT;
-        }
-        for (a = 0; a < 3; ++a) {
-            blk->q[a][l] = rs_v3_get(q->q, (int)a);
-            blk->u[a][l] = rs_v3_get(q->u, (int)a);
-            blk->v[a][l] = rs_v3_get(q->v, (int)a);
-            blk->w[a][l] = rs_v3_get(q->w, (int)a);
-        }
-        blk->prim[l] = prim;
-    }
-    p->n_quad4 += (n->count + 3) / 4;
-    RS_ASSERT(p->n_quad4 <= p->cap_quad4);
+    *n_blocks += (n->count + w - 1) / w;
+    RS_ASSERT(*n_blocks <= cap);
+    (void)cap;
     return first;
 }
 
@@ -128,8 +130,10 @@ int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint1
         *count = (uint16_t)l->count;
         return 0;
     }
-    *child = kind & RS_BVH4_QUADS ? pack_quads(p, l) : pack_tris(p, l);
-    *count = (uint16_t)(kind | (l->count + 3) / 4);
+    *child = kind & RS_BVH4_QUADS
+                 ? pack(p, l, p->quad, &p->n_quad, p->cap_quad, QUAD_FIELDS, 1)
+                 : pack(p, l, p->tri, &p->n_tri, p->cap_tri, TRI_FIELDS, 0);
+    *count = (uint16_t)(kind | (l->count + p->width - 1) / p->width);
     return 1;
 }
 
@@ -137,18 +141,19 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
                            uint32_t max_nodes, uint32_t *cap_nodes)
 {
     uint32_t i, interior = 0;
-    p->cap_tri4 = p->cap_quad4 = 0;
+    p->cap_tri = p->cap_quad = 0;
     for (i = 0; i < b->n_nodes; ++i) {
         if (b->nodes[i].count > 0x7fffu)
             return rs_error_set(RS_ERR_ARG, "%s: a leaf of %u primitives (at most 32767 fit a lane)",
                                 what, b->nodes[i].count);
         interior += b->nodes[i].count == 0;
         if (b->nodes[i].count > 0) {
-            uint32_t kind = pack_kind(p, &b->nodes[i]), blocks = (b->nodes[i].count + 3) / 4;
+            uint32_t kind = pack_kind(p, &b->nodes[i]);
+            uint32_t blocks = (b->nodes[i].count + p->width - 1) / p->width;
             if (kind & RS_BVH4_QUADS)
-                p->cap_quad4 += blocks;
+                p->cap_quad += blocks;
             else if (kind)
-                p->cap_tri4 += blocks;
+                p->cap_tri += blocks;
         }
     }
     if (interior + 1 > max_nodes)

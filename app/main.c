@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "accel/bvh8.h"
 #include "app/checkpoint.h"
 #include "app/options.h"
 #include "app/outputs.h"
@@ -545,8 +546,8 @@ static int build_bvh(const rs_cli_options *o, render_run *r)
     bo.threads = (uint32_t)r->threads;
     if (o->no_bvh) /* one leaf holding everything: each ray tests every primitive */
         bo.max_leaf = UINT32_MAX;
-    else if (o->bvh_width != 2 && r->geom.tri_algo == RS_ISECT_TRI_MOLLER)
-        bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE; /* the CPU's wide trees test triangles 4 at once */
+    else /* leaves the size of the CPU's wide tree's blocks, which test them all at once */
+        bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(o->bvh_width, r->geom.tri_algo);
     if (o->bvh_on_gpu) {
         const char *why = "";
         if (rs_gpu_count(&why) > 0)

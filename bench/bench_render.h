@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "accel/bvh8.h"
 #include "core/cores.h"
 #include "cpu/cpu_device.h"
 #include "scheduler/passes.h"
@@ -52,7 +53,7 @@ static inline int br_load_scene(const char *prog, const char *spec, const char *
     *g = rs_scene_geom(*scene);
     memset(&bo, 0, sizeof bo);
     bo.builder.method = RS_BVH_SAH;
-    bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE; /* as the CLI builds it */
+    bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, g->tri_algo); /* as the CLI builds it */
     if (rs_bvh_build(g, &bo, bvh) != RS_OK) {
         fprintf(stderr, "%s: %s\n", prog, rs_error_message());
         rs_scene_destroy(*scene);

@@ -368,7 +368,8 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
         return 0;
     memset(&bo, 0, sizeof bo);
     bo.builder = st->builder;
-    bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE; /* as the CLI builds it for the CPU device */
+    /* as the CLI builds it for the CPU device */
+    bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, sc->g.tri_algo);
     build_s = rs_bench_now();
     if (rs_bvh_build(&sc->g, &bo, &bvh) != RS_OK) {
         fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
@@ -586,9 +587,10 @@ int main(int argc, char **argv)
 #else
     printf("Embree: not built in (install libembree-dev and re-run CMake to compare)\n");
 #endif
-    printf("settings: our BVH %s (max leaf 4, leaf cost in blocks of %u); median of %d run%s; %d threads in the "
+    printf("settings: our BVH %s (leaves of at most %u, SAH leaf cost in blocks of as many: "
+           "what the CLI builds for this CPU); median of %d run%s; %d threads in the "
            "multi-threaded columns (OpenMP, dynamic chunks of %d rays)\n",
-           st.bvh_name, RS_BVH_LEAF_BLOCK_WIDE, st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
+           st.bvh_name, rs_bvh_wide_leaf_size(0, RS_ISECT_TRI_MOLLER), st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
 
     if (n_scenes == 0) {
         const char *dir = bs_models_dir(models);
