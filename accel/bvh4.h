@@ -69,8 +69,10 @@ typedef struct rs_bvh4 {
  * (RS_BVH4_LEAF | node << 2 | lane). */
 #define RS_BVH4_LEAF      0x80000000u
 #define RS_BVH4_PACKED    0x8000u
-#define RS_BVH4_QUADS     0x4000u /* with RS_BVH4_PACKED: the blocks are quad4 */
-#define RS_BVH4_BLOCKS    0x3fffu /* a packed count's number of blocks (at most 8192) */
+#define RS_BVH4_QUADS     0x4000u /* with RS_BVH4_PACKED: the blocks are quad4 (quad8) */
+#define RS_BVH4_SPHERES   0x2000u /* with RS_BVH4_PACKED: sphere8 blocks (8-wide tree only) */
+#define RS_BVH4_BLOCKS    0x1fffu /* a packed count's number of blocks (a longer leaf stays
+                                     unpacked) */
 #define RS_BVH4_MAX_NODES (1u << 29)
 /* Each level of the tree pushes at most 3 entries (closest) or 4 (any hit), and the tree is at
  * most RS_BVH_MAX_DEPTH deep. */

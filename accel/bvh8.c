@@ -78,17 +78,22 @@ rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out)
             t->tri8 = (rs_bvh8_tri8 *)rs_alloc_aligned(c.pk.cap_tri, sizeof *t->tri8);
         if (c.pk.cap_quad > 0)
             t->quad8 = (rs_bvh8_quad8 *)rs_alloc_aligned(c.pk.cap_quad, sizeof *t->quad8);
-        if (!t->nodes || (c.pk.cap_tri > 0 && !t->tri8) || (c.pk.cap_quad > 0 && !t->quad8)) {
+        if (c.pk.cap_sphere > 0)
+            t->sphere8 = (rs_bvh8_sphere8 *)rs_alloc_aligned(c.pk.cap_sphere, sizeof *t->sphere8);
+        if (!t->nodes || (c.pk.cap_tri > 0 && !t->tri8) || (c.pk.cap_quad > 0 && !t->quad8) ||
+            (c.pk.cap_sphere > 0 && !t->sphere8)) {
             rs_bvh8_destroy(t);
             return rs_error_set(RS_ERR_NOMEM, "out of memory for the 8-wide BVH (%u nodes)", c.cap);
         }
         c.out = t;
         c.pk.tri = t->tri8;
         c.pk.quad = t->quad8;
+        c.pk.sphere = t->sphere8;
         t->n_nodes = 1;
         t->depth = collapse_node(&c, 0, 0);
         t->n_tri8 = c.pk.n_tri;
         t->n_quad8 = c.pk.n_quad;
+        t->n_sphere8 = c.pk.n_sphere;
     }
     *out = t;
     return RS_OK;
@@ -101,6 +106,7 @@ void rs_bvh8_destroy(rs_bvh8 *b)
     rs_free(b->nodes);
     rs_free(b->tri8);
     rs_free(b->quad8);
+    rs_free(b->sphere8);
     rs_free(b);
 }
 

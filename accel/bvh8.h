@@ -8,8 +8,9 @@
  * Same answers as the binary and 4-wide traversals, bit for bit, for the reasons accel/bvh4.h
  * gives: the nodes hold the binary tree's own boxes, the leaves its primitive ranges (triangle
  * and parallelogram leaves packed eight to a block, tri8 and quad8, and tested eight at once with
- * the scalar tests' operations lane by lane, as the 4-wide tree's tri4 and quad4 blocks are), and
- * the
+ * the scalar tests' operations lane by lane, as the 4-wide tree's tri4 and quad4 blocks are; so
+ * are leaves of static spheres with the algebraic test, sphere8, sqrt and division being correctly
+ * rounded in both), and the
  * closest hit follows rs_hit_better.  The box test picks each axis's near and far plane by the sign
  * of the ray's direction instead of taking min / max of the two slab distances: for a finite
  * 1 / d the rounded (bound - o) * (1 / d) is monotone in the bound, so the near plane's distance
@@ -23,7 +24,8 @@
  *   child[8]    interior lane: index of the child node; leaf lane: first prim_ids entry, or for a
  *               packed leaf the first of its blocks
  *   count[8]    0 for an interior lane, else the leaf's primitive count, or for a packed leaf
- *               RS_BVH4_PACKED | its number of blocks (with RS_BVH4_QUADS for quad8 blocks)
+ *               RS_BVH4_PACKED | its number of blocks (with RS_BVH4_QUADS for quad8 blocks,
+ *               RS_BVH4_SPHERES for sphere8 blocks)
  *   n_lanes     lanes in use (1 to 8), packed from lane 0; unused lanes hold an empty box */
 #ifndef RS_ACCEL_BVH8_H
 #define RS_ACCEL_BVH8_H
@@ -49,14 +51,22 @@ typedef struct rs_bvh8_quad8 {
     uint32_t prim[8];
 } rs_bvh8_quad8;
 
+/* Spheres (static, with the algebraic test), eight to a block (160 bytes); unused lanes have a
+ * NaN radius, which no ray hits. */
+typedef struct rs_bvh8_sphere8 {
+    float c[3][8], r[8];
+    uint32_t prim[8];
+} rs_bvh8_sphere8;
+
 typedef struct rs_bvh8 {
     rs_bvh8_node *nodes;      /* node 0 is the root; none for an empty scene */
     rs_bvh8_tri8 *tri8;       /* the packed leaves' triangles */
     rs_bvh8_quad8 *quad8;     /* the packed leaves' parallelograms */
+    rs_bvh8_sphere8 *sphere8; /* the packed leaves' spheres */
     const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
-    uint32_t n_nodes, n_tri8, n_quad8;
+    uint32_t n_nodes, n_tri8, n_quad8, n_sphere8;
     uint32_t depth;    /* in nodes; at most the binary tree's */
-    uint32_t n_packed; /* leaves packed as tri8 or quad8 blocks */
+    uint32_t n_packed; /* leaves packed as blocks */
 } rs_bvh8;
 
 /* A traversal stack entry: an interior node's index, or RS_BVH8_LEAF | node << 3 | lane. */

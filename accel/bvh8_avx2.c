@@ -14,6 +14,7 @@
 #    pragma GCC target("avx2")
 #  endif
 #  include <immintrin.h>
+#  include <string.h>
 
 typedef struct ray8 {
     __m256 o[3], d[3], inv[3];
@@ -176,6 +177,35 @@ static inline uint32_t quad8_hit(const rs_bvh8_quad8 *b, const ray8 *r, float tm
     return (uint32_t)_mm256_movemask_ps(ok);
 }
 
+/* rs_isect_sphere on eight spheres: its operations in its order (sqrt and division are
+ * correctly rounded in SSE/AVX as in sqrtf and '/'). */
+static inline uint32_t sphere8_hit(const rs_bvh8_sphere8 *b, const ray8 *r, float tmin, float tmax,
+                                   float t[8])
+{
+    __m256 dx = r->d[0], dy = r->d[1], dz = r->d[2];
+    __m256 ox = SUB(LD(b->c[0]), r->o[0]), oy = SUB(LD(b->c[1]), r->o[1]);
+    __m256 oz = SUB(LD(b->c[2]), r->o[2]);
+    __m256 a = ADD(ADD(MUL(dx, dx), MUL(dy, dy)), MUL(dz, dz));
+    __m256 h = ADD(ADD(MUL(dx, ox), MUL(dy, oy)), MUL(dz, oz));
+    __m256 ha = _mm256_div_ps(h, a);
+    __m256 lx = SUB(ox, MUL(dx, ha)), ly = SUB(oy, MUL(dy, ha)), lz = SUB(oz, MUL(dz, ha));
+    __m256 rad = LD(b->r);
+    __m256 disc = MUL(a, SUB(MUL(rad, rad), ADD(ADD(MUL(lx, lx), MUL(ly, ly)), MUL(lz, lz))));
+    __m256 ok = CMP_GE(disc, _mm256_setzero_ps()), lo = _mm256_set1_ps(tmin);
+    __m256 hi = _mm256_set1_ps(tmax), sq, near, far, in_near;
+    if (_mm256_movemask_ps(ok) == 0)
+        return 0;
+    sq = _mm256_sqrt_ps(disc);
+    near = _mm256_div_ps(SUB(h, sq), a);
+    far = _mm256_div_ps(ADD(h, sq), a);
+    in_near = AND(CMP_GT(near, lo), CMP_LT(near, hi));
+    /* the near root where it lies inside (tmin, tmax), else the far one */
+    near = _mm256_blendv_ps(far, near, in_near);
+    ok = AND(ok, AND(CMP_GT(near, lo), CMP_LT(near, hi)));
+    _mm256_storeu_ps(t, near);
+    return (uint32_t)_mm256_movemask_ps(ok);
+}
+
 /* A packed leaf for closest hit, as rs_bvh4_packed_closest. */
 static inline void packed_closest(const rs_bvh8 *b, uint32_t first, uint32_t count, const ray8 *r,
                                   rs_ray *ray, rs_hit *hit)
@@ -185,7 +215,12 @@ static inline void packed_closest(const rs_bvh8 *b, uint32_t first, uint32_t cou
         float t[8], u[8], v[8];
         const uint32_t *prim;
         uint32_t m;
-        if (count & RS_BVH4_QUADS) {
+        if (count & RS_BVH4_SPHERES) {
+            m = sphere8_hit(&b->sphere8[first + i], r, ray->tmin, ray->tmax, t);
+            memset(u, 0, sizeof u); /* rs_geom_intersect's u, v for a sphere */
+            memset(v, 0, sizeof v);
+            prim = b->sphere8[first + i].prim;
+        } else if (count & RS_BVH4_QUADS) {
             m = quad8_hit(&b->quad8[first + i], r, ray->tmin, ray->tmax, t, u, v);
             prim = b->quad8[first + i].prim;
         } else {
@@ -213,7 +248,8 @@ static inline int packed_occluded(const rs_bvh8 *b, uint32_t first, uint32_t cou
     uint32_t i, n = count & RS_BVH4_BLOCKS;
     for (i = 0; i < n; ++i) {
         float t[8], u[8], v[8];
-        if (count & RS_BVH4_QUADS
+        if (count & RS_BVH4_SPHERES ? sphere8_hit(&b->sphere8[first + i], r, ray->tmin, ray->tmax, t)
+            : count & RS_BVH4_QUADS
                 ? quad8_hit(&b->quad8[first + i], r, ray->tmin, ray->tmax, t, u, v)
                 : tri8_hit(&b->tri8[first + i], r, ray->tmin, ray->tmax, t, u, v))
             return 1;

@@ -19,6 +19,7 @@
 
 #include "accel/bvh.h"
 #include "accel/bvh4.h"
+#include "accel/bvh8.h"
 
 /* A sort key and the primitive it belongs to (8 bytes). */
 typedef struct rs_bvh_key_id {
@@ -75,15 +76,17 @@ uint32_t rs_bvh_wide_lanes(const rs_bvh_node *bn, uint32_t src, uint32_t width, 
 /* Copies leaves of triangles into triangle blocks and leaves of parallelograms into
  * parallelogram blocks of `width` lanes (4: rs_bvh4_tri4 / quad4, accel/bvh4.h; 8: rs_bvh8_tri8 /
  * quad8, accel/bvh8.h), in SSE builds only; triangles only with the Möller-Trumbore test, whose
- * arithmetic the blocks' test repeats. */
+ * arithmetic the blocks' test repeats; leaves of static spheres with the algebraic test into
+ * rs_bvh8_sphere8 blocks, width 8 only. */
 typedef struct rs_leaf_packer {
     const rs_geom *g;
     const uint32_t *prim_ids;
     uint32_t width;
     void *tri;  /* cap_tri triangle blocks, allocated by the caller */
     void *quad; /* cap_quad parallelogram blocks */
-    uint32_t n_tri, cap_tri, n_quad, cap_quad;
-    int pack_tris, pack_quads;
+    rs_bvh8_sphere8 *sphere; /* cap_sphere sphere blocks (width 8 only) */
+    uint32_t n_tri, cap_tri, n_quad, cap_quad, n_sphere, cap_sphere;
+    int pack_tris, pack_quads, pack_spheres;
 } rs_leaf_packer;
 
 void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, uint32_t width);

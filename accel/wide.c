@@ -2,6 +2,7 @@
  * choice of each wide node's lanes, the size checks, and packing leaves of triangles into tri4
  * blocks and leaves of parallelograms into quad4 blocks (accel/bvh4.h, accel/bvh8.h; declared in
  * accel/internal.h). */
+#include <math.h>
 #include <string.h>
 
 #include "accel/bvh8.h"
@@ -57,6 +58,7 @@ void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, u
 #ifdef RS_BVH4_SSE
     p->pack_tris = g->tri_algo == RS_ISECT_TRI_MOLLER;
     p->pack_quads = 1;
+    p->pack_spheres = width == 8 && !g->sphere_motion && g->sphere_algo == RS_ISECT_SPHERE_ALGEBRAIC;
 #endif
 }
 
@@ -66,16 +68,21 @@ void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, u
 static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
 {
     uint32_t i, first_quad = p->g->n_spheres, first_tri = first_quad + p->g->n_quads;
-    uint32_t tris = 0, quads = 0;
+    uint32_t tris = 0, quads = 0, spheres = 0;
+    if ((n->count + p->width - 1) / p->width > RS_BVH4_BLOCKS)
+        return 0;
     for (i = 0; i < n->count; ++i) {
         uint32_t prim = p->prim_ids[n->left_first + i];
         tris += prim >= first_tri;
         quads += prim >= first_quad && prim < first_tri;
+        spheres += prim < first_quad;
     }
     if (p->pack_tris && tris == n->count)
         return RS_BVH4_PACKED;
     if (p->pack_quads && quads == n->count)
         return RS_BVH4_PACKED | RS_BVH4_QUADS;
+    if (p->pack_spheres && spheres == n->count)
+        return RS_BVH4_PACKED | RS_BVH4_SPHERES;
     return 0;
 }
 
@@ -122,6 +129,31 @@ static uint32_t pack(rs_leaf_packer *p, const rs_bvh_node *n, void *base, uint32
     return first;
 }
 
+/* Packs leaf `n` of spheres into the next sphere8 blocks; returns the first block's index. */
+static uint32_t pack_spheres(rs_leaf_packer *p, const rs_bvh_node *n)
+{
+    uint32_t first = p->n_sphere, i, a, l;
+    for (i = 0; i < n->count; ++i) {
+        uint32_t prim = p->prim_ids[n->left_first + i];
+        const rs_sphere *sp = &p->g->spheres[prim];
+        rs_bvh8_sphere8 *blk = &p->sphere[first + i / 8];
+        if (i % 8 == 0) {
+            memset(blk, 0, sizeof *blk);
+            for (l = 0; l < 8; ++l) {
+                blk->r[l] = NAN; /* an unused lane: disc is NaN, never a hit */
+                blk->prim[l] = RS_NO_HIT;
+            }
+        }
+        for (a = 0; a < 3; ++a)
+            blk->c[a][i % 8] = rs_v3_get(sp->center, (int)a);
+        blk->r[i % 8] = sp->radius;
+        blk->prim[i % 8] = prim;
+    }
+    p->n_sphere += (n->count + 7) / 8;
+    RS_ASSERT(p->n_sphere <= p->cap_sphere);
+    return first;
+}
+
 int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint16_t *count)
 {
     uint32_t kind = pack_kind(p, l);
@@ -130,7 +162,8 @@ int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint1
         *count = (uint16_t)l->count;
         return 0;
     }
-    *child = kind & RS_BVH4_QUADS
+    *child = kind & RS_BVH4_SPHERES ? pack_spheres(p, l)
+             : kind & RS_BVH4_QUADS
                  ? pack(p, l, p->quad, &p->n_quad, p->cap_quad, QUAD_FIELDS, 1)
                  : pack(p, l, p->tri, &p->n_tri, p->cap_tri, TRI_FIELDS, 0);
     *count = (uint16_t)(kind | (l->count + p->width - 1) / p->width);
@@ -141,7 +174,7 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
                            uint32_t max_nodes, uint32_t *cap_nodes)
 {
     uint32_t i, interior = 0;
-    p->cap_tri = p->cap_quad = 0;
+    p->cap_tri = p->cap_quad = p->cap_sphere = 0;
     for (i = 0; i < b->n_nodes; ++i) {
         if (b->nodes[i].count > 0x7fffu)
             return rs_error_set(RS_ERR_ARG, "%s: a leaf of %u primitives (at most 32767 fit a lane)",
@@ -150,7 +183,9 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
         if (b->nodes[i].count > 0) {
             uint32_t kind = pack_kind(p, &b->nodes[i]);
             uint32_t blocks = (b->nodes[i].count + p->width - 1) / p->width;
-            if (kind & RS_BVH4_QUADS)
+            if (kind & RS_BVH4_SPHERES)
+                p->cap_sphere += blocks;
+            else if (kind & RS_BVH4_QUADS)
                 p->cap_quad += blocks;
             else if (kind)
                 p->cap_tri += blocks;
