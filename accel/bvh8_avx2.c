@@ -24,7 +24,7 @@ typedef struct ray8 {
 
 } ray8;
 
-static void ray8_init(ray8 *r, const rs_ray *ray)
+static inline void ray8_init(ray8 *r, const rs_ray *ray)
 {
     rs_vec3 inv_d = rs_bvh_inv_dir(ray->d);
     float iv[3], ov[3];
