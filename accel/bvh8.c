@@ -110,11 +110,18 @@ void rs_bvh8_destroy(rs_bvh8 *b)
     rs_free(b);
 }
 
-uint32_t rs_bvh_wide_leaf_size(uint32_t bvh_width, uint32_t tri_algo)
+uint32_t rs_bvh_wide_leaf_size(uint32_t bvh_width, const rs_geom *g)
 {
-    if (bvh_width == 2 || tri_algo != RS_ISECT_TRI_MOLLER)
+    uint32_t w, n = rs_geom_prim_count(g);
+    uint64_t packed = g->n_quads;
+    if (bvh_width == 2 || n == 0)
         return 0;
-    return bvh_width == 8 || (bvh_width == 0 && rs_bvh8_supported()) ? 8u : 4u;
+    w = bvh_width == 8 || (bvh_width == 0 && rs_bvh8_supported()) ? 8u : 4u;
+    if (g->tri_algo == RS_ISECT_TRI_MOLLER)
+        packed += g->n_tris;
+    if (w == 8 && !g->sphere_motion && g->sphere_algo == RS_ISECT_SPHERE_ALGEBRAIC)
+        packed += g->n_spheres;
+    return packed * 10 >= (uint64_t)n * 9 ? w : 0u;
 }
 
 int rs_bvh8_supported(void)

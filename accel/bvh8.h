@@ -85,11 +85,13 @@ extern "C" {
 rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out);
 void rs_bvh8_destroy(rs_bvh8 *b);
 
-/* The leaf size that suits the CPU device's wide tree, as rs_bvh_build_opts.leaf_block and
- * .max_leaf: the tree's block width (8 for bvh_width 8, or 0 where rs_bvh8_supported(); 4 for
- * width 4 or without AVX2), or 0 (the classic SAH leaves) for the binary kernel (width 2) and for
- * a triangle test other than Möller-Trumbore, whose triangles are not packed. */
-uint32_t rs_bvh_wide_leaf_size(uint32_t bvh_width, uint32_t tri_algo);
+/* The leaf size that suits the CPU device's wide tree over `g`, as rs_bvh_build_opts.leaf_block
+ * and .max_leaf: the tree's block width (8 for bvh_width 8, or 0 where rs_bvh8_supported(); 4 for
+ * width 4 or without AVX2) when at least 90% of the primitives are of a kind that tree packs
+ * into blocks (triangles with the Möller-Trumbore test, parallelograms, and for 8 wide static
+ * spheres with the algebraic test); else 0, the classic SAH leaves (also for the binary kernel,
+ * width 2): a leaf the tree cannot pack is tested one primitive at a time. */
+uint32_t rs_bvh_wide_leaf_size(uint32_t bvh_width, const rs_geom *g);
 
 /* Whether the traversal below can run here: built for x86-64 with GCC or Clang, and the CPU has
  * AVX2.  The functions below must not be called where it says 0. */

@@ -532,6 +532,20 @@ static int make_film(const rs_cli_options *o, render_run *r)
     return RS_EXIT_OK;
 }
 
+/* Whether the render may trace on a GPU (or its fallback): --devices names one, or auto finds
+ * one. */
+static int any_gpu(const rs_cli_options *o)
+{
+    const char *why = "";
+    int i;
+    if (o->devices_auto)
+        return rs_gpu_count(&why) > 0;
+    for (i = 0; i < o->n_devices; ++i)
+        if (o->devices[i].is_gpu)
+            return 1;
+    return 0;
+}
+
 /* The BVH over the geometry with the chosen intersection tests.  Returns an exit code. */
 static int build_bvh(const rs_cli_options *o, render_run *r)
 {
@@ -546,8 +560,9 @@ static int build_bvh(const rs_cli_options *o, render_run *r)
     bo.threads = (uint32_t)r->threads;
     if (o->no_bvh) /* one leaf holding everything: each ray tests every primitive */
         bo.max_leaf = UINT32_MAX;
-    else /* leaves the size of the CPU's wide tree's blocks, which test them all at once */
-        bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(o->bvh_width, r->geom.tri_algo);
+    else if (!any_gpu(o)) /* leaves the size of the CPU's wide tree's blocks, which test them
+                             at once; a GPU's binary kernel keeps the classic SAH leaves */
+        bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(o->bvh_width, &r->geom);
     if (o->bvh_on_gpu) {
         const char *why = "";
         if (rs_gpu_count(&why) > 0)

@@ -21,16 +21,17 @@ typedef struct br_config {
     int threads;
     int megakernel;
     rs_par_strategy strategy;
-    uint32_t bvh_width; /* 2 or 4 */
+    uint32_t bvh_width; /* 2, 4, 8, or 0: the widest this CPU runs */
     int with_gpu;       /* stream: a CUDA device beside the CPU device; megakernel: on CUDA */
 } br_config;
 
 /* A benchmark's scene: a built-in one by name, or "cornell-mesh:FILE" (FILE under the models
  * folder `models`, NULL: the default) dropped into the Cornell box; with its geometry and a SAH
- * BVH.  Returns 1; 0 when the scene cannot be made (a missing model: "NAME: skipped: why" is
+ * BVH as the CLI builds it: leaves sized to the CPU's wide tree for a CPU-only device set
+ * (gpu_too 0), the classic SAH leaves when a GPU (or its fallback) traces too.  Returns 1; 0 when the scene cannot be made (a missing model: "NAME: skipped: why" is
  * printed and the caller goes on); -1 when the BVH fails (printed). */
 static inline int br_load_scene(const char *prog, const char *spec, const char *models,
-                                rs_scene **scene, rs_geom *g, rs_bvh **bvh)
+                                int gpu_too, rs_scene **scene, rs_geom *g, rs_bvh **bvh)
 {
     rs_builtin_opts o;
     rs_bvh_build_opts bo;
@@ -53,7 +54,8 @@ static inline int br_load_scene(const char *prog, const char *spec, const char *
     *g = rs_scene_geom(*scene);
     memset(&bo, 0, sizeof bo);
     bo.builder.method = RS_BVH_SAH;
-    bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, g->tri_algo); /* as the CLI builds it */
+    if (!gpu_too)
+        bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, g);
     if (rs_bvh_build(g, &bo, bvh) != RS_OK) {
         fprintf(stderr, "%s: %s\n", prog, rs_error_message());
         rs_scene_destroy(*scene);

@@ -62,7 +62,7 @@ int main(int argc, char **argv)
         return 1;
 
     rs_bench_print_machine(stdout);
-    printf("settings: %u spp, MIS, max depth 50, SAH BVH, 4-wide CPU traversal; median of %d; "
+    printf("settings: %u spp, MIS, max depth 50, SAH BVH, the CLI's CPU traversal (8-wide with AVX2); median of %d; "
            "speedup S = T(1)/T(p) (thesis Eq. 3.1), efficiency E = S/p (Eq. 3.2)\n\n",
            spp, runs);
 
@@ -81,7 +81,7 @@ int main(int argc, char **argv)
             w = 1;
         if (h < 1)
             h = 1;
-        int loaded = br_load_scene("parallel_bench", scenes[s], NULL, &scene, &g, &bvh);
+        int loaded = br_load_scene("parallel_bench", scenes[s], NULL, 0, &scene, &g, &bvh);
         if (loaded < 0)
             return 1;
         if (loaded == 0)
@@ -108,7 +108,7 @@ int main(int argc, char **argv)
                     c.threads = p;
                     c.megakernel = mk;
                     c.strategy = (rs_par_strategy)st;
-                    c.bvh_width = 4;
+                    c.bvh_width = 0; /* the widest this CPU runs, as the CLI */
                     for (r = 0; r < runs; ++r) {
                         rs_render_stats rstats;
                         int first = mk == 1 && st == 0 && p == 1 && r == 0;

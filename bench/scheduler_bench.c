@@ -279,7 +279,7 @@ int main(int argc, char **argv)
         rs_geom g;
         measure m[N_SETS];
         double eff_t, eff_s;
-        int loaded = br_load_scene("scheduler_bench", scenes[s], models, &scene, &g, &bvh);
+        int loaded = br_load_scene("scheduler_bench", scenes[s], models, 1, &scene, &g, &bvh);
         if (loaded < 0)
             return 1;
         if (loaded == 0)

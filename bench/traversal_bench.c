@@ -369,7 +369,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     memset(&bo, 0, sizeof bo);
     bo.builder = st->builder;
     /* as the CLI builds it for the CPU device */
-    bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, sc->g.tri_algo);
+    bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, &sc->g);
     build_s = rs_bench_now();
     if (rs_bvh_build(&sc->g, &bo, &bvh) != RS_OK) {
         fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
@@ -587,10 +587,10 @@ int main(int argc, char **argv)
 #else
     printf("Embree: not built in (install libembree-dev and re-run CMake to compare)\n");
 #endif
-    printf("settings: our BVH %s (leaves of at most %u, SAH leaf cost in blocks of as many: "
-           "what the CLI builds for this CPU); median of %d run%s; %d threads in the "
+    printf("settings: our BVH %s (leaves of at most %u, SAH leaf cost in blocks of as many, "
+           "where the primitives pack: what the CLI builds for this CPU); median of %d run%s; %d threads in the "
            "multi-threaded columns (OpenMP, dynamic chunks of %d rays)\n",
-           st.bvh_name, rs_bvh_wide_leaf_size(0, RS_ISECT_TRI_MOLLER), st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
+           st.bvh_name, rs_bvh8_supported() ? 8 : 4, st.runs, st.runs == 1 ? "" : "s", st.threads, CHUNK);
 
     if (n_scenes == 0) {
         const char *dir = bs_models_dir(models);
