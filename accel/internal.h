@@ -100,4 +100,32 @@ int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint1
 rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
                            uint32_t max_nodes, uint32_t *cap_nodes);
 
+/* A wide tree's node layout, for the collapse below: bytes per node, where its child[width],
+ * count[width] and n_lanes fields lie, and how a lane's box is written (l NULL: an unused lane,
+ * which no ray may enter); the block sizes of its triangle and parallelogram blocks. */
+#define RS_WIDE_MAX 8u
+typedef struct rs_wide_layout {
+    const char *what; /* "4-wide BVH", for messages */
+    uint32_t width, max_nodes;
+    size_t node_size, child_offset, count_offset, n_lanes_offset;
+    size_t tri_size, quad_size;
+    void (*set_box)(void *node, uint32_t lane, const rs_bvh_node *l);
+} rs_wide_layout;
+
+/* The collapsed tree's arrays (rs_bvh4 and rs_bvh8 take them over). */
+typedef struct rs_wide_tree {
+    void *nodes, *tri, *quad;
+    rs_bvh8_sphere8 *sphere;
+    uint32_t n_nodes, n_tri, n_quad, n_sphere, depth, n_packed;
+} rs_wide_tree;
+
+/* Collapses `b`, built over `g`, into the wide tree `L` describes: each node takes its binary
+ * node's two children and keeps opening the interior child of largest surface area until it has
+ * `width` (rs_bvh_wide_lanes); leaf lanes packed by rs_leaf_lane; nodes in depth-first order from
+ * the root at 0.  RS_ERR_ARG or RS_ERR_NOMEM (with a message naming L->what; *out holds nothing
+ * then); an empty tree has no nodes. */
+rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout *L,
+                        rs_wide_tree *out);
+void rs_wide_free(rs_wide_tree *t);
+
 #endif

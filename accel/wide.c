@@ -7,6 +7,7 @@
 
 #include "accel/bvh8.h"
 #include "accel/internal.h"
+#include "core/alloc.h"
 
 static float half_area(const rs_bvh_node *n)
 {
@@ -197,4 +198,96 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
     /* at most one wide node per binary interior node (one for a single-leaf tree) */
     *cap_nodes = b->n_nodes == 0 ? 0 : interior > 0 ? interior : 1;
     return RS_OK;
+}
+
+/* ---- the collapse itself, for any width ---------------------------------------------------- */
+
+typedef struct collapse {
+    const rs_bvh *bin;
+    const rs_wide_layout *L;
+    rs_wide_tree *out;
+    rs_leaf_packer pk;
+    uint32_t cap;
+} collapse;
+
+static unsigned char *node_at(const collapse *c, uint32_t i)
+{
+    return (unsigned char *)c->out->nodes + (size_t)i * c->L->node_size;
+}
+
+/* Fills wide node `dst` from binary node `src` (or, for a tree that is one leaf, from that leaf
+ * alone) and recurses into its interior lanes.  Returns the depth below, in nodes. */
+static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
+{
+    const rs_bvh_node *bn = c->bin->nodes;
+    uint32_t lanes[RS_WIDE_MAX], n = rs_bvh_wide_lanes(bn, src, c->L->width, lanes), i,
+                                 depth = 0;
+    unsigned char *d = node_at(c, dst);
+    uint32_t *child = (uint32_t *)(void *)(d + c->L->child_offset);
+    uint16_t *count = (uint16_t *)(void *)(d + c->L->count_offset);
+    memset(d, 0, c->L->node_size);
+    *(uint32_t *)(void *)(d + c->L->n_lanes_offset) = n;
+    for (i = 0; i < c->L->width; ++i)
+        c->L->set_box(d, i, i < n ? &bn[lanes[i]] : NULL);
+    for (i = 0; i < n; ++i)
+        if (bn[lanes[i]].count > 0) /* interior lanes below */
+            c->out->n_packed += (uint32_t)rs_leaf_lane(&c->pk, &bn[lanes[i]], &child[i], &count[i]);
+    for (i = 0; i < n; ++i) {
+        if (bn[lanes[i]].count == 0) {
+            uint32_t next = c->out->n_nodes++, below;
+            RS_ASSERT(next < c->cap);
+            /* the recursion writes other nodes only: d stays valid */
+            child[i] = next;
+            below = collapse_node(c, lanes[i], next);
+            if (below > depth)
+                depth = below;
+        }
+    }
+    return depth + 1;
+}
+
+rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout *L,
+                        rs_wide_tree *out)
+{
+    collapse c;
+    rs_status st;
+    memset(out, 0, sizeof *out);
+    memset(&c, 0, sizeof c);
+    c.bin = b;
+    c.L = L;
+    c.out = out;
+    rs_leaf_packer_init(&c.pk, b, g, L->width);
+    st = rs_bvh_wide_plan(b, &c.pk, L->what, L->max_nodes, &c.cap);
+    if (st != RS_OK || c.cap == 0)
+        return st;
+    out->nodes = rs_alloc_aligned(c.cap, L->node_size);
+    if (c.pk.cap_tri > 0)
+        out->tri = rs_alloc_aligned(c.pk.cap_tri, L->tri_size);
+    if (c.pk.cap_quad > 0)
+        out->quad = rs_alloc_aligned(c.pk.cap_quad, L->quad_size);
+    if (c.pk.cap_sphere > 0)
+        out->sphere = (rs_bvh8_sphere8 *)rs_alloc_aligned(c.pk.cap_sphere, sizeof *out->sphere);
+    if (!out->nodes || (c.pk.cap_tri > 0 && !out->tri) || (c.pk.cap_quad > 0 && !out->quad) ||
+        (c.pk.cap_sphere > 0 && !out->sphere)) {
+        rs_wide_free(out);
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for the %s (%u nodes)", L->what, c.cap);
+    }
+    c.pk.tri = out->tri;
+    c.pk.quad = out->quad;
+    c.pk.sphere = out->sphere;
+    out->n_nodes = 1;
+    out->depth = collapse_node(&c, 0, 0);
+    out->n_tri = c.pk.n_tri;
+    out->n_quad = c.pk.n_quad;
+    out->n_sphere = c.pk.n_sphere;
+    return RS_OK;
+}
+
+void rs_wide_free(rs_wide_tree *t)
+{
+    rs_free(t->nodes);
+    rs_free(t->tri);
+    rs_free(t->quad);
+    rs_free(t->sphere);
+    memset(t, 0, sizeof *t);
 }
