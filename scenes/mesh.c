@@ -174,7 +174,8 @@ static rs_status check_ply_header(const char *path)
 {
     FILE *f;
     uint64_t size, lines = 0, bytes = 0, count = 0, inst_bytes = 0, need_lines = 0,
-                   need_bytes = 0;
+                   need_bytes = 0, total = 0;
+    unsigned line = 0;
     char *buf;
     size_t n, hdr = 0, i;
     const char *p, *end;
@@ -204,9 +205,13 @@ static rs_status check_ply_header(const char *path)
         size_t wn;
         if (!eol)
             break; /* the header's last line is cut */
+        ++line;
         is_elem = strncmp(p, "element", 7) == 0 && (p[7] == ' ' || p[7] == '\t');
         is_end = strncmp(p, "end_header", 10) == 0 && (p + 10 == eol || isspace((unsigned char)p[10]));
         if (is_elem || is_end) {
+            /* every instance counts against the data's size (Assimp allocates each one, with
+             * or without properties); only those with properties take a line or bytes */
+            total = add_sat(total, count);
             if (has_prop) {
                 need_lines = add_sat(need_lines, count);
                 need_bytes = add_sat(need_bytes, mul_sat(count, inst_bytes));
@@ -215,9 +220,22 @@ static rs_status check_ply_header(const char *path)
             count = inst_bytes = 0;
         }
         if (is_elem) {
+            /* exactly "element NAME COUNT", COUNT a whole number below 2^32 (Assimp read a
+             * mangled line's count as 2^32 - 1 and asked for 64 GiB: tests/fuzz/fuzz_mesh) */
+            char *num_end = NULL;
             q = p + 7;
             next_word(&q, eol, &wn); /* the element's name */
-            count = strtoull(q, NULL, 10);
+            w = next_word(&q, eol, &wn);
+            if (wn)
+                count = strtoull(w, &num_end, 10);
+            if (!wn || num_end != w + wn || !isdigit((unsigned char)*w) || count > UINT32_MAX ||
+                (next_word(&q, eol, &wn), wn != 0)) {
+                fclose(f);
+                rs_free(buf);
+                return rs_error_set(RS_ERR_ARG,
+                                    "%s: PLY header line %u is not 'element NAME COUNT'", path,
+                                    line);
+            }
         } else if (strncmp(p, "property", 8) == 0) {
             has_prop = 1;
             q = p + 8;
@@ -242,14 +260,13 @@ static rs_status check_ply_header(const char *path)
         return rs_error_set(RS_ERR_ARG, "%s: PLY header has no end_header (within its first %u KiB)",
                             path, PLY_MAX_HEADER >> 10);
     }
-    if (need_lines > size - hdr) {
+    if (total > size - hdr) {
         fclose(f);
         rs_free(buf);
         return rs_error_set(RS_ERR_ARG,
                             "%s: PLY header declares %llu elements, more than its %llu bytes of "
                             "data could hold",
-                            path, (unsigned long long)need_lines,
-                            (unsigned long long)(size - hdr));
+                            path, (unsigned long long)total, (unsigned long long)(size - hdr));
     }
     if (ascii) {
         /* the data's lines: every newline, and a last line without one */

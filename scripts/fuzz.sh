@@ -58,7 +58,8 @@ for h in $harnesses; do
     log="$build/fuzz-$h.log"
     t0="$(date +%s)"
     # shellcheck disable=SC2086
-    if ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:${ASAN_OPTIONS:-}" \
+    if ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:allocator_may_return_null=1:${ASAN_OPTIONS:-}" \
+        LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0:${LSAN_OPTIONS:-}" \
         UBSAN_OPTIONS="print_stacktrace=1:${UBSAN_OPTIONS:-}" \
         $nice "$build/tests/fuzz/fuzz_$h" -max_total_time="$seconds" -max_len="$max_len" \
         -timeout=10 -rss_limit_mb=2048 -close_fd_mask=3 -print_final_stats=1 \

@@ -4,7 +4,8 @@
  * the way `raystream render --mesh FILE` loads it: rs_builtin_create_ex("cornell-mesh") ->
  * rs_scene_add_mesh (the PLY header check, Assimp through our aiFileIO) -> rs_scene_finalize.
  * Any input must give a scene or be refused with one line naming the file; never a crash, a
- * hang, a leak or a sanitizer report.  Built with -DRS_FUZZ=ON (scripts/fuzz.sh). */
+ * hang, a leak or a sanitizer report, and every file opened for Assimp must be closed again
+ * (tests/fuzz/lsan.supp says why that is checked here).  Built with -DRS_FUZZ=ON (scripts/fuzz.sh). */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -20,6 +21,7 @@ static void load_as(const uint8_t *data, size_t size, const char *ext)
     rs_builtin_opts o;
     rs_scene *s = NULL;
     rs_status st;
+    int fds = fz_open_fds();
     snprintf(path, sizeof path, "%s/fuzz.%s", fz_tmpdir(), ext);
     fz_write_file(path, data, size);
     memset(&o, 0, sizeof o);
@@ -30,6 +32,9 @@ static void load_as(const uint8_t *data, size_t size, const char *ext)
     rs_scene_destroy(s);
     rs_error_clear();
     unlink(path);
+    if (fz_open_fds() != fds)
+        fz_broken("%s: %d file descriptors open after the import, %d before", path,
+                  fz_open_fds(), fds);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

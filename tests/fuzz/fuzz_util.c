@@ -1,6 +1,7 @@
 /* tests/fuzz/fuzz_util.c — see fuzz_util.h. */
 #include "fuzz_util.h"
 
+#include <dirent.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,4 +58,17 @@ void fz_check_refusal(rs_status st, const char *label)
     const char *msg = rs_error_message();
     if (st != RS_OK && (!*msg || strchr(msg, '\n') || !strstr(msg, label)))
         fz_broken("refusal (%s) without one line naming %s: '%s'", rs_status_name(st), label, msg);
+}
+
+int fz_open_fds(void)
+{
+    DIR *d = opendir("/proc/self/fd");
+    struct dirent *e;
+    int n = 0;
+    if (!d)
+        fz_broken("cannot list /proc/self/fd");
+    while ((e = readdir(d)) != NULL)
+        n += e->d_name[0] != '.';
+    closedir(d);
+    return n;
 }

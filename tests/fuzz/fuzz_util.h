@@ -28,6 +28,8 @@ void fz_broken(const char *fmt, ...)
     __attribute__((format(printf, 1, 2), noreturn))
 #endif
     ;
+/* The file descriptors this process has open (from /proc/self/fd). */
+int fz_open_fds(void);
 /* A refused input: the first-error slot must hold one non-empty line that names `label`. */
 void fz_check_refusal(rs_status st, const char *label);
 
