@@ -296,6 +296,31 @@ static rs_status check_ply_header(const char *path)
     return RS_OK;
 }
 
+/* Moves the faces of `m` without any index (Assimp's PLY reader makes them from a face line it
+ * cannot read) past mNumFaces, so that its post-processing never sees them: SortByPType read
+ * through one and crashed the process with SIGBUS (tests/fuzz/fuzz_mesh).  They are swapped,
+ * not overwritten, so Assimp still frees each face once (delete[] destroys the whole array).
+ * The scene is Assimp's, not yet post-processed, and ours to edit; returns the faces moved. */
+static unsigned int drop_empty_faces(const struct aiMesh *cm)
+{
+    struct aiMesh *m = (struct aiMesh *)cm;
+    unsigned int k = 0, moved = 0;
+    if (!m || !m->mFaces)
+        return 0;
+    while (k < m->mNumFaces) {
+        if (m->mFaces[k].mNumIndices == 0 || !m->mFaces[k].mIndices) {
+            struct aiFace t = m->mFaces[k];
+            m->mFaces[k] = m->mFaces[m->mNumFaces - 1];
+            m->mFaces[m->mNumFaces - 1] = t;
+            m->mNumFaces--;
+            moved++;
+        } else {
+            ++k;
+        }
+    }
+    return moved;
+}
+
 /* Rotation about x, then y, then z (right-handed, degrees). */
 static rs_vec3 rotate_xyz(rs_vec3 p, rs_vec3 deg)
 {
@@ -403,7 +428,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     mesh_io mio;
     uint64_t size;
     placement pl;
-    uint32_t *mat_of = NULL, mi, k;
+    uint32_t *mat_of = NULL, mi, k, empty_faces = 0;
     char dir[1024];
     const char *slash = strrchr(path, '/');
     rs_status st = RS_OK;
@@ -430,13 +455,19 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
      * below checks every index and coordinate and drops just the bad faces. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE,
                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    as = aiImportFileExWithProperties(path,
-                                      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                          aiProcess_SortByPType | aiProcess_PreTransformVertices |
-                                          aiProcess_GenSmoothNormals |
-                                          aiProcess_ValidateDataStructure,
-                                      &mio.io, props);
+    /* Read and validate without post-processing first (a face index out of range fails the
+     * validation), take out the faces without indices (drop_empty_faces), then post-process. */
+    as = aiImportFileExWithProperties(path, aiProcess_ValidateDataStructure, &mio.io, props);
     aiReleasePropertyStore(props);
+    if (as && mio.refused == RS_OK) {
+        for (mi = 0; mi < as->mNumMeshes; ++mi)
+            empty_faces += drop_empty_faces(as->mMeshes[mi]);
+        /* the validation ran in the import: here it could fail only by freeing the scene, and
+         * Assimp 5.2 crashes doing that (aiApplyPostProcessing -> aiReleaseImport) */
+        as = aiApplyPostProcessing(as, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                           aiProcess_SortByPType | aiProcess_PreTransformVertices |
+                                           aiProcess_GenSmoothNormals);
+    }
     if (mio.refused != RS_OK) {
         /* a file the mesh names was refused: fail even if Assimp carried on without it */
         if (as)
@@ -507,6 +538,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         }
     }
 
+    info->dropped = empty_faces;
     info->bounds.lo = rs_v3_splat(FLT_MAX);
     info->bounds.hi = rs_v3_splat(-FLT_MAX);
     for (mi = 0; mi < as->mNumMeshes && st == RS_OK; ++mi) {
