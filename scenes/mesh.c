@@ -170,7 +170,8 @@ static const char *next_word(const char **p, const char *eol, size_t *n)
     return w;
 }
 
-static rs_status check_ply_header(const char *path)
+/* Checks a file that says it is PLY (*is_ply set); any other file passes. */
+static rs_status check_ply_header(const char *path, int *is_ply_out)
 {
     FILE *f;
     uint64_t size, lines = 0, bytes = 0, count = 0, inst_bytes = 0, need_lines = 0,
@@ -191,6 +192,7 @@ static rs_status check_ply_header(const char *path)
     n = fread(buf, 1, PLY_MAX_HEADER, f);
     buf[n] = '\0';
     is_ply = n >= 4 && memcmp(buf, "ply", 3) == 0 && (buf[3] == '\n' || buf[3] == '\r');
+    *is_ply_out = is_ply;
     if (!is_ply) {
         fclose(f);
         rs_free(buf);
@@ -296,29 +298,20 @@ static rs_status check_ply_header(const char *path)
     return RS_OK;
 }
 
-/* Moves the faces of `m` without any index (Assimp's PLY reader makes them from a face line it
- * cannot read) past mNumFaces, so that its post-processing never sees them: SortByPType read
- * through one and crashed the process with SIGBUS (tests/fuzz/fuzz_mesh).  They are swapped,
- * not overwritten, so Assimp still frees each face once (delete[] destroys the whole array).
- * The scene is Assimp's, not yet post-processed, and ours to edit; returns the faces moved. */
-static unsigned int drop_empty_faces(const struct aiMesh *cm)
+/* 1 when a mesh of `as` has a face without any index.  Assimp's PLY reader makes such faces
+ * from face lines it cannot read (or "0"), and its post-processing then crashes the process
+ * (SortByPType: SIGBUS; found by tests/fuzz/fuzz_mesh).  Post-processing a scene read without
+ * it is no way out: where a step fails, aiApplyPostProcessing crashes releasing the scene. */
+static int has_empty_face(const struct aiScene *as)
 {
-    struct aiMesh *m = (struct aiMesh *)cm;
-    unsigned int k = 0, moved = 0;
-    if (!m || !m->mFaces)
-        return 0;
-    while (k < m->mNumFaces) {
-        if (m->mFaces[k].mNumIndices == 0 || !m->mFaces[k].mIndices) {
-            struct aiFace t = m->mFaces[k];
-            m->mFaces[k] = m->mFaces[m->mNumFaces - 1];
-            m->mFaces[m->mNumFaces - 1] = t;
-            m->mNumFaces--;
-            moved++;
-        } else {
-            ++k;
-        }
+    unsigned int mi, k;
+    for (mi = 0; mi < as->mNumMeshes; ++mi) {
+        const struct aiMesh *m = as->mMeshes[mi];
+        for (k = 0; m && m->mFaces && k < m->mNumFaces; ++k)
+            if (m->mFaces[k].mNumIndices == 0 || !m->mFaces[k].mIndices)
+                return 1;
     }
-    return moved;
+    return 0;
 }
 
 /* Rotation about x, then y, then z (right-handed, degrees). */
@@ -428,7 +421,8 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     mesh_io mio;
     uint64_t size;
     placement pl;
-    uint32_t *mat_of = NULL, mi, k, empty_faces = 0;
+    uint32_t *mat_of = NULL, mi, k;
+    int is_ply = 0;
     char dir[1024];
     const char *slash = strrchr(path, '/');
     rs_status st = RS_OK;
@@ -439,7 +433,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         return st;
     if (size == 0)
         return rs_error_set(RS_ERR_ARG, "%s: empty file", path);
-    st = check_ply_header(path);
+    st = check_ply_header(path, &is_ply);
     if (st != RS_OK)
         return st;
     if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !finite3(o->scale))
@@ -455,19 +449,31 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
      * below checks every index and coordinate and drops just the bad faces. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE,
                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    /* Read and validate without post-processing first (a face index out of range fails the
-     * validation), take out the faces without indices (drop_empty_faces), then post-process. */
-    as = aiImportFileExWithProperties(path, aiProcess_ValidateDataStructure, &mio.io, props);
-    aiReleasePropertyStore(props);
-    if (as && mio.refused == RS_OK) {
-        for (mi = 0; mi < as->mNumMeshes; ++mi)
-            empty_faces += drop_empty_faces(as->mMeshes[mi]);
-        /* the validation ran in the import: here it could fail only by freeing the scene, and
-         * Assimp 5.2 crashes doing that (aiApplyPostProcessing -> aiReleaseImport) */
-        as = aiApplyPostProcessing(as, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                           aiProcess_SortByPType | aiProcess_PreTransformVertices |
-                                           aiProcess_GenSmoothNormals);
+    if (is_ply) {
+        /* a PLY is read once without post-processing first: faces without indices are refused
+         * before the steps that crash on them see them (has_empty_face) */
+        as = aiImportFileEx(path, 0, &mio.io);
+        if (as && mio.refused == RS_OK && has_empty_face(as)) {
+            aiReleaseImport(as);
+            aiReleasePropertyStore(props);
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: a PLY face has no vertex indices (a malformed face line?)",
+                                path);
+        }
+        if (as)
+            aiReleaseImport(as);
     }
+    as = mio.refused != RS_OK
+             ? NULL
+             : aiImportFileExWithProperties(path,
+                                            aiProcess_Triangulate |
+                                                aiProcess_JoinIdenticalVertices |
+                                                aiProcess_SortByPType |
+                                                aiProcess_PreTransformVertices |
+                                                aiProcess_GenSmoothNormals |
+                                                aiProcess_ValidateDataStructure,
+                                            &mio.io, props);
+    aiReleasePropertyStore(props);
     if (mio.refused != RS_OK) {
         /* a file the mesh names was refused: fail even if Assimp carried on without it */
         if (as)
@@ -538,7 +544,6 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         }
     }
 
-    info->dropped = empty_faces;
     info->bounds.lo = rs_v3_splat(FLT_MAX);
     info->bounds.hi = rs_v3_splat(-FLT_MAX);
     for (mi = 0; mi < as->mNumMeshes && st == RS_OK; ++mi) {
