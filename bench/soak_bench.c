@@ -44,7 +44,7 @@
 #include "scheduler/passes.h"
 #include "scheduler/render.h"
 
-#define PROG "soak_bench"
+#define PROG     "soak_bench"
 #define MAX_TEXT (64u << 10)
 
 /* ---- the random stream ------------------------------------------------------------------- */
@@ -95,23 +95,22 @@ static void put_vec(text *t, double lo, double hi)
 /* The ways generate() makes a scene file that must be refused. */
 enum {
     BAD_NONE,
-    BAD_RADIUS,     /* a sphere of radius -1 */
-    BAD_ALBEDO,     /* a reflectance of 5 */
-    BAD_MATERIAL,   /* an object naming a material that is not defined */
-    BAD_KEY,        /* an unknown key */
-    BAD_INFINITE,   /* 1e999, which cJSON reads as inf */
-    BAD_CUT,        /* the file cut short */
-    BAD_TRAILING,   /* content after the JSON value */
-    BAD_DUPLICATE,  /* "objects" twice */
+    BAD_RADIUS,    /* a sphere of radius -1 */
+    BAD_ALBEDO,    /* a reflectance of 5 */
+    BAD_MATERIAL,  /* an object naming a material that is not defined */
+    BAD_KEY,       /* an unknown key */
+    BAD_INFINITE,  /* 1e999, which cJSON reads as inf */
+    BAD_CUT,       /* the file cut short */
+    BAD_TRAILING,  /* content after the JSON value */
+    BAD_DUPLICATE, /* "objects" twice */
     BAD_KINDS
 };
 
-static const char *const bad_names[BAD_KINDS] = {
-    "", "radius", "albedo", "material", "key", "1e999", "cut", "trailing", "duplicate"};
+static const char *const bad_names[BAD_KINDS] = {"",      "radius", "albedo",   "material", "key",
+                                                 "1e999", "cut",    "trailing", "duplicate"};
 
-static const char *const mat_types[] = {"lambertian", "diffuse_uniform", "disney_diffuse",
-                                        "phong",      "metal",           "dielectric",
-                                        "light"};
+static const char *const mat_types[] = {"lambertian", "diffuse_uniform", "disney_diffuse", "phong",
+                                        "metal",      "dielectric",      "light"};
 #define N_MAT_TYPES 7
 
 /* A random scene as JSON text, valid unless `bad` says otherwise. */
@@ -123,8 +122,7 @@ static void generate(text *t, int bad)
     put(t, "{\n  \"camera\": {\"from\": [%.10g, %.10g, %.10g], \"at\": [0, 0, 0], \"vfov\": %.10g",
         fx, rnd_num(-2, 4), fz, rnd_num(20, 90));
     if (rnd() % 4 == 0)
-        put(t, ", \"aperture\": %.10g, \"focus_distance\": %.10g", rnd_num(0, 0.3),
-            rnd_num(1, 10));
+        put(t, ", \"aperture\": %.10g, \"focus_distance\": %.10g", rnd_num(0, 0.3), rnd_num(1, 10));
     if (rnd() % 3 == 0)
         put(t, ", \"shutter\": [0, %.10g]", rnd_num(0, 1));
     put(t, "},\n");
@@ -208,16 +206,17 @@ static void generate(text *t, int bad)
             put(t, ", \"u\": [%.10g, 0, %.10g], \"v\": [0, %.10g, %.10g]", rnd_num(0.1, 4),
                 rnd_num(-1, 1), rnd_num(0.1, 4), rnd_num(-1, 1));
         } else if (k == 2 || k == 3) {
-            put(t, "\"type\": \"triangle\", \"vertices\": [[%.10g, %.10g, %.10g], "
-                   "[%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g]]",
+            put(t,
+                "\"type\": \"triangle\", \"vertices\": [[%.10g, %.10g, %.10g], "
+                "[%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g]]",
                 rnd_num(-3, -0.5), rnd_num(-3, -0.5), rnd_num(-1, 1), rnd_num(0.5, 3),
-                rnd_num(-3, -0.5), rnd_num(-1, 1), rnd_num(-1, 1), rnd_num(0.5, 3),
-                rnd_num(-1, 1));
+                rnd_num(-3, -0.5), rnd_num(-1, 1), rnd_num(-1, 1), rnd_num(0.5, 3), rnd_num(-1, 1));
             if (k == 3)
                 put(t, ", \"uv\": [0, 0, 1, 0, 0.5, 1]");
         } else {
-            put(t, "\"type\": \"box\", \"min\": [%.10g, %.10g, %.10g], \"max\": "
-                   "[%.10g, %.10g, %.10g], \"rotate_y\": %.10g, \"translate\": ",
+            put(t,
+                "\"type\": \"box\", \"min\": [%.10g, %.10g, %.10g], \"max\": "
+                "[%.10g, %.10g, %.10g], \"rotate_y\": %.10g, \"translate\": ",
                 rnd_num(-2, 0), rnd_num(-2, 0), rnd_num(-2, 0), rnd_num(0.1, 2), rnd_num(0.1, 2),
                 rnd_num(0.1, 2), rnd_num(-180, 180));
             put_vec(t, -2, 2);
@@ -249,9 +248,8 @@ static void generate(text *t, int bad)
 /* ---- the soak --------------------------------------------------------------------------- */
 
 enum { SET_CPU, SET_CPU2, SET_CPU_GPU, SET_GPU, SET_MK_CPU, SET_MK_GPU, N_SETS };
-static const char *const set_names[N_SETS] = {"cpu",           "cpu:2",
-                                              "cpu,gpu",       "gpu",
-                                              "megakernel cpu", "megakernel gpu"};
+static const char *const set_names[N_SETS] = {"cpu", "cpu:2",          "cpu,gpu",
+                                              "gpu", "megakernel cpu", "megakernel gpu"};
 
 typedef struct tally {
     long rounds, renders, per_set[N_SETS];
@@ -388,8 +386,8 @@ static void bad_inputs(tally *ty, const char *dir, const text *good)
         failure(ty, "a scene file with a bad %s was accepted (%s)", bad_names[bad], path);
         rs_scene_destroy(s);
     } else if (!refused_well(path)) {
-        failure(ty, "a bad %s was refused without one line naming the file: '%s'",
-                bad_names[bad], rs_error_message());
+        failure(ty, "a bad %s was refused without one line naming the file: '%s'", bad_names[bad],
+                rs_error_message());
     } else {
         ty->bad_refused++;
     }
@@ -511,8 +509,9 @@ static void round_once(tally *ty, const char *dir)
         ty->nonfinite += count_nonfinite(img, nf);
         if (memcmp(img, ref, nf * sizeof *img) != 0) {
             ty->images_differing++;
-            failure(ty, "%s on %s (chunk %u, wave %u, waves %u, fault %d after %d; %ux%u, %u "
-                        "spp, seed %llu): the image differs from cpu's",
+            failure(ty,
+                    "%s on %s (chunk %u, wave %u, waves %u, fault %d after %d; %ux%u, %u "
+                    "spp, seed %llu): the image differs from cpu's",
                     path, set_names[j.set], j.chunk, j.wave, j.waves, j.fault_dev, j.fault_after,
                     st.width, st.height, st.spp, (unsigned long long)st.seed);
         } else if (j.fault_dev >= 0 && retired) {
@@ -585,8 +584,8 @@ int main(int argc, char **argv)
     printf("bad inputs refused: %ld of %ld (", ty.bad_refused, ty.bad_inputs);
     for (i = 1; i < BAD_KINDS; ++i)
         printf("%s%s %ld", i > 1 ? ", " : "", bad_names[i], ty.per_bad[i]);
-    printf("); byte-flipped files: %ld accepted, %ld refused with one line\n",
-           ty.mutated_accepted, ty.mutated_refused);
+    printf("); byte-flipped files: %ld accepted, %ld refused with one line\n", ty.mutated_accepted,
+           ty.mutated_refused);
     printf("samples lost: %llu; rays unanswered: %llu; images differing from cpu: %ld; NaN/Inf "
            "pixels: %ld; failures: %ld\n",
            (unsigned long long)ty.samples_lost, (unsigned long long)ty.rays_unanswered,

@@ -1,10 +1,10 @@
 /* tests/fuzz/fuzz_cli_options.c — libFuzzer harness for the command-line parser.
  *
  * The bytes are split into arguments at NUL and newline bytes (a last newline ends the last
- * argument; each argument is its own allocation, so a read past one is seen) and given to rs_cli_parse after argv[0].  It must
- * return 0 or the usage exit status 2 (after its one line), and a render it accepts must be
- * within the documented ranges; never a crash or a sanitizer report.  Built with -DRS_FUZZ=ON
- * (scripts/fuzz.sh). */
+ * argument; each argument is its own allocation, so a read past one is seen) and given to
+ * rs_cli_parse after argv[0].  It must return 0 or the usage exit status 2 (after its one line),
+ * and a render it accepts must be within the documented ranges; never a crash or a sanitizer
+ * report.  Built with -DRS_FUZZ=ON (scripts/fuzz.sh). */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>

@@ -5,7 +5,8 @@
  * rs_scene_add_mesh (the PLY header check, Assimp through our aiFileIO) -> rs_scene_finalize.
  * Any input must give a scene or be refused with one line naming the file; never a crash, a
  * hang, a leak or a sanitizer report, and every file opened for Assimp must be closed again
- * (tests/fuzz/lsan.supp says why that is checked here).  Built with -DRS_FUZZ=ON (scripts/fuzz.sh). */
+ * (tests/fuzz/lsan.supp says why that is checked here).  Built with -DRS_FUZZ=ON (scripts/fuzz.sh).
+ */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -33,8 +34,8 @@ static void load_as(const uint8_t *data, size_t size, const char *ext)
     rs_error_clear();
     unlink(path);
     if (fz_open_fds() != fds)
-        fz_broken("%s: %d file descriptors open after the import, %d before", path,
-                  fz_open_fds(), fds);
+        fz_broken("%s: %d file descriptors open after the import, %d before", path, fz_open_fds(),
+                  fds);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
