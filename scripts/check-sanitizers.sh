@@ -10,6 +10,14 @@ set -eu
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"
 which="${1:-all}"
+case "$which" in
+all | address | thread | fuzz) ;;
+both) which=all ;; # its name before the fuzzers joined
+*)
+    echo "check-sanitizers.sh: '$which': use address, thread, fuzz or nothing (all)" >&2
+    exit 2
+    ;;
+esac
 
 if [ "$which" = all ] || [ "$which" = address ]; then
     cmake -S . -B build-asan -DRS_SANITIZE=address -DRS_CUDA=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
