@@ -275,6 +275,10 @@ static int parse_image_option(opt_arg *x, rs_cli_options *o)
     int rc = RS_EXIT_OK;
     if (strcmp(name, "--scene") == 0) {
         NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a scene (builtin:NAME or FILE.json), not an empty "
+                               "name%s",
+                               name, "");
         if (o->scene)
             return usage_error("more than one scene given ('%s' and '%s')", o->scene, v);
         o->scene = v;
@@ -542,6 +546,12 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
         name[len] = '\0';
 
         if (a[0] != '-' || a[1] == '\0') {
+            /* an empty argument ('' from a script's unset variable) would be reported later
+             * as the file ": no such scene file", a line that names nothing */
+            if (!*a)
+                return usage_error("an empty argument where the scene (builtin:NAME or "
+                                   "FILE.json) goes%s%s",
+                                   "", "");
             if (o->scene)
                 return usage_error("more than one scene given ('%s' and '%s')", o->scene, a);
             o->scene = a;

@@ -111,10 +111,13 @@ static void mio_close(struct aiFileIO *io, struct aiFile *f)
 
 /* ---- PLY headers ------------------------------------------------------------------------- */
 
-/* Assimp's PLY reader spins for ever on a header that stops before end_header.  A file that
- * says it is PLY (by its first line or its extension) must reach end_header within this many
- * bytes, and may not declare more elements than its bytes after the header could hold (each
- * instance of an element with a property takes at least one byte, ascii or binary). */
+/* Assimp's PLY reader spins for ever on a header that stops before end_header, and aborts the
+ * whole process (an ai_assert in its triangulation, found by tests/fuzz/fuzz_mesh) on an ascii
+ * file whose data stops before the elements its header declares.  A file that says it is PLY
+ * (by its first line or its extension) must reach end_header within this many bytes and hold the
+ * data its header declares: in ascii, a line for every instance of an element that has a
+ * property (one instance a line, as the format writes them); in binary, the bytes of every
+ * instance's fixed-size properties (a list counts its length field only). */
 #define PLY_MAX_HEADER (64u << 10)
 
 static int ext_is(const char *path, const char *ext)
@@ -129,14 +132,55 @@ static int ext_is(const char *path, const char *ext)
     return 1;
 }
 
-static rs_status check_ply_header(const char *path)
+static uint64_t add_sat(uint64_t a, uint64_t b) { return a + b < a ? UINT64_MAX : a + b; }
+
+static uint64_t mul_sat(uint64_t a, uint64_t b)
+{
+    return a && b > UINT64_MAX / a ? UINT64_MAX : a * b;
+}
+
+/* Bytes of a PLY scalar type in binary (char/int8 ... double/float64); 1 for an unknown name
+ * (Assimp refuses those itself). */
+static uint64_t ply_type_bytes(const char *t, size_t n)
+{
+    static const struct {
+        const char *name;
+        uint64_t bytes;
+    } types[] = {{"char", 1},   {"uchar", 1},   {"int8", 1},   {"uint8", 1},   {"short", 2},
+                 {"ushort", 2}, {"int16", 2},   {"uint16", 2}, {"int", 4},     {"uint", 4},
+                 {"int32", 4},  {"uint32", 4},  {"float", 4},  {"float32", 4}, {"double", 8},
+                 {"float64", 8}};
+    size_t k;
+    for (k = 0; k < sizeof types / sizeof types[0]; ++k)
+        if (strlen(types[k].name) == n && strncmp(t, types[k].name, n) == 0)
+            return types[k].bytes;
+    return 1;
+}
+
+/* The next blank-separated word of [*p, eol): its start, and its length in *n (0 at the end). */
+static const char *next_word(const char **p, const char *eol, size_t *n)
+{
+    const char *w = *p;
+    while (w < eol && (*w == ' ' || *w == '\t' || *w == '\r'))
+        ++w;
+    *p = w;
+    while (*p < eol && **p != ' ' && **p != '\t' && **p != '\r')
+        ++*p;
+    *n = (size_t)(*p - w);
+    return w;
+}
+
+/* Checks a file that says it is PLY (*is_ply set); any other file passes. */
+static rs_status check_ply_header(const char *path, int *is_ply_out)
 {
     FILE *f;
-    uint64_t size, total = 0, count = 0;
+    uint64_t size, lines = 0, bytes = 0, count = 0, inst_bytes = 0, need_lines = 0,
+                   need_bytes = 0, total = 0;
+    unsigned line = 0;
     char *buf;
-    size_t n, hdr = 0;
+    size_t n, hdr = 0, i;
     const char *p, *end;
-    int is_ply, has_prop = 0, found = 0;
+    int is_ply, has_prop = 0, found = 0, ascii = 1, last_nl = 1;
     rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
     if (st != RS_OK)
         return st;
@@ -146,10 +190,11 @@ static rs_status check_ply_header(const char *path)
         return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
     }
     n = fread(buf, 1, PLY_MAX_HEADER, f);
-    fclose(f);
     buf[n] = '\0';
     is_ply = n >= 4 && memcmp(buf, "ply", 3) == 0 && (buf[3] == '\n' || buf[3] == '\r');
+    *is_ply_out = is_ply;
     if (!is_ply) {
+        fclose(f);
         rs_free(buf);
         if (ext_is(path, "ply"))
             return rs_error_set(RS_ERR_ARG, "%s: not a PLY file (its first line is not 'ply')",
@@ -157,27 +202,53 @@ static rs_status check_ply_header(const char *path)
         return RS_OK;
     }
     for (p = buf, end = buf + n; p < end;) {
-        const char *eol = (const char *)memchr(p, '\n', (size_t)(end - p));
+        const char *eol = (const char *)memchr(p, '\n', (size_t)(end - p)), *q, *w;
         int is_elem, is_end;
+        size_t wn;
         if (!eol)
             break; /* the header's last line is cut */
+        ++line;
         is_elem = strncmp(p, "element", 7) == 0 && (p[7] == ' ' || p[7] == '\t');
         is_end = strncmp(p, "end_header", 10) == 0 && (p + 10 == eol || isspace((unsigned char)p[10]));
         if (is_elem || is_end) {
-            if (has_prop)
-                total = total + count < total ? UINT64_MAX : total + count;
+            /* every instance counts against the data's size (Assimp allocates each one, with
+             * or without properties); only those with properties take a line or bytes */
+            total = add_sat(total, count);
+            if (has_prop) {
+                need_lines = add_sat(need_lines, count);
+                need_bytes = add_sat(need_bytes, mul_sat(count, inst_bytes));
+            }
             has_prop = 0;
-            count = 0;
+            count = inst_bytes = 0;
         }
         if (is_elem) {
-            const char *q = p + 7;
-            while (q < eol && (*q == ' ' || *q == '\t'))
-                ++q;
-            while (q < eol && *q != ' ' && *q != '\t')
-                ++q; /* the element's name */
-            count = strtoull(q, NULL, 10);
+            /* exactly "element NAME COUNT", COUNT a whole number below 2^32 (Assimp read a
+             * mangled line's count as 2^32 - 1 and asked for 64 GiB: tests/fuzz/fuzz_mesh) */
+            char *num_end = NULL;
+            q = p + 7;
+            next_word(&q, eol, &wn); /* the element's name */
+            w = next_word(&q, eol, &wn);
+            if (wn)
+                count = strtoull(w, &num_end, 10);
+            if (!wn || num_end != w + wn || !isdigit((unsigned char)*w) || count > UINT32_MAX ||
+                (next_word(&q, eol, &wn), wn != 0)) {
+                fclose(f);
+                rs_free(buf);
+                return rs_error_set(RS_ERR_ARG,
+                                    "%s: PLY header line %u is not 'element NAME COUNT'", path,
+                                    line);
+            }
         } else if (strncmp(p, "property", 8) == 0) {
             has_prop = 1;
+            q = p + 8;
+            w = next_word(&q, eol, &wn);
+            if (wn == 4 && strncmp(w, "list", 4) == 0)
+                w = next_word(&q, eol, &wn); /* the list's length type: its items may be 0 */
+            inst_bytes = add_sat(inst_bytes, ply_type_bytes(w, wn));
+        } else if (strncmp(p, "format", 6) == 0) {
+            q = p + 6;
+            w = next_word(&q, eol, &wn);
+            ascii = wn == 5 && strncmp(w, "ascii", 5) == 0;
         } else if (is_end) {
             found = 1;
             hdr = (size_t)(eol + 1 - buf);
@@ -185,16 +256,62 @@ static rs_status check_ply_header(const char *path)
         }
         p = eol + 1;
     }
-    rs_free(buf);
-    if (!found)
+    if (!found) {
+        fclose(f);
+        rs_free(buf);
         return rs_error_set(RS_ERR_ARG, "%s: PLY header has no end_header (within its first %u KiB)",
                             path, PLY_MAX_HEADER >> 10);
-    if (total > size - hdr)
+    }
+    if (total > size - hdr) {
+        fclose(f);
+        rs_free(buf);
         return rs_error_set(RS_ERR_ARG,
                             "%s: PLY header declares %llu elements, more than its %llu bytes of "
                             "data could hold",
                             path, (unsigned long long)total, (unsigned long long)(size - hdr));
+    }
+    if (ascii) {
+        /* the data's lines: every newline, and a last line without one */
+        for (i = hdr; i < n; ++i)
+            lines += buf[i] == '\n';
+        last_nl = n == hdr || buf[n - 1] == '\n';
+        while (lines < need_lines && (n = fread(buf, 1, PLY_MAX_HEADER, f)) > 0) {
+            for (i = 0; i < n; ++i)
+                lines += buf[i] == '\n';
+            last_nl = buf[n - 1] == '\n';
+        }
+        lines += !last_nl;
+    }
+    fclose(f);
+    rs_free(buf);
+    bytes = size - hdr;
+    if (ascii && lines < need_lines)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: PLY header declares %llu elements, but its ascii data has only "
+                            "%llu lines (a cut file?)",
+                            path, (unsigned long long)need_lines, (unsigned long long)lines);
+    if (!ascii && need_bytes > bytes)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: PLY header declares elements of at least %llu bytes, but its "
+                            "binary data has only %llu (a cut file?)",
+                            path, (unsigned long long)need_bytes, (unsigned long long)bytes);
     return RS_OK;
+}
+
+/* 1 when a mesh of `as` has a face without any index.  Assimp's PLY reader makes such faces
+ * from face lines it cannot read (or "0"), and its post-processing then crashes the process
+ * (SortByPType: SIGBUS; found by tests/fuzz/fuzz_mesh).  Post-processing a scene read without
+ * it is no way out: where a step fails, aiApplyPostProcessing crashes releasing the scene. */
+static int has_empty_face(const struct aiScene *as)
+{
+    unsigned int mi, k;
+    for (mi = 0; mi < as->mNumMeshes; ++mi) {
+        const struct aiMesh *m = as->mMeshes[mi];
+        for (k = 0; m && m->mFaces && k < m->mNumFaces; ++k)
+            if (m->mFaces[k].mNumIndices == 0 || !m->mFaces[k].mIndices)
+                return 1;
+    }
+    return 0;
 }
 
 /* Rotation about x, then y, then z (right-handed, degrees). */
@@ -305,6 +422,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     uint64_t size;
     placement pl;
     uint32_t *mat_of = NULL, mi, k;
+    int is_ply = 0;
     char dir[1024];
     const char *slash = strrchr(path, '/');
     rs_status st = RS_OK;
@@ -315,7 +433,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         return st;
     if (size == 0)
         return rs_error_set(RS_ERR_ARG, "%s: empty file", path);
-    st = check_ply_header(path);
+    st = check_ply_header(path, &is_ply);
     if (st != RS_OK)
         return st;
     if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !finite3(o->scale))
@@ -331,12 +449,30 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
      * below checks every index and coordinate and drops just the bad faces. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE,
                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    as = aiImportFileExWithProperties(path,
-                                      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                          aiProcess_SortByPType | aiProcess_PreTransformVertices |
-                                          aiProcess_GenSmoothNormals |
-                                          aiProcess_ValidateDataStructure,
-                                      &mio.io, props);
+    if (is_ply) {
+        /* a PLY is read once without post-processing first: faces without indices are refused
+         * before the steps that crash on them see them (has_empty_face) */
+        as = aiImportFileEx(path, 0, &mio.io);
+        if (as && mio.refused == RS_OK && has_empty_face(as)) {
+            aiReleaseImport(as);
+            aiReleasePropertyStore(props);
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: a PLY face has no vertex indices (a malformed face line?)",
+                                path);
+        }
+        if (as)
+            aiReleaseImport(as);
+    }
+    as = mio.refused != RS_OK
+             ? NULL
+             : aiImportFileExWithProperties(path,
+                                            aiProcess_Triangulate |
+                                                aiProcess_JoinIdenticalVertices |
+                                                aiProcess_SortByPType |
+                                                aiProcess_PreTransformVertices |
+                                                aiProcess_GenSmoothNormals |
+                                                aiProcess_ValidateDataStructure,
+                                            &mio.io, props);
     aiReleasePropertyStore(props);
     if (mio.refused != RS_OK) {
         /* a file the mesh names was refused: fail even if Assimp carried on without it */

@@ -8,7 +8,9 @@
  * Assimp reads every file through core/file.h (the mesh, its MTL, a glTF's buffers), and so do
  * the textures a mesh names: one that is not a regular file of a sane size (a FIFO, /dev/zero, a
  * folder) fails the import, naming it; one that is merely missing does not.  A PLY file must
- * reach end_header within 64 KiB (Assimp's reader spins for ever on a cut header). */
+ * reach end_header within 64 KiB (Assimp's reader spins for ever on a cut header) and hold the
+ * data its header declares: a line per element instance in ascii, the fixed-size properties'
+ * bytes in binary (Assimp aborts the process on a cut ascii body). */
 #ifndef RS_SCENES_MESH_H
 #define RS_SCENES_MESH_H
 

@@ -7,8 +7,11 @@
 #             finds it.  Benchmark only; the renderer and its tests never need it.
 set -eu
 
+# clang, its libFuzzer/sanitizer runtimes (libclang-rt-14-dev: bookworm's clang does not pull it
+# in) and its OpenMP (libomp-14-dev): scripts/fuzz.sh, which check-sanitizers.sh runs
 PACKAGES="gcc g++ make cmake pkg-config libc6-dev
-libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev gnuplot-nox"
+libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev gnuplot-nox
+clang libclang-rt-14-dev libomp-14-dev"
 
 for arg in "$@"; do
     case "$arg" in

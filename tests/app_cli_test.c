@@ -577,6 +577,11 @@ static void test_usage_errors(void **state)
          {"--resume", "no-such.ckpt"}},
         {{"render", "-o", "out.png", "--spp", "1", "--resume", RS_SOURCE_DIR "/scenes", NULL},
          {"--resume", "/scenes", "folder"}},
+        /* found by tests/fuzz/fuzz_cli_options: an empty scene name was let through and
+         * reported as ": no such scene file", naming nothing */
+        {{"render", "", "-o", "out.png", "--spp", "1", NULL}, {"empty argument", "scene"}},
+        {{"render", "--scene=", "-o", "out.png", "--spp", "1", NULL}, {"--scene", "empty"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--scene", "", NULL}, {"--scene", "empty"}},
     };
     char known[256], names[512];
     size_t c;

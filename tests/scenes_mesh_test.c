@@ -109,8 +109,16 @@ static void test_fit(void **state)
 /* Bad files: an error whose one-line message names the file, or dropped faces counted. */
 static void test_malformed(void **state)
 {
-    static const char *const errors[] = {"truncated.ply", "bad_index.obj", "empty.obj",
-                                         "garbage.obj",   "missing.obj",   ""};
+    /* cut_body.ply and bad_number.ply: found by tests/fuzz/fuzz_mesh (Assimp aborted on the
+     * first, leaked on the second) */
+    /* empty_face.ply too: Assimp's PLY reader makes faces without indices from face lines it
+     * cannot read (and from "0"), and its post-processing crashed (SIGBUS) on them */
+    static const char *const errors[] = {"truncated.ply",          "cut_body.ply",
+                                         "bad_number.ply",         "face_past_vertices.ply",
+                                         "empty_face.ply",
+                                         "bad_index.obj",          "empty.obj",
+                                         "garbage.obj",            "missing.obj",
+                                         ""};
     uint32_t mat;
     rs_scene *s = new_scene(&mat);
     rs_mesh_opts o = rs_mesh_opts_default(mat);
@@ -269,6 +277,29 @@ static void test_ply_headers(void **state)
          "property float z\nend_header\n0 0 0\n",
          "declares 4000000000 elements"},
         {"solid cube\nendsolid\n", "not a PLY file"},
+        /* found by tests/fuzz/fuzz_mesh: Assimp aborts the process (an ai_assert in its
+         * triangulation) on an ascii body cut before the declared elements; the same as
+         * tests/data/cut_body.ply, which test_malformed loads */
+        {"ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n",
+         "14 elements, but its ascii data has only 3 lines"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0",
+         "4 elements, but its ascii data has only 3 lines"},
+        /* found by tests/fuzz/fuzz_mesh: Assimp read this mangled line's count as 2^32 - 1
+         * and asked for 64 GiB */
+        {"ply\nformat ascii 1.0\nelement 66666666666666666666666voperty lar int vertex\n"
+         "end_header\n0 0 0\n",
+         "line 3 is not 'element NAME COUNT'"},
+        {"ply\nformat ascii 1.0\nelement vertex 4294967296\nproperty float x\nend_header\n0\n",
+         "line 3 is not 'element NAME COUNT'"},
+        /* binary: 3 vertices of 12 bytes and a face of at least 1 need 37 bytes, not 20 */
+        {"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+         "property float y\nproperty float z\nelement face 1\n"
+         "property list uchar int vertex_indices\nend_header\n0123456789abcdefghij",
+         "at least 37 bytes, but its binary data has only 20"},
     };
     char dir[] = "/tmp/rs_ply_XXXXXX", path[256];
     size_t k;
