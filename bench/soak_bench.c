@@ -35,6 +35,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "accel/bvh8.h"
 #include "core/alloc.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
@@ -445,7 +446,9 @@ static void round_once(tally *ty, const char *dir)
     g = rs_scene_geom(scene);
     memset(&bo, 0, sizeof bo);
     bo.builder.method = RS_BVH_SAH;
-    bo.leaf_block = RS_BVH_LEAF_BLOCK_WIDE;
+    /* leaves sized to the CPU's wide tree's blocks, as the CLI builds for a CPU-only set (every
+     * tree gives the same hits, so the GPU-fallback sets may share it) */
+    bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, &g);
     if (rs_bvh_build(&g, &bo, &bvh) != RS_OK) {
         failure(ty, "%s: BVH: %s", path, rs_error_message());
         goto out;
