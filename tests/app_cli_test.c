@@ -1746,6 +1746,7 @@ static void test_resume_after_signal(void **state)
             samples / 1200, samples % 1200);
     snprintf(spp_text, sizeof spp_text, "%lld", samples / 1200 + 2);
     run_expect(f, resume, 0, &q);
+    proc_free(&q);
     run_expect(f, ref, 0, &q);
     expect_same_image(&q, f, "rs.exr", "ref.exr");
     proc_free(&p);
