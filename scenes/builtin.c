@@ -373,11 +373,11 @@ static rs_status build_cornell_mesh(rs_scene *s, const rs_builtin_opts *o)
     mo.fit_size = 330.0f;
     mo.fit_base = rs_v3(278, 0, 278);
     TRY(rs_scene_add_mesh(s, o->mesh_file, &mo, &info));
-    if (info.dropped)
-        fprintf(stderr,
-                "raystream: warning: %s: %u faces dropped (non-finite, out of range or "
-                "zero area)\n",
-                o->mesh_file, info.dropped);
+    if (info.dropped) {
+        char why[160];
+        fprintf(stderr, "raystream: warning: %s: %s; %u triangles kept\n", o->mesh_file,
+                rs_mesh_dropped_text(&info, why, sizeof why), info.triangles);
+    }
     return RS_OK;
 }
 

@@ -225,8 +225,19 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
             /* exactly "element NAME COUNT", COUNT a whole number below 2^32 (Assimp read a
              * mangled line's count as 2^32 - 1 and asked for 64 GiB: tests/fuzz/fuzz_mesh) */
             char *num_end = NULL;
+            size_t nn;
+            const char *name;
             q = p + 7;
-            next_word(&q, eol, &wn); /* the element's name */
+            name = next_word(&q, eol, &nn);
+            if (nn == 9 && strncmp(name, "tristrips", 9) == 0) {
+                /* Assimp reads no strips: a stripped model came out as one triangle */
+                fclose(f);
+                rs_free(buf);
+                return rs_error_set(RS_ERR_ARG,
+                                    "%s: PLY header line %u: triangle strips (element tristrips) "
+                                    "are not supported; write the faces as 'element face' lists",
+                                    path, line);
+            }
             w = next_word(&q, eol, &wn);
             if (wn)
                 count = strtoull(w, &num_end, 10);
@@ -560,15 +571,19 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
             rs_vec3 v[3];
             float uv[6], nrm[9];
             int c, ok = f->mNumIndices == 3;
+            uint32_t *why = &info->dropped_shape;
             for (c = 0; c < 3 && ok; ++c) {
                 unsigned int idx = f->mIndices[c];
                 if (idx >= m->mNumVertices) {
                     ok = 0;
+                    why = &info->dropped_index;
                     break;
                 }
                 v[c] = place(&pl,
                              rs_v3(m->mVertices[idx].x, m->mVertices[idx].y, m->mVertices[idx].z));
                 ok = finite3(v[c]);
+                if (!ok)
+                    why = &info->dropped_nonfinite;
                 if (m->mTextureCoords[0]) {
                     uv[2 * c] = m->mTextureCoords[0][idx].x;
                     uv[2 * c + 1] = m->mTextureCoords[0][idx].y;
@@ -583,10 +598,13 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
                     nrm[3 * c + 2] = n.z;
                 }
             }
-            if (ok && rs_v3_is_zero(rs_v3_cross(rs_v3_sub(v[1], v[0]), rs_v3_sub(v[2], v[0]))))
-                ok = 0; /* zero area */
+            if (ok && rs_v3_is_zero(rs_v3_cross(rs_v3_sub(v[1], v[0]), rs_v3_sub(v[2], v[0])))) {
+                ok = 0;
+                why = &info->dropped_area;
+            }
             if (!ok) {
                 info->dropped++;
+                ++*why;
                 continue;
             }
             st = rs_scene_add_triangle_full(s, v, m->mTextureCoords[0] ? uv : NULL,
@@ -602,8 +620,11 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     }
     rs_free(mat_of);
     aiReleaseImport(as);
-    if (st == RS_OK && info->triangles == 0)
-        st = rs_error_set(RS_ERR_ARG, "%s: no usable triangles (%u faces dropped)", path,
-                          info->dropped);
+    if (st == RS_OK && (info->triangles == 0 || info->dropped > info->triangles)) {
+        char why[160];
+        st = rs_error_set(RS_ERR_ARG, "%s: %s of %u, %u triangles left: the mesh is broken", path,
+                          rs_mesh_dropped_text(info, why, sizeof why),
+                          info->dropped + info->triangles, info->triangles);
+    }
     return st;
 }

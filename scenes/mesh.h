@@ -4,7 +4,11 @@
  * x, y, z, and a translation, in that order (the thesis's transforms), or fitted into a box.
  *
  * Bad data never crashes or hangs the import: a file Assimp cannot read is an RS_ERR_ARG naming
- * it; faces with non-finite or out-of-range vertices, or of zero area, are dropped and counted.
+ * it; faces with non-finite or out-of-range vertices, of zero area, or that are points or lines,
+ * are dropped and counted by reason, and a mesh that loses more faces than it keeps is an
+ * RS_ERR_ARG too (naming the file and the counts), not a render of what is left.  A PLY of
+ * triangle strips (`element tristrips`, which Assimp does not read: it made one triangle of a
+ * whole model) is refused by name.
  * Assimp reads every file through core/file.h (the mesh, its MTL, a glTF's buffers), and so do
  * the textures a mesh names: one that is not a regular file of a sane size (a FIFO, /dev/zero, a
  * folder) fails the import, naming it; one that is merely missing does not.  A PLY file must
@@ -32,7 +36,10 @@ typedef struct rs_mesh_opts {
 
 typedef struct rs_mesh_info {
     uint32_t triangles;  /* added to the scene */
-    uint32_t dropped;    /* faces dropped: non-finite, out-of-range indices, zero area */
+    uint32_t dropped;    /* faces dropped, the sum of the four below */
+    uint32_t dropped_index, dropped_nonfinite, dropped_area, dropped_shape;
+                         /* out-of-range vertex index; non-finite vertex; zero area; not a
+                            triangle after triangulation (a point or a line) */
     uint32_t materials;  /* materials added from the file */
     rs_aabb bounds;      /* of the placed mesh */
 } rs_mesh_info;
@@ -40,6 +47,8 @@ typedef struct rs_mesh_info {
 #ifdef __cplusplus
 extern "C" {
 #endif
+/* "N faces dropped (why)" for `info` into buf[n] (empty when none were dropped); returns buf. */
+const char *rs_mesh_dropped_text(const rs_mesh_info *info, char *buf, size_t n);
 /* Identity placement with material `mat`. */
 rs_mesh_opts rs_mesh_opts_default(uint32_t mat);
 /* Imports every mesh of the file into the scene (not finalized). */

@@ -115,7 +115,8 @@ static void test_malformed(void **state)
      * cannot read (and from "0"), and its post-processing crashed (SIGBUS) on them */
     static const char *const errors[] = {"truncated.ply",          "cut_body.ply",
                                          "bad_number.ply",         "face_past_vertices.ply",
-                                         "empty_face.ply",
+                                         "empty_face.ply",         "tristrips.ply",
+                                         "mostly_bad.obj",
                                          "bad_index.obj",          "empty.obj",
                                          "garbage.obj",            "missing.obj",
                                          ""};
@@ -143,6 +144,22 @@ static void test_malformed(void **state)
     assert_int_equal(rs_scene_add_mesh(s, DATA "nan.obj", &o, &info), RS_OK);
     assert_int_equal(info.triangles, 1u);
     assert_int_equal(info.dropped, 1u);
+    assert_int_equal(info.dropped_nonfinite, 1u);
+    assert_int_equal(info.dropped_index + info.dropped_area + info.dropped_shape, 0u);
+    {
+        char why[160];
+        assert_string_equal(rs_mesh_dropped_text(&info, why, sizeof why),
+                            "1 faces dropped (1 non-finite vertex)");
+    }
+    /* strips: refused by name, not imported as one triangle (Assimp reads no strips) */
+    rs_error_clear();
+    assert_int_equal(rs_scene_add_mesh(s, DATA "tristrips.ply", &o, &info), RS_ERR_ARG);
+    assert_non_null(strstr(rs_error_message(), "tristrips"));
+    /* more faces lost than kept: an error with the counts by reason */
+    rs_error_clear();
+    assert_int_equal(rs_scene_add_mesh(s, DATA "mostly_bad.obj", &o, &info), RS_ERR_ARG);
+    assert_non_null(strstr(rs_error_message(), "3 faces dropped (1 non-finite vertex, 2 zero area)"));
+    rs_error_clear();
     /* a truncated OBJ: either its good face survives or the file is refused; never a crash */
     if (rs_scene_add_mesh(s, DATA "truncated.obj", &o, &info) == RS_OK)
         assert_int_equal(info.triangles, 1u);
