@@ -59,7 +59,35 @@ static rs_status field_error(const ctx *c, const char *path, const char *fmt, ..
     return rs_error_set(RS_ERR_ARG, "%s", all);
 }
 
-/* Fails on any key of `obj` that is not in the NULL-terminated list `keys`. */
+/* Edit distance between a and b (optimal string alignment: insertions, deletions,
+ * substitutions and swaps of neighbours each cost 1), capped at 99; keys are short. */
+static int key_distance(const char *a, const char *b)
+{
+    enum { N = 48 };
+    int d[N + 1][N + 1], i, j, la = (int)strlen(a), lb = (int)strlen(b);
+    if (la > N || lb > N)
+        return 99;
+    for (i = 0; i <= la; ++i)
+        d[i][0] = i;
+    for (j = 0; j <= lb; ++j)
+        d[0][j] = j;
+    for (i = 1; i <= la; ++i)
+        for (j = 1; j <= lb; ++j) {
+            int cost = a[i - 1] != b[j - 1], v = d[i - 1][j - 1] + cost;
+            if (d[i - 1][j] + 1 < v)
+                v = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < v)
+                v = d[i][j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                d[i - 2][j - 2] + 1 < v)
+                v = d[i - 2][j - 2] + 1;
+            d[i][j] = v;
+        }
+    return d[la][lb];
+}
+
+/* Fails on any key of `obj` that is not in the NULL-terminated list `keys`, naming the closest
+ * known key when one is within a third of its length (at least 2 edits). */
 static rs_status check_keys(const ctx *c, const cJSON *obj, const char *path,
                             const char *const *keys)
 {
@@ -74,6 +102,21 @@ static rs_status check_keys(const ctx *c, const cJSON *obj, const char *path,
             for (k = 0; keys[k]; ++k) {
                 strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
                 strncat(list, keys[k], sizeof list - strlen(list) - 1);
+            }
+            {
+                int best = -1, best_d = 99, limit = (int)strlen(it->string) / 3;
+                if (limit < 2)
+                    limit = 2;
+                for (k = 0; keys[k]; ++k) {
+                    int dk = key_distance(it->string, keys[k]);
+                    if (dk < best_d) {
+                        best_d = dk;
+                        best = k;
+                    }
+                }
+                if (best >= 0 && best_d <= limit)
+                    return FAIL(c, path, "unknown key '%s': did you mean '%s'? (allowed: %s)",
+                                it->string, keys[best], list);
             }
             return FAIL(c, path, "unknown key '%s' (allowed: %s)", it->string, list);
         }

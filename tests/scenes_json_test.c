@@ -80,6 +80,14 @@ static const bad_case g_bad[] = {
     {"{" MAT ",\"objects\":[]}", {"missing 'camera'"}},
     {"{" CAM "," MAT "}", {"missing 'objects'"}},
     {"{" CAM "," MAT ",\"objects\":[],\"bogus\":1}", {"unknown key 'bogus'"}},
+    /* a misspelt key: its JSON path and the closest known key (a swap of neighbours is one
+     * edit) */
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1,"
+     "\"materail\":\"m\"}]}",
+     {"objects[0]", "unknown key 'materail'", "did you mean 'material'?"}},
+    {"{\"camera\":{\"form\":[0,0,5],\"at\":[0,0,0]}," MAT ",\"objects\":[]}",
+     {"camera", "did you mean 'from'?"}},
+    {"{" CAM "," MAT ",\"objectz\":[]}", {"did you mean 'objects'?"}},
     {"{" CAM "," MAT ",\"objects\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1,"
      "\"material\":\"nope\"}]}",
      {"objects[0].material", "nope"}},
