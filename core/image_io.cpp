@@ -157,19 +157,28 @@ extern "C" rs_status rs_image_read_linear(const char *path, uint32_t *w, uint32_
     return read_image(path, w, h, rgb, true);
 }
 
+// Opens `path` for reading; a file OpenImageIO cannot open is the status `fail`.  OpenImageIO
+// gets regular files of a sane size only: its format probing keeps reading a /dev/zero, and
+// opening a FIFO blocks until someone writes to it.  May throw (callers catch).
+static rs_status open_input(const char *path, rs_status fail, OIIO::ImageInput::unique_ptr *in)
+{
+    rs_status st = rs_file_check(path, RS_FILE_MAX_IMAGE_BYTES, nullptr);
+    if (st != RS_OK)
+        return st;
+    *in = OIIO::ImageInput::open(path);
+    if (!*in)
+        return rs_error_set(fail, "%s: cannot open image: %s", path, OIIO::geterror().c_str());
+    return RS_OK;
+}
+
 static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **rgb, bool linear)
 {
     *rgb = nullptr;
     try {
-        // OpenImageIO gets regular files of a sane size only: its format probing keeps reading
-        // a /dev/zero, and opening a FIFO blocks until someone writes to it
-        rs_status st = rs_file_check(path, RS_FILE_MAX_IMAGE_BYTES, nullptr);
+        OIIO::ImageInput::unique_ptr in;
+        rs_status st = open_input(path, RS_ERR_IO, &in);
         if (st != RS_OK)
             return st;
-        auto in = OIIO::ImageInput::open(path);
-        if (!in)
-            return rs_error_set(RS_ERR_IO, "%s: cannot open image: %s", path,
-                                OIIO::geterror().c_str());
         const OIIO::ImageSpec &spec = in->spec();
         if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
             return rs_error_set(RS_ERR_IO, "%s: empty image", path);
@@ -208,13 +217,10 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
 extern "C" rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n)
 {
     try {
-        rs_status st = rs_file_check(path, RS_FILE_MAX_IMAGE_BYTES, nullptr);
+        OIIO::ImageInput::unique_ptr in;
+        rs_status st = open_input(path, RS_ERR_ARG, &in);
         if (st != RS_OK)
             return st;
-        auto in = OIIO::ImageInput::open(path);
-        if (!in)
-            return rs_error_set(RS_ERR_ARG, "%s: cannot open image: %s", path,
-                                OIIO::geterror().c_str());
         const OIIO::ParamValue *p = in->spec().find_attribute(key, OIIO::TypeDesc::STRING);
         if (!p)
             return rs_error_set(RS_ERR_ARG, "%s: no attribute %s", path, key);
