@@ -344,7 +344,7 @@ static int load_scene(const rs_cli_options *o, render_run *r)
             return RS_EXIT_USAGE;
         }
     }
-    if (rs_scene_load_json(o->scene, &r->scene) != RS_OK)
+    if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK)
         return fail(RS_EXIT_RUNTIME, NULL);
     file_stem(o->scene, r->name, sizeof r->name);
     return RS_EXIT_OK;

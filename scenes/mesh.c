@@ -405,6 +405,45 @@ static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, con
     return rs_scene_add_material(s, &m, id);
 }
 
+/* The override for file material am (its index in o->override_names), or -1. */
+static int override_of(const struct aiMaterial *am, const rs_mesh_opts *o)
+{
+    struct aiString name;
+    uint32_t k;
+    if (!o->n_overrides || aiGetMaterialString(am, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS)
+        return -1;
+    for (k = 0; k < o->n_overrides; ++k)
+        if (strcmp(name.data, o->override_names[k]) == 0)
+            return (int)k;
+    return -1;
+}
+
+/* Every override must name a material of the file: a misspelt name would otherwise be ignored
+ * without a word. */
+static rs_status check_overrides(const struct aiScene *as, const char *path, const rs_mesh_opts *o)
+{
+    uint32_t k, j;
+    for (k = 0; k < o->n_overrides; ++k) {
+        int found = 0;
+        char have[512] = "";
+        for (j = 0; j < as->mNumMaterials && !found; ++j) {
+            struct aiString name;
+            if (aiGetMaterialString(as->mMaterials[j], AI_MATKEY_NAME, &name) != aiReturn_SUCCESS)
+                continue;
+            found = strcmp(name.data, o->override_names[k]) == 0;
+            if (strlen(have) + name.length + 5 < sizeof have) {
+                strcat(have, *have ? ", '" : "'");
+                strcat(have, name.data);
+                strcat(have, "'");
+            }
+        }
+        if (!found)
+            return rs_error_set(RS_ERR_ARG, "%s: the file has no material named '%s' (it has: %s)",
+                                path, o->override_names[k], *have ? have : "none");
+    }
+    return RS_OK;
+}
+
 typedef struct placement {
     rs_vec3 scale, rot, translate;
     float fit_scale;
@@ -545,7 +584,13 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
             aiReleaseImport(as);
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
         }
+        st = check_overrides(as, path, o);
         for (k = 0; k < as->mNumMaterials && st == RS_OK; ++k) {
+            int ov = override_of(as->mMaterials[k], o);
+            if (ov >= 0) {
+                mat_of[k] = o->override_ids[ov];
+                continue;
+            }
             st = add_file_material(s, as->mMaterials[k], path, dir, &mat_of[k]);
             info->materials++;
         }

@@ -32,6 +32,12 @@ typedef struct rs_mesh_opts {
                            fit_size, and stand the mesh on fit_base (its bottom centre) */
     float fit_size;
     rs_vec3 fit_base;
+    /* With RS_MESH_FILE_MATERIALS: the file's materials named override_names[k] take the scene
+     * material override_ids[k] instead (the others are converted as usual).  A name the file
+     * does not have is an error naming the file's materials. */
+    const char *const *override_names;
+    const uint32_t *override_ids;
+    uint32_t n_overrides;
 } rs_mesh_opts;
 
 typedef struct rs_mesh_info {

@@ -13,18 +13,51 @@
 
 #include "core/alloc.h"
 #include "core/file.h"
+#include "scenes/mesh.h"
+#include "scenes/transform.h"
 
 #define MAX_NAMES       4096
+#define MAX_NESTING     16 /* instances within instances */
+#define MAX_OVERRIDES   64 /* a mesh's materials replaced by name */
+/* Instances are copied (flattened) into the scene: this bounds what a file of a few lines can
+ * make (ten groups of ten instances of each other would be 10^10 primitives). */
+#define MAX_PRIMS       (1u << 26)
 
 typedef struct named {
     const char *name;
     uint32_t id;
 } named;
 
+/* A named group of objects that instances place (top-level "groups"). */
+typedef struct group {
+    const char *name;
+    const cJSON *objects;
+    uint32_t prims; /* primitives one instance makes, once known */
+    int known;
+} group;
+
+/* A mesh object's triangles as its file gave them (before any transform), so that a mesh that
+ * instances place many times is read once. */
+typedef struct mesh_copy {
+    const cJSON *node;
+    uint32_t n;
+    rs_tri *tris;
+    uint32_t *mat;
+    float *uv, *normal; /* 6 and 9 per triangle, or NULL */
+} mesh_copy;
+
 typedef struct ctx {
+    mesh_copy *meshes;
+    uint32_t n_meshes, cap_meshes;
     const char *label;
     const char *base_dir;
+    FILE *log; /* a line per mesh imported, or NULL */
     rs_scene *scene;
+    group groups[MAX_NAMES];
+    uint32_t n_groups;
+    const group *stack[MAX_NESTING]; /* the groups being expanded, outermost first */
+    uint32_t depth;
+    char instance_path[256]; /* the outermost instance being expanded, for messages */
     named textures[MAX_NAMES];
     uint32_t n_textures;
     named materials[MAX_NAMES];
@@ -124,9 +157,19 @@ static rs_status check_keys(const ctx *c, const cJSON *obj, const char *path,
     return RS_OK;
 }
 
+/* out = path.key (key alone at the top level), cut to n - 1 characters. */
 static void subpath(char *out, size_t n, const char *path, const char *key)
 {
-    snprintf(out, n, "%s%s%s", path, *path ? "." : "", key);
+    size_t k = 0;
+    const char *parts[3];
+    int i;
+    parts[0] = path;
+    parts[1] = *path ? "." : "";
+    parts[2] = key;
+    for (i = 0; i < 3; ++i)
+        for (const char *q = parts[i]; *q && k + 1 < n; ++q)
+            out[k++] = *q;
+    out[k] = '\0';
 }
 
 /* A number in [lo, hi]; `def` when absent and not required. */
@@ -476,20 +519,254 @@ static rs_status object_material(ctx *c, const cJSON *o, const char *path, uint3
     return RS_OK;
 }
 
-static rs_status read_object(ctx *c, const cJSON *o, const char *path)
+/* One step of a transform: {"matrix": [16 numbers, row-major]}, {"translate": [x, y, z]},
+ * {"scale": s or [x, y, z]}, {"rotate": [x, y, z] (degrees about x, then y, then z)} or
+ * {"rotate": {"axis": [x, y, z], "degrees": a}}. */
+static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xform *out)
 {
-    static const char *const k_sphere[] = {"type",     "center",    "radius",
-                                           "material", "moving_to", NULL};
-    static const char *const k_quad[] = {"type", "q", "u", "v", "material", NULL};
-    static const char *const k_tri[] = {"type", "vertices", "uv", "material", NULL};
-    static const char *const k_box[] = {"type",      "min",      "max", "rotate_y",
-                                        "translate", "material", NULL};
+    static const char *const keys[] = {"matrix", "translate", "rotate", "scale", NULL};
+    static const char *const k_axis[] = {"axis", "degrees", NULL};
+    const cJSON *it;
+    char q[256];
+    rs_vec3 v;
+    if (!cJSON_IsObject(st) || !st->child || st->child->next)
+        return FAIL(c, p, "a transform step is an object of one key: matrix, translate, rotate "
+                          "or scale");
+    TRY(check_keys(c, st, p, keys));
+    it = st->child;
+    subpath(q, sizeof q, p, it->string);
+    if (strcmp(it->string, "matrix") == 0) {
+        double m[16];
+        int i;
+        if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != 16)
+            return FAIL(c, q, "expected 16 numbers (a 4x4 matrix, row by row)");
+        for (i = 0; i < 16; ++i) {
+            const cJSON *e = cJSON_GetArrayItem(it, i);
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
+                return FAIL(c, q, "expected 16 finite numbers");
+            m[i] = e->valuedouble;
+        }
+        if (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1)
+            return FAIL(c, q, "the last row must be [0, 0, 0, 1] (an affine transform)");
+        for (i = 0; i < 3; ++i) {
+            out->m[i][0] = m[4 * i];
+            out->m[i][1] = m[4 * i + 1];
+            out->m[i][2] = m[4 * i + 2];
+            out->t[i] = m[4 * i + 3];
+        }
+        return RS_OK;
+    }
+    if (strcmp(it->string, "translate") == 0) {
+        TRY(vec3_of(c, it, q, &v));
+        *out = rs_xform_translate(v.x, v.y, v.z);
+        return RS_OK;
+    }
+    if (strcmp(it->string, "scale") == 0) {
+        if (cJSON_IsNumber(it))
+            v = rs_v3_splat((float)it->valuedouble);
+        else
+            TRY(vec3_of(c, it, q, &v));
+        if (v.x == 0 || v.y == 0 || v.z == 0)
+            return FAIL(c, q, "a scale must not be 0 (it would flatten the object)");
+        *out = rs_xform_scale(v.x, v.y, v.z);
+        return RS_OK;
+    }
+    /* rotate */
+    if (cJSON_IsObject(it)) {
+        double axis[3];
+        float deg;
+        char ap[300];
+        TRY(check_keys(c, it, q, k_axis));
+        TRY(get_vec3(c, it, q, "axis", 1, rs_v3(0, 0, 0), &v));
+        TRY(get_num(c, it, q, "degrees", 1, 0, -1e6, 1e6, &deg));
+        subpath(ap, sizeof ap, q, "axis");
+        if (rs_v3_is_zero(v))
+            return FAIL(c, ap, "the axis must not be zero");
+        axis[0] = v.x, axis[1] = v.y, axis[2] = v.z;
+        *out = rs_xform_rotate_axis(axis, deg);
+        return RS_OK;
+    }
+    if (!cJSON_IsArray(it))
+        return FAIL(c, q, "expected [x, y, z] (Euler angles in degrees) or {\"axis\": [x, y, z], "
+                          "\"degrees\": a}");
+    TRY(vec3_of(c, it, q, &v));
+    if (fabsf(v.x) > 1e6f || fabsf(v.y) > 1e6f || fabsf(v.z) > 1e6f)
+        return FAIL(c, q, "angles must lie within +-1e6 degrees");
+    *out = rs_xform_rotate_euler(v.x, v.y, v.z);
+    return RS_OK;
+}
+
+/* An object's "transform": one step, or an array of steps applied in order (the first to the
+ * object first).  The identity when absent. */
+static rs_status read_transform(ctx *c, const cJSON *o, const char *path, rs_xform *out)
+{
+    const cJSON *tr = cJSON_GetObjectItemCaseSensitive(o, "transform"), *it;
+    char p[256];
+    const char *why;
+    int i = 0;
+    *out = rs_xform_identity();
+    if (!tr)
+        return RS_OK;
+    subpath(p, sizeof p, path, "transform");
+    if (cJSON_IsObject(tr)) {
+        TRY(read_xform_step(c, tr, p, out));
+    } else if (cJSON_IsArray(tr)) {
+        for (it = tr->child; it; it = it->next, ++i) {
+            rs_xform step, all;
+            char sp[280];
+            snprintf(sp, sizeof sp, "%s[%d]", p, i);
+            TRY(read_xform_step(c, it, sp, &step));
+            all = rs_xform_compose(&step, out);
+            *out = all;
+        }
+    } else {
+        return FAIL(c, p, "expected a step ({\"translate\": [x, y, z]}, ...) or an array of steps");
+    }
+    why = rs_xform_invalid(out);
+    if (why)
+        return FAIL(c, p, "%s", why);
+    return RS_OK;
+}
+
+/* Keeps the triangles from `first` on (a mesh just imported, not yet transformed). */
+static rs_status keep_mesh(ctx *c, const cJSON *node, uint32_t first)
+{
+    const rs_scene *s = c->scene;
+    uint32_t n = s->n_tris - first;
+    mesh_copy m;
+    memset(&m, 0, sizeof m);
+    if (c->n_meshes == c->cap_meshes) {
+        uint32_t cap = c->cap_meshes ? 2 * c->cap_meshes : 8;
+        mesh_copy *g = (mesh_copy *)rs_alloc(cap, sizeof *g);
+        if (!g)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", c->label);
+        if (c->n_meshes)
+            memcpy(g, c->meshes, c->n_meshes * sizeof *g);
+        rs_free(c->meshes);
+        c->meshes = g;
+        c->cap_meshes = cap;
+    }
+    m.node = node;
+    m.n = n;
+    m.tris = (rs_tri *)rs_alloc(n, sizeof *m.tris);
+    m.mat = (uint32_t *)rs_alloc(n, sizeof *m.mat);
+    m.uv = s->tri_uv ? (float *)rs_alloc(6 * (size_t)n, sizeof *m.uv) : NULL;
+    m.normal = s->tri_normal ? (float *)rs_alloc(9 * (size_t)n, sizeof *m.normal) : NULL;
+    if (!m.tris || !m.mat || (s->tri_uv && !m.uv) || (s->tri_normal && !m.normal)) {
+        rs_free(m.tris), rs_free(m.mat), rs_free(m.uv), rs_free(m.normal);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", c->label);
+    }
+    memcpy(m.tris, s->tris + first, (size_t)n * sizeof *m.tris);
+    memcpy(m.mat, s->tri_mat + first, (size_t)n * sizeof *m.mat);
+    if (m.uv)
+        memcpy(m.uv, s->tri_uv + 6 * (size_t)first, 6 * (size_t)n * sizeof *m.uv);
+    if (m.normal)
+        memcpy(m.normal, s->tri_normal + 9 * (size_t)first, 9 * (size_t)n * sizeof *m.normal);
+    c->meshes[c->n_meshes++] = m;
+    return RS_OK;
+}
+
+/* The triangles of a mesh read before, added again as they came from the file. */
+static rs_status copy_mesh(ctx *c, const mesh_copy *m)
+{
+    uint32_t i;
+    for (i = 0; i < m->n; ++i) {
+        rs_vec3 v[3];
+        v[0] = m->tris[i].v0, v[1] = m->tris[i].v1, v[2] = m->tris[i].v2;
+        TRY(rs_scene_add_triangle_full(c->scene, v, m->uv ? m->uv + 6 * (size_t)i : NULL,
+                                       m->normal ? m->normal + 9 * (size_t)i : NULL, m->mat[i]));
+    }
+    return RS_OK;
+}
+
+/* A mesh file through Assimp: its own materials, one scene material for all of it ("material"),
+ * or some of its materials replaced by name ("materials": {"file's name": "scene's name"}). */
+static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
+{
+    static const char *const keys[] = {"type",      "file", "material", "materials", "fit",
+                                       "transform", NULL};
+    static const char *const k_fit[] = {"size", "base", NULL};
+    const char *file = "", *names[MAX_OVERRIDES];
+    const cJSON *ov = cJSON_GetObjectItemCaseSensitive(o, "materials");
+    const cJSON *fit = cJSON_GetObjectItemCaseSensitive(o, "fit");
+    uint32_t ids[MAX_OVERRIDES], n = 0, k, first;
+    char full[1024], p[256];
+    rs_mesh_opts mo = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
+    rs_mesh_info info;
+    rs_status st;
+    TRY(check_keys(c, o, path, keys));
+    TRY(get_string(c, o, path, "file", &file));
+    if (cJSON_GetObjectItemCaseSensitive(o, "material")) {
+        if (ov)
+            return FAIL(c, path, "give either 'material' or 'materials', not both");
+        TRY(object_material(c, o, path, &mo.material));
+    }
+    if (ov) {
+        const cJSON *it;
+        subpath(p, sizeof p, path, "materials");
+        if (!cJSON_IsObject(ov))
+            return FAIL(c, p, "expected {\"file's material\": \"scene material\", ...}");
+        for (it = ov->child; it; it = it->next) {
+            char q[300];
+            snprintf(q, sizeof q, "%s.%s", p, it->string);
+            if (n >= MAX_OVERRIDES)
+                return FAIL(c, p, "more than %d materials replaced", MAX_OVERRIDES);
+            if (!cJSON_IsString(it) || !lookup(c->materials, c->n_materials, it->valuestring, &ids[n]))
+                return FAIL(c, q, "no material named %s%s%s", cJSON_IsString(it) ? "'" : "",
+                            cJSON_IsString(it) ? it->valuestring : "(not a string)",
+                            cJSON_IsString(it) ? "'" : "");
+            names[n++] = it->string;
+        }
+        mo.override_names = names;
+        mo.override_ids = ids;
+        mo.n_overrides = n;
+    }
+    if (fit) {
+        subpath(p, sizeof p, path, "fit");
+        if (!cJSON_IsObject(fit))
+            return FAIL(c, p, "expected {\"size\": s, \"base\": [x, y, z]}");
+        TRY(check_keys(c, fit, p, k_fit));
+        mo.fit = 1;
+        TRY(get_num(c, fit, p, "size", 1, 1, 1e-30, 1e30, &mo.fit_size));
+        TRY(get_vec3(c, fit, p, "base", 0, rs_v3(0, 0, 0), &mo.fit_base));
+    }
+    for (k = 0; k < c->n_meshes; ++k)
+        if (c->meshes[k].node == o)
+            return copy_mesh(c, &c->meshes[k]);
+    resolve_path(c, file, full, sizeof full);
+    rs_error_clear();
+    first = c->scene->n_tris;
+    st = rs_scene_add_mesh(c->scene, full, &mo, &info);
+    if (st != RS_OK) {
+        char msg[600];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        return FAIL(c, path, "%s", msg);
+    }
+    if (c->log) {
+        char why[160], mats[160];
+        if (mo.material != RS_MESH_FILE_MATERIALS)
+            snprintf(mats, sizeof mats, "material '%s'",
+                     cJSON_GetObjectItemCaseSensitive(o, "material")->valuestring);
+        else
+            snprintf(mats, sizeof mats, "%u material%s from the file%s", info.materials,
+                     info.materials == 1 ? "" : "s", n ? " and the scene's replacements" : "");
+        fprintf(c->log, "raystream: %s: %u triangles, %s%s%s\n", full, info.triangles, mats,
+                info.dropped ? "; " : "", rs_mesh_dropped_text(&info, why, sizeof why));
+    }
+    return keep_mesh(c, o, first);
+}
+
+static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const char *type)
+{
+    static const char *const k_sphere[] = {"type",      "center",    "radius", "material",
+                                           "moving_to", "transform", NULL};
+    static const char *const k_quad[] = {"type", "q", "u", "v", "material", "transform", NULL};
+    static const char *const k_tri[] = {"type", "vertices", "uv", "material", "transform", NULL};
+    static const char *const k_box[] = {"type",      "min",      "max",       "rotate_y",
+                                        "translate", "material", "transform", NULL};
     rs_scene *s = c->scene;
-    const char *type = "";
     uint32_t mat;
-    if (!cJSON_IsObject(o))
-        return FAIL(c, path, "expected an object");
-    TRY(get_string(c, o, path, "type", &type));
     if (strcmp(type, "sphere") == 0) {
         rs_vec3 center, to;
         float r;
@@ -555,7 +832,93 @@ static rs_status read_object(ctx *c, const cJSON *o, const char *path)
         TRY(object_material(c, o, path, &mat));
         return rs_scene_add_box(s, lo, hi, rot, t, mat);
     }
-    return FAIL(c, path, "unknown object type '%s' (sphere, quad, triangle, box)", type);
+    if (strcmp(type, "mesh") == 0)
+        return add_mesh(c, o, path);
+    return FAIL(c, path, "unknown object type '%s' (sphere, quad, triangle, box, mesh, instance)",
+                type);
+}
+
+static rs_status read_object(ctx *c, const cJSON *o, const char *path, const rs_xform *parent);
+
+static const group *find_group(const ctx *c, const char *name)
+{
+    uint32_t i;
+    for (i = 0; i < c->n_groups; ++i)
+        if (strcmp(c->groups[i].name, name) == 0)
+            return &c->groups[i];
+    return NULL;
+}
+
+/* An instance of a group: the group's objects, each under its own transform and then this
+ * one's (xf), copied into the scene. */
+static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const rs_xform *xf)
+{
+    static const char *const keys[] = {"type", "group", "transform", NULL};
+    const char *name = "";
+    const cJSON *it;
+    group *g;
+    uint32_t k, before = rs_scene_prim_count(c->scene);
+    char p[256];
+    int i = 0;
+    TRY(check_keys(c, o, path, keys));
+    TRY(get_string(c, o, path, "group", &name));
+    subpath(p, sizeof p, path, "group");
+    g = (group *)find_group(c, name);
+    if (!g)
+        return FAIL(c, p, "no group named '%s'", name);
+    for (k = 0; k < c->depth; ++k)
+        if (c->stack[k] == g) {
+            char chain[512] = "";
+            for (; k < c->depth; ++k)
+                snprintf(chain + strlen(chain), sizeof chain - strlen(chain), "%s -> ",
+                         c->stack[k]->name);
+            return FAIL(c, p, "instances form a cycle: %s%s", chain, name);
+        }
+    if (c->depth >= MAX_NESTING)
+        return FAIL(c, p, "instances nested more than %d deep", MAX_NESTING);
+    if (g->known && (uint64_t)before + g->prims > MAX_PRIMS)
+        return FAIL(c, path, "the scene would pass %u primitives (instances are copied)",
+                    MAX_PRIMS);
+    if (c->depth == 0)
+        snprintf(c->instance_path, sizeof c->instance_path, "%s", path);
+    c->stack[c->depth++] = g;
+    for (it = g->objects->child; it; it = it->next, ++i) {
+        char q[300];
+        snprintf(q, sizeof q, "groups.%s[%d]", g->name, i);
+        TRY(read_object(c, it, q, xf));
+        if (rs_scene_prim_count(c->scene) > MAX_PRIMS)
+            return FAIL(c, path, "the scene would pass %u primitives (instances are copied)",
+                        MAX_PRIMS);
+    }
+    c->depth--;
+    g->prims = rs_scene_prim_count(c->scene) - before;
+    g->known = 1;
+    return RS_OK;
+}
+
+static rs_status read_object(ctx *c, const cJSON *o, const char *path, const rs_xform *parent)
+{
+    const char *type = "";
+    rs_scene_mark mark = rs_scene_mark_now(c->scene);
+    rs_xform own, xf;
+    if (!cJSON_IsObject(o))
+        return FAIL(c, path, "expected an object");
+    TRY(get_string(c, o, path, "type", &type));
+    TRY(read_transform(c, o, path, &own));
+    xf = rs_xform_compose(parent, &own);
+    if (strcmp(type, "instance") == 0)
+        return read_instance(c, o, path, &xf);
+    TRY(add_primitive(c, o, path, type));
+    if (!rs_xform_is_identity(&xf) && rs_scene_transform_since(c->scene, &mark, &xf) != RS_OK) {
+        char msg[400], p[256];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        if (c->depth)
+            return FAIL(c, path, "%s (placed by the instance at %s)", msg, c->instance_path);
+        subpath(p, sizeof p, path, "transform");
+        return FAIL(c, p, "%s", msg);
+    }
+    return RS_OK;
 }
 
 /* Reads a name -> definition map (textures, materials) in file order. */
@@ -617,8 +980,9 @@ static rs_status check_tree(const ctx *c, const cJSON *it, const char *path)
 static rs_status build(ctx *c, const cJSON *root)
 {
     static const char *const keys[] = {"camera",    "image",   "background", "textures",
-                                       "materials", "objects", NULL};
-    const cJSON *objs, *it;
+                                       "materials", "groups",  "objects",    NULL};
+    const cJSON *objs, *it, *groups;
+    rs_xform id = rs_xform_identity();
     int i = 0;
     if (!cJSON_IsObject(root))
         return rs_error_set(RS_ERR_ARG, "%s: the scene must be a JSON object", c->label);
@@ -633,6 +997,23 @@ static rs_status build(ctx *c, const cJSON *root)
         TRY(read_background(c, cJSON_GetObjectItemCaseSensitive(root, "background")));
     TRY(read_map(c, root, "textures", read_texture, &c->n_textures));
     TRY(read_map(c, root, "materials", read_material, &c->n_materials));
+    groups = cJSON_GetObjectItemCaseSensitive(root, "groups");
+    if (groups) {
+        if (!cJSON_IsObject(groups))
+            return FAIL(c, "groups", "expected an object of named groups: {\"name\": [objects]}");
+        for (it = groups->child; it; it = it->next) {
+            char p[256];
+            snprintf(p, sizeof p, "groups.%s", it->string);
+            if (!*it->string)
+                return FAIL(c, "groups", "names must not be empty");
+            if (c->n_groups >= MAX_NAMES)
+                return FAIL(c, "groups", "more than %d groups", MAX_NAMES);
+            if (!cJSON_IsArray(it))
+                return FAIL(c, p, "expected an array of objects");
+            c->groups[c->n_groups].name = it->string;
+            c->groups[c->n_groups++].objects = it;
+        }
+    }
     objs = cJSON_GetObjectItemCaseSensitive(root, "objects");
     if (!objs)
         return FAIL(c, "(top level)", "missing 'objects'");
@@ -641,13 +1022,19 @@ static rs_status build(ctx *c, const cJSON *root)
     for (it = objs->child; it; it = it->next, ++i) {
         char p[64];
         snprintf(p, sizeof p, "objects[%d]", i);
-        TRY(read_object(c, it, p));
+        TRY(read_object(c, it, p, &id));
     }
     return RS_OK;
 }
 
 rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, const char *base_dir,
                               rs_scene **out)
+{
+    return rs_scene_parse_json_ex(text, len, label, base_dir, NULL, out);
+}
+
+rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label,
+                                 const char *base_dir, FILE *log, rs_scene **out)
 {
     const char *end = NULL;
     cJSON *root;
@@ -684,6 +1071,7 @@ rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, c
     }
     c->label = label;
     c->base_dir = base_dir;
+    c->log = log;
     st = rs_scene_create(label, &c->scene);
     if (st == RS_OK)
         st = build(c, root);
@@ -702,11 +1090,24 @@ rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, c
     else
         rs_scene_destroy(c->scene);
     cJSON_Delete(root);
+    {
+        uint32_t k;
+        for (k = 0; k < c->n_meshes; ++k) {
+            rs_free(c->meshes[k].tris), rs_free(c->meshes[k].mat);
+            rs_free(c->meshes[k].uv), rs_free(c->meshes[k].normal);
+        }
+        rs_free(c->meshes);
+    }
     rs_free(c);
     return st;
 }
 
 rs_status rs_scene_load_json(const char *path, rs_scene **out)
+{
+    return rs_scene_load_json_ex(path, NULL, out);
+}
+
+rs_status rs_scene_load_json_ex(const char *path, FILE *log, rs_scene **out)
 {
     char *text, dir[1024];
     const char *slash;
@@ -722,7 +1123,7 @@ rs_status rs_scene_load_json(const char *path, rs_scene **out)
         snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     else
         snprintf(dir, sizeof dir, ".");
-    st = rs_scene_parse_json(text, n, path, dir, out);
+    st = rs_scene_parse_json_ex(text, n, path, dir, log, out);
     rs_free(text);
     return st;
 }

@@ -3,11 +3,13 @@
  * The reader is strict, like pbrt's: an unknown key, a wrong type, a value out of range or a
  * name that is not defined is an error, reported in one line naming the file and the JSON path
  * of the offending field ("scene.json: materials.red.albedo: expected 3 numbers"), or the line
- * for a syntax error.  Relative file names (image textures) are relative to the scene file. */
+ * for a syntax error.  Relative file names (image textures, meshes) are relative to the scene
+ * file. */
 #ifndef RS_SCENES_SCENE_JSON_H
 #define RS_SCENES_SCENE_JSON_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "scenes/scene.h"
 
@@ -21,6 +23,11 @@ rs_status rs_scene_load_json(const char *path, rs_scene **out);
  * file names (NULL: the working directory). */
 rs_status rs_scene_parse_json(const char *text, size_t len, const char *label,
                               const char *base_dir, rs_scene **out);
+/* The same, writing a line per mesh file imported (its triangles and materials, the faces it
+ * dropped and why) to `log` (NULL: nothing). */
+rs_status rs_scene_load_json_ex(const char *path, FILE *log, rs_scene **out);
+rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label,
+                                 const char *base_dir, FILE *log, rs_scene **out);
 #ifdef __cplusplus
 }
 #endif

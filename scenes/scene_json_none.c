@@ -15,3 +15,16 @@ rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, c
     *out = NULL;
     return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no scene files", label);
 }
+
+rs_status rs_scene_load_json_ex(const char *path, FILE *log, rs_scene **out)
+{
+    (void)log;
+    return rs_scene_load_json(path, out);
+}
+
+rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label,
+                                 const char *base_dir, FILE *log, rs_scene **out)
+{
+    (void)log;
+    return rs_scene_parse_json(text, len, label, base_dir, out);
+}
