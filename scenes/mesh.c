@@ -586,7 +586,12 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         }
         st = check_overrides(as, path, o);
         for (k = 0; k < as->mNumMaterials && st == RS_OK; ++k) {
-            int ov = override_of(as->mMaterials[k], o);
+            int ov = override_of(as->mMaterials[k], o), used = 0;
+            for (mi = 0; mi < as->mNumMeshes && !used; ++mi)
+                used = as->mMeshes[mi]->mMaterialIndex == k;
+            mat_of[k] = 0;
+            if (!used)
+                continue; /* (Assimp's unused default material, say): not added */
             if (ov >= 0) {
                 mat_of[k] = o->override_ids[ov];
                 continue;

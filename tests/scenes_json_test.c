@@ -172,6 +172,55 @@ static const bad_case g_bad[] = {
     {"{" CAM ",\"textures\":{\"t\":{\"type\":\"checker\",\"a\":[0,0,0],\"b\":[0,1.5,0]}},"
      "\"objects\":[]}",
      {"textures.t.b", "[0, 1]"}},
+    /* transforms: every kind of absurd one, named by its path */
+#define SPH "{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1,\"material\":\"m\""
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"scale\":0}}]}",
+     {"objects[0].transform.scale", "must not be 0"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"scale\":[1,2,1]}}]}",
+     {"objects[0].transform", "ellipsoid"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"matrix\":[1,0,0,0,0,1,0,0,0,0,1,0,"
+     "0,0,1,1]}}]}",
+     {"objects[0].transform.matrix", "last row"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"matrix\":[1,0,0,0,0,1,0,0,1,1,0,0,"
+     "0,0,0,1]}}]}",
+     {"objects[0].transform", "singular"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":[{\"translate\":[1,0,0]},"
+     "{\"scale\":1e20},{\"scale\":1e20}]}]}",
+     {"objects[0].transform", "beyond 1e30"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"rotate\":{\"axis\":[0,0,0],"
+     "\"degrees\":5}}}]}",
+     {"objects[0].transform.rotate.axis", "zero"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"translate\":[1,0,0],\"scale\":2}}]}",
+     {"objects[0].transform", "one key"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":{\"rotat\":[0,0,0]}}]}",
+     {"objects[0].transform", "did you mean 'rotate'?"}},
+    {"{" CAM "," MAT ",\"objects\":[" SPH ",\"transform\":\"up\"}]}",
+     {"objects[0].transform", "array of steps"}},
+    /* groups and instances */
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"instance\",\"group\":\"g\"}]}",
+     {"objects[0].group", "no group named 'g'"}},
+    {"{" CAM "," MAT ",\"groups\":{\"a\":[{\"type\":\"instance\",\"group\":\"b\"}],"
+     "\"b\":[" SPH "},{\"type\":\"instance\",\"group\":\"a\"}]},"
+     "\"objects\":[{\"type\":\"instance\",\"group\":\"a\"}]}",
+     {"groups.b[1].group", "cycle: a -> b -> a"}},
+    {"{" CAM "," MAT ",\"groups\":{\"a\":[{\"type\":\"instance\",\"group\":\"a\"}]},"
+     "\"objects\":[{\"type\":\"instance\",\"group\":\"a\"}]}",
+     {"groups.a[0].group", "cycle: a -> a"}},
+    {"{" CAM "," MAT ",\"groups\":{\"a\":[" SPH "}]},\"objects\":[{\"type\":\"instance\","
+     "\"group\":\"a\",\"transform\":{\"scale\":[1,1,3]}}]}",
+     {"groups.a[0]", "ellipsoid", "placed by the instance at objects[0]"}},
+    {"{" CAM "," MAT ",\"groups\":{\"a\":{}},\"objects\":[]}", {"groups.a", "array of objects"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"instance\",\"group\":\"g\",\"material\":\"m\"}]}",
+     {"objects[0]", "unknown key 'material'"}},
+    /* meshes */
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"mesh\",\"file\":\"/nonexistent/x.obj\"}]}",
+     {"objects[0]", "/nonexistent/x.obj"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"mesh\",\"file\":\"x.obj\",\"material\":\"m\","
+     "\"materials\":{}}]}",
+     {"objects[0]", "either 'material' or 'materials'"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"mesh\",\"file\":\"x.obj\","
+     "\"materials\":{\"a\":\"nope\"}}]}",
+     {"objects[0].materials.a", "no material named 'nope'"}},
     /* a key with a newline in it still gives one line */
     {"{" CAM "," MAT ",\"objects\":[],\"a\\nb\":1}", {"unknown key 'a?b'"}},
 };
