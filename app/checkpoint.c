@@ -69,6 +69,10 @@ uint64_t rs_checkpoint_scene_hash(const rs_scene *s)
     h = fnv(h, &s->background, sizeof s->background);
     h = fnv(h, &s->background_top, sizeof s->background_top);
     h = fnv(h, &s->background_sky, sizeof s->background_sky);
+    h = fnv(h, &s->env_image, sizeof s->env_image);
+    h = fnv(h, &s->env_scale, sizeof s->env_scale);
+    h = fnv(h, s->env_rot, sizeof s->env_rot);
+    h = fnv(h, &s->env_pick, sizeof s->env_pick);
     return h;
 }
 

@@ -1,5 +1,6 @@
 /* scenes/scene.c — see scene.h. */
 #include "scenes/scene.h"
+#include "scenes/scene_env.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -56,6 +57,7 @@ rs_status rs_scene_create(const char *name, rs_scene **out)
     s->camera.up = rs_v3(0, 1, 0);
     s->camera.vfov_deg = 40.0f;
     s->width = s->height = 512;
+    s->env_image = RS_NO_TEXTURE;
     *out = s;
     return RS_OK;
 }
@@ -84,6 +86,8 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->lights);
     rs_free(s->light_cdf);
     rs_free(s->prim_light);
+    rs_free(s->env_marg_cdf);
+    rs_free(s->env_cond_cdf);
     rs_free(s);
 }
 
@@ -398,6 +402,24 @@ rs_status rs_scene_finalize(rs_scene *s)
         s->light_cdf[nl] = 1.0f;
     }
     s->n_lights = nl;
+    {
+        /* the environment map's distribution; light sampling picks it or an emitter in
+         * proportion to their powers, the map's kept within [0.1, 0.9] when both are there
+         * (a map seen through a window is mostly occluded; emitters inside a sky's dome may
+         * be small) */
+        double env_power = 0;
+        rs_status st = rs_scene_env_build(s, &env_power);
+        if (st != RS_OK)
+            return st;
+        if (env_power > 0) {
+            double pick = nl ? env_power / (env_power + total) : 1.0;
+            if (nl)
+                pick = pick < 0.1 ? 0.1 : pick > 0.9 ? 0.9 : pick;
+            s->env_pick = (float)pick;
+            for (i = 0; i < nl; ++i)
+                s->lights[i].pick_pdf *= 1.0f - s->env_pick;
+        }
+    }
     s->finalized = 1;
     return RS_OK;
 }

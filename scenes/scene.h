@@ -118,6 +118,16 @@ typedef struct rs_scene {
     int32_t *prim_light; /* per global primitive: index into lights, or -1 */
     int finalized;
 
+    /* The environment map (rs_scene_set_environment): an equirectangular image of the radiance
+     * arriving from each direction, importance-sampled by luminance times sin(theta) like a
+     * light (shading/envmap.h).  The distribution is built by rs_scene_finalize. */
+    uint32_t env_image;   /* index into images, or RS_NO_TEXTURE: none (the background below) */
+    rs_vec3 env_scale;    /* multiplies the map's texels */
+    float env_rot[9];     /* world -> map rotation, row-major */
+    float env_pick;       /* probability that light sampling picks the map (0 without one) */
+    float *env_marg_cdf;  /* image height + 1 entries: the rows' CDF */
+    float *env_cond_cdf;  /* height x (width + 1): each row's CDF over its texels */
+
     rs_camera_desc camera;
     rs_vec3 background;     /* radiance of rays that leave the scene (the horizon's, when
                                background_sky is set) */
@@ -202,6 +212,12 @@ rs_status rs_scene_load_image(rs_scene *s, const char *path, uint32_t *id);
 rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
                            uint32_t mat);
 
+/* Lights the scene with image `image` (rs_scene_load_image) as an environment map, its texels
+ * times `scale`, turned by `rot_world_to_map` (a rotation, row-major; NULL: none).  The map's
+ * texels must be finite and >= 0 (RS_ERR_ARG otherwise, at finalize). */
+rs_status rs_scene_set_environment(rs_scene *s, uint32_t image, rs_vec3 scale,
+                                   const float *rot_world_to_map);
+
 rs_status rs_scene_finalize(rs_scene *s);
 
 /* A copy of a finalized scene's arrays in memory that `ops` allocates and fills: the host's, or
@@ -229,6 +245,18 @@ typedef struct rs_scene_mirror {
     rs_mirror_blocks made;
 } rs_scene_mirror;
 
+/* The lengths of the environment map's CDF arrays (0 without a map or before finalize). */
+static inline size_t rs_scene_env_marg_len(const rs_scene *s)
+{
+    return s->env_marg_cdf ? (size_t)s->images[s->env_image].height + 1 : 0;
+}
+static inline size_t rs_scene_env_cond_len(const rs_scene *s)
+{
+    return s->env_cond_cdf ? (size_t)s->images[s->env_image].height *
+                                 ((size_t)s->images[s->env_image].width + 1)
+                           : 0;
+}
+
 /* Every array of rs_scene that a copy of the scene holds, with its element count (`s` a pointer
  * to the scene; the element size is the field's own).  An array that is NULL or has no
  * elements is copied as NULL.  The images are nested (each points to its texels) and are the
@@ -250,7 +278,9 @@ typedef struct rs_scene_mirror {
     X(textures, (size_t)(s)->n_textures)                                                           \
     X(lights, (size_t)(s)->n_lights)                                                               \
     X(light_cdf, (s)->n_lights ? (size_t)(s)->n_lights + 1 : 0)                                    \
-    X(prim_light, (size_t)(s)->n_spheres + (s)->n_quads + (s)->n_tris)
+    X(prim_light, (size_t)(s)->n_spheres + (s)->n_quads + (s)->n_tris)                           \
+    X(env_marg_cdf, rs_scene_env_marg_len(s))                                                      \
+    X(env_cond_cdf, rs_scene_env_cond_len(s))
 /* clang-format on */
 
 /* Copies n elements of `size` bytes from `src` through ops into a new block at *dst and lists

@@ -347,10 +347,68 @@ static rs_status read_image_size(ctx *c, const cJSON *img)
     return RS_OK;
 }
 
+static rs_status read_rotation(ctx *c, const cJSON *it, const char *q, rs_xform *out);
+static rs_status resolve_path(const ctx *c, const char *file, char *out, size_t n);
+
+/* "background": {"map": FILE, "scale": s or [r, g, b], "rotate": ...}: an environment map. */
+static rs_status read_envmap(ctx *c, const cJSON *bg)
+{
+    static const char *const keys[] = {"map", "scale", "rotate", NULL};
+    rs_scene *s = c->scene;
+    const cJSON *sc = cJSON_GetObjectItemCaseSensitive(bg, "scale");
+    const cJSON *rot = cJSON_GetObjectItemCaseSensitive(bg, "rotate");
+    const char *file = "";
+    char full[1024];
+    rs_vec3 scale = rs_v3_splat(1.0f);
+    float r[9];
+    uint32_t image;
+    int i, k;
+    TRY(check_keys(c, bg, "background", keys));
+    TRY(get_string(c, bg, "background", "map", &file));
+    if (sc && cJSON_IsNumber(sc)) {
+        if (!(sc->valuedouble >= 0) || sc->valuedouble > 1e30)
+            return FAIL(c, "background.scale", "must be >= 0");
+        scale = rs_v3_splat((float)sc->valuedouble);
+    } else if (sc) {
+        TRY(get_color(c, bg, "background", "scale", 1, scale, &scale));
+    }
+    for (i = 0; i < 9; ++i)
+        r[i] = (i % 4 == 0) ? 1.0f : 0.0f;
+    if (rot) {
+        /* the map turns by `rotate` in the world: directions go back by its inverse */
+        rs_xform x;
+        TRY(read_rotation(c, rot, "background.rotate", &x));
+        for (i = 0; i < 3; ++i)
+            for (k = 0; k < 3; ++k)
+                r[3 * i + k] = (float)x.m[k][i];
+    }
+    resolve_path(c, file, full, sizeof full);
+    rs_error_clear();
+    if (rs_scene_load_image(s, full, &image) != RS_OK) {
+        char msg[400];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        return FAIL(c, "background.map", "%s", msg);
+    }
+    {
+        const rs_image *im = &s->images[image];
+        for (i = 0; i < (int)(3 * im->width * im->height); ++i)
+            if (!isfinite(im->rgb[i]) || im->rgb[i] < 0)
+                return FAIL(c, "background.map", "%s: texel (%u, %u) is %s (an environment map's "
+                            "texels must be finite and >= 0)", full, (unsigned)(i / 3) % im->width,
+                            (unsigned)(i / 3) / im->width,
+                            isfinite(im->rgb[i]) ? "negative" : "not finite");
+    }
+    TRY(rs_scene_set_environment(s, image, scale, r));
+    return RS_OK;
+}
+
 static rs_status read_background(ctx *c, const cJSON *bg)
 {
     static const char *const keys[] = {"horizon", "zenith", NULL};
     rs_scene *s = c->scene;
+    if (cJSON_IsObject(bg) && cJSON_GetObjectItemCaseSensitive(bg, "map"))
+        return read_envmap(c, bg);
     if (cJSON_IsArray(bg)) {
         TRY(vec3_of(c, bg, "background", &s->background));
         if (s->background.x < 0 || s->background.y < 0 || s->background.z < 0)
@@ -525,7 +583,6 @@ static rs_status object_material(ctx *c, const cJSON *o, const char *path, uint3
 static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xform *out)
 {
     static const char *const keys[] = {"matrix", "translate", "rotate", "scale", NULL};
-    static const char *const k_axis[] = {"axis", "degrees", NULL};
     const cJSON *it;
     char q[256];
     rs_vec3 v;
@@ -571,7 +628,14 @@ static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xfor
         *out = rs_xform_scale(v.x, v.y, v.z);
         return RS_OK;
     }
-    /* rotate */
+    return read_rotation(c, it, q, out);
+}
+
+/* A rotation: [x, y, z] (degrees about x, then y, then z) or {"axis": [x, y, z], "degrees": a}. */
+static rs_status read_rotation(ctx *c, const cJSON *it, const char *q, rs_xform *out)
+{
+    static const char *const k_axis[] = {"axis", "degrees", NULL};
+    rs_vec3 v;
     if (cJSON_IsObject(it)) {
         double axis[3];
         float deg;

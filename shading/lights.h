@@ -4,6 +4,8 @@
  *   quad, triangle   a point uniform by area:  p(w) = pick dist^2 / (area |cos theta_light|)
  *   sphere           a direction uniform in the cone the sphere subtends (seen from outside):
  *                    p(w) = pick / (2 pi (1 - cos theta_max)); from inside, uniform by area.
+ *   environment map  a direction by the map's luminance (shading/envmap.h); picked with
+ *                    probability s->env_pick, the emitters sharing the rest.
  * All pdfs are over solid angle at the shading point and include the pick probability.
  * Every function is RS_HD: the CUDA megakernel samples lights with this very code. */
 #ifndef RS_SHADING_LIGHTS_H
@@ -13,6 +15,7 @@
 
 #include "core/sampling.h"
 #include "scenes/scene.h"
+#include "shading/envmap.h"
 
 typedef struct rs_light_sample {
     rs_vec3 point; /* on the light */
@@ -20,6 +23,8 @@ typedef struct rs_light_sample {
     float dist;    /* distance to `point` */
     float pdf;     /* solid-angle pdf, pick probability included */
     rs_vec3 le;    /* radiance arriving along -wi (zero from the back of a one-sided light) */
+    int env;       /* from the environment map: `point` and `dist` are meaningless, the shadow
+                      ray runs to infinity */
 } rs_light_sample;
 
 /* Unit geometric normal of global primitive `prim` at point p on it, at `time` (spheres:
@@ -83,8 +88,22 @@ RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_p
     const rs_light *lt;
     rs_vec3 p, n, to;
     float d2, cos_l;
-    if (s->n_lights == 0)
+    if (!rs_scene_has_lights(s))
         return 0;
+    out->env = 0;
+    if (s->env_pick > 0.0f) {
+        if (u_pick < s->env_pick) {
+            if (!rs_env_sample(s, u1, u2, &out->wi, &out->pdf, &out->le))
+                return 0;
+            out->pdf *= s->env_pick;
+            out->point = x;
+            out->dist = FLT_MAX;
+            out->env = 1;
+            return 1;
+        }
+        /* the rest of [0, 1) picks an emitter as before */
+        u_pick = (u_pick - s->env_pick) / (1.0f - s->env_pick);
+    }
     l = rs_light_pick(s, u_pick);
     lt = &s->lights[l];
     prim = lt->prim;
@@ -160,7 +179,7 @@ RS_HD float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float
 }
 
 /* The pdf of direction w (unit) from x summed over every light that the line x + t w meets,
- * ignoring occlusion (the mixture PDF's light term). */
+ * ignoring occlusion, the environment map's included (the mixture PDF's light term). */
 RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 w)
 {
     rs_geom g = rs_scene_geom(s);
@@ -179,6 +198,8 @@ RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 
             pdf += rs_light_pdf_hit(s, l, x, time, w, t,
                                     rs_prim_normal(s, prim, rs_ray_at(&r, t), time));
     }
+    if (s->env_pick > 0.0f)
+        pdf += s->env_pick * rs_env_pdf(s, w);
     return pdf;
 }
 

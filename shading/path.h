@@ -313,9 +313,14 @@ RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const
         ps->pending = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), c * w / ls.pdf);
     }
     shadow->o = v->origin;
-    shadow->d = rs_v3_sub(ls.point, v->origin); /* unnormalised: the light at t = 1 */
     shadow->tmin = 0.0f;
-    shadow->tmax = 1.0f - 1e-4f;
+    if (ls.env) {
+        shadow->d = ls.wi; /* toward the map: anything in the way occludes */
+        shadow->tmax = FLT_MAX;
+    } else {
+        shadow->d = rs_v3_sub(ls.point, v->origin); /* unnormalised: the light at t = 1 */
+        shadow->tmax = 1.0f - 1e-4f;
+    }
     shadow->time = r->time;
     return RS_SHADE_SHADOW;
 }
@@ -338,7 +343,7 @@ RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const 
         if (!(*pdf > 0.0f))
             return 0;
         *beta = rs_v3_mul(*beta, rs_v3_scale(f, ci / *pdf));
-    } else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > 0) {
+    } else if (it->sampling == RS_SAMPLING_MIXTURE && rs_scene_has_lights(sc)) {
         /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
         if (rl.v[3] < 0.5f) {
             rs_light_sample ls;
@@ -393,7 +398,17 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
     uint32_t out = 0;
 
     if (h->prim == RS_NO_HIT) {
-        rs_vec3 bg = rs_scene_background(sc, r.d);
+        rs_vec3 bg;
+        if (rs_env_present(sc)) {
+            /* the map is a light: MIS-weighted against sampling it, as an emitter hit is */
+            bg = rs_env_radiance(sc, r.d);
+            if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) &&
+                sc->env_pick > 0.0f)
+                bg = rs_v3_scale(bg, rs_power_heuristic(ps->bsdf_pdf,
+                                                        sc->env_pick * rs_env_pdf(sc, r.d)));
+        } else {
+            bg = rs_scene_background(sc, r.d);
+        }
         ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, bg));
         return 0;
     }
@@ -422,7 +437,7 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
     } else {
         rs_rng_f4 rl = pre ? pre[1] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
         v.origin = rs_offset_origin(v.x, v.n_geo, rs_prim_scale(sc, v.prim));
-        if (it->sampling == RS_SAMPLING_MIS && sc->n_lights > 0)
+        if (it->sampling == RS_SAMPLING_MIS && rs_scene_has_lights(sc))
             out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow);
         if (!rs_shade_direction(it, &v, &r, rb, rl, &beta, &wi, &pdf))
             return out;

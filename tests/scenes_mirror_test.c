@@ -57,8 +57,8 @@ static void host_release(void *user, void *p)
 }
 
 /* The materials scene (every material, checker/stripes/image textures, a sphere light, a quad
- * light) plus what it lacks: a moving sphere under an open shutter, and a triangle with UVs and
- * vertex normals under the image texture. */
+ * light) plus what it lacks: a moving sphere under an open shutter, a triangle with UVs and
+ * vertex normals under the image texture, and an environment map. */
 static rs_scene *make_scene(void)
 {
     rs_scene *s;
@@ -83,6 +83,15 @@ static rs_scene *make_scene(void)
     v[1] = rs_v3(2, 0.1f, 2);
     v[2] = rs_v3(0, 2.5f, 2.5f);
     assert_int_equal(rs_scene_add_triangle_full(s, v, uv, nrm, id), RS_OK);
+    {
+        /* an environment map (its CDF arrays), instead of the sky */
+        float env[8 * 4 * 3];
+        uint32_t img;
+        for (k = 0; k < 8 * 4 * 3; ++k)
+            env[k] = 0.1f + 0.05f * (float)(k % 7) + (k / 3 == 9 ? 40.0f : 0.0f);
+        assert_int_equal(rs_scene_add_image(s, 8, 4, env, &img), RS_OK);
+        assert_int_equal(rs_scene_set_environment(s, img, rs_v3(.5f, .6f, .7f), NULL), RS_OK);
+    }
     s->camera.shutter_open = 0.0f;
     s->camera.shutter_close = 1.0f;
     assert_int_equal(rs_scene_finalize(s), RS_OK);
@@ -115,14 +124,17 @@ static void test_mirror_renders_alone(void **state)
     assert_false(SHARED(spheres) || SHARED(sphere_mat) || SHARED(sphere_motion) || SHARED(quads) ||
                  SHARED(quad_mat) || SHARED(tris) || SHARED(tri_mat) || SHARED(tri_uv) ||
                  SHARED(tri_normal) || SHARED(materials) || SHARED(textures) || SHARED(images) ||
-                 SHARED(lights) || SHARED(light_cdf) || SHARED(prim_light));
+                 SHARED(lights) || SHARED(light_cdf) || SHARED(prim_light) ||
+                 SHARED(env_marg_cdf) || SHARED(env_cond_cdf));
     want = s->n_spheres * (sizeof(rs_sphere) + sizeof(uint32_t) + sizeof(rs_vec3)) +
            s->n_quads * (sizeof(rs_quad) + sizeof(uint32_t)) +
            s->n_tris * (sizeof(rs_tri) + sizeof(uint32_t) + 15 * sizeof(float)) +
            s->n_materials * sizeof(rs_material) + s->n_textures * sizeof(rs_texture) +
            s->n_images * sizeof(rs_image) + s->n_lights * sizeof(rs_light) +
            (s->n_lights + 1) * sizeof(float) +
-           (s->n_spheres + s->n_quads + s->n_tris) * sizeof(int32_t);
+           (s->n_spheres + s->n_quads + s->n_tris) * sizeof(int32_t) +
+           (4 + 1 + 4 * (8 + 1)) * sizeof(float); /* the 8 x 4 map's two CDFs */
+    assert_non_null(s->env_marg_cdf);
     for (i = 0; i < s->n_images; ++i) {
         want += 3ull * s->images[i].width * s->images[i].height * sizeof(float);
         assert_ptr_not_equal(m.scene.images[i].rgb, s->images[i].rgb);

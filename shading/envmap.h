@@ -1,0 +1,140 @@
+/* shading/envmap.h — the environment map as a light: its radiance along a direction, a direction
+ * sampled in proportion to luminance times sin(theta), and that sampling's pdf (RS_HD: the CUDA
+ * megakernel lights its paths with this very code).
+ *
+ * Directions d are turned into the map's frame by the scene's rotation, m = R d, then
+ *   theta = acos(m.y)                          v = theta / pi        (v = 0: the top row, +y)
+ *   phi   = atan2(m.x, -m.z), in (-pi, pi]     u = 1/2 + phi / 2 pi  (u = 1/2: the -z direction)
+ * so the middle of the image lies straight ahead of a camera looking down -z, +x to its right.
+ * The radiance is the texel's (nearest, no filtering: the pdf is constant over a texel, and so
+ * the estimate is exact for any map), times the scene's env_scale.
+ * The distribution is built by rs_scene_finalize (scenes/scene_env.c). */
+#ifndef RS_SHADING_ENVMAP_H
+#define RS_SHADING_ENVMAP_H
+
+#include "core/sampling.h"
+#include "scenes/scene.h"
+
+RS_HD int rs_env_present(const rs_scene *s) { return s->env_image != RS_NO_TEXTURE; }
+
+/* Whether light sampling has anything to pick: an emitter or a map that is not black. */
+RS_HD int rs_scene_has_lights(const rs_scene *s) { return s->n_lights > 0 || s->env_pick > 0.0f; }
+
+RS_HD rs_vec3 rs_env_rot(const float *r, rs_vec3 d)
+{
+    return rs_v3(r[0] * d.x + r[1] * d.y + r[2] * d.z, r[3] * d.x + r[4] * d.y + r[5] * d.z,
+                 r[6] * d.x + r[7] * d.y + r[8] * d.z);
+}
+
+RS_HD rs_vec3 rs_env_rot_inv(const float *r, rs_vec3 d)
+{
+    return rs_v3(r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
+                 r[2] * d.x + r[5] * d.y + r[8] * d.z);
+}
+
+/* The texel (i, j) that direction m (in the map's frame, unit) falls in; *sin_t = sin(theta). */
+RS_HD void rs_env_texel_of(const rs_image *im, rs_vec3 m, uint32_t *i, uint32_t *j, float *sin_t)
+{
+    float y = rs_fminf(1.0f, rs_fmaxf(-1.0f, m.y));
+    float u = 0.5f + atan2f(m.x, -m.z) * (0.5f * RS_INV_PI), v = acosf(y) * RS_INV_PI;
+    float fi = u * (float)im->width, fj = v * (float)im->height;
+    *i = fi >= (float)im->width ? im->width - 1 : fi > 0.0f ? (uint32_t)fi : 0u;
+    *j = fj >= (float)im->height ? im->height - 1 : fj > 0.0f ? (uint32_t)fj : 0u;
+    *sin_t = sqrtf(rs_fmaxf(0.0f, 1.0f - y * y));
+}
+
+/* Radiance arriving along -d from the map, d unit (not necessarily: it is normalised). */
+RS_HD rs_vec3 rs_env_radiance(const rs_scene *s, rs_vec3 d)
+{
+    const rs_image *im = &s->images[s->env_image];
+    rs_vec3 m = rs_env_rot(s->env_rot, rs_v3_normalize(d));
+    uint32_t i, j;
+    float st;
+    const float *t;
+    rs_env_texel_of(im, m, &i, &j, &st);
+    t = &im->rgb[3 * ((size_t)j * im->width + i)];
+    return rs_v3_mul(rs_v3(t[0], t[1], t[2]), s->env_scale);
+}
+
+/* The largest k in [0, n) with cdf[k] <= u (cdf[0] = 0, cdf[n] = 1, u in [0, 1)): an entry of
+ * zero probability is never returned. */
+RS_HD uint32_t rs_env_cdf_find(const float *cdf, uint32_t n, float u)
+{
+    uint32_t lo = 0, hi = n;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) / 2;
+        if (cdf[mid] <= u)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The density over (u, v) of texel (i, j): its probability times W H. */
+RS_HD float rs_env_texel_pdf(const rs_scene *s, uint32_t i, uint32_t j)
+{
+    const rs_image *im = &s->images[s->env_image];
+    const float *row = &s->env_cond_cdf[(size_t)j * (im->width + 1)];
+    float pr = s->env_marg_cdf[j + 1] - s->env_marg_cdf[j], pc = row[i + 1] - row[i];
+    return pr * pc * (float)im->width * (float)im->height;
+}
+
+/* The solid-angle pdf with which rs_env_sample draws direction d (unit), pick probability not
+ * included. */
+RS_HD float rs_env_pdf(const rs_scene *s, rs_vec3 d)
+{
+    const rs_image *im = &s->images[s->env_image];
+    uint32_t i, j;
+    float st;
+    if (!s->env_marg_cdf)
+        return 0.0f;
+    rs_env_texel_of(im, rs_env_rot(s->env_rot, rs_v3_normalize(d)), &i, &j, &st);
+    if (!(st > 0.0f))
+        return 0.0f;
+    return rs_env_texel_pdf(s, i, j) / (2.0f * RS_PI * RS_PI * st);
+}
+
+/* A direction *wi toward the map from (u1, u2), its pdf (pick probability not included) and the
+ * radiance along it.  0: none (a black map, or the sample landed on a pole). */
+RS_HD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi, float *pdf,
+                        rs_vec3 *le)
+{
+    const rs_image *im;
+    const float *row;
+    uint32_t i, j;
+    float du, dv, u, v, theta, phi, st, span;
+    rs_vec3 m;
+    if (!s->env_marg_cdf)
+        return 0;
+    im = &s->images[s->env_image];
+    j = rs_env_cdf_find(s->env_marg_cdf, im->height, u1);
+    span = s->env_marg_cdf[j + 1] - s->env_marg_cdf[j];
+    if (!(span > 0.0f))
+        return 0;
+    dv = rs_fminf((u1 - s->env_marg_cdf[j]) / span, 0.99999994f);
+    row = &s->env_cond_cdf[(size_t)j * (im->width + 1)];
+    i = rs_env_cdf_find(row, im->width, u2);
+    span = row[i + 1] - row[i];
+    if (!(span > 0.0f))
+        return 0;
+    du = rs_fminf((u2 - row[i]) / span, 0.99999994f);
+    u = ((float)i + du) / (float)im->width;
+    v = ((float)j + dv) / (float)im->height;
+    theta = v * RS_PI;
+    phi = (u - 0.5f) * 2.0f * RS_PI;
+    st = sinf(theta);
+    if (!(st > 0.0f))
+        return 0;
+    /* the inverse of rs_env_texel_of's mapping: m.x = sin sin(phi), m.z = -sin cos(phi) */
+    m = rs_v3(st * sinf(phi), cosf(theta), -st * cosf(phi));
+    *wi = rs_env_rot_inv(s->env_rot, m);
+    *pdf = rs_env_texel_pdf(s, i, j) / (2.0f * RS_PI * RS_PI * st);
+    {
+        const float *t = &im->rgb[3 * ((size_t)j * im->width + i)];
+        *le = rs_v3_mul(rs_v3(t[0], t[1], t[2]), s->env_scale);
+    }
+    return *pdf > 0.0f;
+}
+
+#endif
