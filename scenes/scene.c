@@ -353,8 +353,19 @@ rs_status rs_scene_finalize(rs_scene *s)
         return rs_error_set(RS_ERR_NOMEM, "out of memory preparing lights");
     for (i = 0; i < s->n_materials; ++i) {
         const rs_material *m = &s->materials[i];
-        if (m->type > RS_MAT_DIFFUSE_LIGHT)
+        if (m->type > RS_MAT_TYPE_LAST)
             return rs_error_set(RS_ERR_ARG, "material %u: unknown type %u", i, m->type);
+        if ((m->type == RS_MAT_CONDUCTOR || m->type == RS_MAT_ROUGH_DIELECTRIC ||
+             m->type == RS_MAT_PBR) &&
+            !(m->alpha >= 0.0f && m->alpha <= 1.0f && m->metallic >= 0.0f && m->metallic <= 1.0f))
+            return rs_error_set(RS_ERR_ARG, "material %u: alpha and metallic must be in [0, 1]", i);
+        if (m->type == RS_MAT_CONDUCTOR && !(m->flags & RS_MAT_F0_COLOR) &&
+            !(m->eta.x > 0 && m->eta.y > 0 && m->eta.z > 0 && m->k.x >= 0 && m->k.y >= 0 &&
+              m->k.z >= 0 && finite3(m->eta) && finite3(m->k)))
+            return rs_error_set(RS_ERR_ARG, "material %u: a conductor's eta must be > 0, k >= 0",
+                                i);
+        if (m->type == RS_MAT_ROUGH_DIELECTRIC && !(m->ior > 0.0f && isfinite(m->ior)))
+            return rs_error_set(RS_ERR_ARG, "material %u: index of refraction must be > 0", i);
         if (!finite3(m->albedo) || !finite3(m->emission) || !finite3(m->specular) ||
             m->albedo.x < 0 || m->albedo.y < 0 || m->albedo.z < 0 || m->emission.x < 0 ||
             m->emission.y < 0 || m->emission.z < 0)
@@ -470,6 +481,47 @@ rs_material rs_mat_dielectric(float ior)
 {
     rs_material m = mat_base(RS_MAT_DIELECTRIC, rs_v3_splat(1.0f));
     m.ior = ior;
+    return m;
+}
+
+/* Reflectance at normal incidence of eta + i k: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2). */
+static float f0_complex(float eta, float k)
+{
+    return ((eta - 1) * (eta - 1) + k * k) / ((eta + 1) * (eta + 1) + k * k);
+}
+
+rs_material rs_mat_conductor(rs_vec3 eta, rs_vec3 k, float alpha)
+{
+    rs_material m = mat_base(RS_MAT_CONDUCTOR, rs_v3(f0_complex(eta.x, k.x), f0_complex(eta.y, k.y),
+                                                     f0_complex(eta.z, k.z)));
+    m.eta = eta;
+    m.k = k;
+    m.alpha = alpha;
+    return m;
+}
+
+rs_material rs_mat_conductor_f0(rs_vec3 f0, float alpha)
+{
+    rs_material m = mat_base(RS_MAT_CONDUCTOR, f0);
+    m.flags = RS_MAT_F0_COLOR;
+    m.eta = rs_v3_splat(1.5f);
+    m.alpha = alpha;
+    return m;
+}
+
+rs_material rs_mat_rough_dielectric(float ior, float alpha)
+{
+    rs_material m = mat_base(RS_MAT_ROUGH_DIELECTRIC, rs_v3_splat(1.0f));
+    m.ior = ior;
+    m.alpha = alpha;
+    return m;
+}
+
+rs_material rs_mat_pbr(rs_vec3 base, float metallic, float roughness)
+{
+    rs_material m = mat_base(RS_MAT_PBR, base);
+    m.metallic = metallic;
+    m.alpha = roughness * roughness < RS_GGX_DELTA_ALPHA ? RS_GGX_DELTA_ALPHA : roughness * roughness;
     return m;
 }
 

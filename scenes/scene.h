@@ -22,8 +22,22 @@ typedef enum rs_material_type {
     RS_MAT_METAL = 4,           /* mirror reflection perturbed by `fuzz` (RTIOW) */
     RS_MAT_DIELECTRIC = 5,      /* glass of index `ior`: Schlick Fresnel, total internal
                                    reflection; albedo tints it */
-    RS_MAT_DIFFUSE_LIGHT = 6    /* emitter of `emission`; reflects nothing */
+    RS_MAT_DIFFUSE_LIGHT = 6,   /* emitter of `emission`; reflects nothing */
+    RS_MAT_CONDUCTOR = 7,       /* GGX rough metal of roughness `alpha`: Fresnel from the complex
+                                   index `eta` + i `k`, or with RS_MAT_F0_COLOR Schlick's from
+                                   the colour `albedo`; alpha < RS_GGX_DELTA_ALPHA: a mirror */
+    RS_MAT_ROUGH_DIELECTRIC = 8, /* GGX rough glass of index `ior` (Walter et al. 2007), exact
+                                    Fresnel; albedo tints it; alpha < RS_GGX_DELTA_ALPHA: smooth */
+    RS_MAT_PBR = 9              /* glTF 2.0 metallic-roughness: `albedo` the base colour,
+                                   `metallic`, GGX `alpha`; a diffuse base under a specular layer
+                                   of index 1.5 mixed with a metal of F0 = albedo */
 } rs_material_type;
+
+#define RS_MAT_TYPE_LAST RS_MAT_PBR
+
+/* Below this GGX alpha a conductor or rough dielectric is perfectly smooth (a delta BSDF); the
+ * pbr material's alpha is held at least this. */
+#define RS_GGX_DELTA_ALPHA 1e-3f
 
 /* Material flags. */
 #define RS_MAT_TWO_SIDED                                                                           \
@@ -32,10 +46,12 @@ typedef enum rs_material_type {
 #define RS_MAT_UNIFORM_SAMPLING                                                                    \
   2u /* not importance-sampled: directions uniform over the                                        \
         hemisphere (the thesis's "without importance sampling") */
+#define RS_MAT_EXACT_FRESNEL 4u /* dielectric: the exact Fresnel equations, not Schlick's */
+#define RS_MAT_F0_COLOR      8u /* conductor: Schlick's Fresnel from the colour albedo */
 
 #define RS_NO_TEXTURE 0xffffffffu
 
-/* One material; the fields a type does not use are ignored.  60 bytes, plain data. */
+/* One material; the fields a type does not use are ignored.  Plain data. */
 typedef struct rs_material {
     uint32_t type;       /* rs_material_type, stored fixed-width */
     uint32_t flags;      /* RS_MAT_* */
@@ -47,6 +63,9 @@ typedef struct rs_material {
     float exponent;      /* Phong n >= 0 */
     float fuzz;          /* metal, in [0, 1] */
     float ior;           /* dielectric index of refraction (> 0) */
+    rs_vec3 eta, k;      /* conductor: complex index of refraction eta + i k per channel */
+    float alpha;         /* GGX roughness (conductor, rough dielectric, pbr), in [0, 1] */
+    float metallic;      /* pbr, in [0, 1] */
 } rs_material;
 
 typedef enum rs_texture_type {
@@ -306,6 +325,14 @@ rs_material rs_mat_phong(rs_vec3 kd, rs_vec3 ks, float exponent);
 rs_material rs_mat_metal(rs_vec3 albedo, float fuzz);
 rs_material rs_mat_dielectric(float ior);
 rs_material rs_mat_light(rs_vec3 emission, int two_sided);
+/* A rough conductor of complex index eta + i k (per channel) and GGX alpha; its albedo (what
+ * Russian roulette reads) is the reflectance at normal incidence. */
+rs_material rs_mat_conductor(rs_vec3 eta, rs_vec3 k, float alpha);
+/* A rough conductor by its colour at normal incidence (Schlick's Fresnel). */
+rs_material rs_mat_conductor_f0(rs_vec3 f0, float alpha);
+rs_material rs_mat_rough_dielectric(float ior, float alpha);
+/* glTF's metallic-roughness: alpha = roughness^2 (held >= RS_GGX_DELTA_ALPHA). */
+rs_material rs_mat_pbr(rs_vec3 base, float metallic, float roughness);
 #ifdef __cplusplus
 }
 #endif

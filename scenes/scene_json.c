@@ -501,6 +501,57 @@ static rs_status read_albedo(ctx *c, const cJSON *m, const char *path, const cha
     return get_reflectance(c, m, path, key, 0, rs_v3(.5f, .5f, .5f), &mat->albedo);
 }
 
+/* Complex indices of refraction of some metals at 650, 550 and 450 nm (red, green, blue),
+ * from the measured data pbrt and Mitsuba ship (Palik; Rakic et al. 1998). */
+static const struct {
+    const char *name;
+    float eta[3], k[3];
+} g_metals[] = {
+    {"gold", {0.143f, 0.374f, 1.442f}, {3.983f, 2.385f, 1.603f}},
+    {"silver", {0.155f, 0.117f, 0.138f}, {4.828f, 3.122f, 2.147f}},
+    {"copper", {0.200f, 0.924f, 1.102f}, {3.912f, 2.452f, 2.142f}},
+    {"aluminium", {1.657f, 0.880f, 0.521f}, {9.224f, 6.270f, 4.837f}},
+};
+
+/* A conductor by a named metal, by "eta" and "k", or by its colour at normal incidence ("color"
+ * or "texture"): exactly one of the three. */
+static rs_status read_conductor(ctx *c, const cJSON *m, const char *path, float alpha,
+                                rs_material *mat)
+{
+    const cJSON *metal = cJSON_GetObjectItemCaseSensitive(m, "metal");
+    int by_metal = metal != NULL, by_index = cJSON_GetObjectItemCaseSensitive(m, "eta") ||
+                                             cJSON_GetObjectItemCaseSensitive(m, "k");
+    int by_color = cJSON_GetObjectItemCaseSensitive(m, "color") ||
+                   cJSON_GetObjectItemCaseSensitive(m, "texture");
+    char p[256];
+    size_t i;
+    if (by_metal + by_index + by_color != 1)
+        return FAIL(c, path, "give one of 'metal' (gold, silver, copper, aluminium), 'eta' and "
+                             "'k', or 'color'");
+    if (by_metal) {
+        subpath(p, sizeof p, path, "metal");
+        for (i = 0; i < sizeof g_metals / sizeof g_metals[0]; ++i)
+            if (cJSON_IsString(metal) && strcmp(metal->valuestring, g_metals[i].name) == 0) {
+                const float *e = g_metals[i].eta, *k = g_metals[i].k;
+                *mat = rs_mat_conductor(rs_v3(e[0], e[1], e[2]), rs_v3(k[0], k[1], k[2]), alpha);
+                return RS_OK;
+            }
+        return FAIL(c, p, "unknown metal (gold, silver, copper, aluminium)");
+    }
+    if (by_index) {
+        rs_vec3 eta, k;
+        TRY(get_color(c, m, path, "eta", 1, rs_v3(0, 0, 0), &eta));
+        TRY(get_color(c, m, path, "k", 1, rs_v3(0, 0, 0), &k));
+        subpath(p, sizeof p, path, "eta");
+        if (!(eta.x > 0 && eta.y > 0 && eta.z > 0))
+            return FAIL(c, p, "must be > 0");
+        *mat = rs_mat_conductor(eta, k, alpha);
+        return RS_OK;
+    }
+    *mat = rs_mat_conductor_f0(rs_v3_splat(.9f), alpha);
+    return read_albedo(c, m, path, "color", mat);
+}
+
 static rs_status read_material(ctx *c, const cJSON *m, const char *path, const char *name)
 {
     static const char *const k_diffuse[] = {"type", "albedo", "texture", "importance_sampling",
@@ -510,7 +561,12 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
     static const char *const k_phong[] = {
         "type", "kd", "texture", "ks", "exponent", "importance_sampling", NULL};
     static const char *const k_metal[] = {"type", "albedo", "fuzz", NULL};
-    static const char *const k_glass[] = {"type", "ior", "tint", NULL};
+    static const char *const k_glass[] = {"type", "ior", "tint", "fresnel", NULL};
+    static const char *const k_cond[] = {"type",    "metal",     "eta", "k", "color",
+                                         "texture", "roughness", NULL};
+    static const char *const k_rglass[] = {"type", "ior", "tint", "roughness", NULL};
+    static const char *const k_pbr[] = {"type", "base_color", "texture", "metallic", "roughness",
+                                        NULL};
     static const char *const k_light[] = {"type", "emission", "two_sided", NULL};
     rs_material mat;
     const char *type = "";
@@ -545,6 +601,35 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
         TRY(check_keys(c, m, path, k_glass));
         TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat.ior));
         TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+        {
+            const cJSON *fr = cJSON_GetObjectItemCaseSensitive(m, "fresnel");
+            char p[256];
+            subpath(p, sizeof p, path, "fresnel");
+            if (fr && (!cJSON_IsString(fr) || (strcmp(fr->valuestring, "schlick") != 0 &&
+                                               strcmp(fr->valuestring, "exact") != 0)))
+                return FAIL(c, p, "expected \"schlick\" (the default) or \"exact\"");
+            if (fr && strcmp(fr->valuestring, "exact") == 0)
+                mat.flags |= RS_MAT_EXACT_FRESNEL;
+        }
+    } else if (strcmp(type, "conductor") == 0) {
+        float r;
+        TRY(check_keys(c, m, path, k_cond));
+        TRY(get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
+        TRY(read_conductor(c, m, path, r * r, &mat));
+    } else if (strcmp(type, "rough_dielectric") == 0) {
+        float r, ior;
+        TRY(check_keys(c, m, path, k_rglass));
+        TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &ior));
+        TRY(get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
+        mat = rs_mat_rough_dielectric(ior, r * r);
+        TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+    } else if (strcmp(type, "pbr") == 0) {
+        float r, metal;
+        TRY(check_keys(c, m, path, k_pbr));
+        TRY(get_num(c, m, path, "metallic", 0, 0.0, 0.0, 1.0, &metal));
+        TRY(get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &r));
+        mat = rs_mat_pbr(rs_v3_splat(.8f), metal, r);
+        TRY(read_albedo(c, m, path, "base_color", &mat));
     } else if (strcmp(type, "light") == 0) {
         mat = rs_mat_light(rs_v3_splat(1.0f), 0);
         TRY(check_keys(c, m, path, k_light));
@@ -554,7 +639,7 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
     } else {
         return FAIL(c, path,
                     "unknown material type '%s' (lambertian, diffuse_uniform, disney_diffuse, "
-                    "phong, metal, dielectric, light)",
+                    "phong, metal, dielectric, conductor, rough_dielectric, pbr, light)",
                     type);
     }
     TRY(get_bool(c, m, path, "importance_sampling", 1, &is_ok));

@@ -19,6 +19,26 @@
  *   dielectric        reflect with Schlick's Fresnel, else refract (RTIOW); total internal
  *                     reflection; weight a (the tint, white for clear glass); delta
  *
+ *   dielectric + RS_MAT_EXACT_FRESNEL: the same with the exact Fresnel equations
+ *   conductor         f = F(wo.h) D(h) G2 / (4 cos_o cos_i) (GGX, shading/microfacet.h), F from
+ *                     the complex index eta + i k, or Schlick's from the colour albedo
+ *                                                            sampled: visible normals (Heitz 2018)
+ *   rough dielectric  Walter et al. 2007 with the exact Fresnel F(wo.h): reflection
+ *                     F D G2 / (4 cos_o cos_i), transmission
+ *                     (1 - F) D G2 |wi.h| |wo.h| / (cos_o |cos_i| (wi.h + wo.h / eta)^2), eta the
+ *                     index across over the index on wo's side; tinted by albedo.  Radiance is
+ *                     not scaled by eta^2 across the surface, as the smooth dielectric's is not
+ *                     (a closed object's entry and exit cancel).
+ *                                                            sampled: a visible normal, then
+ *                     reflection with probability F, else refraction (pbrt-v4)
+ *   pbr (glTF)        (1 - metallic) (Fd spec + (1 - Fd) base / pi) + metallic Fm spec, spec the
+ *                     GGX term D G2 / (4 cos_o cos_i), Fd Schlick's with F0 = 0.04, Fm Schlick's
+ *                     with F0 = base, both at wo.h (the glTF 2.0 specification's BRDF)
+ *                                                            sampled: visible normals or cosine,
+ *                     picked by the lobes' estimated weights at wo (rs_pbr_spec_prob)
+ * A conductor or rough dielectric with alpha below RS_GGX_DELTA_ALPHA is perfectly smooth: a
+ * mirror weighted by its Fresnel, or glass with the exact Fresnel (delta).
+ *
  * Materials flagged RS_MAT_UNIFORM_SAMPLING draw uniform hemisphere directions instead of the
  * sampler above (the same f: only the noise changes). */
 #ifndef RS_SHADING_BSDF_H
@@ -26,6 +46,7 @@
 
 #include "core/sampling.h"
 #include "scenes/scene.h"
+#include "shading/microfacet.h"
 
 typedef struct rs_scatter {
     rs_vec3 wi;     /* sampled direction */
@@ -39,7 +60,84 @@ RS_HD float rs_luminance(rs_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0
 
 RS_HD int rs_material_is_delta(const rs_material *m)
 {
-    return m->type == RS_MAT_METAL || m->type == RS_MAT_DIELECTRIC;
+    return m->type == RS_MAT_METAL || m->type == RS_MAT_DIELECTRIC ||
+           ((m->type == RS_MAT_CONDUCTOR || m->type == RS_MAT_ROUGH_DIELECTRIC) &&
+            m->alpha < RS_GGX_DELTA_ALPHA);
+}
+
+/* Whether a non-delta material sends light through the surface (wi on the far side). */
+RS_HD int rs_material_transmits(const rs_material *m)
+{
+    return m->type == RS_MAT_ROUGH_DIELECTRIC && m->alpha >= RS_GGX_DELTA_ALPHA;
+}
+
+RS_HD rs_vec3 rs_conductor_fresnel(const rs_material *m, rs_vec3 albedo, float c)
+{
+    return (m->flags & RS_MAT_F0_COLOR) ? rs_fresnel_schlick3(c, albedo)
+                                        : rs_fresnel_conductor(c, m->eta, m->k);
+}
+
+/* The probability that pbr sampling picks the specular lobe: its estimated share of the
+ * reflected light at wo (Fresnel at cos_o for both layers). */
+RS_HD float rs_pbr_spec_prob(const rs_material *m, rs_vec3 base, float co)
+{
+    float fd = rs_fresnel_schlick3(co, rs_v3_splat(0.04f)).x;
+    float ws = (1.0f - m->metallic) * fd +
+               m->metallic * rs_luminance(rs_fresnel_schlick3(co, base));
+    float wd = (1.0f - m->metallic) * (1.0f - fd) * rs_luminance(base);
+    return ws + wd > 0.0f ? ws / (ws + wd) : 1.0f;
+}
+
+/* The GGX specular term D G2 / (4 cos_o cos_i) and the pdf of sampling wi by a visible normal;
+ * h = unit(wo + wi). */
+RS_HD float rs_ggx_reflect(float alpha, rs_vec3 n, rs_vec3 wo, rs_vec3 wi, float co, float ci,
+                           float *pdf, float *wo_h)
+{
+    rs_vec3 h = rs_v3_normalize(rs_v3_add(wo, wi));
+    float ch = rs_v3_dot(n, h), s2 = rs_v3_length2(rs_v3_cross(n, h));
+    *wo_h = rs_v3_dot(wo, h);
+    *pdf = *wo_h > 0.0f ? rs_ggx_visible_pdf(alpha, co, ch, s2, *wo_h) / (4.0f * *wo_h) : 0.0f;
+    return rs_ggx_d(alpha, ch, s2) * rs_ggx_g2(alpha, co, ci) / (4.0f * co * ci);
+}
+
+/* The rough dielectric's f (untinted) and pdf for (wo, wi), n on wo's side, `front`: wo
+ * outside. */
+RS_HD float rs_rough_glass(const rs_material *m, int front, rs_vec3 n, rs_vec3 wo, rs_vec3 wi,
+                           float *pdf)
+{
+    float co = rs_v3_dot(n, wo), ci = rs_v3_dot(n, wi), eta = front ? m->ior : 1.0f / m->ior;
+    float etap, wo_h, wi_h, ch, s2, F, D, G, vis, denom;
+    int reflect = ci > 0.0f;
+    rs_vec3 h;
+    *pdf = 0.0f;
+    if (!(co > 0.0f) || ci == 0.0f)
+        return 0.0f;
+    etap = reflect ? 1.0f : eta;
+    h = rs_v3_add(rs_v3_scale(wi, etap), wo);
+    if (rs_v3_is_zero(h))
+        return 0.0f;
+    h = rs_v3_normalize(h);
+    if (rs_v3_dot(h, n) < 0.0f)
+        h = rs_v3_neg(h);
+    wo_h = rs_v3_dot(wo, h);
+    wi_h = rs_v3_dot(wi, h);
+    if (wi_h * ci < 0.0f || !(wo_h > 0.0f))
+        return 0.0f; /* a microfacet seen from its back */
+    ch = rs_v3_dot(n, h);
+    s2 = rs_v3_length2(rs_v3_cross(n, h));
+    F = rs_fresnel_dielectric(wo_h, eta);
+    D = rs_ggx_d(m->alpha, ch, s2);
+    G = rs_ggx_g2(m->alpha, co, fabsf(ci));
+    vis = rs_ggx_visible_pdf(m->alpha, co, ch, s2, wo_h);
+    if (reflect) {
+        *pdf = vis / (4.0f * wo_h) * F;
+        return D * G * F / (4.0f * co * ci);
+    }
+    denom = (wi_h + wo_h / etap) * (wi_h + wo_h / etap);
+    if (!(denom > 0.0f))
+        return 0.0f;
+    *pdf = vis * fabsf(wi_h) / denom * (1.0f - F);
+    return D * (1.0f - F) * G * fabsf(wi_h * wo_h) / (fabsf(ci) * co * denom);
 }
 
 /* Probability that Phong sampling picks the diffuse lobe. */
@@ -57,14 +155,31 @@ RS_HD float rs_schlick(float cos_theta, float eta)
     return r0 + (1.0f - r0) * m * m * m * m * m;
 }
 
-/* f(wo, wi) of a non-delta material; zero when wi is below the surface.  `albedo` is the
- * material's albedo after texturing. */
-RS_HD rs_vec3 rs_bsdf_eval(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, rs_vec3 wi)
+/* f(wo, wi) of a non-delta material; zero when wi is below the surface (unless the material
+ * transmits).  `albedo` is the material's albedo after texturing; `front`: wo is on the side the
+ * geometric normal faces (only a transmitting material reads it). */
+RS_HD rs_vec3 rs_bsdf_eval_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                rs_vec3 wi, int front)
 {
     float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo);
+    if (rs_material_transmits(m)) {
+        float pdf;
+        return rs_v3_scale(albedo, rs_rough_glass(m, front, n, wo, wi, &pdf));
+    }
     if (!(ci > 0.0f && co > 0.0f))
         return rs_v3_splat(0.0f);
     switch (m->type) {
+    case RS_MAT_CONDUCTOR: {
+        float pdf, wo_h, spec = rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
+        return rs_v3_scale(rs_conductor_fresnel(m, albedo, wo_h), spec);
+    }
+    case RS_MAT_PBR: {
+        float pdf, wo_h, spec = rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
+        float fd = rs_fresnel_schlick3(wo_h, rs_v3_splat(0.04f)).x;
+        rs_vec3 diel = rs_v3_add(rs_v3_splat(fd * spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
+        rs_vec3 metal = rs_v3_scale(rs_fresnel_schlick3(wo_h, albedo), spec);
+        return rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
+    }
     case RS_MAT_LAMBERTIAN: return rs_v3_scale(albedo, RS_INV_PI);
     case RS_MAT_DIFFUSE_UNIFORM: return rs_v3_scale(albedo, 0.5f * RS_INV_PI / ci);
     case RS_MAT_DISNEY_DIFFUSE: {
@@ -86,14 +201,34 @@ RS_HD rs_vec3 rs_bsdf_eval(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_v
     }
 }
 
-/* The pdf with which rs_bsdf_sample draws wi (non-delta materials). */
-RS_HD float rs_bsdf_pdf(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, rs_vec3 wi)
+RS_HD rs_vec3 rs_bsdf_eval(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, rs_vec3 wi)
 {
-    float ci = rs_v3_dot(n, wi);
-    if (!(ci > 0.0f) || !(rs_v3_dot(n, wo) > 0.0f))
+    return rs_bsdf_eval_side(m, albedo, n, wo, wi, 1);
+}
+
+/* The pdf with which rs_bsdf_sample draws wi (non-delta materials). */
+RS_HD float rs_bsdf_pdf_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                             rs_vec3 wi, int front)
+{
+    float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo);
+    if (rs_material_transmits(m)) {
+        float pdf;
+        rs_rough_glass(m, front, n, wo, wi, &pdf);
+        return pdf;
+    }
+    if (!(ci > 0.0f) || !(co > 0.0f))
         return 0.0f;
     if ((m->flags & RS_MAT_UNIFORM_SAMPLING) || m->type == RS_MAT_DIFFUSE_UNIFORM)
         return rs_pdf_uniform_hemisphere(ci);
+    if (m->type == RS_MAT_CONDUCTOR || m->type == RS_MAT_PBR) {
+        float pdf, wo_h;
+        rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
+        if (m->type == RS_MAT_PBR) {
+            float ps = rs_pbr_spec_prob(m, albedo, co);
+            pdf = ps * pdf + (1.0f - ps) * rs_pdf_cosine_hemisphere(ci);
+        }
+        return pdf;
+    }
     if (m->type == RS_MAT_PHONG) {
         float pd = rs_phong_diffuse_prob(albedo, m->specular);
         float ca = rs_v3_dot(rs_reflect(wo, n), wi);
@@ -101,6 +236,21 @@ RS_HD float rs_bsdf_pdf(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3
                (1.0f - pd) * rs_pdf_power_cosine(m->exponent, ca);
     }
     return rs_pdf_cosine_hemisphere(ci);
+}
+
+RS_HD float rs_bsdf_pdf(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, rs_vec3 wi)
+{
+    return rs_bsdf_pdf_side(m, albedo, n, wo, wi, 1);
+}
+
+/* wo's mirror image about the microfacet normal drawn from the visible normals of GGX alpha. */
+RS_HD rs_vec3 rs_ggx_sample_reflect(float alpha, const rs_onb *frame, rs_vec3 wo, float u1,
+                                    float u2, rs_vec3 *h_out)
+{
+    rs_vec3 wl = rs_v3(rs_v3_dot(wo, frame->t), rs_v3_dot(wo, frame->b), rs_v3_dot(wo, frame->n));
+    rs_vec3 h = rs_onb_to_world(frame, rs_ggx_sample_visible(alpha, wl, u1, u2));
+    *h_out = h;
+    return rs_reflect(wo, h);
 }
 
 /* Draws wi for wo from three uniform numbers.  Returns 0 when the sample carries nothing (below
@@ -124,13 +274,22 @@ RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec
         out->delta = 1;
         return 1;
     }
-    if (m->type == RS_MAT_DIELECTRIC) {
+    if (m->type == RS_MAT_CONDUCTOR && m->alpha < RS_GGX_DELTA_ALPHA) {
+        out->wi = rs_reflect(wo, n);
+        out->weight = rs_conductor_fresnel(m, albedo, rs_v3_dot(wo, n));
+        out->delta = 1;
+        return 1;
+    }
+    if (m->type == RS_MAT_DIELECTRIC ||
+        (m->type == RS_MAT_ROUGH_DIELECTRIC && m->alpha < RS_GGX_DELTA_ALPHA)) {
         float eta = front ? 1.0f / m->ior : m->ior;
         float co = rs_fminf(rs_v3_dot(wo, n), 1.0f);
         float so = sqrtf(rs_fmaxf(0.0f, 1.0f - co * co));
+        int exact = m->type == RS_MAT_ROUGH_DIELECTRIC || (m->flags & RS_MAT_EXACT_FRESNEL);
         out->delta = 1;
         out->weight = albedo;
-        if (eta * so > 1.0f || rs_schlick(co, eta) > u3) {
+        if (eta * so > 1.0f ||
+            (exact ? rs_fresnel_dielectric(co, 1.0f / eta) : rs_schlick(co, eta)) > u3) {
             out->wi = rs_reflect(wo, n);
         } else {
             /* Snell: the perpendicular part scales by eta, the parallel part fills the rest */
@@ -144,8 +303,39 @@ RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec
     if (m->type == RS_MAT_DIFFUSE_LIGHT)
         return 0;
     frame = rs_onb_from_normal(n);
+    if (m->type == RS_MAT_ROUGH_DIELECTRIC) {
+        /* a visible normal, then reflection with probability F, else refraction about it */
+        float eta = front ? m->ior : 1.0f / m->ior, wo_h, F, c;
+        rs_vec3 h;
+        out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
+        wo_h = rs_v3_dot(wo, h);
+        F = rs_fresnel_dielectric(wo_h, eta);
+        if (!(u3 < F)) {
+            /* Snell about h: wt = -wo / eta + (cos_i / eta - cos_t) h */
+            float s2t = rs_fmaxf(0.0f, 1.0f - wo_h * wo_h) / (eta * eta);
+            if (s2t >= 1.0f)
+                return 0;
+            out->wi = rs_v3_normalize(rs_v3_add(rs_v3_scale(wo, -1.0f / eta),
+                                                rs_v3_scale(h, wo_h / eta - sqrtf(1.0f - s2t))));
+            out->transmit = 1;
+        }
+        c = rs_v3_dot(n, out->wi);
+        if (out->transmit ? !(c < 0.0f) : !(c > 0.0f))
+            return 0; /* the microfacet sent it to the wrong side of the surface */
+        f = rs_bsdf_eval_side(m, albedo, n, wo, out->wi, front);
+        out->pdf = rs_bsdf_pdf_side(m, albedo, n, wo, out->wi, front);
+        if (!(out->pdf > 0.0f))
+            return 0;
+        out->weight = rs_v3_scale(f, fabsf(c) / out->pdf);
+        return 1;
+    }
     if ((m->flags & RS_MAT_UNIFORM_SAMPLING) || m->type == RS_MAT_DIFFUSE_UNIFORM) {
         out->wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(u1, u2));
+    } else if (m->type == RS_MAT_CONDUCTOR ||
+               (m->type == RS_MAT_PBR &&
+                u3 < rs_pbr_spec_prob(m, albedo, rs_v3_dot(n, wo)))) {
+        rs_vec3 h;
+        out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
     } else if (m->type == RS_MAT_PHONG && u3 >= rs_phong_diffuse_prob(albedo, m->specular)) {
         rs_onb lobe = rs_onb_from_normal(rs_reflect(wo, n));
         out->wi = rs_onb_to_world(&lobe, rs_sample_power_cosine(m->exponent, u1, u2));

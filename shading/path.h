@@ -293,6 +293,23 @@ RS_HD int rs_shade_delta(const rs_scene *sc, rs_vertex *v, rs_rng_f4 rb, rs_vec3
     return 1;
 }
 
+/* Whether direction w (c = n.w, `through`: w on the far side of the geometric surface) can
+ * carry light at vertex v: above both the shading and the geometric surface, or for a
+ * transmitting material, on the same side of both. */
+RS_HD int rs_vertex_side_ok(const rs_vertex *v, rs_vec3 w, float c, int through)
+{
+    (void)w;
+    if (through)
+        return rs_material_transmits(v->m) && c < 0.0f;
+    return c > 0.0f;
+}
+
+/* Where rays leaving v through the surface start: the hit point moved to the far side. */
+RS_HD rs_vec3 rs_vertex_far_origin(const rs_scene *sc, const rs_vertex *v)
+{
+    return rs_offset_origin(v->x, rs_v3_neg(v->n_geo), rs_prim_scale(sc, v->prim));
+}
+
 /* Next-event estimation (mis): a shadow ray toward a sampled point on a light, its MIS-weighted
  * contribution in ps->pending.  Returns RS_SHADE_SHADOW when it made one. */
 RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const rs_ray *r,
@@ -301,24 +318,28 @@ RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const
     rs_light_sample ls;
     float c;
     rs_vec3 fl;
+    int through;
     if (!rs_light_sample_at(sc, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
         return 0;
     c = rs_v3_dot(v->n, ls.wi);
-    fl = rs_bsdf_eval(v->m, v->albedo, v->n, v->wo, ls.wi);
-    if (!(c > 0.0f && rs_v3_dot(v->n_geo, ls.wi) > 0.0f && !rs_v3_is_zero(ls.le) &&
-          !rs_v3_is_zero(fl)))
+    through = !(rs_v3_dot(v->n_geo, ls.wi) > 0.0f); /* beyond a transmitting surface */
+    if (!rs_vertex_side_ok(v, ls.wi, c, through) || rs_v3_is_zero(ls.le))
+        return 0;
+    fl = rs_bsdf_eval_side(v->m, v->albedo, v->n, v->wo, ls.wi, v->front);
+    if (rs_v3_is_zero(fl))
         return 0;
     {
-        float w = rs_power_heuristic(ls.pdf, rs_bsdf_pdf(v->m, v->albedo, v->n, v->wo, ls.wi));
-        ps->pending = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), c * w / ls.pdf);
+        float w = rs_power_heuristic(
+            ls.pdf, rs_bsdf_pdf_side(v->m, v->albedo, v->n, v->wo, ls.wi, v->front));
+        ps->pending = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), fabsf(c) * w / ls.pdf);
     }
-    shadow->o = v->origin;
+    shadow->o = through ? rs_vertex_far_origin(sc, v) : v->origin;
     shadow->tmin = 0.0f;
     if (ls.env) {
         shadow->d = ls.wi; /* toward the map: anything in the way occludes */
         shadow->tmax = FLT_MAX;
     } else {
-        shadow->d = rs_v3_sub(ls.point, v->origin); /* unnormalised: the light at t = 1 */
+        shadow->d = rs_v3_sub(ls.point, shadow->o); /* unnormalised: the light at t = 1 */
         shadow->tmax = 1.0f - 1e-4f;
     }
     shadow->time = r->time;
@@ -334,15 +355,21 @@ RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const 
     float ci;
     rs_vec3 f;
     if (it->sampling == RS_SAMPLING_UNIFORM) {
-        /* no importance sampling at all: uniform hemisphere, f cos / (1 / 2pi) */
+        /* no importance sampling at all: uniform hemisphere, f cos / (1 / 2pi) (the whole
+         * sphere, 1 / 4pi, where the material transmits) */
         rs_onb frame = rs_onb_from_normal(v->n);
-        *wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
+        if (rs_material_transmits(v->m)) {
+            *wi = rs_sample_uniform_sphere(rb.v[0], rb.v[1]);
+            *pdf = 0.25f * RS_INV_PI;
+        } else {
+            *wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(rb.v[0], rb.v[1]));
+            *pdf = rs_pdf_uniform_hemisphere(rs_v3_dot(v->n, *wi));
+        }
         ci = rs_v3_dot(v->n, *wi);
-        *pdf = rs_pdf_uniform_hemisphere(ci);
-        f = rs_bsdf_eval(v->m, v->albedo, v->n, v->wo, *wi);
+        f = rs_bsdf_eval_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
         if (!(*pdf > 0.0f))
             return 0;
-        *beta = rs_v3_mul(*beta, rs_v3_scale(f, ci / *pdf));
+        *beta = rs_v3_mul(*beta, rs_v3_scale(f, fabsf(ci) / *pdf));
     } else if (it->sampling == RS_SAMPLING_MIXTURE && rs_scene_has_lights(sc)) {
         /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
         if (rl.v[3] < 0.5f) {
@@ -358,14 +385,14 @@ RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const 
             *wi = bs.wi;
         }
         ci = rs_v3_dot(v->n, *wi);
-        if (!(ci > 0.0f))
+        if (!rs_vertex_side_ok(v, *wi, ci, !(rs_v3_dot(v->n_geo, *wi) > 0.0f)))
             return 0; /* f = 0 below the surface: the path carries nothing further */
         *pdf = 0.5f * rs_lights_pdf_dir(sc, v->origin, r->time, *wi) +
-               0.5f * rs_bsdf_pdf(v->m, v->albedo, v->n, v->wo, *wi);
-        f = rs_bsdf_eval(v->m, v->albedo, v->n, v->wo, *wi);
+               0.5f * rs_bsdf_pdf_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
+        f = rs_bsdf_eval_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
         if (!(*pdf > 0.0f))
             return 0;
-        *beta = rs_v3_mul(*beta, rs_v3_scale(f, ci / *pdf));
+        *beta = rs_v3_mul(*beta, rs_v3_scale(f, fabsf(ci) / *pdf));
     } else {
         /* mis, bsdf, and mixture without lights: the material's own sampling */
         rs_scatter bs;
@@ -441,8 +468,13 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
             out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow);
         if (!rs_shade_direction(it, &v, &r, rb, rl, &beta, &wi, &pdf))
             return out;
-        if (!(rs_v3_dot(wi, v.n_geo) > 0.0f))
-            return out; /* below the real surface (a shading-normal artefact): nothing comes back */
+        if (!(rs_v3_dot(wi, v.n_geo) > 0.0f)) {
+            /* below the real surface: through it for a transmitting material (on the same side
+             * of the shading surface too), else a shading-normal artefact that carries nothing */
+            if (!rs_vertex_side_ok(&v, wi, rs_v3_dot(wi, v.n), 1))
+                return out;
+            v.origin = rs_vertex_far_origin(sc, &v);
+        }
     }
     /* Russian roulette, then the next segment.  The survival probability follows the path's
      * throughput before this vertex times what the surface reflects on average, not the sampled

@@ -354,6 +354,67 @@ static void test_furnace(void **state)
     rs_scene_destroy(s);
 }
 
+/* Spheres of the GGX materials under a uniform map: MIS and the mixture (which sample the map
+ * as a light, through the rough glass too) agree with BSDF sampling on the sphere's mean, within
+ * 5 combined standard errors (pixel spreads, conservative: they include the true variation
+ * between pixels) and 1%. */
+static void test_furnace_ggx(void **state)
+{
+    float rgb[4 * 2 * 3];
+    rs_material mats[3];
+    int k, mode, i;
+    (void)state;
+    for (i = 0; i < 4 * 2 * 3; ++i)
+        rgb[i] = 1.0f;
+    mats[0] = rs_mat_rough_dielectric(1.5f, 0.09f);
+    mats[1] = rs_mat_conductor_f0(rs_v3_splat(1.0f), 0.3f);
+    mats[2] = rs_mat_pbr(rs_v3(0.8f, 0.8f, 0.8f), 0.3f, 0.4f);
+    for (k = 0; k < 3; ++k) {
+        double mean[3], se[3];
+        rs_scene *s;
+        uint32_t img, m;
+        assert_int_equal(rs_scene_create("env-ggx", &s), RS_OK);
+        assert_int_equal(rs_scene_add_image(s, 4, 2, rgb, &img), RS_OK);
+        assert_int_equal(rs_scene_set_environment(s, img, rs_v3_splat(1.0f), NULL), RS_OK);
+        assert_int_equal(rs_scene_add_material(s, &mats[k], &m), RS_OK);
+        assert_int_equal(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, m), RS_OK);
+        s->camera.from = rs_v3(0, 0, 3.2f);
+        s->camera.at = rs_v3(0, 0, 0);
+        s->camera.vfov_deg = 30;
+        assert_int_equal(rs_scene_finalize(s), RS_OK);
+        for (mode = 0; mode < 3; ++mode) {
+            rt_args a = rt_defaults("", 24, 256);
+            float *im;
+            double sum = 0, sum2 = 0;
+            int n = 0;
+            a.sampling = (rs_sampling)mode;
+            a.threads = 2;
+            im = rt_render_scene(s, &a, NULL);
+            assert_non_null(im);
+            for (i = 0; i < 24 * 24; ++i) {
+                float x = (float)(i % 24) - 11.5f, y = (float)(i / 24) - 11.5f;
+                if (x * x + y * y > 64.0f)
+                    continue;
+                sum += im[3 * i];
+                sum2 += (double)im[3 * i] * im[3 * i];
+                ++n;
+            }
+            mean[mode] = sum / n;
+            se[mode] = sqrt(fmax(0, sum2 / n - mean[mode] * mean[mode]) / n);
+            print_message("material %d %-8s mean %.5f (se %.5f)\n", k,
+                          rs_sampling_name((rs_sampling)mode), mean[mode], se[mode]);
+            assert_true(mean[mode] <= 1.01);
+            free(im);
+        }
+        for (mode = 0; mode < 2; ++mode) {
+            double d = fabs(mean[mode] - mean[RS_SAMPLING_BSDF]);
+            assert_true(d <= 5 * sqrt(se[mode] * se[mode] + se[2] * se[2]));
+            assert_true(d <= 0.01 * mean[RS_SAMPLING_BSDF]);
+        }
+        rs_scene_destroy(s);
+    }
+}
+
 /* The four strategies agree on the image mean under the sun map (sphere on a floor): 12 seeds
  * of 256 spp each, means within 4.5 combined standard errors (with t(11) tails a correct
  * renderer fails one of the six comparisons with probability < 0.01) and 3%. */
@@ -481,7 +542,8 @@ int main(void)
         cmocka_unit_test(test_pdf_normalised),     cmocka_unit_test(test_sampling_chi_square),
         cmocka_unit_test(test_sample_consistency), cmocka_unit_test(test_irradiance),
         cmocka_unit_test(test_orientation),        cmocka_unit_test(test_furnace),
-        cmocka_unit_test(test_strategies_agree),   cmocka_unit_test(test_bad_maps),
+        cmocka_unit_test(test_strategies_agree),   cmocka_unit_test(test_furnace_ggx),
+        cmocka_unit_test(test_bad_maps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
