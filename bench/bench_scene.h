@@ -82,10 +82,7 @@ static inline int bs_soup(rs_scene *sc, uint32_t n, uint64_t seed)
 {
     float h = 30.0f * cbrtf((float)n / 100000.0f);
     uint32_t i, mat;
-    rs_material m;
-    memset(&m, 0, sizeof m);
-    m.albedo = rs_v3_splat(0.5f);
-    m.albedo_tex = RS_NO_TEXTURE;
+    rs_material m = rs_mat_lambertian(rs_v3_splat(0.5f));
     if (rs_scene_add_material(sc, &m, &mat) != RS_OK)
         return 0;
     for (i = 0; i < n; ++i) {
@@ -127,12 +124,9 @@ static inline int bs_load(const char *spec, const char *models_dir, bs_scene *ou
     } else {
         rs_mesh_opts mo;
         rs_mesh_info info;
-        rs_material m;
+        rs_material m = rs_mat_lambertian(rs_v3_splat(0.5f));
         uint32_t mat;
         const char *base = strrchr(spec, '/');
-        memset(&m, 0, sizeof m);
-        m.albedo = rs_v3_splat(0.5f);
-        m.albedo_tex = RS_NO_TEXTURE;
         st = rs_scene_create("mesh", &out->scene);
         if (st == RS_OK)
             st = rs_scene_add_material(out->scene, &m, &mat);

@@ -88,14 +88,43 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->prim_light);
     rs_free(s->env_marg_cdf);
     rs_free(s->env_cond_cdf);
+    rs_free(s->punctuals);
     rs_free(s);
+}
+
+rs_status rs_scene_add_punctual(rs_scene *s, const rs_punctual *p)
+{
+    rs_punctual q = *p;
+    if (q.type > RS_PUNCTUAL_DIRECTIONAL || !(q.intensity.x >= 0 && q.intensity.y >= 0 &&
+                                              q.intensity.z >= 0) ||
+        !isfinite(q.intensity.x + q.intensity.y + q.intensity.z) ||
+        !isfinite(q.pos.x + q.pos.y + q.pos.z) || !isfinite(q.dir.x + q.dir.y + q.dir.z))
+        return rs_error_set(RS_ERR_ARG, "a light needs a finite position, direction and an "
+                                        "intensity >= 0");
+    if (q.type != RS_PUNCTUAL_POINT) {
+        if (rs_v3_is_zero(q.dir))
+            return rs_error_set(RS_ERR_ARG, "a spot or directional light needs a direction");
+        q.dir = rs_v3_normalize(q.dir);
+    }
+    if (q.type == RS_PUNCTUAL_SPOT &&
+        !(q.cos_outer >= 0.0f && q.cos_outer <= q.cos_inner && q.cos_inner <= 1.0f))
+        return rs_error_set(RS_ERR_ARG, "a spot light's cones need 0 <= inner <= outer <= 90 "
+                                        "degrees");
+    if (!grow((void **)&s->punctuals, &s->cap_punctuals, s->n_punctuals + 1, sizeof q))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding a light");
+    s->punctuals[s->n_punctuals++] = q;
+    s->finalized = 0;
+    return RS_OK;
 }
 
 rs_status rs_scene_add_material(rs_scene *s, const rs_material *m, uint32_t *id)
 {
-    if (m->albedo_tex != RS_NO_TEXTURE && m->albedo_tex >= s->n_textures)
-        return rs_error_set(RS_ERR_ARG, "material names texture %u (scene has %u)", m->albedo_tex,
-                            s->n_textures);
+    const uint32_t tex[4] = {m->albedo_tex, m->mr_tex, m->emission_tex, m->normal_tex};
+    int k;
+    for (k = 0; k < 4; ++k)
+        if (tex[k] != RS_NO_TEXTURE && tex[k] >= s->n_textures)
+            return rs_error_set(RS_ERR_ARG, "material names texture %u (scene has %u)", tex[k],
+                                s->n_textures);
     if (!grow((void **)&s->materials, &s->cap_materials, s->n_materials + 1, sizeof *m))
         return rs_error_set(RS_ERR_NOMEM, "out of memory adding a material");
     s->materials[s->n_materials] = *m;
@@ -282,6 +311,16 @@ rs_status rs_scene_load_image(rs_scene *s, const char *path, uint32_t *id)
     return add_image_owned(s, w, h, rgb, id);
 }
 
+rs_status rs_scene_load_image_data(rs_scene *s, const char *path, uint32_t *id)
+{
+    uint32_t w, h;
+    float *rgb;
+    rs_status st = rs_image_read(path, &w, &h, &rgb);
+    if (st != RS_OK)
+        return st;
+    return add_image_owned(s, w, h, rgb, id);
+}
+
 rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
                            uint32_t mat)
 {
@@ -387,12 +426,32 @@ rs_status rs_scene_finalize(rs_scene *s)
         if (m->type == RS_MAT_DIFFUSE_LIGHT && luminance(m->emission) > 0.0f)
             s->prim_light[i] = (int32_t)nl++;
     }
+    s->n_area_lights = nl;
+    nl += s->n_punctuals;
     if (nl > 0) {
+        double radius = s->n_punctuals ? rs_scene_bound_radius(s) : 1.0;
         s->lights = (rs_light *)rs_alloc(nl, sizeof *s->lights);
         s->light_cdf = (float *)rs_alloc(nl + 1, sizeof *s->light_cdf);
         if (!s->lights || !s->light_cdf)
             return rs_error_set(RS_ERR_NOMEM, "out of memory preparing %u lights", nl);
-        for (i = 0; i < n; ++i) {
+        for (i = 0; i < s->n_punctuals; ++i) {
+            /* its power: 4 pi I for a point, the cone's solid angle (to the middle of the
+             * falloff) times I for a spot, pi R^2 E for a directional light over the scene */
+            const rs_punctual *p = &s->punctuals[i];
+            rs_light *lt = &s->lights[s->n_area_lights + i];
+            double lum = luminance(p->intensity), pw;
+            if (p->type == RS_PUNCTUAL_POINT)
+                pw = 4.0 * 3.14159265358979 * lum;
+            else if (p->type == RS_PUNCTUAL_SPOT)
+                pw = 2.0 * 3.14159265358979 * (1.0 - 0.5 * (p->cos_inner + p->cos_outer)) * lum;
+            else
+                pw = 3.14159265358979 * radius * radius * lum;
+            lt->prim = RS_LIGHT_PUNCTUAL | i;
+            lt->area = 0.0f;
+            lt->power = (float)pw;
+            total += pw;
+        }
+        for (i = 0; i < n && s->n_area_lights; ++i) {
             int32_t l = s->prim_light[i];
             const rs_material *m;
             if (l < 0)
@@ -411,6 +470,17 @@ rs_status rs_scene_finalize(rs_scene *s)
             s->light_cdf[i + 1] = (float)(acc / total);
         }
         s->light_cdf[nl] = 1.0f;
+        if (!(total > 0)) {
+            /* black lights only: nothing to pick (never a 0/0 pick probability) */
+            rs_free(s->lights);
+            rs_free(s->light_cdf);
+            s->lights = NULL;
+            s->light_cdf = NULL;
+            for (i = 0; i < n; ++i)
+                s->prim_light[i] = -1;
+            nl = 0;
+            s->n_area_lights = 0;
+        }
     }
     s->n_lights = nl;
     {
@@ -431,6 +501,10 @@ rs_status rs_scene_finalize(rs_scene *s)
                 s->lights[i].pick_pdf *= 1.0f - s->env_pick;
         }
     }
+    /* what the mixture's light half may pick: the map and the emitters, not the delta lights */
+    s->area_mass = s->n_lights > s->n_area_lights
+                       ? s->env_pick + (1.0f - s->env_pick) * s->light_cdf[s->n_area_lights]
+                       : 1.0f;
     s->finalized = 1;
     return RS_OK;
 }
@@ -444,6 +518,8 @@ static rs_material mat_base(uint32_t type, rs_vec3 albedo)
     m.type = type;
     m.albedo = albedo;
     m.albedo_tex = RS_NO_TEXTURE;
+    m.mr_tex = m.emission_tex = m.normal_tex = RS_NO_TEXTURE;
+    m.normal_scale = 1.0f;
     m.ior = 1.5f;
     return m;
 }

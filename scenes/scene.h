@@ -66,6 +66,13 @@ typedef struct rs_material {
     rs_vec3 eta, k;      /* conductor: complex index of refraction eta + i k per channel */
     float alpha;         /* GGX roughness (conductor, rough dielectric, pbr), in [0, 1] */
     float metallic;      /* pbr, in [0, 1] */
+    uint32_t mr_tex;     /* pbr: glTF's metallic-roughness texture (roughness *= G, metallic
+                            *= B, linear), or RS_NO_TEXTURE */
+    uint32_t emission_tex; /* pbr: `emission` (glTF's emissive factor; the surface emits on both
+                              sides, found by paths, not light-sampled) times this texture */
+    uint32_t normal_tex; /* a tangent-space normal map (linear, [0, 1] -> [-1, 1]; triangles with
+                            UVs), or RS_NO_TEXTURE */
+    float normal_scale;  /* glTF's normalTexture.scale: x and y of the map are multiplied by it */
 } rs_material;
 
 typedef enum rs_texture_type {
@@ -88,9 +95,31 @@ typedef struct rs_image {
     float *rgb; /* width * height * 3, row-major from the top row */
 } rs_image;
 
-/* An emitter that light sampling can pick: a quad or triangle with an emissive material. */
+/* A punctual light (glTF's KHR_lights_punctual): a delta light, which only light sampling
+ * finds (the bsdf and uniform sampling modes never see it). */
+typedef enum rs_punctual_type {
+    RS_PUNCTUAL_POINT = 0,
+    RS_PUNCTUAL_SPOT = 1,
+    RS_PUNCTUAL_DIRECTIONAL = 2
+} rs_punctual_type;
+
+typedef struct rs_punctual {
+    uint32_t type;     /* rs_punctual_type */
+    rs_vec3 pos;       /* point, spot */
+    rs_vec3 dir;       /* spot: its axis; directional: the way its light travels (unit) */
+    rs_vec3 intensity; /* point, spot: radiant intensity (W/sr); directional: irradiance on a
+                          surface facing it (W/m^2) */
+    float cos_inner, cos_outer; /* spot: full intensity inside the inner cone, none outside the
+                                   outer, glTF's smooth falloff between */
+} rs_punctual;
+
+/* In rs_light.prim: a punctual light, its index in the low bits. */
+#define RS_LIGHT_PUNCTUAL 0x80000000u
+
+/* An emitter that light sampling can pick: a quad or triangle with an emissive material, or a
+ * punctual light (after every emitter in the table). */
 typedef struct rs_light {
-    uint32_t prim;  /* global primitive index */
+    uint32_t prim;  /* global primitive index, or RS_LIGHT_PUNCTUAL | punctual index */
     float area;     /* surface area */
     float power;    /* pi * area * luminance(emission) * (2 if two-sided): selection weight */
     float pick_pdf; /* power / total power: probability that sampling picks this light */
@@ -130,10 +159,16 @@ typedef struct rs_scene {
     rs_image *images;
     uint32_t n_images, cap_images;
 
+    rs_punctual *punctuals;
+    uint32_t n_punctuals, cap_punctuals;
+
     /* built by rs_scene_finalize */
     rs_light *lights;
     float *light_cdf; /* n_lights + 1 entries, cdf[0] = 0, cdf[n] = 1 */
     uint32_t n_lights;
+    uint32_t n_area_lights; /* lights[0, n_area_lights) are emitters, the rest punctual */
+    float area_mass;        /* the probability that light sampling picks the map or an emitter
+                               (1 without punctual lights) */
     int32_t *prim_light; /* per global primitive: index into lights, or -1 */
     int finalized;
 
@@ -226,6 +261,9 @@ rs_status rs_scene_add_image(rs_scene *s, uint32_t width, uint32_t height, const
 /* Reads an image file through OpenImageIO into linear RGB (8- and 16-bit files are decoded from
  * sRGB, float files are taken as linear). */
 rs_status rs_scene_load_image(rs_scene *s, const char *path, uint32_t *id);
+/* The same without decoding: the file's values as stored (8-bit: code / 255), for data textures
+ * (normal maps, glTF's metallic-roughness). */
+rs_status rs_scene_load_image_data(rs_scene *s, const char *path, uint32_t *id);
 /* Axis-aligned box [lo, hi] as six outward-facing quads, rotated by `rot_y_deg` about the y axis
  * (through the origin) and then moved by `offset` (RTNW's box + rotate_y + translate). */
 rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
@@ -236,6 +274,10 @@ rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg,
  * texels must be finite and >= 0 (RS_ERR_ARG otherwise, at finalize). */
 rs_status rs_scene_set_environment(rs_scene *s, uint32_t image, rs_vec3 scale,
                                    const float *rot_world_to_map);
+
+/* A punctual light; intensity >= 0, finite; spot cones with 0 <= inner <= outer <= 90 degrees
+ * (cosines given), dir non-zero (normalised here). */
+rs_status rs_scene_add_punctual(rs_scene *s, const rs_punctual *p);
 
 rs_status rs_scene_finalize(rs_scene *s);
 
@@ -298,6 +340,7 @@ static inline size_t rs_scene_env_cond_len(const rs_scene *s)
     X(lights, (size_t)(s)->n_lights)                                                               \
     X(light_cdf, (s)->n_lights ? (size_t)(s)->n_lights + 1 : 0)                                    \
     X(prim_light, (size_t)(s)->n_spheres + (s)->n_quads + (s)->n_tris)                           \
+    X(punctuals, (size_t)(s)->n_punctuals)                                                         \
     X(env_marg_cdf, rs_scene_env_marg_len(s))                                                      \
     X(env_cond_cdf, rs_scene_env_cond_len(s))
 /* clang-format on */

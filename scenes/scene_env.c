@@ -36,8 +36,7 @@ static float luminance(const float *rgb)
     return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
 }
 
-/* Radius of the bounding sphere of every primitive (1 for an empty scene). */
-static double scene_radius(const rs_scene *s)
+double rs_scene_bound_radius(const rs_scene *s)
 {
     rs_vec3 lo = rs_v3_splat(FLT_MAX), hi = rs_v3_splat(-FLT_MAX);
     uint32_t i;
@@ -135,7 +134,7 @@ rs_status rs_scene_env_build(rs_scene *s, double *power)
      * (2 pi / W) (pi / H) sin(theta) */
     lum_int = total * (2.0 * PI / w) * (PI / h);
     if (total > 0) {
-        double r = scene_radius(s);
+        double r = rs_scene_bound_radius(s);
         *power = PI * r * r * lum_int;
     }
     return RS_OK;

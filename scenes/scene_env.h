@@ -12,4 +12,7 @@
  * is not finite or is negative; RS_ERR_NOMEM. */
 rs_status rs_scene_env_build(rs_scene *s, double *power);
 
+/* Radius of the bounding sphere of every primitive's bounds (1 for an empty scene). */
+double rs_scene_bound_radius(const rs_scene *s);
+
 #endif

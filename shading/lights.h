@@ -23,9 +23,22 @@ typedef struct rs_light_sample {
     float dist;    /* distance to `point` */
     float pdf;     /* solid-angle pdf, pick probability included */
     rs_vec3 le;    /* radiance arriving along -wi (zero from the back of a one-sided light) */
-    int env;       /* from the environment map: `point` and `dist` are meaningless, the shadow
-                      ray runs to infinity */
+    int env;       /* from the environment map or a directional light: `point` and `dist` are
+                      meaningless, the shadow ray runs to infinity */
+    int delta;     /* from a punctual light: no BSDF sample can find it (no MIS weight); `pdf`
+                      is the pick probability alone and `le` includes 1 / dist^2 */
 } rs_light_sample;
+
+/* Which lights a sample may come from. */
+#define RS_LIGHTS_ALL   0 /* every light (MIS's next-event estimation) */
+#define RS_LIGHTS_AREA  1 /* the map and the emitters (the mixture's light half) */
+#define RS_LIGHTS_DELTA 2 /* the punctual lights (the mixture's next-event estimation) */
+
+/* Whether the map or an emitter can be sampled (the mixture's light half has something). */
+RS_HD int rs_scene_has_area_lights(const rs_scene *s)
+{
+    return s->n_area_lights > 0 || s->env_pick > 0.0f;
+}
 
 /* Unit geometric normal of global primitive `prim` at point p on it, at `time` (spheres:
  * outward; quads: along u x v; triangles: along (v1 - v0) x (v2 - v0)). */
@@ -57,10 +70,11 @@ RS_HD rs_vec3 rs_emitted(const rs_material *m, rs_vec3 ng, rs_vec3 d)
     return rs_v3_splat(0.0f);
 }
 
-RS_HD uint32_t rs_light_pick(const rs_scene *s, float u)
+/* Among lights [0, n): the largest l with cdf[l] <= u, so zero-probability lights are never
+ * picked. */
+RS_HD uint32_t rs_light_pick_n(const rs_scene *s, float u, uint32_t n)
 {
-    /* the largest l with cdf[l] <= u, so zero-probability lights are never picked */
-    uint32_t lo = 0, hi = s->n_lights;
+    uint32_t lo = 0, hi = n;
     while (hi - lo > 1) {
         uint32_t mid = (lo + hi) / 2;
         if (s->light_cdf[mid] <= u)
@@ -71,6 +85,44 @@ RS_HD uint32_t rs_light_pick(const rs_scene *s, float u)
     return lo;
 }
 
+RS_HD uint32_t rs_light_pick(const rs_scene *s, float u) { return rs_light_pick_n(s, u, s->n_lights); }
+
+/* A sample of punctual light p from x, picked with probability `pick`. */
+RS_HD int rs_punctual_sample(const rs_punctual *p, rs_vec3 x, float pick, rs_light_sample *out)
+{
+    rs_vec3 to;
+    float d2;
+    out->delta = 1;
+    out->pdf = pick;
+    if (p->type == RS_PUNCTUAL_DIRECTIONAL) {
+        out->wi = rs_v3_neg(p->dir);
+        out->dist = FLT_MAX;
+        out->point = x;
+        out->env = 1;
+        out->le = p->intensity;
+        return pick > 0.0f;
+    }
+    to = rs_v3_sub(p->pos, x);
+    d2 = rs_v3_dot(to, to);
+    if (!(d2 > 0.0f) || !(pick > 0.0f))
+        return 0;
+    out->dist = sqrtf(d2);
+    out->wi = rs_v3_scale(to, 1.0f / out->dist);
+    out->point = p->pos;
+    out->le = rs_v3_scale(p->intensity, 1.0f / d2);
+    if (p->type == RS_PUNCTUAL_SPOT) {
+        /* glTF's falloff: the square of the linear ramp from the outer cone to the inner */
+        float cd = -rs_v3_dot(out->wi, p->dir), t;
+        float span = p->cos_inner - p->cos_outer;
+        t = span > 0.0f ? (cd - p->cos_outer) / span : (cd >= p->cos_outer ? 1.0f : 0.0f);
+        t = rs_fminf(1.0f, rs_fmaxf(0.0f, t));
+        out->le = rs_v3_scale(out->le, t * t);
+        if (!(t > 0.0f))
+            return 0;
+    }
+    return 1;
+}
+
 /* 1 - cos(theta_max) of the cone a sphere of radius r subtends at squared distance d2 > r^2,
  * written as sin^2 / (1 + cos) so that small, far spheres keep their precision. */
 RS_HD float rs_cone_one_minus_cos(float r, float d2)
@@ -79,34 +131,62 @@ RS_HD float rs_cone_one_minus_cos(float r, float d2)
     return sin2 / (1.0f + sqrtf(rs_fmaxf(0.0f, 1.0f - sin2)));
 }
 
-/* Samples a light as seen from x at `time`.  Returns 0 (and no sample) if the scene has no
- * lights or the sample is degenerate (x on the light's plane, or inside a one-point light). */
-RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_pick, float u1,
-                             float u2, rs_light_sample *out)
+/* Samples a light of `subset` (RS_LIGHTS_*) as seen from x at `time`; the pdf is relative to the
+ * subset (the pick probability divided by the subset's).  Returns 0 (and no sample) if the
+ * subset is empty or the sample is degenerate (x on the light's plane, or inside a one-point
+ * light). */
+RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float time, float u_pick,
+                             float u1, float u2, rs_light_sample *out)
 {
-    uint32_t l, prim;
+    uint32_t l, prim, n = s->n_lights;
     const rs_light *lt;
-    rs_vec3 p, n, to;
-    float d2, cos_l;
+    rs_vec3 p, n_l, to;
+    float d2, cos_l, env_pick = s->env_pick, inv_mass = 1.0f;
     if (!rs_scene_has_lights(s))
         return 0;
     out->env = 0;
-    if (s->env_pick > 0.0f) {
-        if (u_pick < s->env_pick) {
+    out->delta = 0;
+    if (subset == RS_LIGHTS_DELTA) {
+        /* the part of the CDF after the emitters, scaled back to [0, 1) */
+        float a = s->n_area_lights ? s->light_cdf[s->n_area_lights] : 0.0f;
+        if (s->n_lights == s->n_area_lights)
+            return 0;
+        l = rs_light_pick(s, a + u_pick * (1.0f - a));
+        if (l < s->n_area_lights)
+            l = s->n_area_lights;
+        return rs_punctual_sample(&s->punctuals[s->lights[l].prim & ~RS_LIGHT_PUNCTUAL], x,
+                                  s->lights[l].pick_pdf / ((1.0f - env_pick) * (1.0f - a)), out);
+    }
+    if (subset == RS_LIGHTS_AREA && s->n_lights > s->n_area_lights) {
+        /* the map and the emitters only: their picks, divided by their share */
+        if (!(s->area_mass > 0.0f))
+            return 0;
+        inv_mass = 1.0f / s->area_mass;
+        env_pick = s->env_pick * inv_mass;
+        n = s->n_area_lights;
+    }
+    if (env_pick > 0.0f) {
+        if (u_pick < env_pick) {
             if (!rs_env_sample(s, u1, u2, &out->wi, &out->pdf, &out->le))
                 return 0;
-            out->pdf *= s->env_pick;
+            out->pdf *= env_pick;
             out->point = x;
             out->dist = FLT_MAX;
             out->env = 1;
             return 1;
         }
         /* the rest of [0, 1) picks an emitter as before */
-        u_pick = (u_pick - s->env_pick) / (1.0f - s->env_pick);
+        u_pick = (u_pick - env_pick) / (1.0f - env_pick);
     }
-    l = rs_light_pick(s, u_pick);
+    if (n == 0)
+        return 0;
+    if (n < s->n_lights) /* the emitters' part of the CDF */
+        u_pick *= s->light_cdf[n];
+    l = rs_light_pick_n(s, u_pick, n);
     lt = &s->lights[l];
     prim = lt->prim;
+    if (prim & RS_LIGHT_PUNCTUAL)
+        return rs_punctual_sample(&s->punctuals[prim & ~RS_LIGHT_PUNCTUAL], x, lt->pick_pdf, out);
     if (prim < s->n_spheres) {
         rs_geom g = rs_scene_geom(s);
         rs_vec3 c = rs_geom_sphere_center(&g, prim, time), axis = rs_v3_sub(c, x);
@@ -126,8 +206,10 @@ RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_p
             out->dist = t;
             out->point = rs_v3_madd(x, w, t);
             out->pdf = lt->pick_pdf * rs_pdf_uniform_cone(omc);
-            n = rs_v3_scale(rs_v3_sub(out->point, c), 1.0f / r);
-            out->le = rs_emitted(rs_scene_prim_material(s, prim), n, w);
+            n_l = rs_v3_scale(rs_v3_sub(out->point, c), 1.0f / r);
+            out->le = rs_emitted(rs_scene_prim_material(s, prim), n_l, w);
+            if (inv_mass != 1.0f)
+                out->pdf *= inv_mass;
             return out->pdf > 0.0f && t > 0.0f;
         }
         /* inside (or on) the sphere: a point uniform on its surface */
@@ -142,20 +224,29 @@ RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_p
         p = rs_v3_add(rs_v3_add(rs_v3_scale(t->v0, 1.0f - b1 - b2), rs_v3_scale(t->v1, b1)),
                       rs_v3_scale(t->v2, b2));
     }
-    n = rs_prim_normal(s, prim, p, time);
+    n_l = rs_prim_normal(s, prim, p, time);
     to = rs_v3_sub(p, x);
     d2 = rs_v3_dot(to, to);
     if (!(d2 > 0.0f))
         return 0;
     out->dist = sqrtf(d2);
     out->wi = rs_v3_scale(to, 1.0f / out->dist);
-    cos_l = fabsf(rs_v3_dot(n, out->wi));
+    cos_l = fabsf(rs_v3_dot(n_l, out->wi));
     if (!(cos_l > 1e-7f))
         return 0;
     out->point = p;
     out->pdf = lt->pick_pdf * d2 / (lt->area * cos_l);
-    out->le = rs_emitted(rs_scene_prim_material(s, prim), n, out->wi);
+    if (inv_mass != 1.0f)
+        out->pdf *= inv_mass;
+    out->le = rs_emitted(rs_scene_prim_material(s, prim), n_l, out->wi);
     return 1;
+}
+
+/* A sample of any light (RS_LIGHTS_ALL). */
+RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_pick, float u1,
+                             float u2, rs_light_sample *out)
+{
+    return rs_light_sample_in(s, RS_LIGHTS_ALL, x, time, u_pick, u1, u2, out);
 }
 
 /* The pdf rs_light_sample_at gives to direction w (unit) from x that reaches light `light` at
@@ -179,7 +270,8 @@ RS_HD float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float
 }
 
 /* The pdf of direction w (unit) from x summed over every light that the line x + t w meets,
- * ignoring occlusion, the environment map's included (the mixture PDF's light term). */
+ * ignoring occlusion, the environment map's included: the pdf of RS_LIGHTS_AREA sampling (the
+ * mixture PDF's light term). */
 RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 w)
 {
     rs_geom g = rs_scene_geom(s);
@@ -191,7 +283,7 @@ RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 
     r.tmin = 0.0f;
     r.tmax = FLT_MAX;
     r.time = time;
-    for (l = 0; l < s->n_lights; ++l) {
+    for (l = 0; l < s->n_area_lights; ++l) {
         float t, u, v;
         uint32_t prim = s->lights[l].prim;
         if (rs_geom_intersect(&g, prim, &r, &t, &u, &v))
@@ -200,6 +292,8 @@ RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 
     }
     if (s->env_pick > 0.0f)
         pdf += s->env_pick * rs_env_pdf(s, w);
+    if (s->n_lights > s->n_area_lights && s->area_mass > 0.0f)
+        pdf /= s->area_mass; /* relative to what RS_LIGHTS_AREA picks from */
     return pdf;
 }
 

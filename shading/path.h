@@ -211,6 +211,75 @@ RS_HD rs_vec3 rs_surface_albedo(const rs_scene *sc, const rs_material *m, uint32
     return rs_texture_eval(&sc->textures[m->albedo_tex], sc->images, u, v, x);
 }
 
+/* The material at a hit with its textures other than the albedo applied (glTF's metallic-
+ * roughness and emissive textures): m itself when it has none, else *local, filled. */
+RS_HD const rs_material *rs_surface_material(const rs_scene *sc, const rs_material *m,
+                                             uint32_t prim, float hu, float hv, rs_vec3 x,
+                                             rs_vec3 ng, rs_material *local)
+{
+    float u, v;
+    if (m->mr_tex == RS_NO_TEXTURE && m->emission_tex == RS_NO_TEXTURE)
+        return m;
+    *local = *m;
+    rs_surface_uv(sc, prim, hu, hv, ng, &u, &v);
+    if (m->mr_tex != RS_NO_TEXTURE) {
+        rs_vec3 t = rs_texture_eval(&sc->textures[m->mr_tex], sc->images, u, v, x);
+        float r = sqrtf(m->alpha) * rs_fminf(1.0f, rs_fmaxf(0.0f, t.y));
+        local->alpha = rs_fmaxf(r * r, RS_GGX_DELTA_ALPHA);
+        local->metallic = m->metallic * rs_fminf(1.0f, rs_fmaxf(0.0f, t.z));
+    }
+    if (m->emission_tex != RS_NO_TEXTURE)
+        local->emission =
+            rs_v3_mul(m->emission, rs_texture_eval(&sc->textures[m->emission_tex], sc->images, u,
+                                                   v, x));
+    return local;
+}
+
+/* The shading normal n (on the incoming side; `front`: that is the side ng faces) bent by the
+ * material's tangent-space normal map, on a triangle with UVs: the tangent frame follows the UV
+ * gradient (dp/du, dp/dv), made orthonormal about the unbent normal.  n where there is no map,
+ * no UVs or a degenerate UV mapping, or where the bent normal would face away from wo. */
+RS_HD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, uint32_t prim, float hu,
+                               float hv, rs_vec3 x, rs_vec3 n, int front, rs_vec3 wo)
+{
+    uint32_t t = prim - sc->n_spheres - sc->n_quads;
+    const rs_tri *tr;
+    const float *uv;
+    rs_vec3 e1, e2, T, B, nf, tex, nm;
+    float du1, dv1, du2, dv2, det, u, v, hand;
+    if (m->normal_tex == RS_NO_TEXTURE || !sc->tri_uv || prim < sc->n_spheres + sc->n_quads)
+        return n;
+    tr = &sc->tris[t];
+    uv = &sc->tri_uv[6 * (size_t)t];
+    e1 = rs_v3_sub(tr->v1, tr->v0);
+    e2 = rs_v3_sub(tr->v2, tr->v0);
+    du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
+    det = du1 * dv2 - du2 * dv1;
+    if (!(fabsf(det) > 1e-12f))
+        return n;
+    nf = front ? n : rs_v3_neg(n); /* the map is in the frame of the surface's own side */
+    T = rs_v3_scale(rs_v3_sub(rs_v3_scale(e1, dv2), rs_v3_scale(e2, dv1)), 1.0f / det);
+    B = rs_v3_scale(rs_v3_sub(rs_v3_scale(e2, du1), rs_v3_scale(e1, du2)), 1.0f / det);
+    T = rs_v3_sub(T, rs_v3_scale(nf, rs_v3_dot(nf, T)));
+    if (!(rs_v3_length2(T) > 0.0f))
+        return n;
+    T = rs_v3_normalize(T);
+    hand = rs_v3_dot(rs_v3_cross(nf, T), B) < 0.0f ? -1.0f : 1.0f;
+    B = rs_v3_scale(rs_v3_cross(nf, T), hand);
+    u = (1.0f - hu - hv) * uv[0] + hu * uv[2] + hv * uv[4];
+    v = (1.0f - hu - hv) * uv[1] + hu * uv[3] + hv * uv[5];
+    tex = rs_texture_eval(&sc->textures[m->normal_tex], sc->images, u, v, x);
+    tex = rs_v3((2.0f * tex.x - 1.0f) * m->normal_scale, (2.0f * tex.y - 1.0f) * m->normal_scale,
+                2.0f * tex.z - 1.0f);
+    nm = rs_v3_add(rs_v3_add(rs_v3_scale(T, tex.x), rs_v3_scale(B, tex.y)), rs_v3_scale(nf, tex.z));
+    if (!(rs_v3_length2(nm) > 1e-12f))
+        return n;
+    nm = rs_v3_normalize(nm);
+    if (!front)
+        nm = rs_v3_neg(nm);
+    return rs_v3_dot(nm, wo) > 0.0f ? nm : n;
+}
+
 /* The shading normal at a hit: the interpolated vertex normal of a triangle that has them,
  * turned to the side of n_geo (the geometric normal on the incoming side); n_geo otherwise, or
  * where the vertex normal would face away from wo. */
@@ -313,13 +382,14 @@ RS_HD rs_vec3 rs_vertex_far_origin(const rs_scene *sc, const rs_vertex *v)
 /* Next-event estimation (mis): a shadow ray toward a sampled point on a light, its MIS-weighted
  * contribution in ps->pending.  Returns RS_SHADE_SHADOW when it made one. */
 RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const rs_ray *r,
-                                   rs_rng_f4 rl, rs_vec3 beta, rs_path_state *ps, rs_ray *shadow)
+                                   rs_rng_f4 rl, rs_vec3 beta, rs_path_state *ps, rs_ray *shadow,
+                                   int subset)
 {
     rs_light_sample ls;
     float c;
     rs_vec3 fl;
     int through;
-    if (!rs_light_sample_at(sc, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+    if (!rs_light_sample_in(sc, subset, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
         return 0;
     c = rs_v3_dot(v->n, ls.wi);
     through = !(rs_v3_dot(v->n_geo, ls.wi) > 0.0f); /* beyond a transmitting surface */
@@ -329,8 +399,10 @@ RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const
     if (rs_v3_is_zero(fl))
         return 0;
     {
-        float w = rs_power_heuristic(
-            ls.pdf, rs_bsdf_pdf_side(v->m, v->albedo, v->n, v->wo, ls.wi, v->front));
+        /* a punctual light: BSDF sampling never finds it, so its sample counts in full */
+        float w = ls.delta ? 1.0f
+                           : rs_power_heuristic(ls.pdf, rs_bsdf_pdf_side(v->m, v->albedo, v->n,
+                                                                         v->wo, ls.wi, v->front));
         ps->pending = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), fabsf(c) * w / ls.pdf);
     }
     shadow->o = through ? rs_vertex_far_origin(sc, v) : v->origin;
@@ -370,11 +442,13 @@ RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const 
         if (!(*pdf > 0.0f))
             return 0;
         *beta = rs_v3_mul(*beta, rs_v3_scale(f, fabsf(ci) / *pdf));
-    } else if (it->sampling == RS_SAMPLING_MIXTURE && rs_scene_has_lights(sc)) {
-        /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf */
+    } else if (it->sampling == RS_SAMPLING_MIXTURE && rs_scene_has_area_lights(sc)) {
+        /* the thesis's radiance_mixture: one direction from 1/2 light pdf + 1/2 BSDF pdf (the
+         * map and the emitters; punctual lights have a shadow ray of their own) */
         if (rl.v[3] < 0.5f) {
             rs_light_sample ls;
-            if (!rs_light_sample_at(sc, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+            if (!rs_light_sample_in(sc, RS_LIGHTS_AREA, v->origin, r->time, rl.v[0], rl.v[1],
+                                    rl.v[2], &ls))
                 return 0;
             *wi = ls.wi;
         } else {
@@ -419,6 +493,7 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
     rs_ray r = *ray;
     rs_vec3 beta = ps->throughput, wi;
     rs_vertex v;
+    rs_material local;
     rs_rng_f4 rb;
     float pdf = 0.0f;
     int specular = 0;
@@ -447,6 +522,10 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
         rs_shade_emitter(it, &r, h->t, v.prim, v.m, v.ng, beta, ps);
         return 0; /* emitters reflect nothing */
     }
+    v.m = rs_surface_material(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, &local);
+    if (v.m->type == RS_MAT_PBR && !rs_v3_is_zero(v.m->emission))
+        /* a glTF emissive surface: not a sampled light, so its radiance counts in full */
+        ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, v.m->emission));
     /* The segment after this vertex would be number bounce + 1. */
     if (bounce + 1 >= it->max_depth)
         return out;
@@ -454,6 +533,7 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
     v.n_geo = v.front ? v.ng : rs_v3_neg(v.ng);
     v.wo = rs_v3_neg(r.d);
     v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
+    v.n = rs_normal_mapped(sc, v.m, v.prim, h->u, h->v, v.x, v.n, v.front, v.wo);
     v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng);
     rb = pre ? pre[0] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
 
@@ -465,7 +545,12 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
         rs_rng_f4 rl = pre ? pre[1] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
         v.origin = rs_offset_origin(v.x, v.n_geo, rs_prim_scale(sc, v.prim));
         if (it->sampling == RS_SAMPLING_MIS && rs_scene_has_lights(sc))
-            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow);
+            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_ALL);
+        else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > sc->n_area_lights)
+            /* the mixture cannot draw a delta light's direction: next-event estimation does,
+             * with the same numbers (the mixture's light half uses them only when it picks the
+             * light side, and independently of this shadow ray's outcome) */
+            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_DELTA);
         if (!rs_shade_direction(it, &v, &r, rb, rl, &beta, &wi, &pdf))
             return out;
         if (!(rs_v3_dot(wi, v.n_geo) > 0.0f)) {

@@ -406,6 +406,105 @@ static void test_several_lights(void **state)
     }
 }
 
+/* ---- punctual lights ------------------------------------------------------------------------ */
+
+/* Estimates from `subset`: the mean of Le cos / pdf (first channel). */
+static estimate irradiance_subset(const rs_scene *s, int subset, rs_vec3 x, rs_vec3 n,
+                                  uint64_t seed, int count)
+{
+    uint64_t st = seed;
+    double sum = 0.0, sum2 = 0.0;
+    estimate e;
+    int i;
+    for (i = 0; i < count; ++i) {
+        rs_light_sample ls;
+        double val = 0.0;
+        float up = rnd_f(&st), u1 = rnd_f(&st), u2 = rnd_f(&st);
+        if (rs_light_sample_in(s, subset, x, 0.0f, up, u1, u2, &ls)) {
+            double c = d3_dot(d3_of(n), d3_of(ls.wi));
+            if (c > 0.0)
+                val = (double)ls.le.x * c / ls.pdf;
+        }
+        sum += val;
+        sum2 += val * val;
+    }
+    e.mean = sum / count;
+    e.se = sqrt(fmax(0.0, sum2 / count - e.mean * e.mean) / (count - 1));
+    return e;
+}
+
+/* A point light of intensity I at distance d gives E = I cos / d^2; a spot the same times glTF's
+ * falloff; a directional light E cos.  With an emitter quad besides: every light through
+ * RS_LIGHTS_ALL sums to the total, RS_LIGHTS_DELTA to the punctual lights' part and
+ * RS_LIGHTS_AREA to the quad's, each from its own pick probabilities (12 times the samples for
+ * the mixes: the pick follows power, not what each light gives x). */
+static void test_punctual(void **state)
+{
+    rs_scene *s = new_scene();
+    rs_punctual p;
+    rs_vec3 x = rs_v3(1, 0, 0), n = v3_of(d3_unit(d3_make(0.2, 1, -0.1)));
+    rs_vec3 q = rs_v3(-1, 6, -1), u = rs_v3(0, 0, 2), v = rs_v3(2, 0, 0);
+    d3 pp = d3_make(2, 4, 1), sp = d3_make(0, 3, 0), to, quad[4];
+    double e_point, e_spot, e_dir, e_quad, c, cd, t;
+    (void)state;
+    memset(&p, 0, sizeof p);
+    p.type = RS_PUNCTUAL_POINT;
+    p.pos = v3_of(pp);
+    p.intensity = rs_v3_splat(40.0f);
+    assert_int_equal(rs_scene_add_punctual(s, &p), RS_OK);
+    p.type = RS_PUNCTUAL_SPOT;
+    p.pos = v3_of(sp);
+    p.dir = rs_v3(0.2f, -1, 0);
+    p.intensity = rs_v3_splat(25.0f);
+    p.cos_inner = cosf(0.05f);
+    p.cos_outer = cosf(0.3f);
+    assert_int_equal(rs_scene_add_punctual(s, &p), RS_OK);
+    p.type = RS_PUNCTUAL_DIRECTIONAL;
+    p.dir = rs_v3(-0.3f, -1, 0.2f);
+    p.intensity = rs_v3_splat(2.0f);
+    assert_int_equal(rs_scene_add_punctual(s, &p), RS_OK);
+    /* u x v = (0, 0, 2) x (2, 0, 0) = (0, 4, 0): facing up, away from x: two-sided */
+    assert_int_equal(rs_scene_add_quad(s, q, u, v, add_light(s, 3.0f, 1)), RS_OK);
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    assert_int_equal(s->n_lights, 4u);
+    assert_int_equal(s->n_area_lights, 1u);
+    to = d3_sub(pp, d3_of(x));
+    c = d3_dot(d3_of(n), d3_unit(to));
+    e_point = 40.0 * c / d3_dot(to, to);
+    to = d3_sub(sp, d3_of(x));
+    c = d3_dot(d3_of(n), d3_unit(to));
+    cd = -d3_dot(d3_unit(to), d3_unit(d3_make(0.2, -1, 0)));
+    t = fmin(1.0, fmax(0.0, (cd - cos(0.3)) / (cos(0.05) - cos(0.3))));
+    assert_true(t > 0.05 && t < 0.95); /* x lies in the falloff */
+    e_spot = 25.0 * t * t * c / d3_dot(to, to);
+    e_dir = 2.0 * d3_dot(d3_of(n), d3_unit(d3_make(0.3, 1, -0.2)));
+    quad_vertices(q, u, v, quad);
+    e_quad = polygon_irradiance(quad, 4, d3_of(x), d3_of(n), 3.0);
+    print_message("point %.6g, spot %.6g, directional %.6g, quad %.6g\n", e_point, e_spot,
+                  e_dir, e_quad);
+    check_irradiance("every light (RS_LIGHTS_ALL)",
+                     irradiance_subset(s, RS_LIGHTS_ALL, x, n, 41, 12 * N_SAMPLES),
+                     e_point + e_spot + e_dir + e_quad);
+    check_irradiance("punctual only (RS_LIGHTS_DELTA)",
+                     irradiance_subset(s, RS_LIGHTS_DELTA, x, n, 42, 12 * N_SAMPLES),
+                     e_point + e_spot + e_dir);
+    check_irradiance("the quad only (RS_LIGHTS_AREA)",
+                     irradiance_subset(s, RS_LIGHTS_AREA, x, n, 43, N_SAMPLES), e_quad);
+    {
+        /* outside the spot's outer cone it gives nothing */
+        rs_light_sample ls;
+        int k, lit = 0;
+        uint64_t st = 44;
+        for (k = 0; k < 2000; ++k)
+            if (rs_light_sample_in(s, RS_LIGHTS_DELTA, rs_v3(5, 0, 0), 0.0f, rnd_f(&st),
+                                   rnd_f(&st), rnd_f(&st), &ls) &&
+                fabsf(ls.point.y - 3.0f) < 1e-6f && ls.point.x == 0.0f)
+                ++lit;
+        assert_int_equal(lit, 0);
+    }
+    rs_scene_destroy(s);
+}
+
 /* ---- pdf consistency ----------------------------------------------------------------------- */
 
 /* For points x around a scene of a sphere, a one-sided quad and a two-sided triangle (all
@@ -487,6 +586,7 @@ int main(void)
         cmocka_unit_test(test_contour_reference), cmocka_unit_test(test_sphere_light),
         cmocka_unit_test(test_quad_light),        cmocka_unit_test(test_triangle_light),
         cmocka_unit_test(test_several_lights),    cmocka_unit_test(test_pdf_consistency),
+        cmocka_unit_test(test_punctual),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
