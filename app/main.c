@@ -18,12 +18,14 @@
 #include "app/outputs.h"
 #include "app/progress.h"
 #include "core/alloc.h"
+#include "core/file.h"
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
 #include "app/timeline_svg.h"
 #include "scenes/builtin.h"
+#include "scenes/gltf.h"
 #include "scenes/scene_json.h"
 #include "scheduler/fault.h"
 #include "scheduler/passes.h"
@@ -344,9 +346,38 @@ static int load_scene(const rs_cli_options *o, render_run *r)
             return RS_EXIT_USAGE;
         }
     }
-    if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK)
+    if (rs_is_gltf_path(o->scene)) {
+        rs_gltf_opts go;
+        go.camera = o->camera;
+        go.log = o->quiet ? NULL : stderr;
+        if (rs_scene_load_gltf(o->scene, &go, &r->scene) != RS_OK)
+            return fail(RS_EXIT_RUNTIME, NULL);
+    } else if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK) {
         return fail(RS_EXIT_RUNTIME, NULL);
+    }
     file_stem(o->scene, r->name, sizeof r->name);
+    return RS_EXIT_OK;
+}
+
+/* --envmap FILE: the scene's background becomes the map, sampled as a light. */
+static int apply_envmap(const rs_cli_options *o, render_run *r)
+{
+    uint32_t image;
+    if (!o->envmap)
+        return RS_EXIT_OK;
+    if (rs_file_check(o->envmap, RS_FILE_MAX_IMAGE_BYTES, NULL) != RS_OK ||
+        rs_scene_load_image(r->scene, o->envmap, &image) != RS_OK ||
+        rs_scene_set_environment(r->scene, image, rs_v3_splat(o->envmap_scale), NULL) != RS_OK ||
+        rs_scene_finalize(r->scene) != RS_OK) {
+        char msg[600];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        if (strncmp(msg, o->envmap, strlen(o->envmap)) != 0)
+            rs_error_set(RS_ERR_ARG, "--envmap %s: %s", o->envmap, msg);
+        else
+            rs_error_set(RS_ERR_ARG, "--envmap %s", msg);
+        return fail(RS_EXIT_RUNTIME, NULL);
+    }
     return RS_EXIT_OK;
 }
 
@@ -399,6 +430,8 @@ static int load_scene_bounded(const rs_cli_options *o, render_run *r)
     pthread_condattr_destroy(&ca);
     watching = pthread_create(&t, NULL, load_watch_main, &w) == 0;
     code = load_scene(o, r);
+    if (code == RS_EXIT_OK)
+        code = apply_envmap(o, r);
     if (watching) {
         pthread_mutex_lock(&w.mu);
         w.done = 1;

@@ -1,5 +1,6 @@
 /* app/options.c — parsing and help text for the command line. */
 #include "app/options.h"
+#include "scenes/gltf.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -136,7 +137,13 @@ void rs_cli_print_help(const char *command)
             "\n"
             "Renders SCENE (default builtin:cornell) to an image.\n"
             "\n"
-            "  SCENE, --scene S    builtin:NAME ('raystream scenes' lists them) or FILE.json\n"
+            "  SCENE, --scene S    builtin:NAME ('raystream scenes' lists them), FILE.json\n"
+            "                      (docs/scene-format.md) or a glTF 2.0 FILE.gltf / FILE.glb\n"
+            "  --camera NAME       a glTF scene's camera by name (default: its first; a\n"
+            "                      camera framing the model when it has none)\n"
+            "  --envmap FILE       light the scene with an equirectangular environment map\n"
+            "                      (EXR, HDR, PNG, ...) in place of its background\n"
+            "  --envmap-scale S    multiply the map's radiance by S (default 1)\n"
             "  --mesh FILE         drop a mesh (OBJ, PLY, glTF, FBX, ...) into the Cornell box,\n"
             "                      scaled to fit, with its own materials\n"
             "  --models DIR        the test models folder for builtin scenes with meshes\n"
@@ -320,6 +327,25 @@ static int parse_image_option(opt_arg *x, rs_cli_options *o)
         if (!*v)
             return usage_error("%s needs a file name%s", name, "");
         o->mesh = v;
+    } else if (strcmp(name, "--camera") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs a camera's name%s", name, "");
+        o->camera = v;
+    } else if (strcmp(name, "--envmap") == 0) {
+        NEEDS_VALUE();
+        if (!*v)
+            return usage_error("%s needs an image file%s", name, "");
+        o->envmap = v;
+    } else if (strcmp(name, "--envmap-scale") == 0) {
+        char *end;
+        double val;
+        NEEDS_VALUE();
+        val = strtod(v, &end);
+        if (end == v || *end || !(val >= 0) || val > 1e30)
+            return usage_error("--envmap-scale needs a number >= 0, not '%s'%s", v, "");
+        o->envmap_scale = (float)val;
+        o->envmap_scale_given = 1;
     } else if (strcmp(name, "--models") == 0) {
         NEEDS_VALUE();
         if (!*v)
@@ -511,6 +537,14 @@ static int check_render_options(rs_cli_options *o)
     }
     if (!o->scene)
         o->scene = "builtin:cornell";
+    if (o->camera && !rs_is_gltf_path(o->scene))
+        return usage_error("--camera picks a glTF scene's camera; '%s' is not a .gltf or .glb "
+                           "file%s",
+                           o->scene, "");
+    if (o->envmap_scale_given && !o->envmap)
+        return usage_error("--envmap-scale needs --envmap FILE%s%s", "", "");
+    if (!o->envmap_scale_given)
+        o->envmap_scale = 1.0f;
     return RS_EXIT_OK;
 }
 

@@ -46,6 +46,10 @@ typedef struct rs_cli_options {
     uint32_t waves; /* waves in flight; 0: auto */
     int quiet;
     const char *mesh;      /* --mesh FILE: into the Cornell box */
+    const char *camera;    /* --camera NAME: a glTF scene's camera */
+    const char *envmap;    /* --envmap FILE: light the scene with this environment map */
+    float envmap_scale;    /* --envmap-scale S (default 1) */
+    int envmap_scale_given;
     const char *models;    /* --models DIR */
     rs_bvh_builder bvh;    /* --bvh NAME */
     int bvh_on_gpu;        /* --bvh-device gpu: Morton codes and sort on CUDA device 0 */

@@ -1,5 +1,8 @@
 /* scenes/mesh.c — see mesh.h. */
+#define _DEFAULT_SOURCE /* mkstemps, for a glTF binary's embedded textures */
 #include "scenes/mesh.h"
+#include "scenes/gltf.h"
+#include "scenes/transform.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -17,6 +20,7 @@
 
 #include "core/alloc.h"
 #include "core/file.h"
+#include "core/image_io.h"
 
 /* ---- every file Assimp opens goes through core/file.h ------------------------------------ */
 
@@ -338,16 +342,203 @@ static rs_vec3 rotate_xyz(rs_vec3 p, rs_vec3 deg)
 
 static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
-/* A scene material for an Assimp material: an emitter if it emits, Phong if it has a specular
- * colour and shininess, else Lambertian; a diffuse texture file becomes an image texture. */
-static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, const char *mesh,
-                                   const char *dir, uint32_t *id)
+/* How a texture's texels are read: colours are sRGB-decoded, data (normals, metallic-roughness)
+ * taken as stored. */
+#define TEX_COLOR 0
+#define TEX_DATA  1
+
+/* Texture `type` of material am as a scene texture in *id (RS_NO_TEXTURE when the material has
+ * none).  A file next to the mesh, or one embedded in it ("*N": a glTF binary's images, written
+ * to a temporary file for OpenImageIO).  A texture that is not a regular file of a sane size is
+ * an error; a missing or unreadable one is an error when `strict`, else a warning and no
+ * texture. */
+static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struct aiMaterial *am,
+                              enum aiTextureType type, const char *mesh, const char *dir,
+                              int data, int strict, uint32_t *id)
+{
+    struct aiString tex;
+    char path[2048], why[1200], tmp[64] = "";
+    uint32_t image;
+    rs_texture tx;
+    rs_status st;
+    int fd;
+    *id = RS_NO_TEXTURE;
+    if (aiGetMaterialTexture(am, type, 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) !=
+            aiReturn_SUCCESS ||
+        tex.length == 0)
+        return RS_OK;
+    if (tex.data[0] == '*') {
+        /* embedded: compressed bytes (mHeight 0, mWidth bytes, a format hint), or raw texels */
+        long k = strtol(tex.data + 1, NULL, 10);
+        const struct aiTexture *t;
+        FILE *f;
+        size_t bytes;
+        if (!as || k < 0 || (unsigned long)k >= as->mNumTextures || !as->mTextures[k])
+            return rs_error_set(RS_ERR_ARG, "%s: a material names embedded texture %s, which "
+                                            "the file does not have", mesh, tex.data);
+        t = as->mTextures[k];
+        if (t->mHeight != 0) {
+            /* raw BGRA texels, top row first */
+            float *rgb;
+            uint32_t i, n;
+            if ((uint64_t)t->mWidth * t->mHeight > RS_IMAGE_MAX_PIXELS)
+                return rs_error_set(RS_ERR_ARG, "%s: embedded texture %s is too large", mesh,
+                                    tex.data);
+            n = t->mWidth * t->mHeight;
+            rgb = (float *)rs_alloc((size_t)n * 3, sizeof *rgb);
+            if (!rgb)
+                return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
+            for (i = 0; i < n; ++i) {
+                const struct aiTexel *px = &t->pcData[i];
+                rgb[3 * i] = px->r / 255.0f;
+                rgb[3 * i + 1] = px->g / 255.0f;
+                rgb[3 * i + 2] = px->b / 255.0f;
+                if (!data) {
+                    int c;
+                    for (c = 0; c < 3; ++c)
+                        rgb[3 * i + c] = rs_srgb_decode(rgb[3 * i + c]);
+                }
+            }
+            st = rs_scene_add_image(s, t->mWidth, t->mHeight, rgb, &image);
+            rs_free(rgb);
+            if (st != RS_OK)
+                return st;
+            goto made;
+        }
+        bytes = t->mWidth;
+        snprintf(tmp, sizeof tmp, "/tmp/raystream-tex-XXXXXX.%.8s",
+                 t->achFormatHint[0] ? t->achFormatHint : "png");
+        fd = mkstemps(tmp, (int)strlen(strrchr(tmp, '.')));
+        if (fd < 0)
+            return rs_error_set(RS_ERR_IO, "%s: cannot write embedded texture %s to /tmp", mesh,
+                                tex.data);
+        f = fdopen(fd, "wb");
+        if (!f || fwrite(t->pcData, 1, bytes, f) != bytes) {
+            if (f)
+                fclose(f);
+            else
+                close(fd);
+            unlink(tmp);
+            return rs_error_set(RS_ERR_IO, "%s: cannot write embedded texture %s to /tmp", mesh,
+                                tex.data);
+        }
+        fclose(f);
+        snprintf(path, sizeof path, "%s", tmp);
+    } else if (tex.data[0] == '/') {
+        snprintf(path, sizeof path, "%s", tex.data);
+    } else {
+        snprintf(path, sizeof path, "%s/%s", dir, tex.data);
+    }
+    /* a texture that is not a regular file of a sane size (a FIFO, /dev/zero, a folder) is
+     * refused outright; a missing or unreadable one fails only a strict import */
+    st = rs_file_open_quiet(path, RS_FILE_MAX_IMAGE_BYTES, &fd, NULL, why, sizeof why);
+    if (st == RS_ERR_ARG) {
+        if (*tmp)
+            unlink(tmp);
+        return rs_error_set(st, "%s: %s", mesh, why);
+    }
+    if (st == RS_OK)
+        close(fd);
+    rs_error_clear();
+    st = data ? rs_scene_load_image_data(s, path, &image) : rs_scene_load_image(s, path, &image);
+    if (*tmp)
+        unlink(tmp);
+    if (st != RS_OK) {
+        if (strict) {
+            char msg[1200];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            return rs_error_set(st, "%s: texture %s: %s", mesh, tex.data, msg);
+        }
+        /* a missing texture file: keep the colour, say so once */
+        fprintf(stderr, "raystream: warning: %s\n", rs_error_message());
+        rs_error_clear();
+        return RS_OK;
+    }
+made:
+    memset(&tx, 0, sizeof tx);
+    tx.type = RS_TEX_IMAGE;
+    tx.image = image;
+    return rs_scene_add_texture(s, &tx, id);
+}
+
+static rs_vec3 clamp01(rs_vec3 c)
+{
+    return rs_v3(fminf(fmaxf(c.x, 0), 1), fminf(fmaxf(c.y, 0), 1), fminf(fmaxf(c.z, 0), 1));
+}
+
+/* glTF's metallic-roughness material (Assimp sets a metallic factor for it): base colour and
+ * its texture, metallic and roughness and their texture, emission and its texture, the normal
+ * map. */
+static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
+                                  const struct aiMaterial *am, const char *mesh, const char *dir,
+                                  int strict, uint32_t *id)
+{
+    struct aiColor4D base = {1, 1, 1, 1}, ke = {0, 0, 0, 1};
+    ai_real metal = 1, rough = 1, scale = 1;
+    unsigned int one = 1;
+    rs_material m;
+    uint32_t t;
+    aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base);
+    aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &ke);
+    aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &one);
+    one = 1;
+    aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &rough, &one);
+    m = rs_mat_pbr(clamp01(rs_v3(base.r, base.g, base.b)), fminf(fmaxf(metal, 0), 1),
+                   fminf(fmaxf(rough, 0), 1));
+    m.emission = rs_v3(fmaxf(ke.r, 0), fmaxf(ke.g, 0), fmaxf(ke.b, 0));
+    if (!isfinite(m.emission.x + m.emission.y + m.emission.z))
+        return rs_error_set(RS_ERR_ARG, "%s: a material's emissive factor is not finite", mesh);
+    if (load_texture(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_COLOR, strict, &t) !=
+        RS_OK)
+        return RS_ERR_ARG;
+    if (t == RS_NO_TEXTURE &&
+        load_texture(s, as, am, aiTextureType_DIFFUSE, mesh, dir, TEX_COLOR, strict, &t) != RS_OK)
+        return RS_ERR_ARG;
+    if (t != RS_NO_TEXTURE) {
+        /* glTF multiplies the texture by the factor: bake the factor into the texels */
+        rs_image *im = &s->images[s->textures[t].image];
+        size_t i, n = (size_t)im->width * im->height;
+        for (i = 0; i < n; ++i) {
+            im->rgb[3 * i] *= m.albedo.x;
+            im->rgb[3 * i + 1] *= m.albedo.y;
+            im->rgb[3 * i + 2] *= m.albedo.z;
+        }
+        m.albedo_tex = t;
+        m.albedo = rs_v3_splat(1.0f);
+    }
+    if (load_texture(s, as, am, aiTextureType_UNKNOWN, mesh, dir, TEX_DATA, strict,
+                     &m.mr_tex) != RS_OK ||
+        load_texture(s, as, am, aiTextureType_EMISSIVE, mesh, dir, TEX_COLOR, strict,
+                     &m.emission_tex) != RS_OK ||
+        load_texture(s, as, am, aiTextureType_NORMALS, mesh, dir, TEX_DATA, strict,
+                     &m.normal_tex) != RS_OK)
+        return RS_ERR_ARG;
+    if (m.emission_tex != RS_NO_TEXTURE && rs_v3_is_zero(m.emission))
+        m.emission_tex = RS_NO_TEXTURE; /* a texture times a zero factor */
+    one = 1;
+    if (m.normal_tex != RS_NO_TEXTURE &&
+        aiGetMaterialFloatArray(am, "$tex.scale", aiTextureType_NORMALS, 0, &scale, &one) ==
+            aiReturn_SUCCESS &&
+        isfinite(scale))
+        m.normal_scale = scale;
+    return rs_scene_add_material(s, &m, id);
+}
+
+/* A scene material for an Assimp material: glTF's metallic-roughness as the pbr material; else an
+ * emitter if it emits, Phong if it has a specular colour and shininess, Lambertian otherwise; a
+ * diffuse texture file becomes an image texture. */
+static rs_status add_file_material(rs_scene *s, const struct aiScene *as,
+                                   const struct aiMaterial *am, const char *mesh, const char *dir,
+                                   int strict, uint32_t *id)
 {
     struct aiColor4D kd = {0.7f, 0.7f, 0.7f, 1}, ks = {0, 0, 0, 1}, ke = {0, 0, 0, 1};
-    ai_real shininess = 0;
+    ai_real shininess = 0, metal;
     unsigned int max = 1;
-    struct aiString tex;
     rs_material m;
+    if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &max) == aiReturn_SUCCESS)
+        return add_pbr_material(s, as, am, mesh, dir, strict, id);
+    max = 1;
     aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &kd);
     aiGetMaterialColor(am, AI_MATKEY_COLOR_SPECULAR, &ks);
     aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &ke);
@@ -355,9 +546,9 @@ static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, con
     if (ke.r > 0 || ke.g > 0 || ke.b > 0) {
         m = rs_mat_light(rs_v3(ke.r, ke.g, ke.b), 0);
     } else {
-        rs_vec3 d =
-            rs_v3(fminf(fmaxf(kd.r, 0), 1), fminf(fmaxf(kd.g, 0), 1), fminf(fmaxf(kd.b, 0), 1));
+        rs_vec3 d = clamp01(rs_v3(kd.r, kd.g, kd.b));
         rs_vec3 sp = rs_v3(fmaxf(ks.r, 0), fmaxf(ks.g, 0), fmaxf(ks.b, 0));
+        uint32_t t;
         if (rs_v3_max_comp(sp) > 0 && shininess > 1) {
             /* keep kd + ks <= 1 per channel so the Phong model conserves energy */
             float sum = rs_v3_max_comp(rs_v3_add(d, sp));
@@ -367,39 +558,12 @@ static rs_status add_file_material(rs_scene *s, const struct aiMaterial *am, con
         } else {
             m = rs_mat_lambertian(d);
         }
-        if (aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, NULL, NULL, NULL, NULL,
-                                 NULL) == aiReturn_SUCCESS &&
-            tex.length > 0 && tex.data[0] != '*') {
-            char path[2048];
-            uint32_t image, t;
-            rs_texture tx;
-            char why[1200];
-            int fd;
-            rs_status st;
-            if (tex.data[0] == '/')
-                snprintf(path, sizeof path, "%s", tex.data);
-            else
-                snprintf(path, sizeof path, "%s/%s", dir, tex.data);
-            /* a texture that is not a regular file of a sane size (a FIFO, /dev/zero, a
-             * folder) is refused outright; only a missing or unreadable one is a warning */
-            st = rs_file_open_quiet(path, RS_FILE_MAX_IMAGE_BYTES, &fd, NULL, why, sizeof why);
-            if (st == RS_ERR_ARG)
-                return rs_error_set(st, "%s: %s", mesh, why);
-            if (st == RS_OK)
-                close(fd);
-            if (rs_scene_load_image(s, path, &image) == RS_OK) {
-                memset(&tx, 0, sizeof tx);
-                tx.type = RS_TEX_IMAGE;
-                tx.image = image;
-                if (rs_scene_add_texture(s, &tx, &t) == RS_OK) {
-                    m.albedo_tex = t;
-                    m.albedo = rs_v3_splat(1.0f);
-                }
-            } else {
-                /* a missing texture file: keep the colour, say so once */
-                fprintf(stderr, "raystream: warning: %s\n", rs_error_message());
-                rs_error_clear();
-            }
+        if (load_texture(s, as, am, aiTextureType_DIFFUSE, mesh, dir, TEX_COLOR, strict, &t) !=
+            RS_OK)
+            return RS_ERR_ARG;
+        if (t != RS_NO_TEXTURE) {
+            m.albedo_tex = t;
+            m.albedo = rs_v3_splat(1.0f);
         }
     }
     return rs_scene_add_material(s, &m, id);
@@ -463,22 +627,80 @@ static rs_vec3 place_normal(const placement *pl, rs_vec3 n)
     return l > 0 ? rs_v3_scale(m, 1.0f / l) : rs_v3(0, 0, 0);
 }
 
-rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o,
-                            rs_mesh_info *info)
+/* The triangles of Assimp mesh m, placed by pl, with material mat; faces with an index out of
+ * range, a non-finite vertex or no area, or that are not triangles, are dropped and counted in
+ * *info (which also gets the triangles added and their bounds). */
+static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const placement *pl, uint32_t mat,
+                           rs_mesh_info *info)
+{
+    rs_status st = RS_OK;
+    uint32_t k;
+    for (k = 0; k < m->mNumFaces && st == RS_OK; ++k) {
+        const struct aiFace *f = &m->mFaces[k];
+        rs_vec3 v[3];
+        float uv[6], nrm[9];
+        int c, ok = f->mNumIndices == 3;
+        uint32_t *why = &info->dropped_shape;
+        for (c = 0; c < 3 && ok; ++c) {
+            unsigned int idx = f->mIndices[c];
+            if (idx >= m->mNumVertices) {
+                ok = 0;
+                why = &info->dropped_index;
+                break;
+            }
+            v[c] = place(pl,
+                         rs_v3(m->mVertices[idx].x, m->mVertices[idx].y, m->mVertices[idx].z));
+            ok = finite3(v[c]);
+            if (!ok)
+                why = &info->dropped_nonfinite;
+            if (m->mTextureCoords[0]) {
+                uv[2 * c] = m->mTextureCoords[0][idx].x;
+                uv[2 * c + 1] = m->mTextureCoords[0][idx].y;
+            }
+            if (m->mNormals) {
+                rs_vec3 n = place_normal(
+                    pl, rs_v3(m->mNormals[idx].x, m->mNormals[idx].y, m->mNormals[idx].z));
+                if (!finite3(n))
+                    n = rs_v3(0, 0, 0);
+                nrm[3 * c] = n.x;
+                nrm[3 * c + 1] = n.y;
+                nrm[3 * c + 2] = n.z;
+            }
+        }
+        if (ok && rs_v3_is_zero(rs_v3_cross(rs_v3_sub(v[1], v[0]), rs_v3_sub(v[2], v[0])))) {
+            ok = 0;
+            why = &info->dropped_area;
+        }
+        if (!ok) {
+            info->dropped++;
+            ++*why;
+            continue;
+        }
+        st = rs_scene_add_triangle_full(s, v, m->mTextureCoords[0] ? uv : NULL,
+                                        m->mNormals ? nrm : NULL, mat);
+        if (st != RS_OK)
+            break;
+        info->triangles++;
+        for (c = 0; c < 3; ++c) {
+            info->bounds.lo = rs_v3_min(info->bounds.lo, v[c]);
+            info->bounds.hi = rs_v3_max(info->bounds.hi, v[c]);
+        }
+    }
+    return st;
+}
+
+/* Imports `path` through core/file.h with Assimp's `flags` (points and lines dropped, our own
+ * checks instead of Assimp's validation; see rs_scene_add_mesh) into *out: a scene with at least
+ * one mesh and a root node, or an error (set) and *out NULL. */
+static rs_status import_file(const char *path, unsigned int flags, const struct aiScene **out)
 {
     const struct aiScene *as;
     struct aiPropertyStore *props;
     mesh_io mio;
     uint64_t size;
-    placement pl;
-    uint32_t *mat_of = NULL, mi, k;
     int is_ply = 0;
-    char dir[1024];
-    const char *slash = strrchr(path, '/');
-    rs_status st = RS_OK;
-    rs_aabb raw;
-    memset(info, 0, sizeof *info);
-    st = rs_file_check(path, RS_FILE_MAX_MESH_BYTES, &size);
+    rs_status st = rs_file_check(path, RS_FILE_MAX_MESH_BYTES, &size);
+    *out = NULL;
     if (st != RS_OK)
         return st;
     if (size == 0)
@@ -486,10 +708,6 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     st = check_ply_header(path, &is_ply);
     if (st != RS_OK)
         return st;
-    if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !finite3(o->scale))
-        return rs_error_set(RS_ERR_ARG, "%s: scale must be finite and non-zero", path);
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
-
     memset(&mio, 0, sizeof mio);
     mio.io.OpenProc = mio_open;
     mio.io.CloseProc = mio_close;
@@ -513,16 +731,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         if (as)
             aiReleaseImport(as);
     }
-    as = mio.refused != RS_OK
-             ? NULL
-             : aiImportFileExWithProperties(path,
-                                            aiProcess_Triangulate |
-                                                aiProcess_JoinIdenticalVertices |
-                                                aiProcess_SortByPType |
-                                                aiProcess_PreTransformVertices |
-                                                aiProcess_GenSmoothNormals |
-                                                aiProcess_ValidateDataStructure,
-                                            &mio.io, props);
+    as = mio.refused != RS_OK ? NULL : aiImportFileExWithProperties(path, flags, &mio.io, props);
     aiReleasePropertyStore(props);
     if (mio.refused != RS_OK) {
         /* a file the mesh names was refused: fail even if Assimp carried on without it */
@@ -542,6 +751,31 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         aiReleaseImport(as);
         return rs_error_set(RS_ERR_ARG, "%s: no triangles in the file", path);
     }
+    *out = as;
+    return RS_OK;
+}
+
+rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o,
+                            rs_mesh_info *info)
+{
+    const struct aiScene *as;
+    placement pl;
+    uint32_t *mat_of = NULL, mi, k;
+    char dir[1024];
+    const char *slash = strrchr(path, '/');
+    rs_status st = RS_OK;
+    rs_aabb raw;
+    memset(info, 0, sizeof *info);
+    if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !finite3(o->scale))
+        return rs_error_set(RS_ERR_ARG, "%s: scale must be finite and non-zero", path);
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
+    st = import_file(path,
+                     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_SortByPType | aiProcess_PreTransformVertices |
+                         aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure,
+                     &as);
+    if (st != RS_OK)
+        return st;
 
     /* placement: the raw bounds of the transformed (unfitted) vertices decide a fit */
     pl.scale = o->scale;
@@ -596,7 +830,8 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
                 mat_of[k] = o->override_ids[ov];
                 continue;
             }
-            st = add_file_material(s, as->mMaterials[k], path, dir, &mat_of[k]);
+            st = add_file_material(s, as, as->mMaterials[k], path, dir, o->strict_textures,
+                                   &mat_of[k]);
             info->materials++;
         }
         if (st == RS_OK && as->mNumMaterials == 0) {
@@ -616,57 +851,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
             mat = as->mNumMaterials
                       ? mat_of[m->mMaterialIndex < as->mNumMaterials ? m->mMaterialIndex : 0]
                       : mat_of[0];
-        for (k = 0; k < m->mNumFaces && st == RS_OK; ++k) {
-            const struct aiFace *f = &m->mFaces[k];
-            rs_vec3 v[3];
-            float uv[6], nrm[9];
-            int c, ok = f->mNumIndices == 3;
-            uint32_t *why = &info->dropped_shape;
-            for (c = 0; c < 3 && ok; ++c) {
-                unsigned int idx = f->mIndices[c];
-                if (idx >= m->mNumVertices) {
-                    ok = 0;
-                    why = &info->dropped_index;
-                    break;
-                }
-                v[c] = place(&pl,
-                             rs_v3(m->mVertices[idx].x, m->mVertices[idx].y, m->mVertices[idx].z));
-                ok = finite3(v[c]);
-                if (!ok)
-                    why = &info->dropped_nonfinite;
-                if (m->mTextureCoords[0]) {
-                    uv[2 * c] = m->mTextureCoords[0][idx].x;
-                    uv[2 * c + 1] = m->mTextureCoords[0][idx].y;
-                }
-                if (m->mNormals) {
-                    rs_vec3 n = place_normal(
-                        &pl, rs_v3(m->mNormals[idx].x, m->mNormals[idx].y, m->mNormals[idx].z));
-                    if (!finite3(n))
-                        n = rs_v3(0, 0, 0);
-                    nrm[3 * c] = n.x;
-                    nrm[3 * c + 1] = n.y;
-                    nrm[3 * c + 2] = n.z;
-                }
-            }
-            if (ok && rs_v3_is_zero(rs_v3_cross(rs_v3_sub(v[1], v[0]), rs_v3_sub(v[2], v[0])))) {
-                ok = 0;
-                why = &info->dropped_area;
-            }
-            if (!ok) {
-                info->dropped++;
-                ++*why;
-                continue;
-            }
-            st = rs_scene_add_triangle_full(s, v, m->mTextureCoords[0] ? uv : NULL,
-                                            m->mNormals ? nrm : NULL, mat);
-            if (st != RS_OK)
-                break;
-            info->triangles++;
-            for (c = 0; c < 3; ++c) {
-                info->bounds.lo = rs_v3_min(info->bounds.lo, v[c]);
-                info->bounds.hi = rs_v3_max(info->bounds.hi, v[c]);
-            }
-        }
+        st = add_faces(s, m, &pl, mat, info);
     }
     rs_free(mat_of);
     aiReleaseImport(as);
@@ -677,4 +862,261 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
                           info->dropped + info->triangles, info->triangles);
     }
     return st;
+}
+
+/* ---- glTF scenes (scenes/gltf.h) ---------------------------------------------------------- */
+
+#define GLTF_MAX_DEPTH 256 /* nodes within nodes */
+
+typedef struct gltf_ctx {
+    rs_scene *s;
+    const struct aiScene *as;
+    const char *path;
+    uint32_t *mat_of;
+    rs_mesh_info info;
+    const struct aiNode *camera_node; /* the camera's node, once found */
+    const struct aiCamera *camera;
+    rs_xform camera_xf;
+    uint32_t lights;
+} gltf_ctx;
+
+/* Assimp's row-major 4x4 (a1..a4 the first row) as an affine transform. */
+static rs_xform xform_of(const struct aiMatrix4x4 *m)
+{
+    rs_xform x;
+    x.m[0][0] = m->a1, x.m[0][1] = m->a2, x.m[0][2] = m->a3, x.t[0] = m->a4;
+    x.m[1][0] = m->b1, x.m[1][1] = m->b2, x.m[1][2] = m->b3, x.t[1] = m->b4;
+    x.m[2][0] = m->c1, x.m[2][1] = m->c2, x.m[2][2] = m->c3, x.t[2] = m->c4;
+    return x;
+}
+
+static rs_vec3 ai_v3(struct aiVector3D v) { return rs_v3(v.x, v.y, v.z); }
+
+static rs_status gltf_light(gltf_ctx *g, const struct aiLight *l, const rs_xform *xf)
+{
+    rs_punctual p;
+    memset(&p, 0, sizeof p);
+    if (l->mType == aiLightSource_POINT)
+        p.type = RS_PUNCTUAL_POINT;
+    else if (l->mType == aiLightSource_SPOT)
+        p.type = RS_PUNCTUAL_SPOT;
+    else if (l->mType == aiLightSource_DIRECTIONAL)
+        p.type = RS_PUNCTUAL_DIRECTIONAL;
+    else
+        return rs_error_set(RS_ERR_ARG, "%s: light '%s' is of a kind glTF does not have", g->path,
+                            l->mName.data);
+    p.pos = rs_xform_point(xf, ai_v3(l->mPosition));
+    p.dir = rs_xform_vector(xf, ai_v3(l->mDirection));
+    p.intensity = rs_v3(l->mColorDiffuse.r, l->mColorDiffuse.g, l->mColorDiffuse.b);
+    if (p.type == RS_PUNCTUAL_SPOT) {
+        float inner = fminf(fmaxf(l->mAngleInnerCone, 0.0f), 1.5707963f);
+        float outer = fminf(fmaxf(l->mAngleOuterCone, inner), 1.5707963f);
+        p.cos_inner = cosf(inner);
+        p.cos_outer = cosf(outer);
+    }
+    if (rs_scene_add_punctual(g->s, &p) != RS_OK) {
+        char msg[400];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        return rs_error_set(RS_ERR_ARG, "%s: light '%s': %s", g->path, l->mName.data, msg);
+    }
+    g->lights++;
+    return RS_OK;
+}
+
+/* Node nd and its children under the parent's transform: their meshes, and the camera and the
+ * lights that name them. */
+static rs_status gltf_node(gltf_ctx *g, const struct aiNode *nd, const rs_xform *parent,
+                           int depth, const char *want_camera)
+{
+    rs_xform local = xform_of(&nd->mTransformation), xf = rs_xform_compose(parent, &local);
+    const char *why = rs_xform_invalid(&xf);
+    uint32_t k;
+    rs_status st;
+    if (depth > GLTF_MAX_DEPTH)
+        return rs_error_set(RS_ERR_ARG, "%s: nodes nested more than %d deep", g->path,
+                            GLTF_MAX_DEPTH);
+    if (nd->mNumMeshes && why)
+        return rs_error_set(RS_ERR_ARG, "%s: node '%s': %s", g->path, nd->mName.data, why);
+    for (k = 0; k < nd->mNumMeshes; ++k) {
+        const struct aiMesh *m;
+        placement id = {{1, 1, 1}, {0, 0, 0}, {0, 0, 0}, 1.0f};
+        rs_scene_mark mark = rs_scene_mark_now(g->s);
+        if (nd->mMeshes[k] >= g->as->mNumMeshes)
+            return rs_error_set(RS_ERR_ARG, "%s: node '%s' names mesh %u of %u", g->path,
+                                nd->mName.data, nd->mMeshes[k], g->as->mNumMeshes);
+        m = g->as->mMeshes[nd->mMeshes[k]];
+        if (!m->mVertices || !m->mFaces)
+            continue;
+        st = add_faces(g->s, m, &id,
+                       g->mat_of[m->mMaterialIndex < g->as->mNumMaterials ? m->mMaterialIndex : 0],
+                       &g->info);
+        if (st == RS_OK && !rs_xform_is_identity(&xf))
+            st = rs_scene_transform_since(g->s, &mark, &xf);
+        if (st != RS_OK) {
+            char msg[400];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            return rs_error_set(st, "%s: node '%s': %s", g->path, nd->mName.data, msg);
+        }
+    }
+    for (k = 0; k < g->as->mNumCameras; ++k) {
+        const struct aiCamera *c = g->as->mCameras[k];
+        if (!g->camera && strcmp(c->mName.data, nd->mName.data) == 0 &&
+            (!want_camera || strcmp(want_camera, c->mName.data) == 0) && c->mHorizontalFOV > 0) {
+            g->camera = c;
+            g->camera_node = nd;
+            g->camera_xf = xf;
+        }
+    }
+    for (k = 0; k < g->as->mNumLights; ++k)
+        if (strcmp(g->as->mLights[k]->mName.data, nd->mName.data) == 0) {
+            st = gltf_light(g, g->as->mLights[k], &xf);
+            if (st != RS_OK)
+                return st;
+        }
+    for (k = 0; k < nd->mNumChildren; ++k) {
+        st = gltf_node(g, nd->mChildren[k], &xf, depth + 1, want_camera);
+        if (st != RS_OK)
+            return st;
+    }
+    return RS_OK;
+}
+
+/* The camera: the glTF camera found (its node's transform applied to looking down -z with +y
+ * up; Assimp gives yfov times the aspect ratio as the horizontal field of view), else one that
+ * frames the model's bounding sphere from the front, a little above. */
+static void gltf_camera(gltf_ctx *g)
+{
+    rs_camera_desc *d = &g->s->camera;
+    if (g->camera) {
+        const struct aiCamera *c = g->camera;
+        float aspect = c->mAspect > 0 ? c->mAspect : 1.0f;
+        float yfov = c->mHorizontalFOV / aspect * 57.29577951f;
+        rs_vec3 look = rs_xform_vector(&g->camera_xf, ai_v3(c->mLookAt));
+        rs_vec3 up = rs_xform_vector(&g->camera_xf, ai_v3(c->mUp));
+        d->from = rs_xform_point(&g->camera_xf, rs_v3(0, 0, 0));
+        d->at = rs_v3_add(d->from, rs_v3_normalize(look));
+        d->up = rs_v3_is_zero(up) ? rs_v3(0, 1, 0) : up;
+        d->vfov_deg = fminf(fmaxf(yfov, 1.0f), 170.0f);
+        if (c->mAspect > 0) {
+            float w = roundf(512.0f * c->mAspect);
+            g->s->height = 512;
+            g->s->width = (uint32_t)fminf(fmaxf(w, 1.0f), 32768.0f);
+        }
+    } else {
+        rs_aabb b = g->info.bounds;
+        rs_vec3 c = rs_v3_scale(rs_v3_add(b.lo, b.hi), 0.5f);
+        float r = 0.5f * rs_v3_length(rs_v3_sub(b.hi, b.lo)), dist;
+        d->vfov_deg = 40.0f;
+        dist = (r > 0 ? r : 1.0f) / sinf(0.5f * 40.0f * 0.017453293f) * 1.05f;
+        d->at = c;
+        d->from = rs_v3_add(c, rs_v3_scale(rs_v3_normalize(rs_v3(0.3f, 0.35f, 1.0f)), dist));
+        d->up = rs_v3(0, 1, 0);
+    }
+    d->aperture = 0;
+    d->focus_dist = 0;
+}
+
+rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scene **out)
+{
+    gltf_ctx g;
+    rs_xform id = rs_xform_identity();
+    char dir[1024];
+    const char *slash = strrchr(path, '/');
+    rs_status st;
+    uint32_t k, emissive = 0;
+    *out = NULL;
+    memset(&g, 0, sizeof g);
+    g.path = path;
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
+    st = import_file(path,
+                     aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_SortByPType | aiProcess_GenSmoothNormals |
+                         aiProcess_ValidateDataStructure,
+                     &g.as);
+    if (st != RS_OK)
+        return st;
+    st = rs_scene_create(path, &g.s);
+    g.info.bounds.lo = rs_v3_splat(FLT_MAX);
+    g.info.bounds.hi = rs_v3_splat(-FLT_MAX);
+    if (st == RS_OK) {
+        g.mat_of = (uint32_t *)rs_calloc(g.as->mNumMaterials ? g.as->mNumMaterials : 1,
+                                         sizeof *g.mat_of);
+        if (!g.mat_of)
+            st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    }
+    for (k = 0; k < g.as->mNumMaterials && st == RS_OK; ++k) {
+        uint32_t mi;
+        int used = 0;
+        for (mi = 0; mi < g.as->mNumMeshes && !used; ++mi)
+            used = g.as->mMeshes[mi]->mMaterialIndex == k;
+        if (!used)
+            continue;
+        st = add_file_material(g.s, g.as, g.as->mMaterials[k], path, dir, 1, &g.mat_of[k]);
+        if (st == RS_OK) {
+            g.info.materials++;
+            emissive += !rs_v3_is_zero(g.s->materials[g.mat_of[k]].emission);
+        }
+    }
+    if (st == RS_OK && g.as->mNumMaterials == 0) {
+        rs_material def = rs_mat_pbr(rs_v3_splat(1.0f), 0.0f, 1.0f);
+        st = rs_scene_add_material(g.s, &def, &g.mat_of[0]);
+    }
+    if (st == RS_OK)
+        st = gltf_node(&g, g.as->mRootNode, &id, 0, opts ? opts->camera : NULL);
+    if (st == RS_OK && opts && opts->camera && !g.camera) {
+        char have[512] = "";
+        for (k = 0; k < g.as->mNumCameras; ++k)
+            if (strlen(have) + g.as->mCameras[k]->mName.length + 5 < sizeof have) {
+                strcat(have, *have ? ", '" : "'");
+                strcat(have, g.as->mCameras[k]->mName.data);
+                strcat(have, "'");
+            }
+        st = rs_error_set(RS_ERR_ARG, "%s: no camera named '%s' (the file has: %s)", path,
+                          opts->camera, *have ? have : "none");
+    }
+    if (st == RS_OK && (g.info.triangles == 0 || g.info.dropped > g.info.triangles)) {
+        char why[160];
+        st = rs_error_set(RS_ERR_ARG, "%s: %s of %u, %u triangles left: the mesh is broken", path,
+                          rs_mesh_dropped_text(&g.info, why, sizeof why),
+                          g.info.dropped + g.info.triangles, g.info.triangles);
+    }
+    if (st == RS_OK) {
+        /* the placed bounds, for a framing camera */
+        g.info.bounds.lo = rs_v3_splat(FLT_MAX);
+        g.info.bounds.hi = rs_v3_splat(-FLT_MAX);
+        for (k = 0; k < g.s->n_tris; ++k) {
+            const rs_tri *t = &g.s->tris[k];
+            g.info.bounds.lo = rs_v3_min(g.info.bounds.lo, rs_v3_min(t->v0, rs_v3_min(t->v1, t->v2)));
+            g.info.bounds.hi = rs_v3_max(g.info.bounds.hi, rs_v3_max(t->v0, rs_v3_max(t->v1, t->v2)));
+        }
+        gltf_camera(&g);
+        if (g.lights == 0 && emissive == 0)
+            g.s->background = rs_v3_splat(1.0f); /* nothing lights it: a white sky does */
+        st = rs_scene_finalize(g.s);
+        if (st != RS_OK) {
+            char msg[400];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            st = rs_error_set(st, "%s: %s", path, msg);
+        }
+    }
+    if (st == RS_OK && opts && opts->log) {
+        char why[160];
+        fprintf(opts->log,
+                "raystream: %s: %u triangles, %u materials, %u lights, camera %s%s%s%s%s\n", path,
+                g.info.triangles, g.info.materials, g.lights,
+                g.camera ? "'" : "(framing the model)", g.camera ? g.camera->mName.data : "",
+                g.camera ? "'" : "", g.info.dropped ? "; " : "",
+                rs_mesh_dropped_text(&g.info, why, sizeof why));
+    }
+    rs_free(g.mat_of);
+    aiReleaseImport(g.as);
+    if (st != RS_OK) {
+        rs_scene_destroy(g.s);
+        return st;
+    }
+    *out = g.s;
+    return RS_OK;
 }

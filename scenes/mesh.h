@@ -38,6 +38,8 @@ typedef struct rs_mesh_opts {
     const char *const *override_names;
     const uint32_t *override_ids;
     uint32_t n_overrides;
+    int strict_textures; /* a texture the file names that is missing or unreadable is an error
+                            (else a warning, and the material keeps its colour) */
 } rs_mesh_opts;
 
 typedef struct rs_mesh_info {

@@ -1,0 +1,491 @@
+/* tests/scenes_gltf_test.c — glTF 2.0 files as scenes (scenes/gltf.h), on files this test
+ * writes itself (no third-party assets):
+ *   - the node hierarchy: a mesh placed by two nodes under a parent, each vertex where the
+ *     composed translation / rotation / scale puts it;
+ *   - the camera on a nested node (position, direction, yfov, aspect ratio -> image size), another
+ *     picked by name, an error naming the file's cameras for a name it lacks, and a framing
+ *     camera for a file without one;
+ *   - KHR_lights_punctual: a point, a spot and a directional light on nested nodes (position,
+ *     direction, colour times intensity, cone angles);
+ *   - every texture slot: base colour (sRGB-decoded, times the factor), metallic-roughness and
+ *     normal (data, as stored), emissive; the normal map's scale; a binary .glb with its texture
+ *     embedded;
+ *   - an emissive texture shows in the image (half of a quad red, half black: the bug that made a
+ *     textured model glow uniformly white);
+ *   - bad files: a missing texture, a missing buffer, cut JSON: one line naming the file, no
+ *     scene. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/image_io.h"
+#include "render_util.h"
+#include "scenes/gltf.h"
+
+static char g_dir[64];
+
+static void path_of(char *out, size_t n, const char *name)
+{
+    snprintf(out, n, "%s/%s", g_dir, name);
+}
+
+static void write_bytes(const char *name, const void *data, size_t n)
+{
+    char p[256];
+    FILE *f;
+    path_of(p, sizeof p, name);
+    f = fopen(p, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, n, f), n);
+    fclose(f);
+}
+
+static void write_text(const char *name, const char *text) { write_bytes(name, text, strlen(text)); }
+
+/* A w x h PNG of linear texels rgb (written sRGB-encoded, 8 bits). */
+static void write_png(const char *name, uint32_t w, uint32_t h, const float *rgb)
+{
+    char p[256];
+    path_of(p, sizeof p, name);
+    assert_int_equal(rs_image_write(p, w, h, rgb), RS_OK);
+}
+
+/* The 8-bit code values / 255 of a PNG this test wrote (what a data texture holds). */
+static float *read_raw(const char *name, uint32_t *w, uint32_t *h)
+{
+    char p[256];
+    float *rgb;
+    path_of(p, sizeof p, name);
+    assert_int_equal(rs_image_read(p, w, h, &rgb), RS_OK);
+    return rgb;
+}
+
+/* The quad's buffer: 4 positions, 4 normals, 4 UVs, 6 indices (16-bit): 140 bytes. */
+#define QUAD_BYTES 140
+static void quad_buffer(unsigned char *b)
+{
+    static const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+    static const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    static const float uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+    static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(b, pos, 48);
+    memcpy(b + 48, nrm, 48);
+    memcpy(b + 96, uv, 32);
+    memcpy(b + 128, idx, 12);
+}
+
+#define VIEWS                                                                                      \
+  "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"                            \
+  "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},"                                            \
+  "{\"buffer\":0,\"byteOffset\":96,\"byteLength\":32},"                                            \
+  "{\"buffer\":0,\"byteOffset\":128,\"byteLength\":12}%s],"                                        \
+  "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","         \
+  "\"min\":[-1,-1,0],\"max\":[1,1,0]},"                                                            \
+  "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"                       \
+  "{\"bufferView\":2,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"                       \
+  "{\"bufferView\":3,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}],"                    \
+  "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},"  \
+  "\"indices\":3,\"material\":0}]}]"
+
+/* The full scene: root (translated) -> quadA (translated), quadB (rotated 90 degrees about z,
+ * scaled by 2, translated), a camera node under root, three light nodes; one material with every
+ * texture. */
+static const char *k_full =
+    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+    "\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+    "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":["
+    "{\"type\":\"point\",\"color\":[1,0.5,0.25],\"intensity\":20},"
+    "{\"type\":\"spot\",\"color\":[1,1,1],\"intensity\":30,"
+    "\"spot\":{\"innerConeAngle\":0.2,\"outerConeAngle\":0.6}},"
+    "{\"type\":\"directional\",\"color\":[0.5,1,1],\"intensity\":2}]}},"
+    "\"nodes\":[{\"name\":\"root\",\"translation\":[0,1,0],\"children\":[1,2,3,4,5,6,7]},"
+    "{\"name\":\"quadA\",\"mesh\":0,\"translation\":[-2,0,0]},"
+    "{\"name\":\"quadB\",\"mesh\":0,\"translation\":[2,0,0],"
+    "\"rotation\":[0,0,0.70710678,0.70710678],\"scale\":[2,2,2]},"
+    "{\"name\":\"cam\",\"camera\":0,\"translation\":[0,0,8]},"
+    "{\"name\":\"side\",\"camera\":1,\"translation\":[8,0,0],"
+    "\"rotation\":[0,0.70710678,0,0.70710678]},"
+    "{\"name\":\"lp\",\"translation\":[0,2,3],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}},"
+    "{\"name\":\"ls\",\"translation\":[0,0,4],\"extensions\":{\"KHR_lights_punctual\":{\"light\":1}}},"
+    "{\"name\":\"ld\",\"rotation\":[-0.70710678,0,0,0.70710678],"
+    "\"extensions\":{\"KHR_lights_punctual\":{\"light\":2}}}],"
+    "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.6,\"aspectRatio\":2.0,"
+    "\"znear\":0.1}},{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.9,\"znear\":0.1}}],"
+    "\"materials\":[{\"name\":\"all\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,1,1,1],"
+    "\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0.8,\"roughnessFactor\":0.6,"
+    "\"metallicRoughnessTexture\":{\"index\":1}},\"normalTexture\":{\"index\":2,\"scale\":0.5},"
+    "\"emissiveFactor\":[1,1,1],\"emissiveTexture\":{\"index\":3}}],"
+    "\"textures\":[{\"source\":0},{\"source\":1},{\"source\":2},{\"source\":3}],"
+    "\"images\":[{\"uri\":\"base.png\"},{\"uri\":\"mr.png\"},{\"uri\":\"normal.png\"},"
+    "{\"uri\":\"emis.png\"}],"
+    "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+
+static void write_full_files(void)
+{
+    unsigned char b[QUAD_BYTES];
+    static const float base[12] = {0.2f, 0.4f, 0.6f, 0.8f, 0.1f, 0.3f,
+                                   0.5f, 0.7f, 0.9f, 0.25f, 0.5f, 0.75f};
+    static const float mr[12] = {0, 0.5f, 1.0f, 0, 0.25f, 0.5f, 0, 1.0f, 0.0f, 0, 0.75f, 0.25f};
+    static const float nm[12] = {0.5f, 0.5f, 1, 0.6f, 0.5f, 0.9f, 0.5f, 0.4f, 0.9f, 0.5f, 0.5f, 1};
+    static const float emis[24] = {1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0,
+                                   1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0};
+    char buf[8192];
+    quad_buffer(b);
+    write_bytes("quad.bin", b, sizeof b);
+    write_png("base.png", 2, 2, base);
+    write_png("mr.png", 2, 2, mr);
+    write_png("normal.png", 2, 2, nm);
+    write_png("emis.png", 4, 2, emis);
+    snprintf(buf, sizeof buf, k_full, "");
+    write_text("full.gltf", buf);
+}
+
+static rs_scene *load(const char *name, const char *camera)
+{
+    char p[256];
+    rs_gltf_opts o;
+    rs_scene *s = NULL;
+    path_of(p, sizeof p, name);
+    o.camera = camera;
+    o.log = NULL;
+    if (rs_scene_load_gltf(p, &o, &s) != RS_OK)
+        fail_msg("%s: %s", p, rs_error_message());
+    return s;
+}
+
+static void expect_v3(rs_vec3 a, float x, float y, float z, float tol)
+{
+    if (fabsf(a.x - x) > tol || fabsf(a.y - y) > tol || fabsf(a.z - z) > tol)
+        fail_msg("(%g, %g, %g) != (%g, %g, %g)", a.x, a.y, a.z, x, y, z);
+}
+
+/* Whether the scene has a triangle vertex at p. */
+static int has_vertex(const rs_scene *s, rs_vec3 p)
+{
+    uint32_t i;
+    for (i = 0; i < s->n_tris; ++i) {
+        const rs_vec3 *v = &s->tris[i].v0;
+        int k;
+        for (k = 0; k < 3; ++k)
+            if (rs_v3_length(rs_v3_sub(v[k], p)) < 1e-5f)
+                return 1;
+    }
+    return 0;
+}
+
+static void test_hierarchy_camera_lights(void **state)
+{
+    rs_scene *s;
+    const rs_punctual *p;
+    (void)state;
+    write_full_files();
+    s = load("full.gltf", NULL);
+    /* two nodes place the quad: 2 x 2 triangles */
+    assert_int_equal(s->n_tris, 4u);
+    /* quadA: translated by root (0,1,0) and (-2,0,0): its corner (-1,-1,0) at (-3, 0, 0) */
+    assert_true(has_vertex(s, rs_v3(-3, 0, 0)));
+    assert_true(has_vertex(s, rs_v3(-1, 2, 0)));
+    /* quadB: scale 2, 90 degrees about z, then (2,0,0), then root: (1,-1,0) -> (2,-2,0) ->
+     * (2,2,0) -> (4,2,0) -> (4,3,0) */
+    assert_true(has_vertex(s, rs_v3(4, 3, 0)));
+    assert_true(has_vertex(s, rs_v3(0, -1, 0)));
+    /* the first camera: at root + (0,0,8), looking down -z; yfov 0.6 rad; aspect 2 */
+    expect_v3(s->camera.from, 0, 1, 8, 1e-5f);
+    expect_v3(rs_v3_normalize(rs_v3_sub(s->camera.at, s->camera.from)), 0, 0, -1, 1e-5f);
+    assert_true(fabsf(s->camera.vfov_deg - 0.6f * 57.29578f) < 1e-3f);
+    assert_int_equal(s->width, 1024u);
+    assert_int_equal(s->height, 512u);
+    /* the three lights on their nodes */
+    assert_int_equal(s->n_punctuals, 3u);
+    p = &s->punctuals[0];
+    assert_int_equal(p->type, RS_PUNCTUAL_POINT);
+    expect_v3(p->pos, 0, 3, 3, 1e-5f);
+    expect_v3(p->intensity, 20, 10, 5, 1e-4f);
+    p = &s->punctuals[1];
+    assert_int_equal(p->type, RS_PUNCTUAL_SPOT);
+    expect_v3(p->pos, 0, 1, 4, 1e-5f);
+    expect_v3(p->dir, 0, 0, -1, 1e-5f);
+    assert_true(fabsf(p->cos_inner - cosf(0.2f)) < 1e-5f && fabsf(p->cos_outer - cosf(0.6f)) < 1e-5f);
+    p = &s->punctuals[2];
+    assert_int_equal(p->type, RS_PUNCTUAL_DIRECTIONAL);
+    /* -90 degrees about x takes -z to -y: light straight down */
+    expect_v3(p->dir, 0, -1, 0, 1e-5f);
+    expect_v3(p->intensity, 1, 2, 2, 1e-5f);
+    assert_true(s->n_lights == 3u && s->n_area_lights == 0u);
+    rs_scene_destroy(s);
+
+    /* the second camera by name: at (8,1,0), turned 90 degrees about y: looking down -x */
+    s = load("full.gltf", "side");
+    expect_v3(s->camera.from, 8, 1, 0, 1e-5f);
+    expect_v3(rs_v3_normalize(rs_v3_sub(s->camera.at, s->camera.from)), -1, 0, 0, 1e-5f);
+    assert_true(fabsf(s->camera.vfov_deg - 0.9f * 57.29578f) < 1e-3f);
+    rs_scene_destroy(s);
+
+    {
+        /* a name the file lacks: the cameras it has */
+        char p2[256];
+        rs_gltf_opts o = {"front", NULL};
+        rs_scene *t = (rs_scene *)0x1;
+        path_of(p2, sizeof p2, "full.gltf");
+        rs_error_clear();
+        assert_int_equal(rs_scene_load_gltf(p2, &o, &t), RS_ERR_ARG);
+        assert_null(t);
+        print_message("%s\n", rs_error_message());
+        assert_non_null(strstr(rs_error_message(), "no camera named 'front'"));
+        assert_non_null(strstr(rs_error_message(), "'cam', 'side'"));
+        rs_error_clear();
+    }
+}
+
+static void test_texture_slots(void **state)
+{
+    rs_scene *s;
+    const rs_material *m;
+    uint32_t w, h, i;
+    float *raw;
+    (void)state;
+    write_full_files();
+    s = load("full.gltf", NULL);
+    assert_int_equal(s->n_materials, 1u);
+    m = &s->materials[0];
+    assert_int_equal(m->type, RS_MAT_PBR);
+    assert_true(fabsf(m->metallic - 0.8f) < 1e-6f && fabsf(m->alpha - 0.36f) < 1e-6f);
+    assert_int_not_equal(m->albedo_tex, RS_NO_TEXTURE);
+    assert_int_not_equal(m->mr_tex, RS_NO_TEXTURE);
+    assert_int_not_equal(m->normal_tex, RS_NO_TEXTURE);
+    assert_int_not_equal(m->emission_tex, RS_NO_TEXTURE);
+    assert_true(fabsf(m->normal_scale - 0.5f) < 1e-6f);
+    expect_v3(m->emission, 1, 1, 1, 0);
+    /* base colour: the stored codes sRGB-decoded, times the factor (0.5, 1, 1) */
+    raw = read_raw("base.png", &w, &h);
+    {
+        const rs_image *im = &s->images[s->textures[m->albedo_tex].image];
+        assert_int_equal(im->width, w);
+        for (i = 0; i < w * h * 3; ++i)
+            assert_true(fabsf(im->rgb[i] - rs_srgb_decode(raw[i]) * (i % 3 == 0 ? 0.5f : 1.0f)) <
+                        1e-5f);
+    }
+    free(raw);
+    /* metallic-roughness and normal: as stored */
+    raw = read_raw("mr.png", &w, &h);
+    {
+        const rs_image *im = &s->images[s->textures[m->mr_tex].image];
+        for (i = 0; i < w * h * 3; ++i)
+            assert_true(fabsf(im->rgb[i] - raw[i]) < 1e-6f);
+    }
+    free(raw);
+    raw = read_raw("normal.png", &w, &h);
+    {
+        const rs_image *im = &s->images[s->textures[m->normal_tex].image];
+        for (i = 0; i < w * h * 3; ++i)
+            assert_true(fabsf(im->rgb[i] - raw[i]) < 1e-6f);
+    }
+    free(raw);
+    rs_scene_destroy(s);
+}
+
+/* One quad facing the camera, lit by nothing but its emissive texture (left half red, right half
+ * black, as UV u runs across it): the image's left half is red, its right half dark. */
+static void test_emissive_texture_renders(void **state)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+        "\"nodes\":[{\"mesh\":0},{\"name\":\"cam\",\"camera\":0,\"translation\":[0,0,2.2]}],"
+        "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.9,\"znear\":0.1}}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],"
+        "\"metallicFactor\":0},\"emissiveFactor\":[2,2,2],\"emissiveTexture\":{\"index\":0}}],"
+        "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"emis.png\"}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+    char buf[4096];
+    rs_scene *s;
+    rt_args a = rt_defaults("", 32, 4);
+    float *img;
+    double left = 0, right = 0, left_g = 0;
+    int x, y;
+    (void)state;
+    write_full_files();
+    snprintf(buf, sizeof buf, k, "");
+    write_text("emis.gltf", buf);
+    s = load("emis.gltf", NULL);
+    img = rt_render_scene(s, &a, NULL);
+    assert_non_null(img);
+    for (y = 8; y < 24; ++y)
+        for (x = 0; x < 32; ++x) {
+            const float *p = &img[3 * (y * 32 + x)];
+            if (x >= 9 && x < 14) {
+                left += p[0];
+                left_g += p[1];
+            } else if (x >= 18 && x < 23) {
+                right += p[0];
+            }
+        }
+    print_message("emissive quad: left red %.3f (green %.3f), right red %.3f\n", left, left_g,
+                  right);
+    assert_true(left > 100.0);         /* 80 pixels of radiance ~2 */
+    assert_true(right < 0.05 * left);  /* the texture's black half */
+    assert_true(left_g < 0.05 * left); /* red, not white */
+    free(img);
+    rs_scene_destroy(s);
+}
+
+/* A .glb: the JSON chunk and a binary chunk holding the buffer and a PNG texture. */
+static void test_glb_embedded(void **state)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+        "\"nodes\":[{\"mesh\":0}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+        "\"textures\":[{\"source\":0}],"
+        "\"images\":[{\"bufferView\":4,\"mimeType\":\"image/png\"}],"
+        "\"buffers\":[{\"byteLength\":%u}]," VIEWS "}";
+    char json[4096], views[128], p[256];
+    unsigned char *png, *glb;
+    size_t png_n, jn, bn, n;
+    uint32_t u, w, h, i;
+    FILE *f;
+    rs_scene *s;
+    float *raw;
+    (void)state;
+    write_full_files();
+    path_of(p, sizeof p, "base.png");
+    f = fopen(p, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    png_n = (size_t)ftell(f);
+    fseek(f, 0, SEEK_SET);
+    png = (unsigned char *)malloc(png_n);
+    assert_int_equal(fread(png, 1, png_n, f), png_n);
+    fclose(f);
+    snprintf(views, sizeof views, ",{\"buffer\":0,\"byteOffset\":140,\"byteLength\":%u}",
+             (unsigned)png_n);
+    snprintf(json, sizeof json, k, (unsigned)(QUAD_BYTES + png_n), views);
+    jn = (strlen(json) + 3) & ~(size_t)3;
+    bn = (QUAD_BYTES + png_n + 3) & ~(size_t)3;
+    n = 12 + 8 + jn + 8 + bn;
+    glb = (unsigned char *)calloc(1, n);
+    memcpy(glb, "glTF", 4);
+    u = 2, memcpy(glb + 4, &u, 4);
+    u = (uint32_t)n, memcpy(glb + 8, &u, 4);
+    u = (uint32_t)jn, memcpy(glb + 12, &u, 4);
+    memcpy(glb + 16, "JSON", 4);
+    memset(glb + 20, ' ', jn);
+    memcpy(glb + 20, json, strlen(json));
+    u = (uint32_t)bn, memcpy(glb + 20 + jn, &u, 4);
+    memcpy(glb + 24 + jn, "BIN\0", 4);
+    quad_buffer(glb + 28 + jn);
+    memcpy(glb + 28 + jn + QUAD_BYTES, png, png_n);
+    write_bytes("embedded.glb", glb, n);
+    free(glb);
+    free(png);
+    s = load("embedded.glb", NULL);
+    assert_int_equal(s->n_tris, 2u);
+    assert_int_not_equal(s->materials[0].albedo_tex, RS_NO_TEXTURE);
+    raw = read_raw("base.png", &w, &h);
+    {
+        const rs_image *im = &s->images[s->textures[s->materials[0].albedo_tex].image];
+        assert_int_equal(im->width, w);
+        assert_int_equal(im->height, h);
+        for (i = 0; i < w * h * 3; ++i)
+            assert_true(fabsf(im->rgb[i] - rs_srgb_decode(raw[i])) < 1e-5f);
+    }
+    free(raw);
+    /* no camera: one that frames the quad (its centre ahead, all of it in view); no light: the
+     * white sky */
+    {
+        rs_vec3 d = rs_v3_normalize(rs_v3_sub(s->camera.at, s->camera.from));
+        float dist = rs_v3_length(s->camera.from);
+        assert_true(rs_v3_length(s->camera.at) < 1e-5f);
+        assert_true(dist * tanf(0.5f * s->camera.vfov_deg * 0.01745329f) > 1.4142f);
+        assert_true(d.z < -0.5f);
+        expect_v3(s->background, 1, 1, 1, 0);
+    }
+    rs_scene_destroy(s);
+}
+
+static void expect_bad(const char *name, const char *text, const char *a, const char *b)
+{
+    char p[256];
+    rs_scene *s = (rs_scene *)0x1;
+    write_text(name, text);
+    path_of(p, sizeof p, name);
+    rs_error_clear();
+    if (rs_scene_load_gltf(p, NULL, &s) == RS_OK)
+        fail_msg("%s loaded", name);
+    assert_null(s);
+    print_message("%s\n", rs_error_message());
+    assert_null(strchr(rs_error_message(), '\n'));
+    assert_non_null(strstr(rs_error_message(), name));
+    if (!strstr(rs_error_message(), a) || (b && !strstr(rs_error_message(), b)))
+        fail_msg("'%s' lacks '%s' or '%s'", rs_error_message(), a, b ? b : "");
+    rs_error_clear();
+}
+
+static void test_bad_files(void **state)
+{
+    char buf[8192];
+    (void)state;
+    write_full_files();
+    /* a texture that is not there */
+    snprintf(buf, sizeof buf, k_full, "");
+    {
+        char *at = strstr(buf, "emis.png");
+        memcpy(at, "gone.png", 8);
+    }
+    expect_bad("notex.gltf", buf, "gone.png", NULL);
+    /* a buffer that is not there */
+    snprintf(buf, sizeof buf, k_full, "");
+    {
+        char *at = strstr(buf, "quad.bin");
+        memcpy(at, "lost.bin", 8);
+    }
+    expect_bad("nobuf.gltf", buf, "nobuf.gltf", NULL);
+    /* cut JSON */
+    snprintf(buf, sizeof buf, k_full, "");
+    buf[strlen(buf) / 2] = '\0';
+    expect_bad("cut.gltf", buf, "cut.gltf", NULL);
+    /* not JSON at all */
+    expect_bad("junk.gltf", "\x01\x02 this is not glTF", "junk.gltf", NULL);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(g_dir, sizeof g_dir, "/tmp/rs_gltf_XXXXXX");
+    return mkdtemp(g_dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    static const char *files[] = {"quad.bin",  "base.png",     "mr.png",     "normal.png",
+                                  "emis.png",  "full.gltf",    "emis.gltf",  "embedded.glb",
+                                  "notex.gltf", "nobuf.gltf",  "cut.gltf",   "junk.gltf"};
+    size_t i;
+    char p[256];
+    (void)state;
+    for (i = 0; i < sizeof files / sizeof files[0]; ++i) {
+        path_of(p, sizeof p, files[i]);
+        remove(p);
+    }
+    rmdir(g_dir);
+    return 0;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hierarchy_camera_lights),
+        cmocka_unit_test(test_texture_slots),
+        cmocka_unit_test(test_emissive_texture_renders),
+        cmocka_unit_test(test_glb_embedded),
+        cmocka_unit_test(test_bad_files),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
