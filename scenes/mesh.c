@@ -2,6 +2,7 @@
 #define _DEFAULT_SOURCE /* mkstemps, for a glTF binary's embedded textures */
 #include "scenes/mesh.h"
 #include "scenes/gltf.h"
+#include "scenes/ply_strips.h"
 #include "scenes/transform.h"
 
 #include <assimp/cfileio.h>
@@ -233,15 +234,10 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
             const char *name;
             q = p + 7;
             name = next_word(&q, eol, &nn);
-            if (nn == 9 && strncmp(name, "tristrips", 9) == 0) {
-                /* Assimp reads no strips: a stripped model came out as one triangle */
-                fclose(f);
-                rs_free(buf);
-                return rs_error_set(RS_ERR_ARG,
-                                    "%s: PLY header line %u: triangle strips (element tristrips) "
-                                    "are not supported; write the faces as 'element face' lists",
-                                    path, line);
-            }
+            if (nn == 9 && strncmp(name, "tristrips", 9) == 0)
+                /* Assimp reads no strips (a stripped model came out as one triangle): our own
+                 * reader does (scenes/ply_strips.h) */
+                *is_ply_out = 2;
             w = next_word(&q, eol, &wn);
             if (wn)
                 count = strtoull(w, &num_end, 10);
@@ -689,6 +685,83 @@ static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const placement 
     return st;
 }
 
+/* A scene of our own making (a PLY of triangle strips) carries this flag; release_scene frees
+ * it (Assimp's flags stop at 0x20). */
+#define OWN_SCENE 0x40000000u
+
+typedef struct own_scene {
+    struct aiScene scene;
+    struct aiNode root;
+    struct aiMesh mesh, *meshes[1];
+    struct aiVector3D *vertices;
+    struct aiFace *faces;
+    unsigned int *indices;
+    rs_ply_strips strips;
+} own_scene;
+
+static void release_scene(const struct aiScene *as)
+{
+    if (as && (as->mFlags & OWN_SCENE)) {
+        own_scene *o = (own_scene *)(void *)as;
+        rs_free(o->vertices);
+        rs_free(o->faces);
+        rs_free(o->indices);
+        rs_ply_strips_free(&o->strips);
+        rs_free(o);
+    } else if (as) {
+        aiReleaseImport(as);
+    }
+}
+
+/* A PLY of triangle strips decoded into a one-mesh scene, as Assimp would hand it over. */
+static rs_status strips_scene(const char *path, const struct aiScene **out)
+{
+    own_scene *o = (own_scene *)rs_calloc(1, sizeof *o);
+    uint32_t i;
+    rs_status st;
+    if (!o)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    st = rs_ply_read_strips(path, &o->strips);
+    if (st != RS_OK) {
+        rs_free(o);
+        return st;
+    }
+    if (o->strips.n_triangles == 0) {
+        release_scene(&o->scene);
+        return rs_error_set(RS_ERR_ARG, "%s: its triangle strips hold no triangle", path);
+    }
+    o->scene.mFlags = OWN_SCENE;
+    o->vertices = (struct aiVector3D *)rs_alloc(o->strips.n_vertices + 1, sizeof *o->vertices);
+    o->faces = (struct aiFace *)rs_alloc(o->strips.n_triangles, sizeof *o->faces);
+    o->indices = (unsigned int *)rs_alloc(3 * (size_t)o->strips.n_triangles, sizeof *o->indices);
+    if (!o->vertices || !o->faces || !o->indices) {
+        release_scene(&o->scene);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    }
+    for (i = 0; i < o->strips.n_vertices; ++i) {
+        o->vertices[i].x = o->strips.vertices[3 * i];
+        o->vertices[i].y = o->strips.vertices[3 * i + 1];
+        o->vertices[i].z = o->strips.vertices[3 * i + 2];
+    }
+    for (i = 0; i < 3 * o->strips.n_triangles; ++i)
+        o->indices[i] = o->strips.triangles[i];
+    for (i = 0; i < o->strips.n_triangles; ++i) {
+        o->faces[i].mNumIndices = 3;
+        o->faces[i].mIndices = &o->indices[3 * i];
+    }
+    o->mesh.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    o->mesh.mNumVertices = o->strips.n_vertices;
+    o->mesh.mVertices = o->vertices;
+    o->mesh.mNumFaces = o->strips.n_triangles;
+    o->mesh.mFaces = o->faces;
+    o->meshes[0] = &o->mesh;
+    o->scene.mNumMeshes = 1;
+    o->scene.mMeshes = o->meshes;
+    o->scene.mRootNode = &o->root;
+    *out = &o->scene;
+    return RS_OK;
+}
+
 /* Imports `path` through core/file.h with Assimp's `flags` (points and lines dropped, our own
  * checks instead of Assimp's validation; see rs_scene_add_mesh) into *out: a scene with at least
  * one mesh and a root node, or an error (set) and *out NULL. */
@@ -717,6 +790,8 @@ static rs_status import_file(const char *path, unsigned int flags, const struct 
      * below checks every index and coordinate and drops just the bad faces. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE,
                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    if (is_ply == 2)
+        return strips_scene(path, out);
     if (is_ply) {
         /* a PLY is read once without post-processing first: faces without indices are refused
          * before the steps that crash on them see them (has_empty_face) */
@@ -797,7 +872,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         }
     }
     if (!(raw.lo.x <= raw.hi.x)) {
-        aiReleaseImport(as);
+        release_scene(as);
         return rs_error_set(RS_ERR_ARG, "%s: no finite vertex in the file", path);
     }
     if (o->fit) {
@@ -815,7 +890,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     if (o->material == RS_MESH_FILE_MATERIALS) {
         mat_of = (uint32_t *)rs_alloc(as->mNumMaterials ? as->mNumMaterials : 1, sizeof *mat_of);
         if (!mat_of) {
-            aiReleaseImport(as);
+            release_scene(as);
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
         }
         st = check_overrides(as, path, o);
@@ -854,7 +929,11 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         st = add_faces(s, m, &pl, mat, info);
     }
     rs_free(mat_of);
-    aiReleaseImport(as);
+    if (as->mFlags & OWN_SCENE) {
+        info->strips = ((const own_scene *)(const void *)as)->strips.strips;
+        info->joins = ((const own_scene *)(const void *)as)->strips.joins;
+    }
+    release_scene(as);
     if (st == RS_OK && (info->triangles == 0 || info->dropped > info->triangles)) {
         char why[160];
         st = rs_error_set(RS_ERR_ARG, "%s: %s of %u, %u triangles left: the mesh is broken", path,
@@ -1112,7 +1191,7 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
                 rs_mesh_dropped_text(&g.info, why, sizeof why));
     }
     rs_free(g.mat_of);
-    aiReleaseImport(g.as);
+    release_scene(g.as);
     if (st != RS_OK) {
         rs_scene_destroy(g.s);
         return st;

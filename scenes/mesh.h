@@ -8,7 +8,7 @@
  * are dropped and counted by reason, and a mesh that loses more faces than it keeps is an
  * RS_ERR_ARG too (naming the file and the counts), not a render of what is left.  A PLY of
  * triangle strips (`element tristrips`, which Assimp does not read: it made one triangle of a
- * whole model) is refused by name.
+ * whole model) is decoded by scenes/ply_strips.h.
  * Assimp reads every file through core/file.h (the mesh, its MTL, a glTF's buffers), and so do
  * the textures a mesh names: one that is not a regular file of a sane size (a FIFO, /dev/zero, a
  * folder) fails the import, naming it; one that is merely missing does not.  A PLY file must
@@ -49,6 +49,8 @@ typedef struct rs_mesh_info {
                          /* out-of-range vertex index; non-finite vertex; zero area; not a
                             triangle after triangulation (a point or a line) */
     uint32_t materials;  /* materials added from the file */
+    uint32_t strips, joins; /* a PLY of triangle strips: the strips decoded, and the triangles
+                               that only joined them (a repeated vertex: not counted as dropped) */
     rs_aabb bounds;      /* of the placed mesh */
 } rs_mesh_info;
 

@@ -900,8 +900,11 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
         else
             snprintf(mats, sizeof mats, "%u material%s from the file%s", info.materials,
                      info.materials == 1 ? "" : "s", n ? " and the scene's replacements" : "");
-        fprintf(c->log, "raystream: %s: %u triangles, %s%s%s\n", full, info.triangles, mats,
-                info.dropped ? "; " : "", rs_mesh_dropped_text(&info, why, sizeof why));
+        char strips[64] = "";
+        if (info.strips)
+            snprintf(strips, sizeof strips, " (from %u triangle strips)", info.strips);
+        fprintf(c->log, "raystream: %s: %u triangles%s, %s%s%s\n", full, info.triangles, strips,
+                mats, info.dropped ? "; " : "", rs_mesh_dropped_text(&info, why, sizeof why));
     }
     return keep_mesh(c, o, first);
 }

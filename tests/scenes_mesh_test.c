@@ -115,8 +115,7 @@ static void test_malformed(void **state)
      * cannot read (and from "0"), and its post-processing crashed (SIGBUS) on them */
     static const char *const errors[] = {"truncated.ply",          "cut_body.ply",
                                          "bad_number.ply",         "face_past_vertices.ply",
-                                         "empty_face.ply",         "tristrips.ply",
-                                         "mostly_bad.obj",
+                                         "empty_face.ply",         "mostly_bad.obj",
                                          "bad_index.obj",          "empty.obj",
                                          "garbage.obj",            "missing.obj",
                                          ""};
@@ -151,10 +150,11 @@ static void test_malformed(void **state)
         assert_string_equal(rs_mesh_dropped_text(&info, why, sizeof why),
                             "1 faces dropped (1 non-finite vertex)");
     }
-    /* strips: refused by name, not imported as one triangle (Assimp reads no strips) */
+    /* strips: decoded (Assimp reads none and made one triangle of the file) */
     rs_error_clear();
-    assert_int_equal(rs_scene_add_mesh(s, DATA "tristrips.ply", &o, &info), RS_ERR_ARG);
-    assert_non_null(strstr(rs_error_message(), "tristrips"));
+    assert_int_equal(rs_scene_add_mesh(s, DATA "tristrips.ply", &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 2u);
+    assert_int_equal(info.strips, 1u);
     /* more faces lost than kept: an error with the counts by reason */
     rs_error_clear();
     assert_int_equal(rs_scene_add_mesh(s, DATA "mostly_bad.obj", &o, &info), RS_ERR_ARG);
@@ -467,6 +467,134 @@ static void test_builtin_mesh_scenes(void **state)
     rs_scene_destroy(s);
 }
 
+/* ---- triangle strips ----------------------------------------------------------------------- */
+
+/* A 3 x 2 grid of vertices (x right, y up, z = 0), as PLY with double coordinates and an extra
+ * uchar property, in `fmt`; its strips: 0 1 2 3 (two triangles), restart, 2 3 4 5, then 5 5 and
+ * 2 2 (joins), restart, and an index past the vertices.  The first triangle, (0,0) (0,1) (1,0),
+ * faces -z, and so must every other. */
+static void write_strip_ply(const char *path, const char *fmt)
+{
+    static const double xy[6][2] = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 0}, {2, 1}};
+    static const int32_t idx[] = {0, 1, 2, 3, -1, 2, 3, 4, 5, 5, 5, 2, 2, -1, 4, 5, 9};
+    const int n_idx = (int)(sizeof idx / sizeof idx[0]);
+    int ascii = strcmp(fmt, "ascii") == 0, big = strcmp(fmt, "binary_big_endian") == 0, i, k;
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fprintf(f,
+            "ply\nformat %s 1.0\ncomment strips test\nelement vertex 6\nproperty double x\n"
+            "property double y\nproperty uchar quality\nproperty double z\n"
+            "element tristrips 1\nproperty list int int vertex_indices\nend_header\n",
+            fmt);
+    for (i = 0; i < 6; ++i) {
+        double v[3] = {xy[i][0], xy[i][1], 0.0};
+        unsigned char q = 7;
+        if (ascii) {
+            fprintf(f, "%g %g %u %g\n", v[0], v[1], q, v[2]);
+            continue;
+        }
+        for (k = 0; k < 4; ++k) {
+            unsigned char b[8];
+            int j;
+            if (k == 2) {
+                fwrite(&q, 1, 1, f);
+                continue;
+            }
+            memcpy(b, &v[k < 2 ? k : 2], 8);
+            for (j = 0; j < 8; ++j)
+                fputc(b[big ? 7 - j : j], f);
+        }
+    }
+    if (ascii) {
+        fprintf(f, "%d", n_idx);
+        for (i = 0; i < n_idx; ++i)
+            fprintf(f, " %d", idx[i]);
+        fprintf(f, "\n");
+    } else {
+        int32_t all[1 + sizeof idx / sizeof idx[0]];
+        all[0] = n_idx;
+        memcpy(all + 1, idx, sizeof idx);
+        for (i = 0; i <= n_idx; ++i) {
+            unsigned char b[4];
+            int j;
+            memcpy(b, &all[i], 4);
+            for (j = 0; j < 4; ++j)
+                fputc(b[big ? 3 - j : j], f);
+        }
+    }
+    fclose(f);
+}
+
+static void test_strips(void **state)
+{
+    static const char *const fmts[] = {"ascii", "binary_little_endian", "binary_big_endian"};
+    char dir[] = "/tmp/rs_strips_XXXXXX", path[256];
+    rs_tri first[8];
+    uint32_t n_first = 0;
+    size_t k;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/grid.ply", dir);
+    for (k = 0; k < 3; ++k) {
+        uint32_t mat, i;
+        rs_scene *s = new_scene(&mat);
+        rs_mesh_opts o = rs_mesh_opts_default(mat);
+        rs_mesh_info info;
+        write_strip_ply(path, fmts[k]);
+        rs_error_clear();
+        if (rs_scene_add_mesh(s, path, &o, &info) != RS_OK)
+            fail_msg("%s: %s", fmts[k], rs_error_message());
+        /* strip 1: 2 triangles; strip 2: 2, then the joins 4 5 5, 5 5 5, 5 5 2, 5 2 2, 2 2 ...;
+         * strip 3: 4 5 9, whose 9 is past the 6 vertices (dropped) */
+        print_message("%-21s %u triangles, %u strips, %u joins, %u dropped\n", fmts[k],
+                      info.triangles, info.strips, info.joins, info.dropped);
+        assert_int_equal(info.strips, 3u);
+        assert_int_equal(info.triangles, 4u);
+        assert_int_equal(info.dropped, 1u);
+        assert_int_equal(info.dropped_index, 1u);
+        assert_true(info.joins >= 4u);
+        for (i = 0; i < s->n_tris; ++i) {
+            const rs_tri *t = &s->tris[i];
+            rs_vec3 n = rs_v3_cross(rs_v3_sub(t->v1, t->v0), rs_v3_sub(t->v2, t->v0));
+            assert_true(n.z < 0.0f); /* alternate triangles reversed: all face as the first */
+            assert_true(fabsf(rs_v3_length(n) - 1.0f) < 1e-6f);
+        }
+        if (k == 0) {
+            n_first = s->n_tris;
+            memcpy(first, s->tris, n_first * sizeof *first);
+        } else {
+            /* the three encodings give the same triangles */
+            assert_int_equal(s->n_tris, n_first);
+            assert_memory_equal(s->tris, first, n_first * sizeof *first);
+        }
+        rs_scene_destroy(s);
+    }
+    {
+        /* cut in its data: one line naming the file */
+        uint32_t mat;
+        rs_scene *s = new_scene(&mat);
+        rs_mesh_opts o = rs_mesh_opts_default(mat);
+        rs_mesh_info info;
+        FILE *f;
+        long size;
+        write_strip_ply(path, "binary_little_endian");
+        f = fopen(path, "r+b");
+        fseek(f, 0, SEEK_END);
+        size = ftell(f);
+        fclose(f);
+        assert_int_equal(truncate(path, size - 20), 0);
+        rs_error_clear();
+        assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_ERR_ARG);
+        print_message("%s\n", rs_error_message());
+        assert_non_null(strstr(rs_error_message(), path));
+        assert_null(strchr(rs_error_message(), '\n'));
+        rs_error_clear();
+        rs_scene_destroy(s);
+    }
+    remove(path);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -474,6 +602,7 @@ int main(void)
         cmocka_unit_test(test_ply_and_gltf),
         cmocka_unit_test(test_fit),
         cmocka_unit_test(test_malformed),
+        cmocka_unit_test(test_strips),
         cmocka_unit_test(test_file_kinds),
         cmocka_unit_test(test_ply_headers),
         cmocka_unit_test(test_shared_models),
