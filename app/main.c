@@ -26,6 +26,7 @@
 #include "app/timeline_svg.h"
 #include "scenes/builtin.h"
 #include "scenes/gltf.h"
+#include "scenes/scene_export.h"
 #include "scenes/scene_json.h"
 #include "scheduler/fault.h"
 #include "scheduler/passes.h"
@@ -1044,6 +1045,28 @@ static int cmd_render(const rs_cli_options *o)
     return code;
 }
 
+/* raystream export SCENE -o FILE.json */
+static int cmd_export(const rs_cli_options *o)
+{
+    render_run r;
+    int code;
+    size_t n = o->output ? strlen(o->output) : 0;
+    if (!o->output || n < 5 || strcmp(o->output + n - 5, ".json") != 0) {
+        fprintf(stderr, "raystream: export needs -o FILE.json\n");
+        return RS_EXIT_USAGE;
+    }
+    memset(&r, 0, sizeof r);
+    if ((code = load_scene_bounded(o, &r)) == RS_EXIT_OK) {
+        if (rs_scene_export_json(r.scene, o->output) != RS_OK)
+            code = fail(RS_EXIT_RUNTIME, NULL);
+        else if (!o->quiet)
+            fprintf(stderr, "raystream: wrote %s (%u spheres, %u quads, %u triangles)\n",
+                    o->output, r.scene->n_spheres, r.scene->n_quads, r.scene->n_tris);
+    }
+    run_release(&r);
+    return code;
+}
+
 int main(int argc, char **argv)
 {
     rs_cli_options o;
@@ -1059,6 +1082,7 @@ int main(int argc, char **argv)
     case RS_CMD_VERSION: return cmd_version();
     case RS_CMD_SCENES: return cmd_scenes();
     case RS_CMD_RENDER: return cmd_render(&o);
+    case RS_CMD_EXPORT: return cmd_export(&o);
     }
     return RS_EXIT_OK;
 }

@@ -131,6 +131,18 @@ static int parse_devices(const char *text, rs_cli_options *o)
 
 void rs_cli_print_help(const char *command)
 {
+    if (command && strcmp(command, "export") == 0) {
+        printf("usage: raystream export SCENE -o FILE.json [--models DIR] [--camera NAME]\n"
+               "\n"
+               "Writes SCENE (builtin:NAME, FILE.json or FILE.gltf) as a scene file\n"
+               "(docs/scene-format.md): the camera, image size, background, textures,\n"
+               "materials (m0, m1, ...) and every primitive as an object.  Image textures\n"
+               "and an environment map go beside it as FILE-image-N.exr.  Numbers keep 9\n"
+               "digits, so the file renders the scene bit for bit.  A scene with what the\n"
+               "format cannot say (vertex normals, punctual lights, glTF textures) is\n"
+               "refused.\n");
+        return;
+    }
     if (command && strcmp(command, "render") == 0) {
         printf(
             "usage: raystream render [SCENE] [options]\n"
@@ -241,6 +253,8 @@ void rs_cli_print_help(const char *command)
            "commands:\n"
            "  render [SCENE] [options]   render a scene to an image (default builtin:cornell)\n"
            "  scenes                     list the built-in scenes\n"
+           "  export SCENE -o FILE.json  write a scene (a built-in one, say) as a scene file\n"
+           "                             (image textures beside it as FILE-image-N.exr)\n"
            "  help [COMMAND]             show help (also -h, --help)\n"
            "  version                    show the version and the build's features (also\n"
            "                             --version)\n"
@@ -508,6 +522,10 @@ static int parse_command(int argc, char **argv, rs_cli_options *o, int *rc)
         o->command = RS_CMD_SCENES;
         return 1;
     }
+    if (strcmp(argv[1], "export") == 0) {
+        o->command = RS_CMD_EXPORT; /* then the render's options: the scene and -o matter */
+        return 0;
+    }
     if (strcmp(argv[1], "render") != 0) {
         *rc = usage_error("unknown command '%s'%s", argv[1], "");
         return 1;
@@ -567,6 +585,9 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->n_devices = 0;
     if (parse_command(argc, argv, o, &rc))
         return rc;
+    if (o->command == RS_CMD_EXPORT) {
+        /* export takes the render's options; they are parsed below as the render's */
+    }
 
     for (i = 2; i < argc; ++i) {
         const char *a = argv[i];
@@ -592,8 +613,9 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
             continue;
         }
         if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
+            int export = o->command == RS_CMD_EXPORT;
             o->command = RS_CMD_HELP;
-            o->scene = "render";
+            o->scene = export ? "export" : "render";
             return RS_EXIT_OK;
         }
         if (strcmp(name, "-q") == 0 || strcmp(name, "--quiet") == 0) {

@@ -21,7 +21,8 @@ typedef enum rs_cli_command {
     RS_CMD_RENDER,
     RS_CMD_SCENES,
     RS_CMD_HELP,
-    RS_CMD_VERSION
+    RS_CMD_VERSION,
+    RS_CMD_EXPORT
 } rs_cli_command;
 
 typedef struct rs_device_spec {

@@ -716,11 +716,34 @@ static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xfor
     return read_rotation(c, it, q, out);
 }
 
-/* A rotation: [x, y, z] (degrees about x, then y, then z) or {"axis": [x, y, z], "degrees": a}. */
+/* A rotation: [x, y, z] (degrees about x, then y, then z), {"axis": [x, y, z], "degrees": a},
+ * or {"matrix": [9 numbers, row by row]} (orthonormal with determinant 1 to 1e-4). */
 static rs_status read_rotation(ctx *c, const cJSON *it, const char *q, rs_xform *out)
 {
     static const char *const k_axis[] = {"axis", "degrees", NULL};
+    static const char *const k_mat[] = {"matrix", NULL};
     rs_vec3 v;
+    if (cJSON_IsObject(it) && cJSON_GetObjectItemCaseSensitive(it, "matrix")) {
+        const cJSON *m = cJSON_GetObjectItemCaseSensitive(it, "matrix");
+        char mp[300];
+        double scale;
+        int i;
+        TRY(check_keys(c, it, q, k_mat));
+        subpath(mp, sizeof mp, q, "matrix");
+        if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 9)
+            return FAIL(c, mp, "expected 9 numbers (a 3x3 rotation, row by row)");
+        *out = rs_xform_identity();
+        for (i = 0; i < 9; ++i) {
+            const cJSON *e = cJSON_GetArrayItem(m, i);
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+                return FAIL(c, mp, "expected 9 finite numbers");
+            out->m[i / 3][i % 3] = e->valuedouble;
+        }
+        if (!rs_xform_is_similarity(out, &scale) || fabs(scale - 1.0) > 1e-4 ||
+            rs_xform_det(out) < 0)
+            return FAIL(c, mp, "not a rotation (rows must be orthonormal, determinant 1)");
+        return RS_OK;
+    }
     if (cJSON_IsObject(it)) {
         double axis[3];
         float deg;
@@ -832,8 +855,8 @@ static rs_status copy_mesh(ctx *c, const mesh_copy *m)
  * or some of its materials replaced by name ("materials": {"file's name": "scene's name"}). */
 static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
 {
-    static const char *const keys[] = {"type",      "file", "material", "materials", "fit",
-                                       "transform", NULL};
+    static const char *const keys[] = {"type",  "file",   "material", "materials", "scale",
+                                       "rotate", "fit",   "transform", NULL};
     static const char *const k_fit[] = {"size", "base", NULL};
     const char *file = "", *names[MAX_OVERRIDES];
     const cJSON *ov = cJSON_GetObjectItemCaseSensitive(o, "materials");
@@ -843,6 +866,7 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
     rs_mesh_opts mo = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
     rs_mesh_info info;
     rs_status st;
+    mo.strict_textures = 1; /* a scene file's textures must be there */
     TRY(check_keys(c, o, path, keys));
     TRY(get_string(c, o, path, "file", &file));
     if (cJSON_GetObjectItemCaseSensitive(o, "material")) {
@@ -870,6 +894,13 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
         mo.override_ids = ids;
         mo.n_overrides = n;
     }
+    /* the thesis's placement, applied to the file's coordinates before the fit: a scale per
+     * axis, then rotations about x, y and z (degrees) */
+    TRY(get_vec3(c, o, path, "scale", 0, rs_v3(1, 1, 1), &mo.scale));
+    subpath(p, sizeof p, path, "scale");
+    if (mo.scale.x == 0 || mo.scale.y == 0 || mo.scale.z == 0)
+        return FAIL(c, p, "a scale must not be 0 (it would flatten the mesh)");
+    TRY(get_vec3(c, o, path, "rotate", 0, rs_v3(0, 0, 0), &mo.rotate_deg));
     if (fit) {
         subpath(p, sizeof p, path, "fit");
         if (!cJSON_IsObject(fit))
@@ -911,8 +942,8 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
 
 static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const char *type)
 {
-    static const char *const k_sphere[] = {"type",      "center",    "radius", "material",
-                                           "moving_to", "transform", NULL};
+    static const char *const k_sphere[] = {"type",     "center",    "radius",    "material",
+                                           "moving_to", "velocity", "transform", NULL};
     static const char *const k_quad[] = {"type", "q", "u", "v", "material", "transform", NULL};
     static const char *const k_tri[] = {"type", "vertices", "uv", "material", "transform", NULL};
     static const char *const k_box[] = {"type",      "min",      "max",       "rotate_y",
@@ -926,10 +957,23 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
         TRY(get_vec3(c, o, path, "center", 1, rs_v3(0, 0, 0), &center));
         TRY(get_num(c, o, path, "radius", 1, 0, 1e-30, 1e30, &r));
         TRY(object_material(c, o, path, &mat));
+        if (cJSON_GetObjectItemCaseSensitive(o, "moving_to") &&
+            cJSON_GetObjectItemCaseSensitive(o, "velocity"))
+            return FAIL(c, path, "give either 'moving_to' or 'velocity', not both");
         if (cJSON_GetObjectItemCaseSensitive(o, "moving_to")) {
             /* the centre moves linearly from `center` at time 0 to `moving_to` at time 1 */
             TRY(get_vec3(c, o, path, "moving_to", 1, center, &to));
             return rs_scene_add_moving_sphere(s, center, 0.0f, to, 1.0f, r, mat);
+        }
+        if (cJSON_GetObjectItemCaseSensitive(o, "velocity")) {
+            /* the centre at time t is center + t velocity (what `raystream export` writes: the
+             * stored motion exactly) */
+            rs_vec3 vel;
+            TRY(get_vec3(c, o, path, "velocity", 1, center, &vel));
+            TRY(rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, vel), 1.0f, r,
+                                           mat));
+            s->sphere_motion[s->n_spheres - 1] = vel;
+            return RS_OK;
         }
         return rs_scene_add_sphere(s, center, r, mat);
     }

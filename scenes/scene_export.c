@@ -1,0 +1,292 @@
+/* scenes/scene_export.c — see scene_export.h. */
+#include "scenes/scene_export.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/file.h"
+#include "core/image_io.h"
+
+static void num(FILE *f, float x) { fprintf(f, "%.9g", (double)x); }
+
+static void vec(FILE *f, rs_vec3 v)
+{
+    fputc('[', f);
+    num(f, v.x);
+    fputs(", ", f);
+    num(f, v.y);
+    fputs(", ", f);
+    num(f, v.z);
+    fputc(']', f);
+}
+
+/* "DIR/STEM-image-N.exr" for image i of the file at `path`, and its name relative to the file. */
+static void image_name(const char *path, uint32_t i, char *full, size_t n, char *rel, size_t rn)
+{
+    const char *slash = strrchr(path, '/'), *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    int stem = dot ? (int)(dot - base) : (int)strlen(base);
+    snprintf(rel, rn, "%.*s-image-%u.exr", stem, base, i);
+    if (slash)
+        snprintf(full, n, "%.*s/%s", (int)(slash - path), path, rel);
+    else
+        snprintf(full, n, "%s", rel);
+}
+
+static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m, uint32_t i)
+{
+    const char *albedo_key = "albedo";
+    fprintf(f, "    \"m%u\": { \"type\": ", i);
+    switch (m->type) {
+    case RS_MAT_LAMBERTIAN: fputs("\"lambertian\"", f); break;
+    case RS_MAT_DIFFUSE_UNIFORM: fputs("\"diffuse_uniform\"", f); break;
+    case RS_MAT_DISNEY_DIFFUSE:
+        fputs("\"disney_diffuse\", \"roughness\": ", f);
+        num(f, m->roughness);
+        break;
+    case RS_MAT_PHONG:
+        fputs("\"phong\", \"ks\": ", f);
+        vec(f, m->specular);
+        fputs(", \"exponent\": ", f);
+        num(f, m->exponent);
+        albedo_key = "kd";
+        break;
+    case RS_MAT_METAL:
+        fputs("\"metal\", \"fuzz\": ", f);
+        num(f, m->fuzz);
+        break;
+    case RS_MAT_DIELECTRIC:
+        fputs("\"dielectric\", \"ior\": ", f);
+        num(f, m->ior);
+        if (m->flags & RS_MAT_EXACT_FRESNEL)
+            fputs(", \"fresnel\": \"exact\"", f);
+        albedo_key = "tint";
+        break;
+    case RS_MAT_DIFFUSE_LIGHT:
+        fputs("\"light\", \"emission\": ", f);
+        vec(f, m->emission);
+        if (m->flags & RS_MAT_TWO_SIDED)
+            fputs(", \"two_sided\": true", f);
+        fputs(" }", f);
+        return RS_OK;
+    case RS_MAT_CONDUCTOR:
+        fputs("\"conductor\", \"roughness\": ", f);
+        num(f, sqrtf(m->alpha));
+        if (m->flags & RS_MAT_F0_COLOR) {
+            albedo_key = "color";
+        } else {
+            fputs(", \"eta\": ", f);
+            vec(f, m->eta);
+            fputs(", \"k\": ", f);
+            vec(f, m->k);
+            fputs(" }", f);
+            return RS_OK;
+        }
+        break;
+    case RS_MAT_ROUGH_DIELECTRIC:
+        fputs("\"rough_dielectric\", \"ior\": ", f);
+        num(f, m->ior);
+        fputs(", \"roughness\": ", f);
+        num(f, sqrtf(m->alpha));
+        albedo_key = "tint";
+        break;
+    case RS_MAT_PBR:
+        if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
+            m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission))
+            return rs_error_set(RS_ERR_ARG, "material %u: a pbr material's metallic-roughness, "
+                                            "emissive and normal textures have no place in a "
+                                            "scene file", i);
+        fputs("\"pbr\", \"metallic\": ", f);
+        num(f, m->metallic);
+        fputs(", \"roughness\": ", f);
+        num(f, sqrtf(m->alpha));
+        albedo_key = "base_color";
+        break;
+    default: return rs_error_set(RS_ERR_ARG, "material %u: unknown type %u", i, m->type);
+    }
+    if (m->flags & RS_MAT_UNIFORM_SAMPLING)
+        fputs(", \"importance_sampling\": false", f);
+    if (m->albedo_tex != RS_NO_TEXTURE && m->type != RS_MAT_METAL &&
+        m->type != RS_MAT_DIELECTRIC && m->type != RS_MAT_ROUGH_DIELECTRIC) {
+        fprintf(f, ", \"texture\": \"t%u\" }", m->albedo_tex);
+    } else {
+        fprintf(f, ", \"%s\": ", albedo_key);
+        vec(f, m->albedo);
+        fputs(" }", f);
+    }
+    (void)s;
+    return RS_OK;
+}
+
+static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
+{
+    const rs_camera_desc *c = &s->camera;
+    uint32_t i, first = 1;
+    rs_status st = RS_OK;
+    if (s->tri_normal)
+        for (i = 0; i < 9 * s->n_tris; ++i)
+            if (s->tri_normal[i] != 0.0f)
+                return rs_error_set(RS_ERR_ARG, "its triangles have vertex normals, which a "
+                                                "scene file's triangles do not (use a mesh "
+                                                "object)");
+    if (s->n_punctuals)
+        return rs_error_set(RS_ERR_ARG, "it has point, spot or directional lights, which a "
+                                        "scene file does not have");
+    fputs("{\n  \"camera\": { \"from\": ", f);
+    vec(f, c->from);
+    fputs(", \"at\": ", f);
+    vec(f, c->at);
+    fputs(", \"up\": ", f);
+    vec(f, c->up);
+    fputs(", \"vfov\": ", f);
+    num(f, c->vfov_deg);
+    if (c->aperture > 0) {
+        fputs(", \"aperture\": ", f);
+        num(f, c->aperture);
+    }
+    if (c->focus_dist > 0) {
+        fputs(", \"focus_distance\": ", f);
+        num(f, c->focus_dist);
+    }
+    if (c->shutter_open != 0 || c->shutter_close != 0) {
+        fputs(", \"shutter\": [", f);
+        num(f, c->shutter_open);
+        fputs(", ", f);
+        num(f, c->shutter_close);
+        fputc(']', f);
+    }
+    fprintf(f, " },\n  \"image\": { \"width\": %u, \"height\": %u },\n", s->width, s->height);
+    /* every image as an EXR beside the file */
+    for (i = 0; i < s->n_images && st == RS_OK; ++i) {
+        char full[1024], rel[512];
+        image_name(path, i, full, sizeof full, rel, sizeof rel);
+        st = rs_image_write(full, s->images[i].width, s->images[i].height, s->images[i].rgb);
+    }
+    if (st != RS_OK)
+        return st;
+    if (s->env_image != RS_NO_TEXTURE) {
+        char full[1024], rel[512];
+        const float *r = s->env_rot;
+        image_name(path, s->env_image, full, sizeof full, rel, sizeof rel);
+        fprintf(f, "  \"background\": { \"map\": \"%s\", \"scale\": ", rel);
+        vec(f, s->env_scale);
+        /* the map's rotation in the world is the transpose of world -> map */
+        fputs(", \"rotate\": { \"matrix\": [", f);
+        for (i = 0; i < 9; ++i) {
+            num(f, r[3 * (i % 3) + i / 3]);
+            fputs(i < 8 ? ", " : "", f);
+        }
+        fputs("] } },\n", f);
+    } else if (s->background_sky) {
+        fputs("  \"background\": { \"horizon\": ", f);
+        vec(f, s->background);
+        fputs(", \"zenith\": ", f);
+        vec(f, s->background_top);
+        fputs(" },\n", f);
+    } else {
+        fputs("  \"background\": ", f);
+        vec(f, s->background);
+        fputs(",\n", f);
+    }
+    if (s->n_textures) {
+        fputs("  \"textures\": {\n", f);
+        for (i = 0; i < s->n_textures; ++i) {
+            const rs_texture *t = &s->textures[i];
+            fprintf(f, "    \"t%u\": { \"type\": ", i);
+            if (t->type == RS_TEX_SOLID) {
+                fputs("\"solid\", \"color\": ", f);
+                vec(f, t->a);
+            } else if (t->type == RS_TEX_CHECKER || t->type == RS_TEX_STRIPES) {
+                fprintf(f, "\"%s\", \"a\": ", t->type == RS_TEX_CHECKER ? "checker" : "stripes");
+                vec(f, t->a);
+                fputs(", \"b\": ", f);
+                vec(f, t->b);
+                fputs(", \"scale\": ", f);
+                num(f, t->scale);
+            } else {
+                char full[1024], rel[512];
+                image_name(path, t->image, full, sizeof full, rel, sizeof rel);
+                fprintf(f, "\"image\", \"file\": \"%s\"", rel);
+            }
+            fprintf(f, " }%s\n", i + 1 < s->n_textures ? "," : "");
+        }
+        fputs("  },\n", f);
+    }
+    fputs("  \"materials\": {\n", f);
+    for (i = 0; i < s->n_materials && st == RS_OK; ++i) {
+        st = write_material(f, s, &s->materials[i], i);
+        fputs(i + 1 < s->n_materials ? ",\n" : "\n", f);
+    }
+    if (st != RS_OK)
+        return st;
+    fputs("  },\n  \"objects\": [\n", f);
+    for (i = 0; i < s->n_spheres; ++i, first = 0) {
+        fprintf(f, "%s    { \"type\": \"sphere\", \"center\": ", first ? "" : ",\n");
+        vec(f, s->spheres[i].center);
+        fputs(", \"radius\": ", f);
+        num(f, s->spheres[i].radius);
+        if (s->sphere_motion && !rs_v3_is_zero(s->sphere_motion[i])) {
+            fputs(", \"velocity\": ", f);
+            vec(f, s->sphere_motion[i]);
+        }
+        fprintf(f, ", \"material\": \"m%u\" }", s->sphere_mat[i]);
+    }
+    for (i = 0; i < s->n_quads; ++i, first = 0) {
+        fprintf(f, "%s    { \"type\": \"quad\", \"q\": ", first ? "" : ",\n");
+        vec(f, s->quads[i].q);
+        fputs(", \"u\": ", f);
+        vec(f, s->quads[i].u);
+        fputs(", \"v\": ", f);
+        vec(f, s->quads[i].v);
+        fprintf(f, ", \"material\": \"m%u\" }", s->quad_mat[i]);
+    }
+    for (i = 0; i < s->n_tris; ++i, first = 0) {
+        fprintf(f, "%s    { \"type\": \"triangle\", \"vertices\": [", first ? "" : ",\n");
+        vec(f, s->tris[i].v0);
+        fputs(", ", f);
+        vec(f, s->tris[i].v1);
+        fputs(", ", f);
+        vec(f, s->tris[i].v2);
+        fputc(']', f);
+        if (s->tri_uv) {
+            int k;
+            fputs(", \"uv\": [", f);
+            for (k = 0; k < 6; ++k) {
+                num(f, s->tri_uv[6 * (size_t)i + k]);
+                fputs(k < 5 ? ", " : "]", f);
+            }
+        }
+        fprintf(f, ", \"material\": \"m%u\" }", s->tri_mat[i]);
+    }
+    fputs("\n  ]\n}\n", f);
+    return RS_OK;
+}
+
+rs_status rs_scene_export_json(const rs_scene *s, const char *path)
+{
+    char tmp[1100];
+    FILE *f;
+    rs_status st;
+    if (!rs_file_temp_name(path, tmp, sizeof tmp))
+        return rs_error_set(RS_ERR_IO, "%s: path too long", path);
+    f = fopen(tmp, "w");
+    if (!f)
+        return rs_error_set(RS_ERR_IO, "%s: cannot write", path);
+    st = write_all(f, s, path);
+    if (fclose(f) != 0 && st == RS_OK)
+        st = rs_error_set(RS_ERR_IO, "%s: cannot write", path);
+    if (st == RS_OK && rename(tmp, path) != 0)
+        st = rs_error_set(RS_ERR_IO, "%s: cannot write", path);
+    if (st != RS_OK) {
+        unlink(tmp);
+        if (!strstr(rs_error_message(), path)) {
+            char msg[600];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            rs_error_set(st, "%s: %s", path, msg);
+        }
+    }
+    return st;
+}
