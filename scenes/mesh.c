@@ -817,7 +817,7 @@ static rs_status import_file(const char *path, unsigned int flags, const struct 
         return rs_error_set(mio.refused, "%s: %s", path, mio.why);
     }
     if (!as || !as->mRootNode) {
-        st = rs_error_set(RS_ERR_ARG, "%s: cannot import mesh: %s", path, aiGetErrorString());
+        st = rs_error_set(RS_ERR_ARG, "%s: cannot import: %s", path, aiGetErrorString());
         if (as)
             aiReleaseImport(as);
         return st;

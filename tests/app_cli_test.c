@@ -1563,6 +1563,98 @@ static void expect_same_image(const proc *p, const fixture *f, const char *a, co
     rs_free(y.rgb);
 }
 
+/* Scenes as users make them: bad glTF, instance cycles, absurd transforms, a camera the file
+ * lacks, a missing environment map: exit 1 (2 for a misused option), one line naming the file,
+ * no image.  `raystream export` of builtin:cornell renders builtin:cornell bit for bit. */
+static void write_in(const fixture *f, const char *name, const char *text)
+{
+    char path[512];
+    FILE *fp;
+    path_in(f, name, path, sizeof path);
+    fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs(text, fp);
+    fclose(fp);
+}
+
+static void test_user_scenes(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const struct {
+        const char *file, *text, *words[2];
+        const char *extra;
+        int code;
+    } cases[] = {
+        {"cut.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],\"nod",
+         {"cut.gltf", NULL}, NULL, 1},
+        {"cycle.json",
+         "{\"camera\":{\"from\":[0,0,5],\"at\":[0,0,0]},\"groups\":{\"a\":[{\"type\":"
+         "\"instance\",\"group\":\"b\"}],\"b\":[{\"type\":\"instance\",\"group\":\"a\"}]},"
+         "\"objects\":[{\"type\":\"instance\",\"group\":\"a\"}]}",
+         {"cycle.json", "cycle: a -> b -> a"}, NULL, 1},
+        {"flat.json",
+         "{\"camera\":{\"from\":[0,0,5],\"at\":[0,0,0]},\"materials\":{\"m\":{\"type\":"
+         "\"lambertian\"}},\"objects\":[{\"type\":\"quad\",\"q\":[0,0,0],\"u\":[1,0,0],"
+         "\"v\":[0,1,0],\"material\":\"m\",\"transform\":{\"scale\":[1,1,0]}}]}",
+         {"flat.json", "objects[0].transform.scale"}, NULL, 1},
+        {"cam.json", "{}", {"--camera", NULL}, "--camera", 2},
+        {"env.json", NULL, {"nosuch.exr", NULL}, "--envmap", 1},
+    };
+    size_t k;
+    char path[512];
+    proc p;
+    for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        const char *args[12];
+        int n = 0;
+        if (cases[k].text)
+            write_in(f, cases[k].file, cases[k].text);
+        args[n++] = "render";
+        args[n++] = cases[k].text ? cases[k].file
+                                  : RS_SOURCE_DIR "/scenes/examples/cornell.json";
+        if (cases[k].extra) {
+            args[n++] = cases[k].extra;
+            args[n++] = strcmp(cases[k].extra, "--camera") == 0 ? "front" : "nosuch.exr";
+        }
+        args[n++] = "--width";
+        args[n++] = "16";
+        args[n++] = "-o";
+        args[n++] = "user.png";
+        args[n] = NULL;
+        run(&p, f->dir, DEFAULT_TIMEOUT_S, args);
+        EXPECT(&p,
+               exited_with(&p, cases[k].code) && one_line(&p.err) &&
+                   strstr(p.err.data, cases[k].words[0]) &&
+                   (!cases[k].words[1] || strstr(p.err.data, cases[k].words[1])),
+               "%s: exit %d, one line naming it", cases[k].file, cases[k].code);
+        path_in(f, "user.png", path, sizeof path);
+        EXPECT(&p, !file_exists(path), "%s: an image was written for a refused scene",
+               cases[k].file);
+        proc_free(&p);
+    }
+    {
+        /* export, then render the file: the built-in scene's image bit for bit */
+        static const char *const exp[] = {"export", "builtin:cornell", "-q", "-o", "e.json",
+                                          NULL};
+        static const char *const from_file[] = {"render", "e.json", "--width", "24", "--spp",
+                                                "2", "-q", "-o", "e.exr", NULL};
+        static const char *const builtin[] = {"render", "builtin:cornell", "--width", "24",
+                                              "--spp", "2", "-q", "-o", "b.exr", NULL};
+        static const char *const bad_out[] = {"export", "builtin:cornell", "-q", "-o", "e.png",
+                                              NULL};
+        run_expect(f, exp, 0, &p);
+        proc_free(&p);
+        run_expect(f, from_file, 0, &p);
+        proc_free(&p);
+        run_expect(f, builtin, 0, &p);
+        expect_same_image(&p, f, "e.exr", "b.exr");
+        proc_free(&p);
+        run(&p, f->dir, DEFAULT_TIMEOUT_S, bad_out);
+        EXPECT(&p, exited_with(&p, 2) && one_line(&p.err) && strstr(p.err.data, "-o FILE.json"),
+               "export to a .png: a usage error");
+        proc_free(&p);
+    }
+}
+
 /* --time-limit: a render that would take minutes stops on a whole pass, says how many spp it
  * did (summary, --stats-json), and its image is the one `--spp THAT` gives, bit for bit: every
  * pixel has that many samples and the image is divided by them.  Stream and megakernel. */
@@ -1956,6 +2048,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_device_fault_and_stats, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_user_scenes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_files_and_meshes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_stage_stats_and_timeline, setup, teardown),
         cmocka_unit_test_setup_teardown(test_time_limit, setup, teardown),
