@@ -158,28 +158,20 @@ RS_HD float rs_schlick(float cos_theta, float eta)
 /* f(wo, wi) of a non-delta material; zero when wi is below the surface (unless the material
  * transmits).  `albedo` is the material's albedo after texturing; `front`: wo is on the side the
  * geometric normal faces (only a transmitting material reads it). */
+RS_HD_COLD rs_vec3 rs_bsdf_eval_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                    rs_vec3 wi, int front);
+RS_HD_COLD float rs_bsdf_pdf_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                 rs_vec3 wi, int front);
+
 RS_HD rs_vec3 rs_bsdf_eval_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
                                 rs_vec3 wi, int front)
 {
     float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo);
-    if (rs_material_transmits(m)) {
-        float pdf;
-        return rs_v3_scale(albedo, rs_rough_glass(m, front, n, wo, wi, &pdf));
-    }
+    if (m->type >= RS_MAT_CONDUCTOR)
+        return rs_bsdf_eval_ggx(m, albedo, n, wo, wi, front);
     if (!(ci > 0.0f && co > 0.0f))
         return rs_v3_splat(0.0f);
     switch (m->type) {
-    case RS_MAT_CONDUCTOR: {
-        float pdf, wo_h, spec = rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
-        return rs_v3_scale(rs_conductor_fresnel(m, albedo, wo_h), spec);
-    }
-    case RS_MAT_PBR: {
-        float pdf, wo_h, spec = rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
-        float fd = rs_fresnel_schlick3(wo_h, rs_v3_splat(0.04f)).x;
-        rs_vec3 diel = rs_v3_add(rs_v3_splat(fd * spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
-        rs_vec3 metal = rs_v3_scale(rs_fresnel_schlick3(wo_h, albedo), spec);
-        return rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
-    }
     case RS_MAT_LAMBERTIAN: return rs_v3_scale(albedo, RS_INV_PI);
     case RS_MAT_DIFFUSE_UNIFORM: return rs_v3_scale(albedo, 0.5f * RS_INV_PI / ci);
     case RS_MAT_DISNEY_DIFFUSE: {
@@ -201,6 +193,27 @@ RS_HD rs_vec3 rs_bsdf_eval_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n,
     }
 }
 
+/* The GGX materials' f (out of line: see RS_HD_COLD). */
+RS_HD_COLD rs_vec3 rs_bsdf_eval_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                    rs_vec3 wi, int front)
+{
+    float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo), pdf, wo_h, spec;
+    if (rs_material_transmits(m))
+        return rs_v3_scale(albedo, rs_rough_glass(m, front, n, wo, wi, &pdf));
+    if (!(ci > 0.0f && co > 0.0f) || m->type == RS_MAT_ROUGH_DIELECTRIC)
+        return rs_v3_splat(0.0f);
+    spec = rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
+    if (m->type == RS_MAT_CONDUCTOR)
+        return rs_v3_scale(rs_conductor_fresnel(m, albedo, wo_h), spec);
+    {
+        float fd = rs_fresnel_schlick3(wo_h, rs_v3_splat(0.04f)).x;
+        rs_vec3 diel =
+            rs_v3_add(rs_v3_splat(fd * spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
+        rs_vec3 metal = rs_v3_scale(rs_fresnel_schlick3(wo_h, albedo), spec);
+        return rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
+    }
+}
+
 RS_HD rs_vec3 rs_bsdf_eval(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, rs_vec3 wi)
 {
     return rs_bsdf_eval_side(m, albedo, n, wo, wi, 1);
@@ -210,25 +223,13 @@ RS_HD rs_vec3 rs_bsdf_eval(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_v
 RS_HD float rs_bsdf_pdf_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
                              rs_vec3 wi, int front)
 {
-    float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo);
-    if (rs_material_transmits(m)) {
-        float pdf;
-        rs_rough_glass(m, front, n, wo, wi, &pdf);
-        return pdf;
-    }
-    if (!(ci > 0.0f) || !(co > 0.0f))
+    float ci = rs_v3_dot(n, wi);
+    if (m->type >= RS_MAT_CONDUCTOR)
+        return rs_bsdf_pdf_ggx(m, albedo, n, wo, wi, front);
+    if (!(ci > 0.0f) || !(rs_v3_dot(n, wo) > 0.0f))
         return 0.0f;
     if ((m->flags & RS_MAT_UNIFORM_SAMPLING) || m->type == RS_MAT_DIFFUSE_UNIFORM)
         return rs_pdf_uniform_hemisphere(ci);
-    if (m->type == RS_MAT_CONDUCTOR || m->type == RS_MAT_PBR) {
-        float pdf, wo_h;
-        rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
-        if (m->type == RS_MAT_PBR) {
-            float ps = rs_pbr_spec_prob(m, albedo, co);
-            pdf = ps * pdf + (1.0f - ps) * rs_pdf_cosine_hemisphere(ci);
-        }
-        return pdf;
-    }
     if (m->type == RS_MAT_PHONG) {
         float pd = rs_phong_diffuse_prob(albedo, m->specular);
         float ca = rs_v3_dot(rs_reflect(wo, n), wi);
@@ -236,6 +237,24 @@ RS_HD float rs_bsdf_pdf_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs
                (1.0f - pd) * rs_pdf_power_cosine(m->exponent, ca);
     }
     return rs_pdf_cosine_hemisphere(ci);
+}
+
+RS_HD_COLD float rs_bsdf_pdf_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                 rs_vec3 wi, int front)
+{
+    float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo), pdf, wo_h;
+    if (rs_material_transmits(m)) {
+        rs_rough_glass(m, front, n, wo, wi, &pdf);
+        return pdf;
+    }
+    if (!(ci > 0.0f) || !(co > 0.0f) || m->type == RS_MAT_ROUGH_DIELECTRIC)
+        return 0.0f;
+    rs_ggx_reflect(m->alpha, n, wo, wi, co, ci, &pdf, &wo_h);
+    if (m->type == RS_MAT_PBR) {
+        float ps = rs_pbr_spec_prob(m, albedo, co);
+        pdf = ps * pdf + (1.0f - ps) * rs_pdf_cosine_hemisphere(ci);
+    }
+    return pdf;
 }
 
 RS_HD float rs_bsdf_pdf(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, rs_vec3 wi)
@@ -253,60 +272,48 @@ RS_HD rs_vec3 rs_ggx_sample_reflect(float alpha, const rs_onb *frame, rs_vec3 wo
     return rs_reflect(wo, h);
 }
 
-/* Draws wi for wo from three uniform numbers.  Returns 0 when the sample carries nothing (below
- * the surface, absorbed): the path ends there. */
-RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, int front,
-                         float u1, float u2, float u3, rs_scatter *out)
+/* Smooth glass: reflection with the Fresnel probability (Schlick's, or exactly), else Snell's
+ * refraction; total internal reflection; weight the tint. */
+RS_HD int rs_sample_glass(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, int front,
+                          float u3, int exact, rs_scatter *out)
+{
+    float eta = front ? 1.0f / m->ior : m->ior;
+    float co = rs_fminf(rs_v3_dot(wo, n), 1.0f);
+    float so = sqrtf(rs_fmaxf(0.0f, 1.0f - co * co));
+    out->delta = 1;
+    out->weight = albedo;
+    if (eta * so > 1.0f ||
+        (exact ? rs_fresnel_dielectric(co, 1.0f / eta) : rs_schlick(co, eta)) > u3) {
+        out->wi = rs_reflect(wo, n);
+    } else {
+        /* Snell: the perpendicular part scales by eta, the parallel part fills the rest */
+        rs_vec3 perp = rs_v3_scale(rs_v3_madd(rs_v3_neg(wo), n, co), eta);
+        rs_vec3 par = rs_v3_scale(n, -sqrtf(fabsf(1.0f - rs_v3_length2(perp))));
+        out->wi = rs_v3_normalize(rs_v3_add(perp, par));
+        out->transmit = 1;
+    }
+    return 1;
+}
+
+/* The GGX materials' sampling (out of line: see RS_HD_COLD); out's flags are reset. */
+RS_HD_COLD int rs_bsdf_sample_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                  int front, float u1, float u2, float u3, rs_scatter *out)
 {
     rs_onb frame;
-    rs_vec3 f;
-    float ci;
-    out->delta = 0;
-    out->transmit = 0;
-    out->pdf = 0.0f;
-    if (m->type == RS_MAT_METAL) {
-        rs_vec3 r =
-            rs_v3_add(rs_reflect(wo, n), rs_v3_scale(rs_sample_uniform_sphere(u1, u2), m->fuzz));
-        if (!(rs_v3_dot(r, n) > 0.0f) || rs_v3_is_zero(r))
-            return 0; /* fuzzed below the surface: absorbed (RTIOW) */
-        out->wi = rs_v3_normalize(r);
-        out->weight = albedo;
-        out->delta = 1;
-        return 1;
-    }
-    if (m->type == RS_MAT_CONDUCTOR && m->alpha < RS_GGX_DELTA_ALPHA) {
+    rs_vec3 f, h;
+    float c;
+    if (m->alpha < RS_GGX_DELTA_ALPHA && m->type == RS_MAT_CONDUCTOR) {
         out->wi = rs_reflect(wo, n);
         out->weight = rs_conductor_fresnel(m, albedo, rs_v3_dot(wo, n));
         out->delta = 1;
         return 1;
     }
-    if (m->type == RS_MAT_DIELECTRIC ||
-        (m->type == RS_MAT_ROUGH_DIELECTRIC && m->alpha < RS_GGX_DELTA_ALPHA)) {
-        float eta = front ? 1.0f / m->ior : m->ior;
-        float co = rs_fminf(rs_v3_dot(wo, n), 1.0f);
-        float so = sqrtf(rs_fmaxf(0.0f, 1.0f - co * co));
-        int exact = m->type == RS_MAT_ROUGH_DIELECTRIC || (m->flags & RS_MAT_EXACT_FRESNEL);
-        out->delta = 1;
-        out->weight = albedo;
-        if (eta * so > 1.0f ||
-            (exact ? rs_fresnel_dielectric(co, 1.0f / eta) : rs_schlick(co, eta)) > u3) {
-            out->wi = rs_reflect(wo, n);
-        } else {
-            /* Snell: the perpendicular part scales by eta, the parallel part fills the rest */
-            rs_vec3 perp = rs_v3_scale(rs_v3_madd(rs_v3_neg(wo), n, co), eta);
-            rs_vec3 par = rs_v3_scale(n, -sqrtf(fabsf(1.0f - rs_v3_length2(perp))));
-            out->wi = rs_v3_normalize(rs_v3_add(perp, par));
-            out->transmit = 1;
-        }
-        return 1;
-    }
-    if (m->type == RS_MAT_DIFFUSE_LIGHT)
-        return 0;
+    if (m->alpha < RS_GGX_DELTA_ALPHA && m->type == RS_MAT_ROUGH_DIELECTRIC)
+        return rs_sample_glass(m, albedo, n, wo, front, u3, 1, out);
     frame = rs_onb_from_normal(n);
     if (m->type == RS_MAT_ROUGH_DIELECTRIC) {
         /* a visible normal, then reflection with probability F, else refraction about it */
-        float eta = front ? m->ior : 1.0f / m->ior, wo_h, F, c;
-        rs_vec3 h;
+        float eta = front ? m->ior : 1.0f / m->ior, wo_h, F;
         out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
         wo_h = rs_v3_dot(wo, h);
         F = rs_fresnel_dielectric(wo_h, eta);
@@ -322,20 +329,54 @@ RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec
         c = rs_v3_dot(n, out->wi);
         if (out->transmit ? !(c < 0.0f) : !(c > 0.0f))
             return 0; /* the microfacet sent it to the wrong side of the surface */
-        f = rs_bsdf_eval_side(m, albedo, n, wo, out->wi, front);
-        out->pdf = rs_bsdf_pdf_side(m, albedo, n, wo, out->wi, front);
-        if (!(out->pdf > 0.0f))
-            return 0;
-        out->weight = rs_v3_scale(f, fabsf(c) / out->pdf);
+    } else {
+        if (m->type == RS_MAT_CONDUCTOR || u3 < rs_pbr_spec_prob(m, albedo, rs_v3_dot(n, wo)))
+            out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
+        else
+            out->wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(u1, u2));
+        c = rs_v3_dot(n, out->wi);
+        if (!(c > 0.0f))
+            return 0; /* reflected below the surface */
+    }
+    f = rs_bsdf_eval_ggx(m, albedo, n, wo, out->wi, front);
+    out->pdf = rs_bsdf_pdf_ggx(m, albedo, n, wo, out->wi, front);
+    if (!(out->pdf > 0.0f))
+        return 0;
+    out->weight = rs_v3_scale(f, fabsf(c) / out->pdf);
+    return 1;
+}
+
+/* Draws wi for wo from three uniform numbers.  Returns 0 when the sample carries nothing (below
+ * the surface, absorbed): the path ends there. */
+RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, int front,
+                         float u1, float u2, float u3, rs_scatter *out)
+{
+    rs_onb frame;
+    rs_vec3 f;
+    float ci;
+    out->delta = 0;
+    out->transmit = 0;
+    out->pdf = 0.0f;
+    if (m->type >= RS_MAT_CONDUCTOR)
+        return rs_bsdf_sample_ggx(m, albedo, n, wo, front, u1, u2, u3, out);
+    if (m->type == RS_MAT_METAL) {
+        rs_vec3 r =
+            rs_v3_add(rs_reflect(wo, n), rs_v3_scale(rs_sample_uniform_sphere(u1, u2), m->fuzz));
+        if (!(rs_v3_dot(r, n) > 0.0f) || rs_v3_is_zero(r))
+            return 0; /* fuzzed below the surface: absorbed (RTIOW) */
+        out->wi = rs_v3_normalize(r);
+        out->weight = albedo;
+        out->delta = 1;
         return 1;
     }
+    if (m->type == RS_MAT_DIELECTRIC)
+        return rs_sample_glass(m, albedo, n, wo, front, u3, (m->flags & RS_MAT_EXACT_FRESNEL) != 0,
+                               out);
+    if (m->type == RS_MAT_DIFFUSE_LIGHT)
+        return 0;
+    frame = rs_onb_from_normal(n);
     if ((m->flags & RS_MAT_UNIFORM_SAMPLING) || m->type == RS_MAT_DIFFUSE_UNIFORM) {
         out->wi = rs_onb_to_world(&frame, rs_sample_uniform_hemisphere(u1, u2));
-    } else if (m->type == RS_MAT_CONDUCTOR ||
-               (m->type == RS_MAT_PBR &&
-                u3 < rs_pbr_spec_prob(m, albedo, rs_v3_dot(n, wo)))) {
-        rs_vec3 h;
-        out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
     } else if (m->type == RS_MAT_PHONG && u3 >= rs_phong_diffuse_prob(albedo, m->specular)) {
         rs_onb lobe = rs_onb_from_normal(rs_reflect(wo, n));
         out->wi = rs_onb_to_world(&lobe, rs_sample_power_cosine(m->exponent, u1, u2));

@@ -44,7 +44,7 @@ RS_HD void rs_env_texel_of(const rs_image *im, rs_vec3 m, uint32_t *i, uint32_t 
 }
 
 /* Radiance arriving along -d from the map, d unit (not necessarily: it is normalised). */
-RS_HD rs_vec3 rs_env_radiance(const rs_scene *s, rs_vec3 d)
+RS_HD_COLD rs_vec3 rs_env_radiance(const rs_scene *s, rs_vec3 d)
 {
     const rs_image *im = &s->images[s->env_image];
     rs_vec3 m = rs_env_rot(s->env_rot, rs_v3_normalize(d));
@@ -82,7 +82,7 @@ RS_HD float rs_env_texel_pdf(const rs_scene *s, uint32_t i, uint32_t j)
 
 /* The solid-angle pdf with which rs_env_sample draws direction d (unit), pick probability not
  * included. */
-RS_HD float rs_env_pdf(const rs_scene *s, rs_vec3 d)
+RS_HD_COLD float rs_env_pdf(const rs_scene *s, rs_vec3 d)
 {
     const rs_image *im = &s->images[s->env_image];
     uint32_t i, j;
@@ -97,8 +97,8 @@ RS_HD float rs_env_pdf(const rs_scene *s, rs_vec3 d)
 
 /* A direction *wi toward the map from (u1, u2), its pdf (pick probability not included) and the
  * radiance along it.  0: none (a black map, or the sample landed on a pole). */
-RS_HD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi, float *pdf,
-                        rs_vec3 *le)
+RS_HD_COLD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi, float *pdf,
+                             rs_vec3 *le)
 {
     const rs_image *im;
     const float *row;

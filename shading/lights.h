@@ -88,7 +88,8 @@ RS_HD uint32_t rs_light_pick_n(const rs_scene *s, float u, uint32_t n)
 RS_HD uint32_t rs_light_pick(const rs_scene *s, float u) { return rs_light_pick_n(s, u, s->n_lights); }
 
 /* A sample of punctual light p from x, picked with probability `pick`. */
-RS_HD int rs_punctual_sample(const rs_punctual *p, rs_vec3 x, float pick, rs_light_sample *out)
+RS_HD_COLD int rs_punctual_sample(const rs_punctual *p, rs_vec3 x, float pick,
+                              rs_light_sample *out)
 {
     rs_vec3 to;
     float d2;
@@ -131,6 +132,22 @@ RS_HD float rs_cone_one_minus_cos(float r, float d2)
     return sin2 / (1.0f + sqrtf(rs_fmaxf(0.0f, 1.0f - sin2)));
 }
 
+/* A punctual light picked by u_pick among the punctual lights alone. */
+RS_HD_COLD int rs_light_sample_delta(const rs_scene *s, rs_vec3 x, float u_pick,
+                                     rs_light_sample *out)
+{
+    /* the part of the CDF after the emitters, scaled back to [0, 1) */
+    float a = s->n_area_lights ? s->light_cdf[s->n_area_lights] : 0.0f;
+    uint32_t l;
+    if (s->n_lights == s->n_area_lights)
+        return 0;
+    l = rs_light_pick(s, a + u_pick * (1.0f - a));
+    if (l < s->n_area_lights)
+        l = s->n_area_lights;
+    return rs_punctual_sample(&s->punctuals[s->lights[l].prim & ~RS_LIGHT_PUNCTUAL], x,
+                              s->lights[l].pick_pdf / ((1.0f - s->env_pick) * (1.0f - a)), out);
+}
+
 /* Samples a light of `subset` (RS_LIGHTS_*) as seen from x at `time`; the pdf is relative to the
  * subset (the pick probability divided by the subset's).  Returns 0 (and no sample) if the
  * subset is empty or the sample is degenerate (x on the light's plane, or inside a one-point
@@ -146,17 +163,8 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
         return 0;
     out->env = 0;
     out->delta = 0;
-    if (subset == RS_LIGHTS_DELTA) {
-        /* the part of the CDF after the emitters, scaled back to [0, 1) */
-        float a = s->n_area_lights ? s->light_cdf[s->n_area_lights] : 0.0f;
-        if (s->n_lights == s->n_area_lights)
-            return 0;
-        l = rs_light_pick(s, a + u_pick * (1.0f - a));
-        if (l < s->n_area_lights)
-            l = s->n_area_lights;
-        return rs_punctual_sample(&s->punctuals[s->lights[l].prim & ~RS_LIGHT_PUNCTUAL], x,
-                                  s->lights[l].pick_pdf / ((1.0f - env_pick) * (1.0f - a)), out);
-    }
+    if (subset == RS_LIGHTS_DELTA)
+        return rs_light_sample_delta(s, x, u_pick, out);
     if (subset == RS_LIGHTS_AREA && s->n_lights > s->n_area_lights) {
         /* the map and the emitters only: their picks, divided by their share */
         if (!(s->area_mass > 0.0f))

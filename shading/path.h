@@ -213,9 +213,9 @@ RS_HD rs_vec3 rs_surface_albedo(const rs_scene *sc, const rs_material *m, uint32
 
 /* The material at a hit with its textures other than the albedo applied (glTF's metallic-
  * roughness and emissive textures): m itself when it has none, else *local, filled. */
-RS_HD const rs_material *rs_surface_material(const rs_scene *sc, const rs_material *m,
-                                             uint32_t prim, float hu, float hv, rs_vec3 x,
-                                             rs_vec3 ng, rs_material *local)
+RS_HD_COLD const rs_material *rs_surface_material(const rs_scene *sc, const rs_material *m,
+                                                  uint32_t prim, float hu, float hv, rs_vec3 x,
+                                                  rs_vec3 ng, rs_material *local)
 {
     float u, v;
     if (m->mr_tex == RS_NO_TEXTURE && m->emission_tex == RS_NO_TEXTURE)
@@ -239,8 +239,9 @@ RS_HD const rs_material *rs_surface_material(const rs_scene *sc, const rs_materi
  * material's tangent-space normal map, on a triangle with UVs: the tangent frame follows the UV
  * gradient (dp/du, dp/dv), made orthonormal about the unbent normal.  n where there is no map,
  * no UVs or a degenerate UV mapping, or where the bent normal would face away from wo. */
-RS_HD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, uint32_t prim, float hu,
-                               float hv, rs_vec3 x, rs_vec3 n, int front, rs_vec3 wo)
+RS_HD_COLD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, uint32_t prim,
+                                    float hu, float hv, rs_vec3 x, rs_vec3 n, int front,
+                                    rs_vec3 wo)
 {
     uint32_t t = prim - sc->n_spheres - sc->n_quads;
     const rs_tri *tr;
@@ -381,7 +382,7 @@ RS_HD rs_vec3 rs_vertex_far_origin(const rs_scene *sc, const rs_vertex *v)
 
 /* Next-event estimation (mis): a shadow ray toward a sampled point on a light, its MIS-weighted
  * contribution in ps->pending.  Returns RS_SHADE_SHADOW when it made one. */
-RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const rs_ray *r,
+RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const rs_ray *r,
                                    rs_rng_f4 rl, rs_vec3 beta, rs_path_state *ps, rs_ray *shadow,
                                    int subset)
 {
@@ -420,7 +421,7 @@ RS_HD uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const
 
 /* The next direction at a non-delta vertex, by the render's sampling mode; *beta gains f cos /
  * pdf and *pdf is the solid-angle pdf it was drawn with.  0: the path ends here. */
-RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const rs_ray *r,
+RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const rs_ray *r,
                              rs_rng_f4 rb, rs_rng_f4 rl, rs_vec3 *beta, rs_vec3 *wi, float *pdf)
 {
     const rs_scene *sc = it->scene;
@@ -485,7 +486,7 @@ RS_HD int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const 
  * light (returns RS_SHADE_SHADOW, *shadow set, its contribution in ps->pending if the ray is
  * unoccluded).  `pre`: the vertex's numbers made ahead, pre[0] group RS_DIM_BSDF and pre[1]
  * RS_DIM_LIGHT (rs_path_rand's); NULL: made here, only where the vertex needs them. */
-RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_t sample,
+RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_t sample,
                                 uint32_t bounce, const rs_rng_f4 *pre, const rs_ray *ray,
                                 const rs_hit *h, rs_path_state *ps, rs_ray *next, rs_ray *shadow)
 {
@@ -522,10 +523,13 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
         rs_shade_emitter(it, &r, h->t, v.prim, v.m, v.ng, beta, ps);
         return 0; /* emitters reflect nothing */
     }
-    v.m = rs_surface_material(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, &local);
-    if (v.m->type == RS_MAT_PBR && !rs_v3_is_zero(v.m->emission))
-        /* a glTF emissive surface: not a sampled light, so its radiance counts in full */
-        ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, v.m->emission));
+    if (v.m->type >= RS_MAT_CONDUCTOR) {
+        if (v.m->mr_tex != RS_NO_TEXTURE || v.m->emission_tex != RS_NO_TEXTURE)
+            v.m = rs_surface_material(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, &local);
+        if (v.m->type == RS_MAT_PBR && !rs_v3_is_zero(v.m->emission))
+            /* a glTF emissive surface: not a sampled light, so its radiance counts in full */
+            ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, v.m->emission));
+    }
     /* The segment after this vertex would be number bounce + 1. */
     if (bounce + 1 >= it->max_depth)
         return out;
@@ -533,7 +537,8 @@ RS_HD uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_
     v.n_geo = v.front ? v.ng : rs_v3_neg(v.ng);
     v.wo = rs_v3_neg(r.d);
     v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
-    v.n = rs_normal_mapped(sc, v.m, v.prim, h->u, h->v, v.x, v.n, v.front, v.wo);
+    if (v.m->type >= RS_MAT_CONDUCTOR && v.m->normal_tex != RS_NO_TEXTURE)
+        v.n = rs_normal_mapped(sc, v.m, v.prim, h->u, h->v, v.x, v.n, v.front, v.wo);
     v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng);
     rb = pre ? pre[0] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
 
@@ -644,6 +649,7 @@ RS_HD rs_vec3 rs_path_radiance(const rs_integrator *it, const rs_path_tracer *tr
 {
     rs_path_state ps;
     rs_ray r = rs_path_begin(it, g, &ps), next, shadow;
+    next = shadow = r; /* set by rs_path_shade where its flags say: this quiets gcc */
     uint32_t bounce;
     for (bounce = 0;; ++bounce) {
         rs_hit h;
