@@ -25,6 +25,7 @@
 #include "scenes/builtin.h"
 #include "scenes/scene_json.h"
 #include "test_rand.h"
+#include "test_files.h"
 
 #ifndef RS_SOURCE_DIR
 #  define RS_SOURCE_DIR "."
@@ -364,14 +365,6 @@ static void test_image_texture_relative(void **state)
     remove(png);
     remove(scene_path);
     rmdir(dir);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
 }
 
 /* Loads `scene` (a file) and expects a failure whose one-line message has `a` and `b`. */

@@ -21,6 +21,7 @@
 #include "accel/bvh.h"
 #include "scenes/builtin.h"
 #include "scenes/mesh.h"
+#include "test_files.h"
 #include "test_rand.h"
 
 #ifndef RS_SOURCE_DIR
@@ -168,14 +169,6 @@ static void test_malformed(void **state)
     rs_error_clear();
     assert_int_equal(rs_scene_finalize(s), RS_OK);
     rs_scene_destroy(s);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
 }
 
 /* Imports `path` with the file's own materials and expects an error whose one-line message

@@ -25,6 +25,7 @@
 #include "render_util.h"
 #include "scenes/scene_json.h"
 #include "scenes/transform.h"
+#include "test_files.h"
 
 #define CAM "\"camera\":{\"from\":[0,1,9],\"at\":[0,0,0]},\"image\":{\"width\":24,\"height\":24}"
 #define MATS                                                                                       \
@@ -234,14 +235,6 @@ static void test_instances_equal_flattened(void **state)
     free(ib);
     rs_scene_destroy(a);
     rs_scene_destroy(b);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
 }
 
 static rs_status load_in(const char *dir, const char *json, rs_scene **s)

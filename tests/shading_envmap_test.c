@@ -415,6 +415,33 @@ static void test_furnace_ggx(void **state)
     }
 }
 
+/* The image mean over 12 seeds (seed0 ...) of 16x16 renders of s at spp with `mode` and
+ * independent numbers, and its standard error from the seeds' spread. */
+static void seed_mean(const rs_scene *s, rs_sampling mode, uint32_t spp, uint64_t seed0,
+                      double *mean, double *se)
+{
+    double m[12], sum = 0, var = 0;
+    int k;
+    for (k = 0; k < 12; ++k) {
+        rt_args a = rt_defaults("", 16, spp);
+        float *img;
+        a.sampling = mode;
+        a.sampler = RS_SAMPLER_INDEPENDENT;
+        a.seed = seed0 + (uint64_t)k;
+        a.threads = 2;
+        img = rt_render_scene(s, &a, NULL);
+        assert_non_null(img);
+        m[k] = rt_mean(img, 16 * 16 * 3);
+        sum += m[k];
+        free(img);
+    }
+    *mean = sum / 12;
+    for (k = 0; k < 12; ++k)
+        var += (m[k] - *mean) * (m[k] - *mean);
+    *se = sqrt(var / 11 / 12);
+    print_message("%-8s mean %.5f  se %.5f\n", rs_sampling_name(mode), *mean, *se);
+}
+
 /* The four strategies agree on the image mean under the sun map (sphere on a floor): 12 seeds
  * of 256 spp each, means within 4.5 combined standard errors (with t(11) tails a correct
  * renderer fails one of the six comparisons with probability < 0.01) and 3%. */
@@ -427,29 +454,8 @@ static void test_strategies_agree(void **state)
     (void)state;
     sun_map(rgb);
     s = env_scene(rgb, MW, MH, NULL, 0.6f, 1);
-    for (mode = 0; mode < 4; ++mode) {
-        double m[12], sum = 0, var = 0;
-        int k;
-        for (k = 0; k < 12; ++k) {
-            rt_args a = rt_defaults("", 16, 256);
-            float *img;
-            a.sampling = (rs_sampling)mode;
-            a.sampler = RS_SAMPLER_INDEPENDENT;
-            a.seed = 500 + (uint64_t)k;
-            a.threads = 2;
-            img = rt_render_scene(s, &a, NULL);
-            assert_non_null(img);
-            m[k] = rt_mean(img, 16 * 16 * 3);
-            sum += m[k];
-            free(img);
-        }
-        mean[mode] = sum / 12;
-        for (k = 0; k < 12; ++k)
-            var += (m[k] - mean[mode]) * (m[k] - mean[mode]);
-        se[mode] = sqrt(var / 11 / 12);
-        print_message("%-8s mean %.5f  se %.5f\n", rs_sampling_name((rs_sampling)mode),
-                      mean[mode], se[mode]);
-    }
+    for (mode = 0; mode < 4; ++mode)
+        seed_mean(s, (rs_sampling)mode, 256, 500, &mean[mode], &se[mode]);
     for (i = 0; i < 4; ++i)
         for (j = i + 1; j < 4; ++j) {
             double d = fabs(mean[i] - mean[j]), bound = 4.5 * sqrt(se[i] * se[i] + se[j] * se[j]);
@@ -510,28 +516,9 @@ static void test_mixed_lights_agree(void **state)
     s->camera.vfov_deg = 40;
     assert_int_equal(rs_scene_finalize(s), RS_OK);
     assert_true(s->area_mass > 0.0f && s->area_mass < 1.0f);
-    for (mode = 0; mode < 2; ++mode) {
-        double m[12], sum = 0, var = 0;
-        int k;
-        for (k = 0; k < 12; ++k) {
-            rt_args a = rt_defaults("", 16, 64);
-            float *img;
-            a.sampling = mode ? RS_SAMPLING_MIXTURE : RS_SAMPLING_MIS;
-            a.sampler = RS_SAMPLER_INDEPENDENT;
-            a.seed = 700 + (uint64_t)k;
-            a.threads = 2;
-            img = rt_render_scene(s, &a, NULL);
-            assert_non_null(img);
-            m[k] = rt_mean(img, 16 * 16 * 3);
-            sum += m[k];
-            free(img);
-        }
-        mean[mode] = sum / 12;
-        for (k = 0; k < 12; ++k)
-            var += (m[k] - mean[mode]) * (m[k] - mean[mode]);
-        se[mode] = sqrt(var / 11 / 12);
-        print_message("%s mean %.5f se %.5f\n", mode ? "mixture" : "mis    ", mean[mode], se[mode]);
-    }
+    for (mode = 0; mode < 2; ++mode)
+        seed_mean(s, mode ? RS_SAMPLING_MIXTURE : RS_SAMPLING_MIS, 64, 700, &mean[mode],
+                  &se[mode]);
     assert_true(fabs(mean[0] - mean[1]) <= 4.5 * sqrt(se[0] * se[0] + se[1] * se[1]));
     assert_true(fabs(mean[0] - mean[1]) <= 0.02 * mean[0]);
     rs_scene_destroy(s);
