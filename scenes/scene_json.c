@@ -21,7 +21,7 @@
 #define MAX_OVERRIDES   64 /* a mesh's materials replaced by name */
 /* Instances are copied (flattened) into the scene: this bounds what a file of a few lines can
  * make (ten groups of ten instances of each other would be 10^10 primitives). */
-#define MAX_PRIMS       (1u << 26)
+#define MAX_PRIMS       (1u << 24)
 
 typedef struct named {
     const char *name;
