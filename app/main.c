@@ -324,6 +324,7 @@ static int load_scene(const rs_cli_options *o, render_run *r)
         }
         bo.models_dir = o->models;
         bo.mesh_file = o->mesh;
+        bo.log = o->quiet ? NULL : stderr;
         bst = rs_builtin_create_ex(o->scene + 8, &bo, &r->scene);
         if (bst != RS_OK)
             return fail(bst == RS_ERR_ARG && !o->mesh ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);

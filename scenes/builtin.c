@@ -373,7 +373,15 @@ static rs_status build_cornell_mesh(rs_scene *s, const rs_builtin_opts *o)
     mo.fit_size = 330.0f;
     mo.fit_base = rs_v3(278, 0, 278);
     TRY(rs_scene_add_mesh(s, o->mesh_file, &mo, &info));
-    if (info.dropped) {
+    if (o->log) {
+        char why[160], strips[64] = "";
+        if (info.strips)
+            snprintf(strips, sizeof strips, " (from %u triangle strips)", info.strips);
+        fprintf(o->log, "raystream: %s: %u triangles%s, %u material%s from the file%s%s\n",
+                o->mesh_file, info.triangles, strips, info.materials,
+                info.materials == 1 ? "" : "s", info.dropped ? "; " : "",
+                rs_mesh_dropped_text(&info, why, sizeof why));
+    } else if (info.dropped) {
         char why[160];
         fprintf(stderr, "raystream: warning: %s: %s; %u triangles kept\n", o->mesh_file,
                 rs_mesh_dropped_text(&info, why, sizeof why), info.triangles);

@@ -2,12 +2,16 @@
 #ifndef RS_SCENES_BUILTIN_H
 #define RS_SCENES_BUILTIN_H
 
+#include <stdio.h>
+
 #include "scenes/scene.h"
 
 typedef struct rs_builtin_opts {
     const char *models_dir; /* the test models (bunny/, teapot/, ...); NULL: $RS_MODELS_DIR,
                                else the shared/models folder beside the source tree */
     const char *mesh_file;  /* for "cornell-mesh": the mesh dropped into the Cornell box */
+    FILE *log;              /* a line of what the mesh import loaded, or NULL (then only a
+                               warning, on stderr, if it dropped faces) */
 } rs_builtin_opts;
 
 /* Creates and finalizes built-in scene `name` (without the "builtin:" prefix).  An unknown name

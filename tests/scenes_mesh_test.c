@@ -441,7 +441,7 @@ static void test_obj_mtl_materials(void **state)
 static void test_builtin_mesh_scenes(void **state)
 {
     rs_scene *s;
-    rs_builtin_opts bo = {"/nonexistent-models", NULL};
+    rs_builtin_opts bo = {"/nonexistent-models", NULL, NULL};
     (void)state;
     rs_error_clear();
     assert_int_equal(rs_builtin_create_ex("cornell-teapot", &bo, &s), RS_ERR_IO);
