@@ -685,6 +685,37 @@ static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const placement 
     return st;
 }
 
+/* A file named .gltf must hold JSON (its first non-blank byte '{') and one named .glb the binary
+ * container (magic "glTF"): when the glTF reader turns a file down, Assimp offers it to every
+ * other reader, and its PLY reader spun for ever on junk that began with "ply" (found by
+ * tests/fuzz/fuzz_mesh). */
+static rs_status check_gltf_start(const char *path)
+{
+    unsigned char b[64];
+    size_t n, i = 0;
+    FILE *f;
+    int glb = ext_is(path, "glb");
+    if (!glb && !ext_is(path, "gltf"))
+        return RS_OK;
+    if (rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, NULL) != RS_OK)
+        return RS_ERR_IO;
+    n = fread(b, 1, sizeof b, f);
+    fclose(f);
+    if (glb) {
+        if (n < 12 || memcmp(b, "glTF", 4) != 0)
+            return rs_error_set(RS_ERR_ARG, "%s: not a glTF binary (no 'glTF' magic)", path);
+        return RS_OK;
+    }
+    if (n >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF)
+        i = 3; /* a UTF-8 byte order mark */
+    while (i < n && (b[i] == ' ' || b[i] == '\t' || b[i] == '\n' || b[i] == '\r'))
+        ++i;
+    if (i >= n || b[i] != '{')
+        return rs_error_set(RS_ERR_ARG, "%s: not a glTF file (it does not start with a JSON object)",
+                            path);
+    return RS_OK;
+}
+
 /* A scene of our own making (a PLY of triangle strips) carries this flag; release_scene frees
  * it (Assimp's flags stop at 0x20). */
 #define OWN_SCENE 0x40000000u
@@ -721,6 +752,9 @@ static rs_status strips_scene(const char *path, const struct aiScene **out)
     rs_status st;
     if (!o)
         return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    /* first: release_scene tells our scene from Assimp's by it (tests/fuzz/fuzz_mesh found a
+     * strip file without triangles handed to Assimp's release before this was set) */
+    o->scene.mFlags = OWN_SCENE;
     st = rs_ply_read_strips(path, &o->strips);
     if (st != RS_OK) {
         rs_free(o);
@@ -730,7 +764,6 @@ static rs_status strips_scene(const char *path, const struct aiScene **out)
         release_scene(&o->scene);
         return rs_error_set(RS_ERR_ARG, "%s: its triangle strips hold no triangle", path);
     }
-    o->scene.mFlags = OWN_SCENE;
     o->vertices = (struct aiVector3D *)rs_alloc(o->strips.n_vertices + 1, sizeof *o->vertices);
     o->faces = (struct aiFace *)rs_alloc(o->strips.n_triangles, sizeof *o->faces);
     o->indices = (unsigned int *)rs_alloc(3 * (size_t)o->strips.n_triangles, sizeof *o->indices);
@@ -778,6 +811,9 @@ static rs_status import_file(const char *path, unsigned int flags, const struct 
         return st;
     if (size == 0)
         return rs_error_set(RS_ERR_ARG, "%s: empty file", path);
+    st = check_gltf_start(path);
+    if (st != RS_OK)
+        return st;
     st = check_ply_header(path, &is_ply);
     if (st != RS_OK)
         return st;

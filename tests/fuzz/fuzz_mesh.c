@@ -2,7 +2,9 @@
  *
  * The bytes are written to FUZZ.obj and to FUZZ.ply in a folder of its own, and each is loaded
  * the way `raystream render --mesh FILE` loads it: rs_builtin_create_ex("cornell-mesh") ->
- * rs_scene_add_mesh (the PLY header check, Assimp through our aiFileIO) -> rs_scene_finalize.
+ * rs_scene_add_mesh (the PLY header check or the strip reader, Assimp through our aiFileIO) ->
+ * rs_scene_finalize; and to FUZZ.gltf, loaded as `raystream render FUZZ.gltf` loads it
+ * (rs_scene_load_gltf: nodes, cameras, lights, materials and textures).
  * Any input must give a scene or be refused with one line naming the file; never a crash, a
  * hang, a leak or a sanitizer report, and every file opened for Assimp must be closed again
  * (tests/fuzz/lsan.supp says why that is checked here).  Built with -DRS_FUZZ=ON (scripts/fuzz.sh).
@@ -15,6 +17,7 @@
 
 #include "fuzz_util.h"
 #include "scenes/builtin.h"
+#include "scenes/gltf.h"
 
 static void load_as(const uint8_t *data, size_t size, const char *ext)
 {
@@ -38,9 +41,29 @@ static void load_as(const uint8_t *data, size_t size, const char *ext)
                   fds);
 }
 
+static void load_gltf(const uint8_t *data, size_t size)
+{
+    char path[600];
+    rs_scene *s = NULL;
+    rs_status st;
+    int fds = fz_open_fds();
+    snprintf(path, sizeof path, "%s/fuzz.gltf", fz_tmpdir());
+    fz_write_file(path, data, size);
+    rs_error_clear();
+    st = rs_scene_load_gltf(path, NULL, &s);
+    fz_check_refusal(st, path);
+    rs_scene_destroy(s);
+    rs_error_clear();
+    unlink(path);
+    if (fz_open_fds() != fds)
+        fz_broken("%s: %d file descriptors open after the import, %d before", path, fz_open_fds(),
+                  fds);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     load_as(data, size, "obj");
     load_as(data, size, "ply");
+    load_gltf(data, size);
     return 0;
 }
