@@ -471,7 +471,7 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
                                   int strict, uint32_t *id)
 {
     struct aiColor4D base = {1, 1, 1, 1}, ke = {0, 0, 0, 1};
-    ai_real metal = 1, rough = 1, scale = 1;
+    ai_real metal = 1, rough = 1, scale = 1, trans = 0, strength = 1;
     unsigned int one = 1;
     rs_material m;
     uint32_t t;
@@ -480,9 +480,29 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
     aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &one);
     one = 1;
     aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &rough, &one);
+    one = 1;
+    if (aiGetMaterialFloatArray(am, AI_MATKEY_TRANSMISSION_FACTOR, &trans, &one) ==
+            aiReturn_SUCCESS &&
+        trans >= 0.5f && metal < 0.5f) {
+        /* KHR_materials_transmission (mostly transmitting): rough glass of the material's index
+         * (KHR_materials_ior, else 1.5), tinted by the base colour; the transmission texture
+         * is not read */
+        ai_real ior = 1.5f;
+        float r = fminf(fmaxf(rough, 0), 1);
+        one = 1;
+        aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &ior, &one);
+        m = rs_mat_rough_dielectric(isfinite(ior) && ior > 1e-3f && ior < 100 ? ior : 1.5f, r * r);
+        m.albedo = clamp01(rs_v3(base.r, base.g, base.b));
+        return rs_scene_add_material(s, &m, id);
+    }
     m = rs_mat_pbr(clamp01(rs_v3(base.r, base.g, base.b)), fminf(fmaxf(metal, 0), 1),
                    fminf(fmaxf(rough, 0), 1));
     m.emission = rs_v3(fmaxf(ke.r, 0), fmaxf(ke.g, 0), fmaxf(ke.b, 0));
+    one = 1;
+    if (aiGetMaterialFloatArray(am, AI_MATKEY_EMISSIVE_INTENSITY, &strength, &one) ==
+            aiReturn_SUCCESS &&
+        strength >= 0 && isfinite(strength))
+        m.emission = rs_v3_scale(m.emission, strength); /* KHR_materials_emissive_strength */
     if (!isfinite(m.emission.x + m.emission.y + m.emission.z))
         return rs_error_set(RS_ERR_ARG, "%s: a material's emissive factor is not finite", mesh);
     if (load_texture(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_COLOR, strict, &t) !=

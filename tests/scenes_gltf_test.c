@@ -336,6 +336,35 @@ static void test_emissive_texture_renders(void **state)
     rs_scene_destroy(s);
 }
 
+/* KHR_materials_transmission (with KHR_materials_ior) makes rough glass of the base colour's
+ * tint and the material's roughness. */
+static void test_transmission(void **state)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+        "\"extensionsUsed\":[\"KHR_materials_transmission\",\"KHR_materials_ior\"],"
+        "\"nodes\":[{\"mesh\":0}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.95,1,1],"
+        "\"metallicFactor\":0,\"roughnessFactor\":0.3},\"extensions\":{"
+        "\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+        "\"KHR_materials_ior\":{\"ior\":1.33}}}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+    char buf[4096];
+    rs_scene *s;
+    const rs_material *m;
+    (void)state;
+    write_full_files();
+    snprintf(buf, sizeof buf, k, "");
+    write_text("glass.gltf", buf);
+    s = load("glass.gltf", NULL);
+    m = &s->materials[s->tri_mat[0]];
+    assert_int_equal(m->type, RS_MAT_ROUGH_DIELECTRIC);
+    assert_true(fabsf(m->ior - 1.33f) < 1e-6f);
+    assert_true(fabsf(m->alpha - 0.09f) < 1e-6f);
+    expect_v3(m->albedo, 0.9f, 0.95f, 1.0f, 1e-6f);
+    rs_scene_destroy(s);
+}
+
 /* A .glb: the JSON chunk and a binary chunk holding the buffer and a PNG texture. */
 static void test_glb_embedded(void **state)
 {
@@ -473,7 +502,7 @@ static int teardown(void **state)
     static const char *files[] = {"quad.bin",  "base.png",     "mr.png",     "normal.png",
                                   "emis.png",  "full.gltf",    "emis.gltf",  "embedded.glb",
                                   "notex.gltf", "nobuf.gltf",  "cut.gltf",   "junk.gltf",
-                                  "plyish.gltf", "plyish.glb"};
+                                  "plyish.gltf", "plyish.glb",  "glass.gltf"};
     size_t i;
     char p[256];
     (void)state;
@@ -492,6 +521,7 @@ int main(void)
         cmocka_unit_test(test_texture_slots),
         cmocka_unit_test(test_emissive_texture_renders),
         cmocka_unit_test(test_glb_embedded),
+        cmocka_unit_test(test_transmission),
         cmocka_unit_test(test_bad_files),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
