@@ -328,14 +328,10 @@ static void test_mesh_objects(void **state)
     expect_v3(s->tris[1].v1, 2, 5, 0);
     rs_scene_destroy(s);
 
-    snprintf(p, sizeof p, "%s/two.mtl", dir);
-    remove(p);
-    snprintf(p, sizeof p, "%s/two.obj", dir);
-    remove(p);
-    snprintf(p, sizeof p, "%s/log.txt", dir);
-    remove(p);
-    snprintf(p, sizeof p, "%s/scene.json", dir);
-    remove(p);
+    remove_in(dir, "two.mtl");
+    remove_in(dir, "two.obj");
+    remove_in(dir, "log.txt");
+    remove_in(dir, "scene.json");
     rmdir(dir);
 }
 

@@ -28,6 +28,7 @@
 #include "render_util.h"
 #include "scenes/scene_json.h"
 #include "shading/lights.h"
+#include "test_files.h"
 #include "test_rand.h"
 
 #define PI_D 3.14159265358979323846
@@ -589,12 +590,9 @@ static void test_bad_maps(void **state)
         rs_scene_destroy(s);
     }
     remove(sp);
-    snprintf(p, sizeof p, "%s/neg.pfm", dir);
-    remove(p);
-    snprintf(p, sizeof p, "%s/nan.pfm", dir);
-    remove(p);
-    snprintf(p, sizeof p, "%s/ok.pfm", dir);
-    remove(p);
+    remove_in(dir, "neg.pfm");
+    remove_in(dir, "nan.pfm");
+    remove_in(dir, "ok.pfm");
     rmdir(dir);
 }
 

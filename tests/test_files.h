@@ -14,4 +14,12 @@ static inline void write_file(const char *path, const char *text)
     fclose(f);
 }
 
+/* Removes dir/name (a file a test made in its own temporary folder). */
+static inline void remove_in(const char *dir, const char *name)
+{
+    char p[512];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    remove(p);
+}
+
 #endif
