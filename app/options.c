@@ -139,8 +139,8 @@ void rs_cli_print_help(const char *command)
                "materials (m0, m1, ...) and every primitive as an object.  Image textures\n"
                "and an environment map go beside it as FILE-image-N.exr.  Numbers keep 9\n"
                "digits, so the file renders the scene bit for bit.  A scene with what the\n"
-               "format cannot say (vertex normals, punctual lights, glTF textures) is\n"
-               "refused.\n");
+               "format cannot say (glTF's metallic-roughness, emissive and normal textures)\n"
+               "is refused.\n");
         return;
     }
     if (command && strcmp(command, "render") == 0) {

@@ -125,15 +125,6 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
     const rs_camera_desc *c = &s->camera;
     uint32_t i, first = 1;
     rs_status st = RS_OK;
-    if (s->tri_normal)
-        for (i = 0; i < 9 * s->n_tris; ++i)
-            if (s->tri_normal[i] != 0.0f)
-                return rs_error_set(RS_ERR_ARG, "its triangles have vertex normals, which a "
-                                                "scene file's triangles do not (use a mesh "
-                                                "object)");
-    if (s->n_punctuals)
-        return rs_error_set(RS_ERR_ARG, "it has point, spot or directional lights, which a "
-                                        "scene file does not have");
     fputs("{\n  \"camera\": { \"from\": ", f);
     vec(f, c->from);
     fputs(", \"at\": ", f);
@@ -258,7 +249,37 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
                 fputs(k < 5 ? ", " : "]", f);
             }
         }
+        if (s->tri_normal) {
+            int k;
+            fputs(", \"normals\": [", f);
+            for (k = 0; k < 9; ++k) {
+                num(f, s->tri_normal[9 * (size_t)i + k]);
+                fputs(k < 8 ? ", " : "]", f);
+            }
+        }
         fprintf(f, ", \"material\": \"m%u\" }", s->tri_mat[i]);
+    }
+    for (i = 0; i < s->n_punctuals; ++i, first = 0) {
+        const rs_punctual *p = &s->punctuals[i];
+        static const char *const kind[] = {"point_light", "spot_light", "directional_light"};
+        fprintf(f, "%s    { \"type\": \"%s\"", first ? "" : ",\n", kind[p->type]);
+        if (p->type != RS_PUNCTUAL_DIRECTIONAL) {
+            fputs(", \"position\": ", f);
+            vec(f, p->pos);
+        }
+        if (p->type != RS_PUNCTUAL_POINT) {
+            fputs(", \"direction\": ", f);
+            vec(f, p->dir);
+        }
+        fputs(p->type == RS_PUNCTUAL_DIRECTIONAL ? ", \"irradiance\": " : ", \"intensity\": ", f);
+        vec(f, p->intensity);
+        if (p->type == RS_PUNCTUAL_SPOT) {
+            fputs(", \"inner\": ", f);
+            num(f, acosf(p->cos_inner) * 57.2957795f);
+            fputs(", \"outer\": ", f);
+            num(f, acosf(p->cos_outer) * 57.2957795f);
+        }
+        fputs(" }", f);
     }
     fputs("\n  ]\n}\n", f);
     return RS_OK;

@@ -851,6 +851,66 @@ static rs_status copy_mesh(ctx *c, const mesh_copy *m)
     return RS_OK;
 }
 
+/* `n` finite numbers (|x| <= 1e30) from array `a` into out. */
+static rs_status read_floats(ctx *c, const cJSON *a, const char *p, int n, const char *what,
+                             float *out)
+{
+    int i;
+    if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) != n)
+        return FAIL(c, p, "expected %d numbers %s", n, what);
+    for (i = 0; i < n; ++i) {
+        const cJSON *e = cJSON_GetArrayItem(a, i);
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
+            return FAIL(c, p, "expected %d finite numbers %s", n, what);
+        out[i] = (float)e->valuedouble;
+    }
+    return RS_OK;
+}
+
+/* point_light {position, intensity}, spot_light {position, direction, intensity, inner, outer
+ * (degrees)}, directional_light {direction, irradiance}: delta lights, as glTF's. */
+static rs_status add_punctual(ctx *c, const cJSON *o, const char *path, const char *type)
+{
+    static const char *const k_point[] = {"type", "position", "intensity", "transform", NULL};
+    static const char *const k_spot[] = {"type",  "position", "direction", "intensity",
+                                         "inner", "outer",    "transform", NULL};
+    static const char *const k_dir[] = {"type", "direction", "irradiance", "transform", NULL};
+    rs_punctual p;
+    memset(&p, 0, sizeof p);
+    if (type[0] == 'p') {
+        p.type = RS_PUNCTUAL_POINT;
+        TRY(check_keys(c, o, path, k_point));
+        TRY(get_vec3(c, o, path, "position", 1, rs_v3(0, 0, 0), &p.pos));
+        TRY(get_color(c, o, path, "intensity", 1, rs_v3(0, 0, 0), &p.intensity));
+    } else if (type[0] == 's') {
+        float inner, outer;
+        char q[256];
+        p.type = RS_PUNCTUAL_SPOT;
+        TRY(check_keys(c, o, path, k_spot));
+        TRY(get_vec3(c, o, path, "position", 1, rs_v3(0, 0, 0), &p.pos));
+        TRY(get_vec3(c, o, path, "direction", 1, rs_v3(0, 0, 0), &p.dir));
+        TRY(get_color(c, o, path, "intensity", 1, rs_v3(0, 0, 0), &p.intensity));
+        TRY(get_num(c, o, path, "inner", 0, 0.0, 0.0, 90.0, &inner));
+        TRY(get_num(c, o, path, "outer", 0, 45.0, 0.0, 90.0, &outer));
+        subpath(q, sizeof q, path, "outer");
+        if (outer < inner)
+            return FAIL(c, q, "the outer cone must not be narrower than the inner");
+        p.cos_inner = cosf(inner * 0.017453292519943295f);
+        p.cos_outer = cosf(outer * 0.017453292519943295f);
+    } else {
+        p.type = RS_PUNCTUAL_DIRECTIONAL;
+        TRY(check_keys(c, o, path, k_dir));
+        TRY(get_vec3(c, o, path, "direction", 1, rs_v3(0, 0, 0), &p.dir));
+        TRY(get_color(c, o, path, "irradiance", 1, rs_v3(0, 0, 0), &p.intensity));
+    }
+    if (p.type != RS_PUNCTUAL_POINT && rs_v3_is_zero(p.dir)) {
+        char q[256];
+        subpath(q, sizeof q, path, "direction");
+        return FAIL(c, q, "must not be zero");
+    }
+    return rs_scene_add_punctual(c->scene, &p);
+}
+
 /* A mesh file through Assimp: its own materials, one scene material for all of it ("material"),
  * or some of its materials replaced by name ("materials": {"file's name": "scene's name"}). */
 static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
@@ -945,7 +1005,8 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
     static const char *const k_sphere[] = {"type",     "center",    "radius",    "material",
                                            "moving_to", "velocity", "transform", NULL};
     static const char *const k_quad[] = {"type", "q", "u", "v", "material", "transform", NULL};
-    static const char *const k_tri[] = {"type", "vertices", "uv", "material", "transform", NULL};
+    static const char *const k_tri[] = {"type", "vertices", "uv", "normals", "material",
+                                        "transform", NULL};
     static const char *const k_box[] = {"type",      "min",      "max",       "rotate_y",
                                         "translate", "material", "transform", NULL};
     rs_scene *s = c->scene;
@@ -991,8 +1052,9 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
     if (strcmp(type, "triangle") == 0) {
         const cJSON *vs = cJSON_GetObjectItemCaseSensitive(o, "vertices");
         const cJSON *uv = cJSON_GetObjectItemCaseSensitive(o, "uv");
+        const cJSON *nrm = cJSON_GetObjectItemCaseSensitive(o, "normals");
         rs_vec3 p[3];
-        float uvs[6];
+        float uvs[6], ns[9];
         char sp[256];
         int i;
         TRY(check_keys(c, o, path, k_tri));
@@ -1002,18 +1064,20 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
         for (i = 0; i < 3; ++i)
             TRY(vec3_of(c, cJSON_GetArrayItem(vs, i), sp, &p[i]));
         TRY(object_material(c, o, path, &mat));
-        if (!uv)
+        if (!uv && !nrm)
             return rs_scene_add_triangle(s, p[0], p[1], p[2], mat);
-        subpath(sp, sizeof sp, path, "uv");
-        if (!cJSON_IsArray(uv) || cJSON_GetArraySize(uv) != 6)
-            return FAIL(c, sp, "expected 6 numbers (u0, v0, u1, v1, u2, v2)");
-        for (i = 0; i < 6; ++i) {
-            const cJSON *e = cJSON_GetArrayItem(uv, i);
-            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
-                return FAIL(c, sp, "expected 6 finite numbers (u0, v0, u1, v1, u2, v2)");
-            uvs[i] = (float)e->valuedouble;
+        if (uv) {
+            subpath(sp, sizeof sp, path, "uv");
+            TRY(read_floats(c, uv, sp, 6, "(u0, v0, u1, v1, u2, v2)", uvs));
         }
-        return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
+        if (nrm) {
+            /* unit vertex normals (zeros: the face's), as `raystream export` writes a mesh's */
+            subpath(sp, sizeof sp, path, "normals");
+            TRY(read_floats(c, nrm, sp, 9, "(three normals)", ns));
+        }
+        if (!nrm)
+            return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
+        return rs_scene_add_triangle_full(s, p, uv ? uvs : NULL, ns, mat);
     }
     if (strcmp(type, "box") == 0) {
         rs_vec3 lo, hi, t;
@@ -1030,7 +1094,12 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
     }
     if (strcmp(type, "mesh") == 0)
         return add_mesh(c, o, path);
-    return FAIL(c, path, "unknown object type '%s' (sphere, quad, triangle, box, mesh, instance)",
+    if (strcmp(type, "point_light") == 0 || strcmp(type, "spot_light") == 0 ||
+        strcmp(type, "directional_light") == 0)
+        return add_punctual(c, o, path, type);
+    return FAIL(c, path,
+                "unknown object type '%s' (sphere, quad, triangle, box, mesh, instance, "
+                "point_light, spot_light, directional_light)",
                 type);
 }
 

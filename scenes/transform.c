@@ -196,6 +196,7 @@ rs_scene_mark rs_scene_mark_now(const rs_scene *s)
     m.n_spheres = s->n_spheres;
     m.n_quads = s->n_quads;
     m.n_tris = s->n_tris;
+    m.n_punctuals = s->n_punctuals;
     return m;
 }
 
@@ -282,6 +283,18 @@ rs_status rs_scene_transform_since(rs_scene *s, const rs_scene_mark *from, const
                 vn[6 + j] = out[(mirror ? 3 : 6) + j];
             }
         }
+    }
+    for (i = from->n_punctuals; i < s->n_punctuals; ++i) {
+        rs_punctual *p = &s->punctuals[i];
+        p->pos = rs_xform_point(x, p->pos);
+        if (p->type != RS_PUNCTUAL_POINT) {
+            rs_vec3 d = rs_xform_vector(x, p->dir);
+            if (!in_range(p->pos) || rs_v3_is_zero(d) || !in_range(d))
+                return out_of_range();
+            p->dir = rs_v3_normalize(d);
+        }
+        if (!in_range(p->pos))
+            return out_of_range();
     }
     s->finalized = 0;
     return RS_OK;

@@ -23,7 +23,7 @@ typedef struct rs_xform {
 /* Where a scene's primitive arrays stood before an object was added: the object's primitives are
  * those after these counts. */
 typedef struct rs_scene_mark {
-    uint32_t n_spheres, n_quads, n_tris;
+    uint32_t n_spheres, n_quads, n_tris, n_punctuals;
 } rs_scene_mark;
 
 #ifdef __cplusplus
@@ -52,7 +52,8 @@ rs_vec3 rs_xform_vector(const rs_xform *x, rs_vec3 v);
 
 rs_scene_mark rs_scene_mark_now(const rs_scene *s);
 /* Applies x to every primitive added since `from` (spheres, their motion, quads, triangles and
- * their vertex normals).  RS_ERR_ARG (message: what went wrong, no file or path: the caller
+ * their vertex normals) and every punctual light (positions, and directions by the linear part,
+ * normalised; intensities stay).  RS_ERR_ARG (message: what went wrong, no file or path: the caller
  * prefixes them) if x is invalid, a sphere would become an ellipsoid, or a coordinate would
  * leave the range of a float. */
 rs_status rs_scene_transform_since(rs_scene *s, const rs_scene_mark *from, const rs_xform *x);

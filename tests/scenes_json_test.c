@@ -288,6 +288,19 @@ static const bad_case g_bad[] = {
     {"{" CAM "," MAT ",\"groups\":{\"a\":{}},\"objects\":[]}", {"groups.a", "array of objects"}},
     {"{" CAM "," MAT ",\"objects\":[{\"type\":\"instance\",\"group\":\"g\",\"material\":\"m\"}]}",
      {"objects[0]", "unknown key 'material'"}},
+    /* lights */
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"spot_light\",\"position\":[0,0,0],"
+     "\"direction\":[0,-1,0],\"intensity\":[1,1,1],\"inner\":40,\"outer\":20}]}",
+     {"objects[0].outer", "narrower"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"directional_light\",\"direction\":[0,0,0],"
+     "\"irradiance\":[1,1,1]}]}",
+     {"objects[0].direction", "zero"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"point_light\",\"position\":[0,0,0],"
+     "\"intensity\":[-1,1,1]}]}",
+     {"objects[0].intensity", ">= 0"}},
+    {"{" CAM "," MAT ",\"objects\":[{\"type\":\"triangle\",\"vertices\":[[0,0,0],[1,0,0],"
+     "[0,1,0]],\"normals\":[0,0,1],\"material\":\"m\"}]}",
+     {"objects[0].normals", "9 numbers"}},
     /* meshes */
     {"{" CAM "," MAT ",\"objects\":[{\"type\":\"mesh\",\"file\":\"/nonexistent/x.obj\"}]}",
      {"objects[0]", "/nonexistent/x.obj"}},

@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "render_util.h"
+#include "scenes/scene_export.h"
 #include "scenes/scene_json.h"
 #include "scenes/transform.h"
 #include "test_files.h"
@@ -335,6 +336,64 @@ static void test_mesh_objects(void **state)
     rmdir(dir);
 }
 
+/* Lights in scene files: moved by their transform (a point's position; a spot's and a directional
+ * light's direction by the linear part, normalised), copied by instances; and a scene written by
+ * rs_scene_export_json reads back the same, vertex normals, UVs and lights included. */
+static void test_lights_and_export(void **state)
+{
+    const char *json =
+        "{" CAM "," MATS ",\"groups\":{\"lamp\":["
+        "{\"type\":\"point_light\",\"position\":[0,1,0],\"intensity\":[3,2,1]},"
+        "{\"type\":\"spot_light\",\"position\":[0,2,0],\"direction\":[0,-1,0],"
+        "\"intensity\":[5,5,5],\"inner\":10,\"outer\":30}]},"
+        "\"objects\":[{\"type\":\"instance\",\"group\":\"lamp\","
+        "\"transform\":{\"translate\":[4,0,0]}},"
+        "{\"type\":\"instance\",\"group\":\"lamp\",\"transform\":{\"rotate\":[90,0,0]}},"
+        "{\"type\":\"directional_light\",\"direction\":[0,0,-2],\"irradiance\":[1,1,1],"
+        "\"transform\":{\"rotate\":{\"axis\":[0,1,0],\"degrees\":90}}},"
+        "{\"type\":\"triangle\",\"vertices\":[[0,0,0],[1,0,0],[0,1,0]],\"uv\":[0,0,1,0,0,1],"
+        "\"normals\":[0,0,1,0.6,0,0.8,0,0,1],\"material\":\"m\"}]}";
+    char dir[] = "/tmp/rs_exp_XXXXXX", path[256];
+    rs_scene *s = parse(json), *t = NULL;
+    (void)state;
+    assert_int_equal(s->n_punctuals, 5u);
+    expect_v3(s->punctuals[0].pos, 4, 1, 0);
+    expect_v3(s->punctuals[1].pos, 4, 2, 0);
+    expect_v3(s->punctuals[1].dir, 0, -1, 0);
+    /* 90 degrees about x takes +y to +z */
+    expect_v3(s->punctuals[2].pos, 0, 0, 1);
+    expect_v3(s->punctuals[3].dir, 0, 0, -1);
+    /* 90 degrees about y takes -z to -x; the direction is normalised */
+    expect_v3(s->punctuals[4].dir, -1, 0, 0);
+    assert_true(fabsf(s->punctuals[1].cos_inner - cosf(10 * 0.0174532925f)) < 1e-6f);
+    assert_true(s->n_lights == 5u && s->n_area_lights == 0u);
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/out.json", dir);
+    assert_int_equal(rs_scene_export_json(s, path), RS_OK);
+    assert_int_equal(rs_scene_load_json(path, &t), RS_OK);
+    assert_int_equal(t->n_tris, 1u);
+    assert_memory_equal(t->tris, s->tris, sizeof *s->tris);
+    assert_memory_equal(t->tri_uv, s->tri_uv, 6 * sizeof(float));
+    assert_memory_equal(t->tri_normal, s->tri_normal, 9 * sizeof(float));
+    assert_int_equal(t->n_punctuals, 5u);
+    {
+        uint32_t i;
+        for (i = 0; i < 5; ++i) {
+            assert_int_equal(t->punctuals[i].type, s->punctuals[i].type);
+            assert_memory_equal(&t->punctuals[i].pos, &s->punctuals[i].pos, sizeof(rs_vec3));
+            assert_memory_equal(&t->punctuals[i].dir, &s->punctuals[i].dir, sizeof(rs_vec3));
+            assert_memory_equal(&t->punctuals[i].intensity, &s->punctuals[i].intensity,
+                                sizeof(rs_vec3));
+            /* the cone goes through degrees: within a float ulp or two */
+            assert_true(fabsf(t->punctuals[i].cos_outer - s->punctuals[i].cos_outer) < 1e-6f);
+        }
+    }
+    rs_scene_destroy(t);
+    rs_scene_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
 /* Ten groups, each ten instances of the next, around one box: 6 * 10^10 quads if copied.  The
  * reader stops at its budget with one line, in well under a second here. */
 static void test_instance_budget(void **state)
@@ -373,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_mirror_keeps_orientation),
         cmocka_unit_test(test_instances_equal_flattened),
         cmocka_unit_test(test_mesh_objects),
+        cmocka_unit_test(test_lights_and_export),
         cmocka_unit_test(test_instance_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
