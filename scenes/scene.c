@@ -423,7 +423,11 @@ rs_status rs_scene_finalize(rs_scene *s)
     for (i = 0; i < n; ++i) {
         const rs_material *m = rs_scene_prim_material(s, i);
         s->prim_light[i] = -1;
-        if (m->type == RS_MAT_DIFFUSE_LIGHT && luminance(m->emission) > 0.0f)
+        /* a glTF material's constant emission is sampled too (two-sided); a textured one is
+         * left to the paths that hit it */
+        if ((m->type == RS_MAT_DIFFUSE_LIGHT ||
+             (m->type == RS_MAT_PBR && m->emission_tex == RS_NO_TEXTURE)) &&
+            luminance(m->emission) > 0.0f)
             s->prim_light[i] = (int32_t)nl++;
     }
     s->n_area_lights = nl;
@@ -460,7 +464,8 @@ rs_status rs_scene_finalize(rs_scene *s)
             s->lights[l].prim = i;
             s->lights[l].area = prim_area(s, i);
             s->lights[l].power = 3.14159265f * s->lights[l].area * luminance(m->emission) *
-                                 ((m->flags & RS_MAT_TWO_SIDED) ? 2.0f : 1.0f);
+                                 ((m->flags & RS_MAT_TWO_SIDED) || m->type == RS_MAT_PBR ? 2.0f
+                                                                                   : 1.0f);
             total += s->lights[l].power;
         }
         s->light_cdf[0] = 0.0f;

@@ -69,7 +69,8 @@ typedef struct rs_material {
     uint32_t mr_tex;     /* pbr: glTF's metallic-roughness texture (roughness *= G, metallic
                             *= B, linear), or RS_NO_TEXTURE */
     uint32_t emission_tex; /* pbr: `emission` (glTF's emissive factor; the surface emits on both
-                              sides, found by paths, not light-sampled) times this texture */
+                              sides: light-sampled when constant, found by paths when textured)
+                              times this texture */
     uint32_t normal_tex; /* pbr: a tangent-space normal map (linear, [0, 1] -> [-1, 1]; triangles with
                             UVs), or RS_NO_TEXTURE */
     float normal_scale;  /* glTF's normalTexture.scale: x and y of the map are multiplied by it */

@@ -63,6 +63,8 @@ RS_HD rs_vec3 rs_prim_normal(const rs_scene *s, uint32_t prim, rs_vec3 p, float 
  * along d (that is, toward -d). */
 RS_HD rs_vec3 rs_emitted(const rs_material *m, rs_vec3 ng, rs_vec3 d)
 {
+    if (m->type == RS_MAT_PBR) /* glTF's emission: both sides (a textured one is not sampled) */
+        return m->emission_tex == RS_NO_TEXTURE ? m->emission : rs_v3_splat(0.0f);
     if (m->type != RS_MAT_DIFFUSE_LIGHT)
         return rs_v3_splat(0.0f);
     if ((m->flags & RS_MAT_TWO_SIDED) || rs_v3_dot(ng, d) < 0.0f)

@@ -526,9 +526,16 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
     if (v.m->type >= RS_MAT_CONDUCTOR) {
         if (v.m->mr_tex != RS_NO_TEXTURE || v.m->emission_tex != RS_NO_TEXTURE)
             v.m = rs_surface_material(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, &local);
-        if (v.m->type == RS_MAT_PBR && !rs_v3_is_zero(v.m->emission))
-            /* a glTF emissive surface: not a sampled light, so its radiance counts in full */
-            ps->radiance = rs_v3_add(ps->radiance, rs_v3_mul(beta, v.m->emission));
+        if (v.m->type == RS_MAT_PBR && !rs_v3_is_zero(v.m->emission)) {
+            /* a glTF emissive surface: MIS-weighted against light sampling where that samples
+             * it (constant emission), in full where it cannot (a textured one) */
+            float w = 1.0f;
+            int32_t l = sc->prim_light[v.prim];
+            if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
+                w = rs_power_heuristic(ps->bsdf_pdf, rs_light_pdf_hit(sc, (uint32_t)l, r.o, r.time,
+                                                                      r.d, h->t, v.ng));
+            ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, v.m->emission), w));
+        }
     }
     /* The segment after this vertex would be number bounce + 1. */
     if (bounce + 1 >= it->max_depth)

@@ -525,6 +525,49 @@ static void test_mixed_lights_agree(void **state)
     rs_scene_destroy(s);
 }
 
+/* A glTF-style emissive pbr quad (it also reflects) as the only light: it is light-sampled
+ * (two-sided), and MIS, the mixture and BSDF sampling (which finds it only by hitting it) agree
+ * on the image mean (12 seeds, 4.5 combined standard errors and 3%), MIS with less spread. */
+static void test_pbr_emitter(void **state)
+{
+    rs_scene *s;
+    uint32_t floor_m, glow;
+    rs_material fm = rs_mat_lambertian(rs_v3(0.6f, 0.6f, 0.6f));
+    rs_material gm = rs_mat_pbr(rs_v3(0.5f, 0.5f, 0.5f), 0.0f, 0.5f);
+    double mean[3], se[3];
+    int mode, i, j;
+    (void)state;
+    gm.emission = rs_v3(4, 3, 2);
+    assert_int_equal(rs_scene_create("pbr-emitter", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &fm, &floor_m), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &gm, &glow), RS_OK);
+    assert_int_equal(rs_scene_add_quad(s, rs_v3(-4, -1, 4), rs_v3(8, 0, 0), rs_v3(0, 0, -8),
+                                       floor_m),
+                     RS_OK);
+    assert_int_equal(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, floor_m), RS_OK);
+    /* facing up (u x v = +y): its light reaches the floor only through its back side */
+    assert_int_equal(rs_scene_add_quad(s, rs_v3(-1, 2.5f, 1), rs_v3(2, 0, 0), rs_v3(0, 0, -2),
+                                       glow),
+                     RS_OK);
+    s->camera.from = rs_v3(0, 1.5f, 5);
+    s->camera.at = rs_v3(0, 0, 0);
+    s->camera.vfov_deg = 50;
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    assert_int_equal(s->n_lights, 1u);
+    for (mode = 0; mode < 3; ++mode)
+        seed_mean(s, (rs_sampling)mode, 64, 900, &mean[mode], &se[mode]);
+    for (i = 0; i < 3; ++i)
+        for (j = i + 1; j < 3; ++j) {
+            double d = fabs(mean[i] - mean[j]), bound = 4.5 * sqrt(se[i] * se[i] + se[j] * se[j]);
+            if (d > bound || d > 0.03 * mean[i])
+                fail_msg("%s and %s disagree: %.5f vs %.5f (bound %.5f)",
+                         rs_sampling_name((rs_sampling)i), rs_sampling_name((rs_sampling)j),
+                         mean[i], mean[j], bound);
+        }
+    assert_true(se[RS_SAMPLING_MIS] < se[RS_SAMPLING_BSDF]);
+    rs_scene_destroy(s);
+}
+
 /* A PFM of w x h texels, all `v` but texel 0 = `first`. */
 static void write_pfm(const char *path, int w, int h, float v, float first)
 {
@@ -603,7 +646,8 @@ int main(void)
         cmocka_unit_test(test_sample_consistency), cmocka_unit_test(test_irradiance),
         cmocka_unit_test(test_orientation),        cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_strategies_agree),   cmocka_unit_test(test_furnace_ggx),
-        cmocka_unit_test(test_mixed_lights_agree), cmocka_unit_test(test_bad_maps),
+        cmocka_unit_test(test_mixed_lights_agree), cmocka_unit_test(test_pbr_emitter),
+        cmocka_unit_test(test_bad_maps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
