@@ -797,7 +797,7 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
             (unsigned long long)(r->resumed + r->stats.paths_done), (unsigned long long)r->resumed,
             r->stats.time_limited ? "true" : "false", r->interrupted ? "true" : "false");
     for (i = 0; i < RS_STAGE_COUNT; ++i)
-        fprintf(f, "%s\"%s\": %.6f", i ? ", " : "", rs_stage_name((rs_stage)i),
+        fprintf(f, "%s\"%s\": %.9f", i ? ", " : "", rs_stage_name((rs_stage)i),
                 r->stats.stage_s[i]);
     fprintf(f, "},\n  \"devices\": [\n");
     for (i = 0; i < t->n; ++i) {
