@@ -31,6 +31,7 @@
 #include "core/alloc.h"
 #include "core/parallel.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* Subtrees over at least this many primitives are built as OpenMP tasks. */
@@ -77,6 +78,8 @@ rs_aabb rs_geom_prim_bounds(const rs_geom *g, uint32_t prim)
         return b;
     }
     prim -= g->n_quads;
+    if (prim >= g->n_tris)
+        return g->instances[prim - g->n_tris].box; /* an instance, as a whole */
     {
         const rs_tri *t = &g->tris[prim];
         b.lo = rs_v3_min(t->v0, rs_v3_min(t->v1, t->v2));
@@ -353,7 +356,7 @@ static rs_status finish_tree(rs_bvh *b, const rs_bvh_node *slots, rec_out res)
     return RS_OK;
 }
 
-rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out)
+static rs_status build_one(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out)
 {
     uint32_t n = rs_geom_prim_count(g), max_leaf = (opts && opts->max_leaf) ? opts->max_leaf : 4;
     int threads = (opts && opts->threads) ? (int)opts->threads : rs_default_threads();
@@ -397,6 +400,123 @@ rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *
     return RS_OK;
 }
 
+/* Instances of the same prototype together: by first triangle, count, then instance. */
+typedef struct proto_key {
+    uint32_t first, n, inst;
+} proto_key;
+
+static int by_prototype(const void *a, const void *b)
+{
+    const proto_key *x = (const proto_key *)a, *y = (const proto_key *)b;
+    if (x->first != y->first)
+        return x->first < y->first ? -1 : 1;
+    if (x->n != y->n)
+        return x->n < y->n ? -1 : 1;
+    return x->inst < y->inst ? -1 : x->inst > y->inst;
+}
+
+/* The bottom levels: one binary BVH per prototype, over its triangles in object space, by the
+ * same builder as the top level, appended to b's pools (node and prim-id indices rebased), and
+ * b's copy of the instance table with each instance's root. */
+static rs_status build_instances(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh *b)
+{
+    rs_bvh_build_opts o;
+    proto_key *order;
+    uint32_t i, n = g->n_instances, cap_nodes = 0;
+    rs_status st = RS_OK;
+    if (opts)
+        o = *opts;
+    else
+        memset(&o, 0, sizeof o);
+    o.lbvh_sort = NULL; /* the host's LBVH gives the same tree */
+    /* disjoint prototypes over n_inst_tris triangles have at most 2 n_inst_tris nodes */
+    cap_nodes = 2 * g->n_inst_tris;
+    b->instances = (rs_instance *)rs_alloc(n, sizeof *b->instances);
+    b->blas_nodes = (rs_bvh_node *)rs_alloc(cap_nodes ? cap_nodes : 1, sizeof *b->blas_nodes);
+    b->blas_prim_ids = (uint32_t *)rs_alloc(g->n_inst_tris ? g->n_inst_tris : 1, sizeof(uint32_t));
+    order = (proto_key *)rs_alloc(n, sizeof *order);
+    if (!b->instances || !b->blas_nodes || !b->blas_prim_ids || !order) {
+        rs_free(order);
+        return RS_ERR_NOMEM;
+    }
+    memcpy(b->instances, g->instances, (size_t)n * sizeof *b->instances);
+    for (i = 0; i < n; ++i) {
+        order[i].first = g->instances[i].first_tri;
+        order[i].n = g->instances[i].n_tris;
+        order[i].inst = i;
+    }
+    qsort(order, n, sizeof *order, by_prototype);
+    for (i = 0; i < n && st == RS_OK; ++i) {
+        const rs_instance *in = &g->instances[order[i].inst];
+        const rs_instance *prev = i ? &g->instances[order[i - 1].inst] : NULL;
+        rs_geom pg;
+        rs_bvh *blas = NULL;
+        uint32_t k, base;
+        if (prev && prev->first_tri == in->first_tri && prev->n_tris == in->n_tris) {
+            b->instances[order[i].inst].root = b->instances[order[i - 1].inst].root;
+            continue;
+        }
+        if (in->n_tris == 0 || (uint64_t)in->first_tri + in->n_tris > g->n_inst_tris) {
+            st = rs_error_set(RS_ERR_ARG, "BVH: instance %u's triangles out of range", order[i].inst);
+            break;
+        }
+        memset(&pg, 0, sizeof pg);
+        pg.tris = g->inst_tris + in->first_tri;
+        pg.n_tris = in->n_tris;
+        pg.tri_algo = g->tri_algo;
+        pg.time0 = g->time0;
+        pg.time1 = g->time1;
+        if ((st = build_one(&pg, &o, &blas)) != RS_OK)
+            break;
+        base = b->n_blas_nodes;
+        if ((uint64_t)base + blas->n_nodes > cap_nodes) { /* prototypes that overlap */
+            rs_bvh_destroy(blas);
+            st = rs_error_set(RS_ERR_ARG, "BVH: instance prototypes overlap");
+            break;
+        }
+        for (k = 0; k < blas->n_nodes; ++k) {
+            rs_bvh_node nd = blas->nodes[k];
+            /* interior: the child's index; leaf: its first prim id, both rebased */
+            nd.left_first += nd.count > 0 ? in->first_tri : base;
+            b->blas_nodes[base + k] = nd;
+        }
+        for (k = 0; k < in->n_tris; ++k)
+            b->blas_prim_ids[in->first_tri + k] = in->first_tri + blas->prim_ids[k];
+        b->n_blas_nodes += blas->n_nodes;
+        b->instances[order[i].inst].root = base;
+        rs_bvh_destroy(blas);
+    }
+    rs_free(order);
+    return st;
+}
+
+rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out)
+{
+    rs_status st = build_one(g, opts, out);
+    if (st != RS_OK || g->n_instances == 0)
+        return st;
+    st = build_instances(g, opts, *out);
+    if (st != RS_OK) {
+        rs_bvh_destroy(*out);
+        *out = NULL;
+        return st != RS_ERR_NOMEM ? st
+                                  : rs_error_set(RS_ERR_NOMEM,
+                                                 "out of memory building %u instances' BVHs",
+                                                 g->n_instances);
+    }
+    return RS_OK;
+}
+
+void rs_bvh_attach(const rs_bvh *b, rs_geom *g)
+{
+    if (!b || !b->instances)
+        return;
+    g->instances = b->instances;
+    g->blas_nodes = b->blas_nodes;
+    g->blas_prim_ids = b->blas_prim_ids;
+    g->n_blas_nodes = b->n_blas_nodes;
+}
+
 static double box_area(rs_vec3 lo, rs_vec3 hi)
 {
     double x = (double)hi.x - lo.x, y = (double)hi.y - lo.y, z = (double)hi.z - lo.z;
@@ -424,6 +544,9 @@ void rs_bvh_destroy(rs_bvh *b)
         return;
     rs_free(b->nodes);
     rs_free(b->prim_ids);
+    rs_free(b->instances);
+    rs_free(b->blas_nodes);
+    rs_free(b->blas_prim_ids);
     rs_free(b);
 }
 

@@ -75,6 +75,13 @@ typedef struct rs_bvh {
     uint32_t n_fallback;     /* interior nodes split at the middle because the heuristic could not
                                 split them (identical centroids or Morton codes) or because its
                                 split would have broken the depth bound; 0 for median and grid */
+    /* Instances (core/geom.h): the bottom levels, one per prototype, in one pool (node indices
+     * and prim ids absolute), and a copy of the geometry's instance table with each root set.
+     * NULL / 0 without instances.  rs_bvh_attach points a geometry at them. */
+    rs_instance *instances;
+    rs_bvh_node *blas_nodes;
+    uint32_t *blas_prim_ids;
+    uint32_t n_blas_nodes;
 } rs_bvh;
 
 /* Build options.  A zeroed struct (or NULL) gives the median builder with 4-primitive leaves and
@@ -103,7 +110,8 @@ typedef struct rs_bvh_build_opts {
 void rs_bvh_lbvh_frame(const rs_vec3 *centroid, uint32_t n, int threads, float lo[3],
                        float scale[3]);
 
-/* Builds a BVH over every primitive of `g` with the builder and leaf size in `opts` (NULL: the
+/* Builds a BVH over every primitive of `g` (each instance one primitive, and a bottom level per
+ * prototype: see rs_bvh.instances) with the builder and leaf size in `opts` (NULL: the
  * defaults above).  The result owns its arrays; the same inputs give the same tree, bit for bit,
  * for any thread count.  RS_ERR_ARG for an invalid builder, RS_ERR_NOMEM when memory runs out
  * (nothing leaks, *out is NULL).  Every builder keeps the invariants listed in accel/bvh.c. */
@@ -111,6 +119,9 @@ void rs_bvh_lbvh_frame(const rs_vec3 *centroid, uint32_t n, int threads, float l
 extern "C" {
 #endif
 rs_status rs_bvh_build(const rs_geom *g, const rs_bvh_build_opts *opts, rs_bvh **out);
+/* Points g's instance table and bottom levels at b's (a no-op without instances): the geometry
+ * that traversal reads, on the host and in device copies, must be attached to its BVH. */
+void rs_bvh_attach(const rs_bvh *b, rs_geom *g);
 /* Frees `b` and its arrays; NULL is a no-op. */
 void rs_bvh_destroy(rs_bvh *b);
 /* What traversal reads of `b` (accel/bvh_traverse.h): its host arrays, borrowed. */

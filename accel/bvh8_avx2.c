@@ -375,11 +375,9 @@ int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray)
                     return 1;
                 continue;
             }
-            for (i = 0; i < count; ++i) {
-                float t, u, v;
-                if (rs_geom_intersect(g, b->prim_ids[first + i], &ray, &t, &u, &v))
+            for (i = 0; i < count; ++i)
+                if (rs_bvh_leaf_occluded(g, b->prim_ids[first + i], &ray))
                     return 1;
-            }
         }
     }
     return 0;

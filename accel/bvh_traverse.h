@@ -18,12 +18,7 @@
 
 #include "core/geom.h"
 
-typedef struct rs_bvh_node {
-    rs_vec3 lo;
-    uint32_t left_first;
-    rs_vec3 hi;
-    uint32_t count;
-} rs_bvh_node;
+/* rs_bvh_node itself is core/geom.h's (the geometry holds instances' bottom levels). */
 
 /* What traversal needs: pointers (host or device) and counts.  Plain data, copied by value. */
 typedef struct rs_bvh_view {
@@ -123,12 +118,150 @@ RS_HD int rs_hit_better(float t, uint32_t prim, const rs_hit *best)
     return t < best->t || (t == best->t && prim < best->prim);
 }
 
+/* Instances (core/geom.h).  A bottom level's box test: node n widened by `margin` on every side
+ * (the slab test with the margin above as well). */
+RS_HD int rs_blas_node_hit(const rs_bvh_node *n, float margin, rs_vec3 o, rs_vec3 inv_d,
+                           float tmin, float tmax, float *t_entry)
+{
+    rs_aabb b;
+    b.lo = rs_v3_sub(n->lo, rs_v3_splat(margin));
+    b.hi = rs_v3_add(n->hi, rs_v3_splat(margin));
+    return rs_bvh_slab(&b, o, inv_d, tmin, tmax, t_entry);
+}
+
+/* The world ray r in instance in's object space, for the box tests: the direction is not
+ * normalised, so t means the same distance along both. */
+RS_HD void rs_instance_ray(const rs_instance *in, const rs_ray *r, rs_vec3 *o, rs_vec3 *d)
+{
+    const double *m = in->inv;
+    double x = r->o.x, y = r->o.y, z = r->o.z, a = r->d.x, b = r->d.y, c = r->d.z;
+    *o = rs_v3((float)(m[0] * x + m[1] * y + m[2] * z + m[3]),
+               (float)(m[4] * x + m[5] * y + m[6] * z + m[7]),
+               (float)(m[8] * x + m[9] * y + m[10] * z + m[11]));
+    *d = rs_v3((float)(m[0] * a + m[1] * b + m[2] * c), (float)(m[4] * a + m[5] * b + m[6] * c),
+               (float)(m[8] * a + m[9] * b + m[10] * c));
+}
+
+/* Triangle t of the prototype (an index into inst_tris) as instance `in` places it, tested in
+ * world space against `ray`; *prim is its global number. */
+RS_HD int rs_instance_tri_hit(const rs_geom *g, const rs_instance *in, uint32_t t,
+                              const rs_ray *ray, float *th, float *u, float *v, uint32_t *prim)
+{
+    rs_tri w = rs_instance_tri(in, &g->inst_tris[t]);
+    *prim = in->prim_base + (t - in->first_tri);
+    return rs_isect_tri_by(g->tri_algo, &w, ray, th, u, v);
+}
+
+/* The closest hit of `ray` among instance i's triangles, if closer than *hit (rs_hit_better):
+ * the bottom level's walk, nearer child first, the ray cut just past each hit. */
+RS_HD_COLD void rs_instance_closest(const rs_geom *g, uint32_t i, rs_ray *ray, rs_hit *hit)
+{
+    const rs_instance *in = &g->instances[i];
+    uint32_t stack[RS_BVH_STACK];
+    uint32_t sp = 0, node = in->root;
+    rs_vec3 o, d, inv_d;
+    float te, margin = in->margin;
+    RS_ASSERT(g->blas_nodes); /* rs_bvh_attach */
+    rs_instance_ray(in, ray, &o, &d);
+    inv_d = rs_bvh_inv_dir(d);
+    if (!rs_blas_node_hit(&g->blas_nodes[node], margin, o, inv_d, ray->tmin, ray->tmax, &te))
+        return;
+    for (;;) {
+        const rs_bvh_node *n = &g->blas_nodes[node];
+        if (n->count > 0) {
+            uint32_t k;
+            RS_COUNT(prim_tests, n->count);
+            for (k = 0; k < n->count; ++k) {
+                float t, u, v;
+                uint32_t prim;
+                if (rs_instance_tri_hit(g, in, g->blas_prim_ids[n->left_first + k], ray, &t, &u,
+                                        &v, &prim) &&
+                    rs_hit_better(t, prim, hit)) {
+                    ray->tmax = rs_float_next_up(t);
+                    hit->t = t;
+                    hit->u = u;
+                    hit->v = v;
+                    hit->prim = prim;
+                }
+            }
+        } else {
+            uint32_t l = n->left_first, r = l + 1;
+            float tl = 0.0f, tr = 0.0f;
+            int hl = rs_blas_node_hit(&g->blas_nodes[l], margin, o, inv_d, ray->tmin, ray->tmax, &tl);
+            int hr = rs_blas_node_hit(&g->blas_nodes[r], margin, o, inv_d, ray->tmin, ray->tmax, &tr);
+            RS_COUNT(box_tests, 2);
+            if (hl && hr) {
+                if (tr < tl) {
+                    uint32_t tmp = l;
+                    l = r;
+                    r = tmp;
+                }
+                RS_ASSERT(sp < RS_BVH_STACK);
+                stack[sp++] = r;
+                node = l;
+                continue;
+            }
+            if (hl || hr) {
+                node = hl ? l : r;
+                continue;
+            }
+        }
+        for (;;) {
+            if (sp == 0)
+                return;
+            node = stack[--sp];
+            if (rs_blas_node_hit(&g->blas_nodes[node], margin, o, inv_d, ray->tmin, ray->tmax, &te))
+                break;
+        }
+    }
+}
+
+/* Whether any of instance i's triangles blocks `ray` inside (tmin, tmax). */
+RS_HD_COLD int rs_instance_occluded(const rs_geom *g, uint32_t i, const rs_ray *ray)
+{
+    const rs_instance *in = &g->instances[i];
+    uint32_t stack[RS_BVH_STACK];
+    uint32_t sp = 0;
+    rs_vec3 o, d, inv_d;
+    float te;
+    RS_ASSERT(g->blas_nodes);
+    rs_instance_ray(in, ray, &o, &d);
+    inv_d = rs_bvh_inv_dir(d);
+    stack[sp++] = in->root;
+    while (sp > 0) {
+        const rs_bvh_node *n = &g->blas_nodes[stack[--sp]];
+        if (!rs_blas_node_hit(n, in->margin, o, inv_d, ray->tmin, ray->tmax, &te))
+            continue;
+        if (n->count > 0) {
+            uint32_t k;
+            for (k = 0; k < n->count; ++k) {
+                float t, u, v;
+                uint32_t prim;
+                if (rs_instance_tri_hit(g, in, g->blas_prim_ids[n->left_first + k], ray, &t, &u,
+                                        &v, &prim))
+                    return 1;
+            }
+        } else {
+            RS_ASSERT(sp + 2 <= RS_BVH_STACK);
+            stack[sp++] = n->left_first + 1;
+            stack[sp++] = n->left_first;
+        }
+    }
+    return 0;
+}
+
 /* One primitive of a leaf for closest hit: where it is hit no farther than the best so far (ties
  * to the lower primitive, rs_hit_better), it becomes the best and the ray is cut just past it.
- * The binary and the 4-wide traversal (accel/bvh4.h) both take their leaves' primitives here. */
+ * An instance's triangles go through its bottom level.  The binary and the wide traversals
+ * (accel/bvh4.h, accel/bvh8.h) all take their leaves' unpacked primitives here. */
 RS_HD void rs_bvh_leaf_closest(const rs_geom *g, uint32_t prim, rs_ray *ray, rs_hit *hit)
 {
     float t, u, v;
+    uint32_t own = rs_geom_own_count(g);
+    if (prim >= own) {
+        rs_instance_closest(g, prim - own, ray, hit);
+        return;
+    }
     if (rs_geom_intersect(g, prim, ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
         ray->tmax = rs_float_next_up(t);
         hit->t = t;
@@ -136,6 +269,16 @@ RS_HD void rs_bvh_leaf_closest(const rs_geom *g, uint32_t prim, rs_ray *ray, rs_
         hit->v = v;
         hit->prim = prim;
     }
+}
+
+/* One primitive of a leaf for the any-hit query (instances through their bottom levels). */
+RS_HD int rs_bvh_leaf_occluded(const rs_geom *g, uint32_t prim, const rs_ray *ray)
+{
+    float t, u, v;
+    uint32_t own = rs_geom_own_count(g);
+    if (prim >= own)
+        return rs_instance_occluded(g, prim - own, ray);
+    return rs_geom_intersect(g, prim, ray, &t, &u, &v);
 }
 
 /* Closest hit along `ray` (ordered, stack-based traversal: the nearer child first, the other
@@ -226,9 +369,8 @@ RS_HD int rs_bvh_occluded(const rs_bvh_view *b, const rs_geom *g, rs_ray ray)
         if (n->count > 0) {
             uint32_t i;
             for (i = 0; i < n->count; ++i) {
-                float t, u, v;
                 RS_COUNT(prim_tests, 1);
-                if (rs_geom_intersect(g, b->prim_ids[n->left_first + i], &ray, &t, &u, &v))
+                if (rs_bvh_leaf_occluded(g, b->prim_ids[n->left_first + i], &ray))
                     return 1;
             }
         } else {

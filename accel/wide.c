@@ -69,12 +69,13 @@ void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, u
 static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
 {
     uint32_t i, first_quad = p->g->n_spheres, first_tri = first_quad + p->g->n_quads;
+    uint32_t first_inst = first_tri + p->g->n_tris; /* instances are never packed */
     uint32_t tris = 0, quads = 0, spheres = 0;
     if ((n->count + p->width - 1) / p->width > RS_BVH4_BLOCKS)
         return 0;
     for (i = 0; i < n->count; ++i) {
         uint32_t prim = p->prim_ids[n->left_first + i];
-        tris += prim >= first_tri;
+        tris += prim >= first_tri && prim < first_inst;
         quads += prim >= first_quad && prim < first_tri;
         spheres += prim < first_quad;
     }

@@ -357,6 +357,9 @@ static int load_scene(const rs_cli_options *o, render_run *r)
     } else if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK) {
         return fail(RS_EXIT_RUNTIME, NULL);
     }
+    if (o->flatten_instances && r->scene->n_instances &&
+        (rs_scene_flatten_instances(r->scene) != RS_OK || rs_scene_finalize(r->scene) != RS_OK))
+        return fail(RS_EXIT_RUNTIME, "flattening the instances");
     file_stem(o->scene, r->name, sizeof r->name);
     return RS_EXIT_OK;
 }
@@ -608,6 +611,7 @@ static int build_bvh(const rs_cli_options *o, render_run *r)
     t0 = rs_now_s();
     if (rs_bvh_build(&r->geom, &bo, &r->bvh) != RS_OK)
         return fail(RS_EXIT_RUNTIME, "building the BVH");
+    rs_bvh_attach(r->bvh, &r->geom);
     r->bvh_ms = 1e3 * (rs_now_s() - t0);
     return RS_EXIT_OK;
 }
@@ -1058,7 +1062,11 @@ static int cmd_export(const rs_cli_options *o)
     }
     memset(&r, 0, sizeof r);
     if ((code = load_scene_bounded(o, &r)) == RS_EXIT_OK) {
-        if (rs_scene_export_json(r.scene, o->output) != RS_OK)
+        /* the format's instances are written as the copies they render as */
+        if (r.scene->n_instances && (rs_scene_flatten_instances(r.scene) != RS_OK ||
+                                     rs_scene_finalize(r.scene) != RS_OK))
+            code = fail(RS_EXIT_RUNTIME, NULL);
+        else if (rs_scene_export_json(r.scene, o->output) != RS_OK)
             code = fail(RS_EXIT_RUNTIME, NULL);
         else if (!o->quiet)
             fprintf(stderr, "raystream: wrote %s (%u spheres, %u quads, %u triangles)\n",

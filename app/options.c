@@ -193,6 +193,8 @@ void rs_cli_print_help(const char *command)
             "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
             "                      tasks (the thesis's three OpenMP strategies)\n"
             "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
+            "  --flatten-instances copy every instance's triangles into the scene instead of\n"
+            "                      placing shared ones by a two-level BVH (same image)\n"
             "  --bvh-device D      where --bvh lbvh computes and sorts its Morton codes: cpu\n"
             "                      (default) or gpu (CUDA device 0; the tree is the same)\n"
             "  --bvh-width W       the CPU's traversal: 8 (the default where the CPU has AVX2;\n"
@@ -464,6 +466,8 @@ static int parse_accel_option(opt_arg *x, rs_cli_options *o)
         }
     } else if (strcmp(name, "--no-bvh") == 0) {
         o->no_bvh = 1;
+    } else if (strcmp(name, "--flatten-instances") == 0) {
+        o->flatten_instances = 1;
     } else if (strcmp(name, "--bvh-device") == 0) {
         NEEDS_VALUE();
         if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)

@@ -65,6 +65,7 @@ typedef struct rs_cli_options {
     int megakernel;           /* --integrator megakernel: the per-pixel loop on one device */
     rs_par_strategy strategy; /* --cpu-strategy */
     int no_bvh;               /* --no-bvh: every ray tests every primitive */
+    int flatten_instances;    /* --flatten-instances: instances copied, one-level BVH */
     int stats;                /* --stats: a per-device table after the render */
     const char *stats_json;   /* --stats-json FILE */
     const char *timeline;     /* --timeline FILE.svg */

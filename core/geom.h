@@ -4,12 +4,73 @@
  *   prim in [0, ns)              sphere  prim
  *   prim in [ns, ns + nq)        quad    prim - ns
  *   prim in [ns + nq, ns+nq+nt)  tri     prim - ns - nq
+ *   prim in [ns+nq+nt, +ni)      instance prim - ns - nq - nt (BVH leaves only, see below)
+ *
+ * Instances (the two-level BVH).  An instance places a shared set of triangles, the prototype
+ * inst_tris[first_tri, first_tri + n_tris) in object space, by an affine transform.  The scene's
+ * BVH (the top level) holds each instance as one primitive with its world bounds; its bottom
+ * level is a binary BVH over the prototype, in object space, shared by every instance of it
+ * (blas_nodes, built by accel/bvh.c and attached with rs_bvh_attach).  A hit on an instance's
+ * triangle k reports the primitive number prim_base + k: the number the triangle has when the
+ * instances are flattened (copied, after the scene's own triangles, in instance order:
+ * rs_scene_flatten_instances).  The bottom level's boxes are tested in object space, but each
+ * triangle is tested in world space, transformed by rs_instance_tri exactly as flattening
+ * transforms it; the closest-hit rule (rs_hit_better) makes the visit order irrelevant, so an
+ * instanced scene and its flattened twin give the same hits bit for bit.
  *
  * The same struct holds host pointers on the CPU and device pointers on the GPU. */
 #ifndef RS_CORE_GEOM_H
 #define RS_CORE_GEOM_H
 
 #include "core/intersect.h"
+
+/* A node of a binary BVH (accel/bvh_traverse.h describes the layout; the bottom levels of
+ * instances use it too, so the geometry can hold them). */
+typedef struct rs_bvh_node {
+    rs_vec3 lo;
+    uint32_t left_first;
+    rs_vec3 hi;
+    uint32_t count;
+} rs_bvh_node;
+
+/* One placement of a prototype.  The transform is kept in double precision, as the scene file's
+ * transforms are (scenes/transform.h), and applied by rs_instance_point. */
+typedef struct rs_instance {
+    double m[12];       /* object -> world, row-major 3x4: x'_i = m[4i] x + m[4i+1] y + m[4i+2] z
+                           + m[4i+3] */
+    double inv[12];     /* world -> object, the same layout (the bottom level's box tests) */
+    double cof[9];      /* the cofactor matrix of the linear part (normals), row-major */
+    rs_aabb box;        /* world bounds of the placed triangles, slightly widened */
+    float margin;       /* object-space widening of the bottom level's boxes (rounding of the
+                           transforms; rs_instance_margin) */
+    uint32_t mirror;    /* det < 0: v1 and v2 (and their UVs and normals) swap, as flattening
+                           swaps them so that normals keep pointing out */
+    uint32_t first_tri; /* the prototype: inst_tris[first_tri, first_tri + n_tris) */
+    uint32_t n_tris;
+    uint32_t prim_base; /* global number of the instance's first triangle */
+    uint32_t root;      /* the prototype's bottom-level root in blas_nodes (rs_bvh_attach) */
+    uint32_t reserved;  /* zero: the struct has no padding (scene hashes read every byte) */
+} rs_instance;
+
+/* Point p of an instance's object space in world space: each coordinate computed in double and
+ * rounded to float once (what scenes/transform.c does to a copied object). */
+RS_HD rs_vec3 rs_instance_point(const rs_instance *in, rs_vec3 p)
+{
+    double x = p.x, y = p.y, z = p.z;
+    return rs_v3((float)(in->m[0] * x + in->m[1] * y + in->m[2] * z + in->m[3]),
+                 (float)(in->m[4] * x + in->m[5] * y + in->m[6] * z + in->m[7]),
+                 (float)(in->m[8] * x + in->m[9] * y + in->m[10] * z + in->m[11]));
+}
+
+/* A prototype triangle placed by instance `in` (v1 and v2 swapped under a mirror). */
+RS_HD rs_tri rs_instance_tri(const rs_instance *in, const rs_tri *t)
+{
+    rs_tri w;
+    w.v0 = rs_instance_point(in, t->v0);
+    w.v1 = rs_instance_point(in, in->mirror ? t->v2 : t->v1);
+    w.v2 = rs_instance_point(in, in->mirror ? t->v1 : t->v2);
+    return w;
+}
 
 typedef struct rs_geom {
     const rs_sphere *spheres;
@@ -21,6 +82,13 @@ typedef struct rs_geom {
     const rs_quad *quads;
     const rs_tri *tris;
     uint32_t n_spheres, n_quads, n_tris;
+    /* instances (NULL / 0 without): the table, the prototypes' triangles, and the bottom levels
+     * (from the scene's BVH: rs_bvh_attach; node indices and prim ids into these arrays) */
+    const rs_instance *instances;
+    const rs_tri *inst_tris;
+    const rs_bvh_node *blas_nodes;
+    const uint32_t *blas_prim_ids; /* indices into inst_tris */
+    uint32_t n_instances, n_inst_tris, n_blas_nodes;
 } rs_geom;
 
 /* Every array of rs_geom, with its element count (`g` a pointer to the geometry; the element
@@ -30,7 +98,11 @@ typedef struct rs_geom {
   X(spheres, (size_t)(g)->n_spheres)                                                               \
   X(sphere_motion, (size_t)(g)->n_spheres)                                                         \
   X(quads, (size_t)(g)->n_quads)                                                                   \
-  X(tris, (size_t)(g)->n_tris)
+  X(tris, (size_t)(g)->n_tris)                                                                     \
+  X(instances, (size_t)(g)->n_instances)                                                           \
+  X(inst_tris, (size_t)(g)->n_inst_tris)                                                           \
+  X(blas_nodes, (size_t)(g)->n_blas_nodes)                                                         \
+  X(blas_prim_ids, (size_t)(g)->n_inst_tris)
 
 /* Centre of sphere i at `time`. */
 RS_HD rs_vec3 rs_geom_sphere_center(const rs_geom *g, uint32_t i, float time)
@@ -39,12 +111,17 @@ RS_HD rs_vec3 rs_geom_sphere_center(const rs_geom *g, uint32_t i, float time)
                             : g->spheres[i].center;
 }
 
+/* The primitives the scene's BVH is built over: the scene's own, then one per instance. */
 RS_HD uint32_t rs_geom_prim_count(const rs_geom *g)
 {
-    return g->n_spheres + g->n_quads + g->n_tris;
+    return g->n_spheres + g->n_quads + g->n_tris + g->n_instances;
 }
 
-/* Intersects global primitive `prim`; on a hit writes t, u, v and returns 1. */
+/* The scene's own primitives (not instances): those rs_geom_intersect takes. */
+RS_HD uint32_t rs_geom_own_count(const rs_geom *g) { return g->n_spheres + g->n_quads + g->n_tris; }
+
+/* Intersects global primitive `prim` (one of the scene's own, < rs_geom_own_count; an instance's
+ * triangles are accel/bvh_traverse.h's); on a hit writes t, u, v and returns 1. */
 RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, float *t, float *u,
                             float *v)
 {

@@ -89,6 +89,11 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->env_marg_cdf);
     rs_free(s->env_cond_cdf);
     rs_free(s->punctuals);
+    rs_free(s->inst_tris);
+    rs_free(s->inst_tri_mat);
+    rs_free(s->inst_tri_uv);
+    rs_free(s->inst_tri_normal);
+    rs_free(s->instances);
     rs_free(s);
 }
 
@@ -347,6 +352,86 @@ rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg,
 
 static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
+rs_status rs_scene_make_prototype(rs_scene *s, uint32_t from, uint32_t *first, uint32_t *count)
+{
+    uint32_t n = from < s->n_tris ? s->n_tris - from : 0, base = s->n_inst_tris, i;
+    *first = base;
+    *count = n;
+    if (n == 0)
+        return RS_OK;
+    if (grow_prims((void **)&s->inst_tris, &s->inst_tri_mat, &s->cap_inst_tris, base + n,
+                   sizeof *s->inst_tris) != RS_OK)
+        return RS_ERR_NOMEM;
+    memcpy(&s->inst_tris[base], &s->tris[from], (size_t)n * sizeof *s->tris);
+    memcpy(&s->inst_tri_mat[base], &s->tri_mat[from], (size_t)n * sizeof *s->tri_mat);
+    /* UVs and normals as the scene's own arrays hold them: once any triangle has them, every
+     * prototype triangle gets a row (the defaults (0,0), (1,0), (0,1) and zero normals where it
+     * had none) */
+    if (s->tri_uv || s->inst_tri_uv) {
+        static const float def[6] = {0, 0, 1, 0, 0, 1};
+        int had = s->inst_tri_uv != NULL;
+        if (!grow((void **)&s->inst_tri_uv, &s->cap_inst_uv, base + n, 6 * sizeof(float)))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory making a prototype");
+        for (i = had ? base : 0; i < base + n; ++i)
+            if (i < base || !s->tri_uv)
+                memcpy(&s->inst_tri_uv[6 * (size_t)i], def, sizeof def);
+            else
+                memcpy(&s->inst_tri_uv[6 * (size_t)i], &s->tri_uv[6 * (size_t)(from + i - base)],
+                       sizeof def);
+    }
+    if (s->tri_normal || s->inst_tri_normal) {
+        int had = s->inst_tri_normal != NULL;
+        if (!grow((void **)&s->inst_tri_normal, &s->cap_inst_normal, base + n, 9 * sizeof(float)))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory making a prototype");
+        for (i = had ? base : 0; i < base + n; ++i)
+            if (i < base || !s->tri_normal)
+                memset(&s->inst_tri_normal[9 * (size_t)i], 0, 9 * sizeof(float));
+            else
+                memcpy(&s->inst_tri_normal[9 * (size_t)i],
+                       &s->tri_normal[9 * (size_t)(from + i - base)], 9 * sizeof(float));
+    }
+    s->n_inst_tris += n;
+    s->n_tris = from; /* the triangles now belong to the prototype */
+    s->finalized = 0;
+    return RS_OK;
+}
+
+rs_status rs_scene_push_instance(rs_scene *s, const rs_instance *in)
+{
+    if (!grow((void **)&s->instances, &s->cap_instances, s->n_instances + 1, sizeof *in))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding an instance");
+    s->instances[s->n_instances++] = *in;
+    s->n_inst_prims += in->n_tris;
+    s->finalized = 0;
+    return RS_OK;
+}
+
+rs_status rs_scene_flatten_instances(rs_scene *s)
+{
+    uint32_t i, k;
+    for (i = 0; i < s->n_instances; ++i) {
+        const rs_instance *in = &s->instances[i];
+        for (k = in->first_tri; k < in->first_tri + in->n_tris; ++k) {
+            float uvt[6], vnt[9];
+            rs_tri w = rs_instance_tri(in, &s->inst_tris[k]);
+            rs_vec3 v[3];
+            const float *uv = s->inst_tri_uv ? rs_instance_tri_uv(s, in, k, uvt) : NULL;
+            const float *vn = rs_instance_tri_normals(s, in, k, vnt);
+            rs_status st;
+            v[0] = w.v0;
+            v[1] = w.v1;
+            v[2] = w.v2;
+            if ((st = rs_scene_add_triangle_full(s, v, uv, vn, s->inst_tri_mat[k])) != RS_OK)
+                return st;
+        }
+    }
+    s->n_instances = 0;
+    s->n_inst_prims = 0;
+    s->n_inst_tris = 0;
+    s->finalized = 0;
+    return RS_OK;
+}
+
 static float luminance(rs_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 static float prim_area(const rs_scene *s, uint32_t prim)
@@ -380,6 +465,30 @@ rs_status rs_scene_finalize(rs_scene *s)
     for (i = 0; i < s->n_tris; ++i)
         if (!finite3(s->tris[i].v0) || !finite3(s->tris[i].v1) || !finite3(s->tris[i].v2))
             return rs_error_set(RS_ERR_ARG, "triangle %u: non-finite vertex", i);
+    for (i = 0; i < s->n_inst_tris; ++i) {
+        const rs_material *m;
+        if (!finite3(s->inst_tris[i].v0) || !finite3(s->inst_tris[i].v1) ||
+            !finite3(s->inst_tris[i].v2))
+            return rs_error_set(RS_ERR_ARG, "prototype triangle %u: non-finite vertex", i);
+        if (s->inst_tri_mat[i] >= s->n_materials)
+            return rs_error_set(RS_ERR_ARG, "prototype triangle %u: no material %u", i,
+                                s->inst_tri_mat[i]);
+        m = &s->materials[s->inst_tri_mat[i]];
+        if (rs_material_is_light(m))
+            return rs_error_set(RS_ERR_ARG, "prototype triangle %u emits light: emitters are "
+                                            "copied, never instanced", i);
+    }
+    {
+        /* instances' triangles are numbered after the scene's own, in instance order */
+        uint64_t base = (uint64_t)n;
+        for (i = 0; i < s->n_instances; ++i) {
+            s->instances[i].prim_base = (uint32_t)base;
+            base += s->instances[i].n_tris;
+        }
+        if (base > 0x7fffffffu)
+            return rs_error_set(RS_ERR_ARG, "the scene has %llu primitives, at most 2^31 - 1",
+                                (unsigned long long)base);
+    }
 
     rs_free(s->lights);
     rs_free(s->light_cdf);
@@ -425,9 +534,7 @@ rs_status rs_scene_finalize(rs_scene *s)
         s->prim_light[i] = -1;
         /* a glTF material's constant emission is sampled too (two-sided); a textured one is
          * left to the paths that hit it */
-        if ((m->type == RS_MAT_DIFFUSE_LIGHT ||
-             (m->type == RS_MAT_PBR && m->emission_tex == RS_NO_TEXTURE)) &&
-            luminance(m->emission) > 0.0f)
+        if (rs_material_is_light(m))
             s->prim_light[i] = (int32_t)nl++;
     }
     s->n_area_lights = nl;

@@ -76,6 +76,15 @@ typedef struct rs_material {
     float normal_scale;  /* glTF's normalTexture.scale: x and y of the map are multiplied by it */
 } rs_material;
 
+/* Whether a surface of material m is a light that light sampling picks: an emitter, or a glTF
+ * material of constant emission (a textured one is left to the paths that hit it). */
+static inline int rs_material_is_light(const rs_material *m)
+{
+    return (m->type == RS_MAT_DIFFUSE_LIGHT ||
+            (m->type == RS_MAT_PBR && m->emission_tex == RS_NO_TEXTURE)) &&
+           0.2126f * m->emission.x + 0.7152f * m->emission.y + 0.0722f * m->emission.z > 0.0f;
+}
+
 typedef enum rs_texture_type {
     RS_TEX_SOLID = 0,   /* a */
     RS_TEX_CHECKER = 1, /* 3D checker of cell size `scale` (RTNW v4): a on even cells, b on odd */
@@ -113,6 +122,9 @@ typedef struct rs_punctual {
     float cos_inner, cos_outer; /* spot: full intensity inside the inner cone, none outside the
                                    outer, glTF's smooth falloff between */
 } rs_punctual;
+
+/* Most triangles the instances of one scene may place (global numbers stay below 2^31). */
+#define RS_MAX_INST_PRIMS (1u << 30)
 
 /* In rs_light.prim: a punctual light, its index in the low bits. */
 #define RS_LIGHT_PUNCTUAL 0x80000000u
@@ -163,6 +175,19 @@ typedef struct rs_scene {
     rs_punctual *punctuals;
     uint32_t n_punctuals, cap_punctuals;
 
+    /* Instances (core/geom.h): the prototypes' triangles in object space, with materials, UVs
+     * and vertex normals as the scene's own triangles have them, and their placements.  An
+     * instance's triangles are numbered after every primitive of the scene's own, in instance
+     * order (rs_instance.prim_base, set by finalize); no array here is per placed triangle. */
+    rs_tri *inst_tris;
+    uint32_t *inst_tri_mat;
+    float *inst_tri_uv;     /* NULL until a prototype triangle has UVs; then 6 per triangle */
+    float *inst_tri_normal; /* NULL until one has vertex normals; then 9 per triangle */
+    uint32_t n_inst_tris, cap_inst_tris, cap_inst_uv, cap_inst_normal;
+    rs_instance *instances;
+    uint32_t n_instances, cap_instances;
+    uint32_t n_inst_prims; /* triangles the instances place, all together */
+
     /* built by rs_scene_finalize */
     rs_light *lights;
     float *light_cdf; /* n_lights + 1 entries, cdf[0] = 0, cdf[n] = 1 */
@@ -208,7 +233,135 @@ RS_HD rs_geom rs_scene_geom(const rs_scene *s)
     g.n_spheres = s->n_spheres;
     g.n_quads = s->n_quads;
     g.n_tris = s->n_tris;
+    /* the instances' bottom levels come with the BVH (accel/bvh.h: rs_bvh_attach) */
+    g.instances = s->instances;
+    g.inst_tris = s->inst_tris;
+    g.blas_nodes = NULL;
+    g.blas_prim_ids = NULL;
+    g.n_instances = s->n_instances;
+    g.n_inst_tris = s->n_inst_tris;
+    g.n_blas_nodes = 0;
     return g;
+}
+
+/* The instance that places global primitive `prim` (one of the instances' triangles: prim >=
+ * rs_scene_prim_count), and in *k the prototype triangle's index into inst_tris. */
+RS_HD const rs_instance *rs_scene_prim_instance(const rs_scene *s, uint32_t prim, uint32_t *k)
+{
+    uint32_t lo = 0, hi = s->n_instances;
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (s->instances[mid].prim_base <= prim)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    *k = s->instances[lo].first_tri + (prim - s->instances[lo].prim_base);
+    return &s->instances[lo];
+}
+
+/* Triangle `prim` (a global number in the triangles' range: the scene's own or an instance's) as
+ * it lies in the world. */
+RS_HD rs_tri rs_scene_tri(const rs_scene *s, uint32_t prim)
+{
+    uint32_t t = prim - s->n_spheres - s->n_quads, k;
+    const rs_instance *in;
+    if (t < s->n_tris)
+        return s->tris[t];
+    in = rs_scene_prim_instance(s, prim, &k);
+    return rs_instance_tri(in, &s->inst_tris[k]);
+}
+
+/* The UVs (u0, v0, u1, v1, u2, v2) of prototype triangle k (an inst_tris index) as instance
+ * `in` places it, into tmp[6] (v1 and v2 swapped under a mirror), or (0,0), (1,0), (0,1) when no
+ * prototype triangle has UVs. */
+RS_HD const float *rs_instance_tri_uv(const rs_scene *s, const rs_instance *in, uint32_t k,
+                                      float *tmp)
+{
+    const float *src;
+    tmp[0] = tmp[1] = tmp[3] = tmp[4] = 0.0f;
+    tmp[2] = tmp[5] = 1.0f;
+    if (!s->inst_tri_uv)
+        return tmp;
+    src = &s->inst_tri_uv[6 * (size_t)k];
+    tmp[0] = src[0];
+    tmp[1] = src[1];
+    tmp[2] = src[in->mirror ? 4 : 2];
+    tmp[3] = src[in->mirror ? 5 : 3];
+    tmp[4] = src[in->mirror ? 2 : 4];
+    tmp[5] = src[in->mirror ? 3 : 5];
+    return tmp;
+}
+
+/* The vertex normals (9 floats) of prototype triangle k as instance `in` places it, into tmp,
+ * transformed as flattening transforms a copied triangle's (scenes/transform.c: by the cofactor
+ * matrix in double precision, normalised, v1 and v2 swapped under a mirror); NULL when no
+ * prototype triangle has normals. */
+RS_HD const float *rs_instance_tri_normals(const rs_scene *s, const rs_instance *in, uint32_t k,
+                                           float *tmp)
+{
+    const float *vn;
+    uint32_t c, j;
+    if (!s->inst_tri_normal)
+        return NULL;
+    vn = &s->inst_tri_normal[9 * (size_t)k];
+    for (c = 0; c < 3; ++c) {
+        /* corner c of the placed triangle is corner src of the prototype's */
+        uint32_t src = in->mirror && c ? 3 - c : c;
+        double n[3], l;
+        for (j = 0; j < 3; ++j)
+            n[j] = in->cof[3 * j] * vn[3 * src] + in->cof[3 * j + 1] * vn[3 * src + 1] +
+                   in->cof[3 * j + 2] * vn[3 * src + 2];
+        l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        /* a zero normal ("use the face's") stays zero; det < 0 flips the cofactor's */
+        if (l > 0)
+            l = (in->mirror ? -1.0 : 1.0) / l;
+        for (j = 0; j < 3; ++j)
+            tmp[3 * c + j] = (float)(n[j] * l);
+    }
+    return tmp;
+}
+
+/* The UVs (u0, v0, u1, v1, u2, v2) of triangle `prim`: the scene's own array, or tmp[6] filled;
+ * NULL where no triangle of the scene has UVs (shading then takes the barycentrics).  A triangle
+ * without UVs in a scene where others have them gets (0,0), (1,0), (0,1), as the scene's own
+ * arrays give it, so that a scene and its flattened twin read the same UVs. */
+RS_HD const float *rs_scene_tri_uv(const rs_scene *s, uint32_t prim, float *tmp)
+{
+    uint32_t t = prim - s->n_spheres - s->n_quads, k;
+    const rs_instance *in;
+    if (t < s->n_tris && s->tri_uv)
+        return &s->tri_uv[6 * (size_t)t];
+    if (!s->tri_uv && !s->inst_tri_uv)
+        return NULL;
+    if (t < s->n_tris) {
+        tmp[0] = tmp[1] = tmp[3] = tmp[4] = 0.0f;
+        tmp[2] = tmp[5] = 1.0f;
+        return tmp;
+    }
+    in = rs_scene_prim_instance(s, prim, &k);
+    return rs_instance_tri_uv(s, in, k, tmp);
+}
+
+/* The unit vertex normals (9 floats) of triangle `prim`: the scene's own, or an instance's in
+ * tmp[9] (rs_instance_tri_normals); NULL where it has none (zeros also mean none). */
+RS_HD const float *rs_scene_tri_normals(const rs_scene *s, uint32_t prim, float *tmp)
+{
+    uint32_t t = prim - s->n_spheres - s->n_quads, k;
+    const rs_instance *in;
+    if (t < s->n_tris)
+        return s->tri_normal ? &s->tri_normal[9 * (size_t)t] : NULL;
+    if (!s->inst_tri_normal)
+        return NULL;
+    in = rs_scene_prim_instance(s, prim, &k);
+    return rs_instance_tri_normals(s, in, k, tmp);
+}
+
+/* Index into the light table of global primitive `prim`, or -1 (instances' triangles are never
+ * lights: a group with emitters is copied, not instanced). */
+RS_HD int32_t rs_scene_prim_light(const rs_scene *s, uint32_t prim)
+{
+    return prim < s->n_spheres + s->n_quads + s->n_tris ? s->prim_light[prim] : -1;
 }
 
 /* The material of global primitive `prim`. */
@@ -219,7 +372,13 @@ RS_HD const rs_material *rs_scene_prim_material(const rs_scene *s, uint32_t prim
     prim -= s->n_spheres;
     if (prim < s->n_quads)
         return &s->materials[s->quad_mat[prim]];
-    return &s->materials[s->tri_mat[prim - s->n_quads]];
+    if (prim - s->n_quads < s->n_tris)
+        return &s->materials[s->tri_mat[prim - s->n_quads]];
+    {
+        uint32_t k;
+        rs_scene_prim_instance(s, prim + s->n_spheres, &k);
+        return &s->materials[s->inst_tri_mat[k]];
+    }
 }
 
 /* Radiance arriving along direction d (unit) from outside the scene. */
@@ -279,6 +438,22 @@ rs_status rs_scene_set_environment(rs_scene *s, uint32_t image, rs_vec3 scale,
 /* A punctual light; intensity >= 0, finite; spot cones with 0 <= inner <= outer <= 90 degrees
  * (cosines given), dir non-zero (normalised here). */
 rs_status rs_scene_add_punctual(rs_scene *s, const rs_punctual *p);
+
+/* Moves the scene's own triangles [from, n_tris) (with their materials, UVs and normals) into
+ * the prototype pool, as prototype *first .. *first + *count - 1 (inst_tris indices): what a
+ * group's triangles become when it is instanced. */
+rs_status rs_scene_make_prototype(rs_scene *s, uint32_t from, uint32_t *first, uint32_t *count);
+/* Places prototype [first, first + count) by the affine transform m (row-major 3x4, double:
+ * core/geom.h's rs_instance.m).  RS_ERR_ARG (message without a file: the caller prefixes it)
+ * for a singular or non-finite transform, a placed coordinate beyond 1e30, or more than 2^30
+ * placed triangles in all. */
+rs_status rs_scene_add_instance(rs_scene *s, uint32_t first, uint32_t count, const double m[12]);
+/* Appends a prepared placement (rs_scene_add_instance's last step). */
+rs_status rs_scene_push_instance(rs_scene *s, const rs_instance *in);
+/* Replaces every instance by copies of its triangles, transformed as instancing transforms
+ * them, appended to the scene's own triangles in instance order: the flattened twin, which
+ * numbers, shades and renders every triangle as the instanced scene does.  Before finalize. */
+rs_status rs_scene_flatten_instances(rs_scene *s);
 
 rs_status rs_scene_finalize(rs_scene *s);
 
@@ -343,7 +518,12 @@ static inline size_t rs_scene_env_cond_len(const rs_scene *s)
     X(prim_light, (size_t)(s)->n_spheres + (s)->n_quads + (s)->n_tris)                           \
     X(punctuals, (size_t)(s)->n_punctuals)                                                         \
     X(env_marg_cdf, rs_scene_env_marg_len(s))                                                      \
-    X(env_cond_cdf, rs_scene_env_cond_len(s))
+    X(env_cond_cdf, rs_scene_env_cond_len(s))                                                      \
+    X(inst_tris, (size_t)(s)->n_inst_tris)                                                         \
+    X(inst_tri_mat, (size_t)(s)->n_inst_tris)                                                      \
+    X(inst_tri_uv, 6 * (size_t)(s)->n_inst_tris)                                                   \
+    X(inst_tri_normal, 9 * (size_t)(s)->n_inst_tris)                                               \
+    X(instances, (size_t)(s)->n_instances)
 /* clang-format on */
 
 /* Copies n elements of `size` bytes from `src` through ops into a new block at *dst and lists

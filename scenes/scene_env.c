@@ -58,6 +58,10 @@ double rs_scene_bound_radius(const rs_scene *s)
         lo = rs_v3_min(lo, rs_v3_min(s->tris[i].v0, rs_v3_min(s->tris[i].v1, s->tris[i].v2)));
         hi = rs_v3_max(hi, rs_v3_max(s->tris[i].v0, rs_v3_max(s->tris[i].v1, s->tris[i].v2)));
     }
+    for (i = 0; i < s->n_instances; ++i) { /* the exact bounds of the placed triangles */
+        lo = rs_v3_min(lo, s->instances[i].box.lo);
+        hi = rs_v3_max(hi, s->instances[i].box.hi);
+    }
     if (!(lo.x <= hi.x))
         return 1.0;
     {

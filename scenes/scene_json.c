@@ -28,12 +28,17 @@ typedef struct named {
     uint32_t id;
 } named;
 
-/* A named group of objects that instances place (top-level "groups"). */
+/* A named group of objects that instances place (top-level "groups").  A group of triangles
+ * (triangle, mesh and instances of such groups) is instanced at the top level: read once into a
+ * prototype that every instance shares (core/geom.h); any other group is copied. */
 typedef struct group {
     const char *name;
     const cJSON *objects;
     uint32_t prims; /* primitives one instance makes, once known */
     int known;
+    int shape;            /* 0: not yet known, 1: triangles only, -1: copied */
+    int made;             /* the prototype is read */
+    uint32_t first, n;    /* the prototype's triangles (inst_tris) */
 } group;
 
 /* A mesh object's triangles as its file gave them (before any transform), so that a mesh that
@@ -1114,8 +1119,99 @@ static const group *find_group(const ctx *c, const char *name)
     return NULL;
 }
 
-/* An instance of a group: the group's objects, each under its own transform and then this
- * one's (xf), copied into the scene. */
+/* Whether group g holds only triangles (triangle and mesh objects, and instances of groups that
+ * do): such a group can be instanced.  Unknown groups and cycles answer no (and are reported
+ * when the group is copied). */
+static int group_of_triangles(ctx *c, group *g, uint32_t depth)
+{
+    const cJSON *it;
+    if (g->shape)
+        return g->shape > 0;
+    if (depth >= MAX_NESTING)
+        return 0;
+    g->shape = -1; /* until shown otherwise: also what a cycle finds */
+    for (it = g->objects->child; it; it = it->next) {
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(it, "type");
+        const char *type = cJSON_IsString(t) ? t->valuestring : "";
+        if (strcmp(type, "triangle") == 0 || strcmp(type, "mesh") == 0)
+            continue;
+        if (strcmp(type, "instance") == 0) {
+            const cJSON *gn = cJSON_GetObjectItemCaseSensitive(it, "group");
+            group *inner = cJSON_IsString(gn) ? (group *)find_group(c, gn->valuestring) : NULL;
+            if (inner && inner != g && group_of_triangles(c, inner, depth + 1))
+                continue;
+        }
+        return 0;
+    }
+    g->shape = 1;
+    return 1;
+}
+
+/* A top-level instance of a group of triangles: the group read once (the first time) into a
+ * prototype, then placed by xf.  A group whose triangles emit light is copied instead (*copied
+ * set): emitters are lights, one per placed triangle. */
+static rs_status place_instance(ctx *c, group *g, const char *path, const rs_xform *xf,
+                                int *copied)
+{
+    double m[12];
+    int i, j;
+    *copied = 0;
+    if (!g->made) {
+        const cJSON *it;
+        rs_xform id = rs_xform_identity();
+        uint32_t from = c->scene->n_tris, k;
+        int emits = 0;
+        c->stack[c->depth++] = g;
+        for (it = g->objects->child, i = 0; it; it = it->next, ++i) {
+            char q[300];
+            snprintf(q, sizeof q, "groups.%s[%d]", g->name, i);
+            TRY(read_object(c, it, q, &id));
+            if (rs_scene_prim_count(c->scene) > MAX_PRIMS)
+                return FAIL(c, path, "the scene would pass %u primitives", MAX_PRIMS);
+        }
+        c->depth--;
+        for (k = from; k < c->scene->n_tris && !emits; ++k)
+            emits = rs_material_is_light(&c->scene->materials[c->scene->tri_mat[k]]);
+        if (emits) {
+            rs_scene_mark mark = rs_scene_mark_now(c->scene);
+            mark.n_tris = from;
+            mark.n_spheres = c->scene->n_spheres;
+            mark.n_quads = c->scene->n_quads;
+            mark.n_punctuals = c->scene->n_punctuals;
+            g->shape = -1;
+            *copied = 1;
+            if (!rs_xform_is_identity(xf) &&
+                rs_scene_transform_since(c->scene, &mark, xf) != RS_OK) {
+                char msg[400];
+                snprintf(msg, sizeof msg, "%s", rs_error_message());
+                rs_error_clear();
+                return FAIL(c, path, "%s", msg);
+            }
+            return RS_OK;
+        }
+        if (rs_scene_make_prototype(c->scene, from, &g->first, &g->n) != RS_OK)
+            return FAIL(c, path, "out of memory");
+        g->made = 1;
+    }
+    if (g->n == 0)
+        return RS_OK; /* an empty group places nothing */
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j)
+            m[4 * i + j] = xf->m[i][j];
+        m[4 * i + 3] = xf->t[i];
+    }
+    if (rs_scene_add_instance(c->scene, g->first, g->n, m) != RS_OK) {
+        char msg[400];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        return FAIL(c, path, "%s", msg);
+    }
+    return RS_OK;
+}
+
+/* An instance of a group: at the top level, a group of triangles is placed (place_instance);
+ * otherwise the group's objects, each under its own transform and then this one's (xf), are
+ * copied into the scene. */
 static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const rs_xform *xf)
 {
     static const char *const keys[] = {"type", "group", "transform", NULL};
@@ -1146,6 +1242,15 @@ static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const r
                     MAX_PRIMS);
     if (c->depth == 0)
         snprintf(c->instance_path, sizeof c->instance_path, "%s", path);
+    if (c->depth == 0 && group_of_triangles(c, g, 0)) {
+        int copied;
+        TRY(place_instance(c, g, path, xf, &copied));
+        if (!copied)
+            return RS_OK;
+        g->prims = rs_scene_prim_count(c->scene) - before;
+        g->known = 1;
+        return RS_OK;
+    }
     c->stack[c->depth++] = g;
     for (it = g->objects->child; it; it = it->next, ++i) {
         char q[300];

@@ -104,6 +104,10 @@ rs_status rs_scene_mirror_create(const rs_scene *s, const rs_mirror_ops *ops, rs
     d->cap_motion = d->sphere_motion ? d->n_spheres : 0;
     d->cap_uv = d->tri_uv ? d->n_tris : 0;
     d->cap_normal = d->tri_normal ? d->n_tris : 0;
+    d->cap_inst_tris = d->n_inst_tris;
+    d->cap_inst_uv = d->inst_tri_uv ? d->n_inst_tris : 0;
+    d->cap_inst_normal = d->inst_tri_normal ? d->n_inst_tris : 0;
+    d->cap_instances = d->n_instances;
     d->cap_materials = d->n_materials;
     d->cap_textures = d->n_textures;
     d->cap_images = d->n_images;

@@ -299,3 +299,80 @@ rs_status rs_scene_transform_since(rs_scene *s, const rs_scene_mark *from, const
     s->finalized = 0;
     return RS_OK;
 }
+
+/* The object-space widening of an instance's bottom-level boxes (core/geom.h).  Its triangles
+ * are tested where rs_instance_point puts them, each coordinate within half an ulp of the exact
+ * transform, so up to 2^-24 (|M| R + |t|) away from it in world space and |M^-1| times that in
+ * object space (R the prototype's largest coordinate, norms the rows' largest absolute sums);
+ * the object-space ray, transformed in double and rounded once, is as close.  The margin is 2^8
+ * times that bound (and at least 2^-16 R), so the boxes cull nothing the world-space test could
+ * hit, and they grow by well under a thousandth of the prototype. */
+static float instance_margin(const double m[12], const double inv[12], double r)
+{
+    double nm = 0, ni = 0, nt = 0;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        double a = fabs(m[4 * i]) + fabs(m[4 * i + 1]) + fabs(m[4 * i + 2]);
+        double b = fabs(inv[4 * i]) + fabs(inv[4 * i + 1]) + fabs(inv[4 * i + 2]);
+        nm = a > nm ? a : nm;
+        ni = b > ni ? b : ni;
+        nt = fabs(m[4 * i + 3]) > nt ? fabs(m[4 * i + 3]) : nt;
+    }
+    return (float)(0x1.0p-16 * (ni * (nm * r + nt) + r));
+}
+
+rs_status rs_scene_add_instance(rs_scene *s, uint32_t first, uint32_t count, const double m[12])
+{
+    rs_xform x;
+    rs_instance in;
+    double cof[3][3], det, r = 0;
+    const char *why;
+    uint32_t i, j;
+    if (count == 0 || (uint64_t)first + count > s->n_inst_tris)
+        return rs_error_set(RS_ERR_ARG, "an instance of triangles %u..%u (the prototypes have %u)",
+                            first, first + count, s->n_inst_tris);
+    if ((uint64_t)s->n_inst_prims + count > RS_MAX_INST_PRIMS)
+        return rs_error_set(RS_ERR_ARG, "the instances would place more than 2^30 triangles");
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j)
+            x.m[i][j] = m[4 * i + j];
+        x.t[i] = m[4 * i + 3];
+    }
+    if ((why = rs_xform_invalid(&x)) != NULL)
+        return rs_error_set(RS_ERR_ARG, "%s", why);
+    memset(&in, 0, sizeof in);
+    det = rs_xform_det(&x);
+    cofactor(&x, cof);
+    for (i = 0; i < 12; ++i)
+        in.m[i] = m[i];
+    for (i = 0; i < 3; ++i) {
+        double t = 0;
+        for (j = 0; j < 3; ++j) {
+            in.inv[4 * i + j] = cof[j][i] / det; /* M^-1 = adj(M) / det, adj = cof^T */
+            in.cof[3 * i + j] = cof[i][j];
+        }
+        for (j = 0; j < 3; ++j)
+            t -= in.inv[4 * i + j] * m[4 * j + 3];
+        in.inv[4 * i + 3] = t;
+    }
+    in.mirror = det < 0;
+    in.first_tri = first;
+    in.n_tris = count;
+    in.box.lo = rs_v3_splat(INFINITY);
+    in.box.hi = rs_v3_splat(-INFINITY);
+    for (i = first; i < first + count; ++i) {
+        const rs_tri *t = &s->inst_tris[i];
+        rs_tri w = rs_instance_tri(&in, t);
+        if (!in_range(w.v0) || !in_range(w.v1) || !in_range(w.v2))
+            return out_of_range();
+        in.box.lo = rs_v3_min(in.box.lo, rs_v3_min(w.v0, rs_v3_min(w.v1, w.v2)));
+        in.box.hi = rs_v3_max(in.box.hi, rs_v3_max(w.v0, rs_v3_max(w.v1, w.v2)));
+        for (j = 0; j < 3; ++j) {
+            rs_vec3 v = j == 0 ? t->v0 : j == 1 ? t->v1 : t->v2;
+            double a = fmax(fabs((double)v.x), fmax(fabs((double)v.y), fabs((double)v.z)));
+            r = a > r ? a : r;
+        }
+    }
+    in.margin = instance_margin(in.m, in.inv, r);
+    return rs_scene_push_instance(s, &in);
+}

@@ -3,7 +3,10 @@
 
 rs_status rs_device_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
 {
-    return d->ops->upload(d, g, bvh);
+    /* the instances' bottom levels travel with the geometry (core/geom.h) */
+    rs_geom a = *g;
+    rs_bvh_attach(bvh, &a);
+    return d->ops->upload(d, &a, bvh);
 }
 
 void rs_device_destroy(rs_device *d)

@@ -65,7 +65,8 @@ rs_status rs_device_copy_scene(const rs_scene *s, const rs_device_geom *geom,
     void *p;
     memset(out, 0, sizeof *out);
     if (geom->geom.n_spheres != s->n_spheres || geom->geom.n_quads != s->n_quads ||
-        geom->geom.n_tris != s->n_tris)
+        geom->geom.n_tris != s->n_tris || geom->geom.n_instances != s->n_instances ||
+        geom->geom.n_inst_tris != s->n_inst_tris)
         return rs_error_set(RS_ERR_ARG,
                             "the device's geometry (%u spheres, %u quads, %u triangles) is not the "
                             "scene's (%u, %u, %u)",
@@ -85,6 +86,11 @@ rs_status rs_device_copy_scene(const rs_scene *s, const rs_device_geom *geom,
 #define RS_TAKE_ARRAY(field, count) out->tracer.geom.field = sg.field;
     RS_GEOM_ARRAYS(RS_TAKE_ARRAY, &sg)
 #undef RS_TAKE_ARRAY
+    /* but the instance table with its roots and the bottom levels are the BVH's (rs_bvh_attach),
+     * which the uploaded copy holds */
+    out->tracer.geom.instances = geom->geom.instances;
+    out->tracer.geom.blas_nodes = geom->geom.blas_nodes;
+    out->tracer.geom.blas_prim_ids = geom->geom.blas_prim_ids;
     out->tracer.bvh = geom->bvh;
     out->tracer.bvh4 = NULL;
     out->tracer.bvh8 = NULL;

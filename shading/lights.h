@@ -52,10 +52,9 @@ RS_HD rs_vec3 rs_prim_normal(const rs_scene *s, uint32_t prim, rs_vec3 p, float 
     prim -= s->n_spheres;
     if (prim < s->n_quads)
         return rs_v3_normalize(s->quads[prim].w);
-    prim -= s->n_quads;
     {
-        const rs_tri *t = &s->tris[prim];
-        return rs_v3_normalize(rs_v3_cross(rs_v3_sub(t->v1, t->v0), rs_v3_sub(t->v2, t->v0)));
+        rs_tri t = rs_scene_tri(s, prim + s->n_spheres);
+        return rs_v3_normalize(rs_v3_cross(rs_v3_sub(t.v1, t.v0), rs_v3_sub(t.v2, t.v0)));
     }
 }
 

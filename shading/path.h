@@ -187,14 +187,14 @@ RS_HD void rs_surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, 
         *v = theta * RS_INV_PI;
         return;
     }
-    prim -= sc->n_spheres;
-    if (prim < sc->n_quads || !sc->tri_uv) {
+    if (prim - sc->n_spheres < sc->n_quads || (!sc->tri_uv && !sc->inst_tri_uv)) {
         *u = hu;
         *v = hv;
         return;
     }
     {
-        const float *uv = &sc->tri_uv[6 * (size_t)(prim - sc->n_quads)];
+        float tmp[6];
+        const float *uv = rs_scene_tri_uv(sc, prim, tmp);
         float b0 = 1.0f - hu - hv;
         *u = b0 * uv[0] + hu * uv[2] + hv * uv[4];
         *v = b0 * uv[1] + hu * uv[3] + hv * uv[5];
@@ -243,17 +243,19 @@ RS_HD_COLD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, ui
                                     float hu, float hv, rs_vec3 x, rs_vec3 n, int front,
                                     rs_vec3 wo)
 {
-    uint32_t t = prim - sc->n_spheres - sc->n_quads;
-    const rs_tri *tr;
+    rs_tri tr;
     const float *uv;
+    float tmp[6];
     rs_vec3 e1, e2, T, B, nf, tex, nm;
     float du1, dv1, du2, dv2, det, u, v, hand;
-    if (m->normal_tex == RS_NO_TEXTURE || !sc->tri_uv || prim < sc->n_spheres + sc->n_quads)
+    if (m->normal_tex == RS_NO_TEXTURE || prim < sc->n_spheres + sc->n_quads)
         return n;
-    tr = &sc->tris[t];
-    uv = &sc->tri_uv[6 * (size_t)t];
-    e1 = rs_v3_sub(tr->v1, tr->v0);
-    e2 = rs_v3_sub(tr->v2, tr->v0);
+    uv = rs_scene_tri_uv(sc, prim, tmp);
+    if (!uv)
+        return n;
+    tr = rs_scene_tri(sc, prim);
+    e1 = rs_v3_sub(tr.v1, tr.v0);
+    e2 = rs_v3_sub(tr.v2, tr.v0);
     du1 = uv[2] - uv[0], dv1 = uv[3] - uv[1], du2 = uv[4] - uv[0], dv2 = uv[5] - uv[1];
     det = du1 * dv2 - du2 * dv1;
     if (!(fabsf(det) > 1e-12f))
@@ -287,13 +289,15 @@ RS_HD_COLD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, ui
 RS_HD rs_vec3 rs_shading_normal(const rs_scene *sc, uint32_t prim, float hu, float hv,
                                 rs_vec3 n_geo, rs_vec3 wo)
 {
-    uint32_t t = prim - sc->n_spheres - sc->n_quads;
     const float *vn;
+    float tmp[9];
     rs_vec3 ns;
     float len;
-    if (!sc->tri_normal || prim < sc->n_spheres + sc->n_quads)
+    if ((!sc->tri_normal && !sc->inst_tri_normal) || prim < sc->n_spheres + sc->n_quads)
         return n_geo;
-    vn = &sc->tri_normal[9 * (size_t)t];
+    vn = rs_scene_tri_normals(sc, prim, tmp);
+    if (!vn)
+        return n_geo;
     ns = rs_v3_add(rs_v3_add(rs_v3_scale(rs_v3(vn[0], vn[1], vn[2]), 1.0f - hu - hv),
                              rs_v3_scale(rs_v3(vn[3], vn[4], vn[5]), hu)),
                    rs_v3_scale(rs_v3(vn[6], vn[7], vn[8]), hv));
@@ -339,7 +343,7 @@ RS_HD void rs_shade_emitter(const rs_integrator *it, const rs_ray *r, float t, u
     const rs_scene *sc = it->scene;
     rs_vec3 le = rs_emitted(m, ng, r->d);
     float w = 1.0f;
-    int32_t l = sc->prim_light[prim];
+    int32_t l = rs_scene_prim_light(sc, prim);
     if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
         w = rs_power_heuristic(ps->bsdf_pdf,
                                rs_light_pdf_hit(sc, (uint32_t)l, r->o, r->time, r->d, t, ng));
@@ -530,7 +534,7 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
             /* a glTF emissive surface: MIS-weighted against light sampling where that samples
              * it (constant emission), in full where it cannot (a textured one) */
             float w = 1.0f;
-            int32_t l = sc->prim_light[v.prim];
+            int32_t l = rs_scene_prim_light(sc, v.prim);
             if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
                 w = rs_power_heuristic(ps->bsdf_pdf, rs_light_pdf_hit(sc, (uint32_t)l, r.o, r.time,
                                                                       r.d, h->t, v.ng));

@@ -288,14 +288,31 @@ static void test_mesh_objects(void **state)
         write_file(path, json);
         assert_int_equal(rs_scene_load_json_ex(path, log, &s), RS_OK);
     }
-    assert_int_equal(s->n_tris, 4u);
+    /* a group of triangles: one shared prototype of 2, placed twice (numbers 0..3) */
+    assert_int_equal(s->n_tris, 0u);
+    assert_int_equal(s->n_inst_tris, 2u);
+    assert_int_equal(s->n_instances, 2u);
     /* red from the file (and maybe Assimp's default); blue is the scene's m, id 0 */
     assert_true(s->n_materials >= 3u);
-    assert_int_equal(s->tri_mat[1], 0u);
-    assert_int_equal(s->tri_mat[3], 0u);
-    assert_int_equal(s->tri_mat[0], s->tri_mat[2]);
-    expect_v3(s->tris[2].v0, 0, 0, 5);
-    expect_v3(s->tris[0].v0, 0, 0, 0);
+    assert_int_equal(s->inst_tri_mat[1], 0u);
+    assert_ptr_equal(rs_scene_prim_material(s, 3), &s->materials[0]);
+    assert_ptr_equal(rs_scene_prim_material(s, 0), rs_scene_prim_material(s, 2));
+    expect_v3(rs_scene_tri(s, 2).v0, 0, 0, 5);
+    expect_v3(rs_scene_tri(s, 0).v0, 0, 0, 0);
+    /* flattened: the same four triangles, in the same order */
+    {
+        rs_tri t[4];
+        uint32_t i;
+        for (i = 0; i < 4; ++i)
+            t[i] = rs_scene_tri(s, i);
+        assert_int_equal(rs_scene_flatten_instances(s), RS_OK);
+        assert_int_equal(rs_scene_finalize(s), RS_OK);
+        assert_int_equal(s->n_tris, 4u);
+        assert_int_equal(s->n_instances, 0u);
+        assert_memory_equal(s->tris, t, sizeof t);
+        assert_int_equal(s->tri_mat[1], 0u);
+        assert_int_equal(s->tri_mat[3], 0u);
+    }
     rs_scene_destroy(s);
     log_len = (size_t)ftell(log);
     rewind(log);
