@@ -35,6 +35,7 @@ typedef struct rt_args {
     rs_bvh_method bvh; /* the builder (zeroed: median) */
     int fail_after;    /* > 0: the second device fails after this many chunks (RS_FAULT) */
     int shared_cores;  /* devices and shading share a budget of `threads` cores */
+    uint32_t bvh_width; /* the CPU device's traversal: 2, 4 or 8 (0: 4) */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -76,7 +77,7 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     co.threads = a->threads;
     co.cores = budget;
     co.strategy = a->strategy;
-    co.bvh_width = a->no_bvh ? 2 : 4;
+    co.bvh_width = a->no_bvh ? 2 : a->bvh_width ? a->bvh_width : 4;
     memset(&bo, 0, sizeof bo);
     bo.max_leaf = a->no_bvh ? UINT32_MAX : 0;
     bo.builder.method = a->bvh;

@@ -84,6 +84,18 @@ static rs_scene *make_scene(void)
     v[2] = rs_v3(0, 2.5f, 2.5f);
     assert_int_equal(rs_scene_add_triangle_full(s, v, uv, nrm, id), RS_OK);
     {
+        /* instances: a prototype of that triangle (with UVs and normals), placed twice, once
+         * mirrored (the instance table, the prototypes' arrays, the bottom levels) */
+        static const double m1[12] = {0.5, 0, 0, 1, 0, 0.5, 0, 0.2, 0, 0, 0.5, 0.5};
+        static const double m2[12] = {-0.4, 0, 0, -1, 0, 0.4, 0, 0.3, 0, 0, 0.4, 0.2};
+        uint32_t first, count;
+        assert_int_equal(rs_scene_add_triangle_full(s, v, uv, nrm, id), RS_OK);
+        assert_int_equal(rs_scene_make_prototype(s, s->n_tris - 1, &first, &count), RS_OK);
+        assert_int_equal(count, 1u);
+        assert_int_equal(rs_scene_add_instance(s, first, count, m1), RS_OK);
+        assert_int_equal(rs_scene_add_instance(s, first, count, m2), RS_OK);
+    }
+    {
         /* an environment map (its CDF arrays), instead of the sky */
         float env[8 * 4 * 3];
         uint32_t img;
@@ -125,7 +137,9 @@ static void test_mirror_renders_alone(void **state)
                  SHARED(quad_mat) || SHARED(tris) || SHARED(tri_mat) || SHARED(tri_uv) ||
                  SHARED(tri_normal) || SHARED(materials) || SHARED(textures) || SHARED(images) ||
                  SHARED(lights) || SHARED(light_cdf) || SHARED(prim_light) ||
-                 SHARED(env_marg_cdf) || SHARED(env_cond_cdf));
+                 SHARED(env_marg_cdf) || SHARED(env_cond_cdf) || SHARED(inst_tris) ||
+                 SHARED(inst_tri_mat) || SHARED(inst_tri_uv) || SHARED(inst_tri_normal) ||
+                 SHARED(instances));
     want = s->n_spheres * (sizeof(rs_sphere) + sizeof(uint32_t) + sizeof(rs_vec3)) +
            s->n_quads * (sizeof(rs_quad) + sizeof(uint32_t)) +
            s->n_tris * (sizeof(rs_tri) + sizeof(uint32_t) + 15 * sizeof(float)) +
@@ -133,7 +147,10 @@ static void test_mirror_renders_alone(void **state)
            s->n_images * sizeof(rs_image) + s->n_lights * sizeof(rs_light) +
            (s->n_lights + 1) * sizeof(float) +
            (s->n_spheres + s->n_quads + s->n_tris) * sizeof(int32_t) +
-           (4 + 1 + 4 * (8 + 1)) * sizeof(float); /* the 8 x 4 map's two CDFs */
+           (4 + 1 + 4 * (8 + 1)) * sizeof(float) + /* the 8 x 4 map's two CDFs */
+           s->n_inst_tris * (sizeof(rs_tri) + sizeof(uint32_t) + 15 * sizeof(float)) +
+           s->n_instances * sizeof(rs_instance);
+    assert_int_equal(s->n_instances, 2u);
     assert_non_null(s->env_marg_cdf);
     for (i = 0; i < s->n_images; ++i) {
         want += 3ull * s->images[i].width * s->images[i].height * sizeof(float);
@@ -146,6 +163,8 @@ static void test_mirror_renders_alone(void **state)
     memset(s->spheres, 0x7f, s->n_spheres * sizeof *s->spheres);
     memset(s->materials, 0x7f, s->n_materials * sizeof *s->materials);
     memset(s->tri_uv, 0x7f, 6 * s->n_tris * sizeof(float));
+    memset(s->inst_tri_uv, 0x7f, 6 * s->n_inst_tris * sizeof(float));
+    memset(s->instances, 0x7f, s->n_instances * sizeof *s->instances);
     for (i = 0; i < s->n_images; ++i)
         memset(s->images[i].rgb, 0,
                3ull * s->images[i].width * s->images[i].height * sizeof(float));
@@ -329,6 +348,7 @@ static void observed_build(observed_scene *o, const char *builtin)
     memset(&bo, 0, sizeof bo);
     bo.threads = 1;
     assert_int_equal(rs_bvh_build(&o->geom, &bo, &o->bvh), RS_OK);
+    rs_bvh_attach(o->bvh, &o->geom); /* as rs_device_upload does */
     rs_alloc_set_observer(NULL, NULL);
     assert_true(o->orig.n > 0);
 }
@@ -385,6 +405,21 @@ static void check_device_copy(const char *builtin)
         assert_memory_equal(dg.geom.sphere_motion, o.scene->sphere_motion,
                             o.scene->n_spheres * sizeof *o.scene->sphere_motion);
         assert_ptr_equal(ds.tracer.geom.sphere_motion, ms->sphere_motion);
+    }
+    if (o.scene->n_instances) {
+        /* the instances: the BVH's table (with roots) and bottom levels, copied, in the tracer */
+        assert_true(set_holds(&r.made, (uintptr_t)dg.geom.instances));
+        assert_true(set_holds(&r.made, (uintptr_t)dg.geom.blas_nodes));
+        assert_memory_equal(dg.geom.instances, o.bvh->instances,
+                            o.scene->n_instances * sizeof *o.bvh->instances);
+        assert_memory_equal(dg.geom.blas_nodes, o.bvh->blas_nodes,
+                            o.bvh->n_blas_nodes * sizeof *o.bvh->blas_nodes);
+        assert_ptr_equal(ds.tracer.geom.instances, dg.geom.instances);
+        assert_ptr_equal(ds.tracer.geom.blas_nodes, dg.geom.blas_nodes);
+        assert_ptr_equal(ds.tracer.geom.blas_prim_ids, dg.geom.blas_prim_ids);
+        assert_ptr_equal(ds.tracer.geom.inst_tris, ms->inst_tris);
+        assert_non_null(ms->inst_tri_uv);
+        assert_non_null(ms->inst_tri_normal);
     }
     /* the tracer: the mirror's arrays, the uploaded algorithms and BVH copy */
     assert_ptr_equal(ds.tracer.geom.spheres, ms->spheres);
