@@ -859,7 +859,7 @@ static int write_timeline(const char *path, const rs_cli_options *o, const rende
 /* The summary line on stderr (or, with --quiet, only a word on an interruption). */
 static void print_summary(const rs_cli_options *o, const render_run *r)
 {
-    char sps[32], rps[32], rays[32], bvh_name[64], spp[96];
+    char sps[32], rps[32], rays[32], bvh_name[64], spp[96], inst[160] = "";
     double secs = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
     uint64_t rays_total = r->stats.rays_closest + r->stats.rays_shadow;
     const rs_render_settings *st = &r->st;
@@ -881,16 +881,22 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
                  rs_film_min_count(r->film), st->spp, o->time_limit_s);
     else
         snprintf(spp, sizeof spp, "%u spp", st->spp);
+    if (r->scene->n_instances)
+        snprintf(inst, sizeof inst,
+                 " (%u of them instances placing %u triangles; bottom levels: %u nodes over %u "
+                 "shared triangles)",
+                 r->scene->n_instances, r->scene->n_inst_prims, r->bvh->n_blas_nodes,
+                 r->scene->n_inst_tris);
     fprintf(stderr,
             "%s %s at %ux%u, %s (%s sampling, %s sampler, max depth %u, seed %llu) in %.2f s: "
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
-            "BVH (%s, SAH cost %.1f): %u nodes over %u primitives, built in %.2f ms. ",
+            "BVH (%s, SAH cost %.1f): %u nodes over %u primitives%s, built in %.2f ms. ",
             r->interrupted ? "Partial render (interrupted):" : "Rendered", o->scene, st->width,
             st->height, spp, rs_sampling_name(st->sampling), rs_sampler_name(st->sampler),
             st->max_depth, (unsigned long long)st->seed, r->stats.seconds, sps, rps, rays,
             (unsigned long long)r->stats.rays_closest, (unsigned long long)r->stats.rays_shadow,
             rs_bvh_builder_name(&r->bvh->builder, bvh_name, sizeof bvh_name),
-            rs_bvh_sah_cost(r->bvh), r->bvh->n_nodes, r->bvh->n_prims, r->bvh_ms);
+            rs_bvh_sah_cost(r->bvh), r->bvh->n_nodes, r->bvh->n_prims, inst, r->bvh_ms);
     for (i = 0; i < r->n_devs; ++i) {
         rs_device_stats ds;
         int alive;

@@ -19,8 +19,9 @@
 #define MAX_NAMES       4096
 #define MAX_NESTING     16 /* instances within instances */
 #define MAX_OVERRIDES   64 /* a mesh's materials replaced by name */
-/* Instances are copied (flattened) into the scene: this bounds what a file of a few lines can
- * make (ten groups of ten instances of each other would be 10^10 primitives). */
+/* Groups that are not instanced are copied into the scene (and nested groups into their
+ * prototype): this bounds what a file of a few lines can make (ten groups of ten instances of each
+ * other would be 10^10 primitives).  Placed triangles are bounded by RS_MAX_INST_PRIMS. */
 #define MAX_PRIMS       (1u << 24)
 
 typedef struct named {
@@ -39,6 +40,7 @@ typedef struct group {
     int shape;            /* 0: not yet known, 1: triangles only, -1: copied */
     int made;             /* the prototype is read */
     uint32_t first, n;    /* the prototype's triangles (inst_tris) */
+    uint32_t placed;      /* instances of it */
 } group;
 
 /* A mesh object's triangles as its file gave them (before any transform), so that a mesh that
@@ -1206,6 +1208,7 @@ static rs_status place_instance(ctx *c, group *g, const char *path, const rs_xfo
         rs_error_clear();
         return FAIL(c, path, "%s", msg);
     }
+    g->placed++;
     return RS_OK;
 }
 
@@ -1238,7 +1241,7 @@ static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const r
     if (c->depth >= MAX_NESTING)
         return FAIL(c, p, "instances nested more than %d deep", MAX_NESTING);
     if (g->known && (uint64_t)before + g->prims > MAX_PRIMS)
-        return FAIL(c, path, "the scene would pass %u primitives (instances are copied)",
+        return FAIL(c, path, "the scene would pass %u primitives (this group is copied, not instanced)",
                     MAX_PRIMS);
     if (c->depth == 0)
         snprintf(c->instance_path, sizeof c->instance_path, "%s", path);
@@ -1257,7 +1260,7 @@ static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const r
         snprintf(q, sizeof q, "groups.%s[%d]", g->name, i);
         TRY(read_object(c, it, q, xf));
         if (rs_scene_prim_count(c->scene) > MAX_PRIMS)
-            return FAIL(c, path, "the scene would pass %u primitives (instances are copied)",
+            return FAIL(c, path, "the scene would pass %u primitives (this group is copied, not instanced)",
                         MAX_PRIMS);
     }
     c->depth--;
@@ -1393,6 +1396,16 @@ static rs_status build(ctx *c, const cJSON *root)
         char p[64];
         snprintf(p, sizeof p, "objects[%d]", i);
         TRY(read_object(c, it, p, &id));
+    }
+    if (c->log) {
+        uint32_t g;
+        for (g = 0; g < c->n_groups; ++g)
+            if (c->groups[g].made && c->groups[g].placed)
+                fprintf(c->log,
+                        "raystream: %s: group '%s': %u triangles placed %u time%s (instanced: "
+                        "one copy in memory)\n",
+                        c->label, c->groups[g].name, c->groups[g].n, c->groups[g].placed,
+                        c->groups[g].placed == 1 ? "" : "s");
     }
     return RS_OK;
 }

@@ -1655,6 +1655,41 @@ static void test_user_scenes(void **state)
                "export to a .png: a usage error");
         proc_free(&p);
     }
+    {
+        /* a group of triangles placed three times: one shared copy, said so on loading; the
+         * same image with --flatten-instances (copies), and export writes the copies */
+        static const char *const inst[] = {"render", "inst.json", "--width", "24", "--spp", "4",
+                                           "-o", "i.exr", NULL};
+        static const char *const flat[] = {"render", "inst.json", "--width", "24", "--spp", "4",
+                                           "-q", "--flatten-instances", "-o", "f.exr", NULL};
+        static const char *const exp[] = {"export", "inst.json", "-o", "ie.json", NULL};
+        static const char *const from_export[] = {"render", "ie.json", "--width", "24", "--spp",
+                                                  "4", "-q", "-o", "ie.exr", NULL};
+        write_in(f, "inst.json",
+                 "{\"camera\":{\"from\":[0,1,5],\"at\":[0,0.5,0]},\"materials\":{\"m\":"
+                 "{\"type\":\"lambertian\",\"albedo\":[0.6,0.5,0.4]}},\"groups\":{\"fin\":["
+                 "{\"type\":\"triangle\",\"vertices\":[[0,0,0],[0.8,0,0],[0,1,0.2]],"
+                 "\"material\":\"m\"},{\"type\":\"triangle\",\"vertices\":[[0,0,0],[0,1,0.2],"
+                 "[-0.5,0,0.4]],\"material\":\"m\"}]},\"objects\":["
+                 "{\"type\":\"instance\",\"group\":\"fin\"},"
+                 "{\"type\":\"instance\",\"group\":\"fin\",\"transform\":[{\"rotate\":[0,120,0]},"
+                 "{\"translate\":[-1,0,0]}]},"
+                 "{\"type\":\"instance\",\"group\":\"fin\",\"transform\":{\"scale\":[-1,1,1]}}]}");
+        run_expect(f, inst, 0, &p);
+        EXPECT(&p, strstr(p.err.data, "group 'fin': 2 triangles placed 3 times (instanced") &&
+                       strstr(p.err.data, "3 of them instances placing 6 triangles"),
+               "the load and the summary should say what was instanced");
+        proc_free(&p);
+        run_expect(f, flat, 0, &p);
+        expect_same_image(&p, f, "i.exr", "f.exr");
+        proc_free(&p);
+        run_expect(f, exp, 0, &p);
+        EXPECT(&p, strstr(p.err.data, "6 triangles"), "export writes the six copies");
+        proc_free(&p);
+        run_expect(f, from_export, 0, &p);
+        expect_same_image(&p, f, "i.exr", "ie.exr");
+        proc_free(&p);
+    }
 }
 
 /* --time-limit: a render that would take minutes stops on a whole pass, says how many spp it
