@@ -75,7 +75,9 @@ static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
         return 0;
     for (i = 0; i < n->count; ++i) {
         uint32_t prim = p->prim_ids[n->left_first + i];
-        tris += prim >= first_tri && prim < first_inst;
+        /* a cut-out triangle takes the scalar test, which looks up its mask */
+        tris += prim >= first_tri && prim < first_inst &&
+                !(p->g->tri_mask && p->g->tri_mask[prim - first_tri]);
         quads += prim >= first_quad && prim < first_tri;
         spheres += prim < first_quad;
     }

@@ -72,6 +72,15 @@ RS_HD rs_tri rs_instance_tri(const rs_instance *in, const rs_tri *t)
     return w;
 }
 
+/* An alpha cut-out (glTF's alphaMode MASK): one byte per texel, 1 where the surface is there,
+ * 0 where rays pass through it (the texture's alpha times the factor against the cutoff,
+ * decided when the scene is made).  Looked up at the hit's UVs by the nearest texel, wrapping,
+ * v = 0 at the bottom row, as the image textures are. */
+typedef struct rs_alpha_mask {
+    uint32_t width, height;
+    uint32_t offset; /* of its first texel in mask_bits, rows from the top */
+} rs_alpha_mask;
+
 typedef struct rs_geom {
     const rs_sphere *spheres;
     const rs_vec3 *sphere_motion; /* per sphere: centre displacement per unit time; NULL: none */
@@ -89,6 +98,13 @@ typedef struct rs_geom {
     const rs_bvh_node *blas_nodes;
     const uint32_t *blas_prim_ids; /* indices into inst_tris */
     uint32_t n_instances, n_inst_tris, n_blas_nodes;
+    /* alpha cut-outs (NULL / 0 without): per triangle 1 + its mask's index, or 0 (opaque), and
+     * the triangles' UVs where the scene has them */
+    const uint32_t *tri_mask;
+    const rs_alpha_mask *masks;
+    const uint8_t *mask_bits;
+    const float *tri_uv;
+    uint32_t n_masks, n_mask_bits;
 } rs_geom;
 
 /* Every array of rs_geom, with its element count (`g` a pointer to the geometry; the element
@@ -102,7 +118,11 @@ typedef struct rs_geom {
   X(instances, (size_t)(g)->n_instances)                                                           \
   X(inst_tris, (size_t)(g)->n_inst_tris)                                                           \
   X(blas_nodes, (size_t)(g)->n_blas_nodes)                                                         \
-  X(blas_prim_ids, (size_t)(g)->n_inst_tris)
+  X(blas_prim_ids, (size_t)(g)->n_inst_tris)                                                      \
+  X(tri_mask, (g)->tri_mask ? (size_t)(g)->n_tris : 0)                                             \
+  X(masks, (size_t)(g)->n_masks)                                                                   \
+  X(mask_bits, (size_t)(g)->n_mask_bits)                                                           \
+  X(tri_uv, (g)->tri_mask ? 6 * (size_t)(g)->n_tris : 0)
 
 /* Centre of sphere i at `time`. */
 RS_HD rs_vec3 rs_geom_sphere_center(const rs_geom *g, uint32_t i, float time)
@@ -119,6 +139,31 @@ RS_HD uint32_t rs_geom_prim_count(const rs_geom *g)
 
 /* The scene's own primitives (not instances): those rs_geom_intersect takes. */
 RS_HD uint32_t rs_geom_own_count(const rs_geom *g) { return g->n_spheres + g->n_quads + g->n_tris; }
+
+/* Whether own triangle t (0-based among triangles), cut out by its mask, is there at the hit's
+ * barycentrics (u, v): its UVs interpolated as shading interpolates them (the barycentrics
+ * themselves without UVs), the nearest texel of the mask. */
+RS_HD_COLD int rs_geom_mask_opaque(const rs_geom *g, uint32_t t, float hu, float hv)
+{
+    const rs_alpha_mask *m = &g->masks[g->tri_mask[t] - 1];
+    float u = hu, v = hv, x, y;
+    uint32_t col, row;
+    if (g->tri_uv) {
+        const float *uv = &g->tri_uv[6 * (size_t)t];
+        float b0 = 1.0f - hu - hv;
+        u = b0 * uv[0] + hu * uv[2] + hv * uv[4];
+        v = b0 * uv[1] + hu * uv[3] + hv * uv[5];
+    }
+    x = u - floorf(u);
+    y = v - floorf(v);
+    if (!(x >= 0.0f && y >= 0.0f)) /* a NaN UV: keep the hit */
+        return 1;
+    col = (uint32_t)(x * (float)m->width);
+    row = (uint32_t)(y * (float)m->height);
+    col = col < m->width ? col : m->width - 1;
+    row = row < m->height ? row : m->height - 1;
+    return g->mask_bits[m->offset + (size_t)(m->height - 1 - row) * m->width + col] != 0;
+}
 
 /* Intersects global primitive `prim` (one of the scene's own, < rs_geom_own_count; an instance's
  * triangles are accel/bvh_traverse.h's); on a hit writes t, u, v and returns 1. */
@@ -139,7 +184,9 @@ RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, fl
     if (prim < g->n_quads)
         return rs_isect_quad(&g->quads[prim], r, t, u, v);
     prim -= g->n_quads;
-    return rs_isect_tri_by(g->tri_algo, &g->tris[prim], r, t, u, v);
+    if (!rs_isect_tri_by(g->tri_algo, &g->tris[prim], r, t, u, v))
+        return 0;
+    return !g->tri_mask || !g->tri_mask[prim] || rs_geom_mask_opaque(g, prim, *u, *v);
 }
 
 #endif

@@ -214,6 +214,47 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
     }
 }
 
+extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t *h,
+                                         float **alpha)
+{
+    *alpha = nullptr;
+    try {
+        OIIO::ImageInput::unique_ptr in;
+        rs_status st = open_input(path, RS_ERR_IO, &in);
+        if (st != RS_OK)
+            return st;
+        const OIIO::ImageSpec &spec = in->spec();
+        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+            return rs_error_set(RS_ERR_IO, "%s: empty image", path);
+        if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE ||
+            (uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
+            return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d is too large (at most %llu pixels)",
+                                path, spec.width, spec.height,
+                                (unsigned long long)RS_IMAGE_MAX_PIXELS);
+        int ch = spec.alpha_channel;
+        if (ch < 0 && (spec.nchannels == 2 || spec.nchannels == 4))
+            ch = spec.nchannels - 1;
+        *w = (uint32_t)spec.width;
+        *h = (uint32_t)spec.height;
+        if (ch < 0 || ch >= spec.nchannels)
+            return RS_OK; // no alpha: opaque
+        size_t npix = (size_t)spec.width * (size_t)spec.height;
+        float *o = (float *)rs_alloc(npix, sizeof(float));
+        if (!o)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
+        if (!in->read_image(0, 0, ch, ch + 1, OIIO::TypeDesc::FLOAT, o)) {
+            rs_free(o);
+            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
+        }
+        *alpha = o;
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
+    } catch (...) {
+        return rs_error_set(RS_ERR_IO, "%s: unknown error reading the image", path);
+    }
+}
+
 extern "C" rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n)
 {
     try {

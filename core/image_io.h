@@ -51,6 +51,11 @@ rs_status rs_image_read(const char *path, uint32_t *width, uint32_t *height, flo
  * as sRGB-encoded and decoded; float files (EXR, HDR) are already linear.  For textures. */
 rs_status rs_image_read_linear(const char *path, uint32_t *width, uint32_t *height, float **rgb);
 
+/* Reads an image's alpha channel (OpenImageIO's alpha channel, or the second of two channels,
+ * or the fourth of four), as stored (8-bit: code / 255): width * height floats, rows from the top.
+ * An image without one gives RS_OK and *alpha NULL.  Free with rs_free. */
+rs_status rs_image_read_alpha(const char *path, uint32_t *width, uint32_t *height, float **alpha);
+
 /* The linear value of an sRGB-encoded one in [0, 1]. */
 float rs_srgb_decode(float encoded);
 

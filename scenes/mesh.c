@@ -7,6 +7,7 @@
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
+#include <assimp/GltfMaterial.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -348,9 +349,42 @@ static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinit
  * to a temporary file for OpenImageIO).  A texture that is not a regular file of a sane size is
  * an error; a missing or unreadable one is an error when `strict`, else a warning and no
  * texture. */
+/* With `alpha`, the texture's alpha channel times alpha->scale against alpha->cutoff becomes an
+ * alpha cut-out instead (rs_scene_add_mask; *id a material's alpha_mask; 0 when the texture has
+ * no alpha channel: the constant scale decides). */
+typedef struct alpha_req {
+    float scale, cutoff;
+} alpha_req;
+
+/* A mask from the alpha channel of image file `path` (none: the constant). */
+static rs_status load_mask_file(rs_scene *s, const char *path, const alpha_req *a, uint32_t *id)
+{
+    uint32_t w = 0, h = 0;
+    float *alpha = NULL;
+    rs_status st = rs_image_read_alpha(path, &w, &h, &alpha);
+    *id = 0;
+    if (st == RS_OK && alpha) /* without an alpha channel the constant decides (the caller) */
+        st = rs_scene_add_mask(s, w, h, alpha, a->scale, a->cutoff, id);
+    rs_free(alpha);
+    return st;
+}
+
+static rs_status load_texture_ex(rs_scene *s, const struct aiScene *as,
+                                 const struct aiMaterial *am, enum aiTextureType type,
+                                 const char *mesh, const char *dir, int data, int strict,
+                                 const alpha_req *alpha, uint32_t *id);
+
 static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struct aiMaterial *am,
                               enum aiTextureType type, const char *mesh, const char *dir,
                               int data, int strict, uint32_t *id)
+{
+    return load_texture_ex(s, as, am, type, mesh, dir, data, strict, NULL, id);
+}
+
+static rs_status load_texture_ex(rs_scene *s, const struct aiScene *as,
+                                 const struct aiMaterial *am, enum aiTextureType type,
+                                 const char *mesh, const char *dir, int data, int strict,
+                                 const alpha_req *alpha, uint32_t *id)
 {
     struct aiString tex;
     char path[2048], why[1200], tmp[64] = "";
@@ -358,7 +392,7 @@ static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struc
     rs_texture tx;
     rs_status st;
     int fd;
-    *id = RS_NO_TEXTURE;
+    *id = alpha ? 0 : RS_NO_TEXTURE;
     if (aiGetMaterialTexture(am, type, 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) !=
             aiReturn_SUCCESS ||
         tex.length == 0)
@@ -381,6 +415,17 @@ static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struc
                 return rs_error_set(RS_ERR_ARG, "%s: embedded texture %s is too large", mesh,
                                     tex.data);
             n = t->mWidth * t->mHeight;
+            if (alpha) {
+                float *a = (float *)rs_alloc(n ? n : 1, sizeof *a);
+                if (!a)
+                    return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
+                for (i = 0; i < n; ++i)
+                    a[i] = t->pcData[i].a / 255.0f;
+                st = rs_scene_add_mask(s, t->mWidth, t->mHeight, a, alpha->scale, alpha->cutoff,
+                                       id);
+                rs_free(a);
+                return st;
+            }
             rgb = (float *)rs_alloc((size_t)n * 3, sizeof *rgb);
             if (!rgb)
                 return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
@@ -436,7 +481,9 @@ static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struc
     if (st == RS_OK)
         close(fd);
     rs_error_clear();
-    st = data ? rs_scene_load_image_data(s, path, &image) : rs_scene_load_image(s, path, &image);
+    st = alpha ? load_mask_file(s, path, alpha, id)
+         : data ? rs_scene_load_image_data(s, path, &image)
+                : rs_scene_load_image(s, path, &image);
     if (*tmp)
         unlink(tmp);
     if (st != RS_OK) {
@@ -451,6 +498,8 @@ static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struc
         rs_error_clear();
         return RS_OK;
     }
+    if (alpha)
+        return RS_OK; /* the mask is made */
 made:
     memset(&tx, 0, sizeof tx);
     tx.type = RS_TEX_IMAGE;
@@ -522,6 +571,28 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         }
         m.albedo_tex = t;
         m.albedo = rs_v3_splat(1.0f);
+    }
+    {
+        /* glTF's alpha cut-out: MASK at its alphaCutoff, BLEND taken as a mask at 0.5 (no
+         * partial transparency); the base colour texture's alpha times the factor's */
+        struct aiString mode;
+        ai_real cutoff = 0.5f;
+        if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) == aiReturn_SUCCESS &&
+            (strcmp(mode.data, "MASK") == 0 || strcmp(mode.data, "BLEND") == 0)) {
+            alpha_req ar;
+            one = 1;
+            if (strcmp(mode.data, "MASK") == 0)
+                aiGetMaterialFloatArray(am, AI_MATKEY_GLTF_ALPHACUTOFF, &cutoff, &one);
+            ar.scale = isfinite(base.a) ? fminf(fmaxf(base.a, 0), 1) : 1.0f;
+            ar.cutoff = isfinite(cutoff) ? cutoff : 0.5f;
+            if (load_texture_ex(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_DATA, strict,
+                                &ar, &m.alpha_mask) != RS_OK)
+                return RS_ERR_ARG;
+            /* no alpha texels: the factor alone, all or nothing */
+            if (!m.alpha_mask && ar.scale < ar.cutoff &&
+                rs_scene_add_mask(s, 1, 1, NULL, ar.scale, ar.cutoff, &m.alpha_mask) != RS_OK)
+                return RS_ERR_ARG;
+        }
     }
     if (load_texture(s, as, am, aiTextureType_UNKNOWN, mesh, dir, TEX_DATA, strict,
                      &m.mr_tex) != RS_OK ||

@@ -94,6 +94,9 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->inst_tri_uv);
     rs_free(s->inst_tri_normal);
     rs_free(s->instances);
+    rs_free(s->masks);
+    rs_free(s->mask_bits);
+    rs_free(s->tri_mask);
     rs_free(s);
 }
 
@@ -265,6 +268,31 @@ rs_status rs_scene_add_triangle_full(rs_scene *s, const rs_vec3 v[3], const floa
     if (st == RS_OK && normals)
         memcpy(&s->tri_normal[9 * (size_t)(s->n_tris - 1)], normals, 9 * sizeof *normals);
     return st;
+}
+
+rs_status rs_scene_add_mask(rs_scene *s, uint32_t width, uint32_t height, const float *alpha,
+                            float scale, float cutoff, uint32_t *id)
+{
+    uint64_t n = alpha ? (uint64_t)width * height : 1, i;
+    rs_alpha_mask m;
+    if (!alpha)
+        width = height = 1;
+    if (width == 0 || height == 0 || n > RS_IMAGE_MAX_PIXELS ||
+        (uint64_t)s->n_mask_bits + n > 0xffffffffu)
+        return rs_error_set(RS_ERR_ARG, "an alpha mask of %ux%u texels", width, height);
+    if (!grow((void **)&s->mask_bits, &s->cap_mask_bits, s->n_mask_bits + (uint32_t)n, 1) ||
+        !grow((void **)&s->masks, &s->cap_masks, s->n_masks + 1, sizeof m))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory adding an alpha mask");
+    for (i = 0; i < n; ++i)
+        s->mask_bits[s->n_mask_bits + i] = (alpha ? alpha[i] * scale : scale) >= cutoff;
+    m.width = width;
+    m.height = height;
+    m.offset = s->n_mask_bits;
+    s->masks[s->n_masks++] = m;
+    s->n_mask_bits += (uint32_t)n;
+    *id = s->n_masks;
+    s->finalized = 0;
+    return RS_OK;
 }
 
 rs_status rs_scene_add_texture(rs_scene *s, const rs_texture *t, uint32_t *id)
@@ -526,6 +554,27 @@ rs_status rs_scene_finalize(rs_scene *s)
             return rs_error_set(RS_ERR_ARG, "material %u: metal fuzz must be in [0, 1]", i);
         if (m->type == RS_MAT_DISNEY_DIFFUSE && !(m->roughness >= 0.0f && m->roughness <= 1.0f))
             return rs_error_set(RS_ERR_ARG, "material %u: roughness must be in [0, 1]", i);
+        if (m->alpha_mask > s->n_masks)
+            return rs_error_set(RS_ERR_ARG, "material %u: no alpha mask %u", i, m->alpha_mask);
+    }
+    {
+        /* the triangles' cut-outs, for traversal */
+        int any = 0;
+        rs_free(s->tri_mask);
+        s->tri_mask = NULL;
+        for (i = 0; i < s->n_tris && !any; ++i)
+            any = s->materials[s->tri_mat[i]].alpha_mask != 0;
+        if (any) {
+            s->tri_mask = (uint32_t *)rs_alloc(s->n_tris, sizeof *s->tri_mask);
+            if (!s->tri_mask)
+                return rs_error_set(RS_ERR_NOMEM, "out of memory preparing alpha masks");
+            for (i = 0; i < s->n_tris; ++i)
+                s->tri_mask[i] = s->materials[s->tri_mat[i]].alpha_mask;
+        }
+        for (i = 0; i < s->n_inst_tris; ++i)
+            if (s->materials[s->inst_tri_mat[i]].alpha_mask)
+                return rs_error_set(RS_ERR_ARG, "prototype triangle %u has an alpha cut-out: "
+                                                "cut-outs are copied, never instanced", i);
     }
     /* Every primitive with an emissive material becomes a samplable light: spheres by the cone
      * they subtend, quads and triangles by area. */

@@ -74,6 +74,8 @@ typedef struct rs_material {
     uint32_t normal_tex; /* pbr: a tangent-space normal map (linear, [0, 1] -> [-1, 1]; triangles with
                             UVs), or RS_NO_TEXTURE */
     float normal_scale;  /* glTF's normalTexture.scale: x and y of the map are multiplied by it */
+    uint32_t alpha_mask; /* 1 + index of an alpha cut-out (rs_scene_add_mask) that rays pass
+                            through where it is 0; 0: opaque.  Triangles only */
 } rs_material;
 
 /* Whether a surface of material m is a light that light sampling picks: an emitter, or a glTF
@@ -175,6 +177,13 @@ typedef struct rs_scene {
     rs_punctual *punctuals;
     uint32_t n_punctuals, cap_punctuals;
 
+    /* Alpha cut-outs (core/geom.h): the masks materials name, and per own triangle 1 + its
+     * material's mask or 0, built by finalize (NULL when no triangle has one). */
+    rs_alpha_mask *masks;
+    uint8_t *mask_bits;
+    uint32_t n_masks, cap_masks, n_mask_bits, cap_mask_bits;
+    uint32_t *tri_mask;
+
     /* Instances (core/geom.h): the prototypes' triangles in object space, with materials, UVs
      * and vertex normals as the scene's own triangles have them, and their placements.  An
      * instance's triangles are numbered after every primitive of the scene's own, in instance
@@ -241,6 +250,12 @@ RS_HD rs_geom rs_scene_geom(const rs_scene *s)
     g.n_instances = s->n_instances;
     g.n_inst_tris = s->n_inst_tris;
     g.n_blas_nodes = 0;
+    g.tri_mask = s->tri_mask;
+    g.masks = s->masks;
+    g.mask_bits = s->mask_bits;
+    g.tri_uv = s->tri_uv;
+    g.n_masks = s->n_masks;
+    g.n_mask_bits = s->n_mask_bits;
     return g;
 }
 
@@ -415,6 +430,11 @@ rs_status rs_scene_add_triangle_uv(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 
 rs_status rs_scene_add_triangle_full(rs_scene *s, const rs_vec3 v[3], const float *uv,
                                      const float *normals, uint32_t mat);
 rs_status rs_scene_add_texture(rs_scene *s, const rs_texture *t, uint32_t *id);
+/* An alpha cut-out of width x height texels (rows from the top): opaque where
+ * alpha[i] * scale >= cutoff; alpha NULL: the constant `scale`.  *id is what a material's
+ * alpha_mask takes (1 + the mask's index). */
+rs_status rs_scene_add_mask(rs_scene *s, uint32_t width, uint32_t height, const float *alpha,
+                            float scale, float cutoff, uint32_t *id);
 /* Copies a width x height linear-RGB image into the scene. */
 rs_status rs_scene_add_image(rs_scene *s, uint32_t width, uint32_t height, const float *rgb,
                              uint32_t *id);
@@ -523,7 +543,10 @@ static inline size_t rs_scene_env_cond_len(const rs_scene *s)
     X(inst_tri_mat, (size_t)(s)->n_inst_tris)                                                      \
     X(inst_tri_uv, 6 * (size_t)(s)->n_inst_tris)                                                   \
     X(inst_tri_normal, 9 * (size_t)(s)->n_inst_tris)                                               \
-    X(instances, (size_t)(s)->n_instances)
+    X(instances, (size_t)(s)->n_instances)                                                         \
+    X(masks, (size_t)(s)->n_masks)                                                                 \
+    X(mask_bits, (size_t)(s)->n_mask_bits)                                                         \
+    X(tri_mask, (s)->tri_mask ? (size_t)(s)->n_tris : 0)
 /* clang-format on */
 
 /* Copies n elements of `size` bytes from `src` through ops into a new block at *dst and lists

@@ -94,10 +94,10 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         break;
     case RS_MAT_PBR:
         if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
-            m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission))
+            m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission) || m->alpha_mask)
             return rs_error_set(RS_ERR_ARG, "material %u: a pbr material's metallic-roughness, "
-                                            "emissive and normal textures have no place in a "
-                                            "scene file", i);
+                                            "emissive and normal textures and alpha cut-outs "
+                                            "have no place in a scene file", i);
         fputs("\"pbr\", \"metallic\": ", f);
         num(f, m->metallic);
         fputs(", \"roughness\": ", f);

@@ -1172,8 +1172,10 @@ static rs_status place_instance(ctx *c, group *g, const char *path, const rs_xfo
                 return FAIL(c, path, "the scene would pass %u primitives", MAX_PRIMS);
         }
         c->depth--;
+        /* emitters (lights, one per placed triangle) and cut-outs are copied */
         for (k = from; k < c->scene->n_tris && !emits; ++k)
-            emits = rs_material_is_light(&c->scene->materials[c->scene->tri_mat[k]]);
+            emits = rs_material_is_light(&c->scene->materials[c->scene->tri_mat[k]]) ||
+                    c->scene->materials[c->scene->tri_mat[k]].alpha_mask;
         if (emits) {
             rs_scene_mark mark = rs_scene_mark_now(c->scene);
             mark.n_tris = from;

@@ -108,6 +108,8 @@ rs_status rs_scene_mirror_create(const rs_scene *s, const rs_mirror_ops *ops, rs
     d->cap_inst_uv = d->inst_tri_uv ? d->n_inst_tris : 0;
     d->cap_inst_normal = d->inst_tri_normal ? d->n_inst_tris : 0;
     d->cap_instances = d->n_instances;
+    d->cap_masks = d->n_masks;
+    d->cap_mask_bits = d->n_mask_bits;
     d->cap_materials = d->n_materials;
     d->cap_textures = d->n_textures;
     d->cap_images = d->n_images;

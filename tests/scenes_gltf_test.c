@@ -12,6 +12,8 @@
  *     embedded;
  *   - an emissive texture shows in the image (half of a quad red, half black: the bug that made a
  *     textured model glow uniformly white);
+ *   - alpha cut-outs (MASK by the texture's alpha times the factor's, OPAQUE ignoring it) let
+ *     an emitter behind show through, the same on every traversal;
  *   - bad files: a missing texture, a missing buffer, cut JSON: one line naming the file, no
  *     scene. */
 #include <setjmp.h>
@@ -26,6 +28,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "accel/bvh8.h"
 #include "core/image_io.h"
 #include "render_util.h"
 #include "scenes/gltf.h"
@@ -336,6 +339,104 @@ static void test_emissive_texture_renders(void **state)
     rs_scene_destroy(s);
 }
 
+/* A w x h TGA with alpha (uncompressed, 32-bit BGRA, top row first): grey, alpha[i] / 255. */
+static void write_tga_alpha(const char *name, uint32_t w, uint32_t h, const unsigned char *alpha)
+{
+    unsigned char buf[18 + 4 * 64];
+    uint32_t i;
+    assert_true(w * h <= 64);
+    memset(buf, 0, 18);
+    buf[2] = 2; /* uncompressed true colour */
+    buf[12] = (unsigned char)w, buf[14] = (unsigned char)h;
+    buf[16] = 32;
+    buf[17] = 0x28; /* 8 alpha bits, top-left origin */
+    for (i = 0; i < w * h; ++i) {
+        buf[18 + 4 * i] = buf[19 + 4 * i] = buf[20 + 4 * i] = 128;
+        buf[21 + 4 * i] = alpha[i];
+    }
+    write_bytes(name, buf, 18 + 4 * (size_t)w * h);
+}
+
+/* glTF's alpha cut-out: a black quad in front of an emitting one, cut out where its base colour
+ * texture's alpha (times the factor's) is under alphaCutoff: the emitter shows through the left
+ * half (alpha 0) and not the right (alpha 1); a factor alpha under the cutoff cuts the whole
+ * quad; OPAQUE ignores alpha.  The cut-out triangles take the scalar leaf test (never packed), so
+ * the binary, 4- and 8-wide traversals agree. */
+static void test_alpha_cutout(void **state)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],"
+        "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[0,0,0.5]},"
+        "{\"name\":\"cam\",\"camera\":0,\"translation\":[0,0,2.7]}],"
+        "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.9,\"znear\":0.1}}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],"
+        "\"metallicFactor\":0},\"emissiveFactor\":[2,2,2]},"
+        "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,%s],\"metallicFactor\":0,"
+        "\"baseColorTexture\":{\"index\":0}},\"alphaMode\":\"%s\",\"alphaCutoff\":0.5}],"
+        "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"alpha.tga\"}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+    static const unsigned char alpha[8] = {0, 0, 255, 255, 0, 0, 255, 255};
+    static const struct {
+        const char *factor, *mode;
+        int left, right; /* whether the emitter shows */
+    } cases[] = {{"1", "MASK", 1, 0}, {"0.3", "MASK", 1, 1}, {"1", "OPAQUE", 0, 0},
+                 {"0.3", "OPAQUE", 0, 0}};
+    size_t c;
+    (void)state;
+    write_full_files();
+    write_tga_alpha("alpha.tga", 4, 2, alpha);
+    for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        char buf[8192], json[8192], *m;
+        rs_scene *s;
+        float *ref = NULL;
+        uint32_t width;
+        snprintf(json, sizeof json, k, cases[c].factor, cases[c].mode, "");
+        /* a second mesh, the same quad with material 1 */
+        m = strstr(json, "\"material\":0}]}]");
+        assert_non_null(m);
+        snprintf(buf, sizeof buf, "%.*s\"material\":0}]},{\"primitives\":[{\"attributes\":"
+                 "{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},\"indices\":3,\"material\":1}]}]%s",
+                 (int)(m - json), json, m + strlen("\"material\":0}]}]"));
+        write_text("alpha.gltf", buf);
+        s = load("alpha.gltf", NULL);
+        assert_int_equal(s->n_masks != 0, strcmp(cases[c].mode, "MASK") == 0);
+        for (width = 2; width <= 8; width *= 2) {
+            rt_args a = rt_defaults("", 32, 2);
+            float *img;
+            double left = 0, right = 0;
+            int x, y;
+            if (width == 8 && !rs_bvh8_supported())
+                continue;
+            a.bvh_width = width;
+            img = rt_render_scene(s, &a, NULL);
+            assert_non_null(img);
+            for (y = 10; y < 22; ++y)
+                for (x = 0; x < 32; ++x) {
+                    const float *p = &img[3 * (y * 32 + x)];
+                    if (x >= 9 && x < 14)
+                        left += p[0];
+                    else if (x >= 18 && x < 23)
+                        right += p[0];
+                }
+            if (width == 2)
+                print_message("alpha %s %s: left %.2f, right %.2f\n", cases[c].factor,
+                              cases[c].mode, left, right);
+            if ((left > 60.0) != cases[c].left || (right > 60.0) != cases[c].right)
+                fail_msg("alpha %s %s, %u-wide: left %.2f, right %.2f (60 pixels of ~2 when the "
+                         "emitter shows)",
+                         cases[c].factor, cases[c].mode, width, left, right);
+            if (!ref)
+                ref = img;
+            else {
+                assert_memory_equal(ref, img, sizeof(float) * 32 * 32 * 3);
+                free(img);
+            }
+        }
+        free(ref);
+        rs_scene_destroy(s);
+    }
+}
+
 /* KHR_materials_transmission (with KHR_materials_ior) makes rough glass of the base colour's
  * tint and the material's roughness. */
 static void test_transmission(void **state)
@@ -502,7 +603,7 @@ static int teardown(void **state)
     static const char *files[] = {"quad.bin",  "base.png",     "mr.png",     "normal.png",
                                   "emis.png",  "full.gltf",    "emis.gltf",  "embedded.glb",
                                   "notex.gltf", "nobuf.gltf",  "cut.gltf",   "junk.gltf",
-                                  "plyish.gltf", "plyish.glb",  "glass.gltf"};
+                                  "plyish.gltf", "plyish.glb",  "glass.gltf", "alpha.gltf", "alpha.tga"};
     size_t i;
     char p[256];
     (void)state;
@@ -522,6 +623,7 @@ int main(void)
         cmocka_unit_test(test_emissive_texture_renders),
         cmocka_unit_test(test_glb_embedded),
         cmocka_unit_test(test_transmission),
+        cmocka_unit_test(test_alpha_cutout),
         cmocka_unit_test(test_bad_files),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -84,6 +84,20 @@ static rs_scene *make_scene(void)
     v[2] = rs_v3(0, 2.5f, 2.5f);
     assert_int_equal(rs_scene_add_triangle_full(s, v, uv, nrm, id), RS_OK);
     {
+        /* an alpha cut-out on a second triangle (the masks, the per-triangle table, the UVs the
+         * traversal reads) */
+        static const float alpha[4] = {0, 1, 1, 0};
+        rs_material cut = rs_mat_lambertian(rs_v3(.2f, .6f, .3f));
+        uint32_t cid;
+        rs_vec3 w[3];
+        assert_int_equal(rs_scene_add_mask(s, 2, 2, alpha, 1.0f, 0.5f, &cut.alpha_mask), RS_OK);
+        assert_int_equal(rs_scene_add_material(s, &cut, &cid), RS_OK);
+        w[0] = rs_v3(-2, 0.2f, 1.5f);
+        w[1] = rs_v3(2, 0.2f, 1.5f);
+        w[2] = rs_v3(0, 3, 1.5f);
+        assert_int_equal(rs_scene_add_triangle_full(s, w, uv, NULL, cid), RS_OK);
+    }
+    {
         /* instances: a prototype of that triangle (with UVs and normals), placed twice, once
          * mirrored (the instance table, the prototypes' arrays, the bottom levels) */
         static const double m1[12] = {0.5, 0, 0, 1, 0, 0.5, 0, 0.2, 0, 0, 0.5, 0.5};
@@ -139,7 +153,8 @@ static void test_mirror_renders_alone(void **state)
                  SHARED(lights) || SHARED(light_cdf) || SHARED(prim_light) ||
                  SHARED(env_marg_cdf) || SHARED(env_cond_cdf) || SHARED(inst_tris) ||
                  SHARED(inst_tri_mat) || SHARED(inst_tri_uv) || SHARED(inst_tri_normal) ||
-                 SHARED(instances));
+                 SHARED(instances) || SHARED(masks) || SHARED(mask_bits) ||
+                 SHARED(tri_mask));
     want = s->n_spheres * (sizeof(rs_sphere) + sizeof(uint32_t) + sizeof(rs_vec3)) +
            s->n_quads * (sizeof(rs_quad) + sizeof(uint32_t)) +
            s->n_tris * (sizeof(rs_tri) + sizeof(uint32_t) + 15 * sizeof(float)) +
@@ -149,7 +164,9 @@ static void test_mirror_renders_alone(void **state)
            (s->n_spheres + s->n_quads + s->n_tris) * sizeof(int32_t) +
            (4 + 1 + 4 * (8 + 1)) * sizeof(float) + /* the 8 x 4 map's two CDFs */
            s->n_inst_tris * (sizeof(rs_tri) + sizeof(uint32_t) + 15 * sizeof(float)) +
-           s->n_instances * sizeof(rs_instance);
+           s->n_instances * sizeof(rs_instance) + s->n_masks * sizeof(rs_alpha_mask) +
+           s->n_mask_bits + s->n_tris * sizeof(uint32_t); /* the masks, tri_mask */
+    assert_non_null(s->tri_mask);
     assert_int_equal(s->n_instances, 2u);
     assert_non_null(s->env_marg_cdf);
     for (i = 0; i < s->n_images; ++i) {
@@ -165,6 +182,7 @@ static void test_mirror_renders_alone(void **state)
     memset(s->tri_uv, 0x7f, 6 * s->n_tris * sizeof(float));
     memset(s->inst_tri_uv, 0x7f, 6 * s->n_inst_tris * sizeof(float));
     memset(s->instances, 0x7f, s->n_instances * sizeof *s->instances);
+    memset(s->mask_bits, 1, s->n_mask_bits); /* all opaque: a shared mask would show */
     for (i = 0; i < s->n_images; ++i)
         memset(s->images[i].rgb, 0,
                3ull * s->images[i].width * s->images[i].height * sizeof(float));
@@ -405,6 +423,17 @@ static void check_device_copy(const char *builtin)
         assert_memory_equal(dg.geom.sphere_motion, o.scene->sphere_motion,
                             o.scene->n_spheres * sizeof *o.scene->sphere_motion);
         assert_ptr_equal(ds.tracer.geom.sphere_motion, ms->sphere_motion);
+    }
+    if (o.scene->tri_mask) {
+        /* the cut-outs: the trace copy's own, the megakernel's from the mirror */
+        assert_true(set_holds(&r.made, (uintptr_t)dg.geom.tri_mask));
+        assert_true(set_holds(&r.made, (uintptr_t)dg.geom.mask_bits));
+        assert_true(set_holds(&r.made, (uintptr_t)dg.geom.tri_uv));
+        assert_memory_equal(dg.geom.tri_mask, o.scene->tri_mask,
+                            o.scene->n_tris * sizeof *o.scene->tri_mask);
+        assert_ptr_equal(ds.tracer.geom.tri_mask, ms->tri_mask);
+        assert_ptr_equal(ds.tracer.geom.mask_bits, ms->mask_bits);
+        assert_ptr_equal(ds.tracer.geom.tri_uv, ms->tri_uv);
     }
     if (o.scene->n_instances) {
         /* the instances: the BVH's table (with roots) and bottom levels, copied, in the tracer */
