@@ -15,6 +15,7 @@
 #include "accel/bvh8.h"
 #include "app/checkpoint.h"
 #include "app/options.h"
+#include "shading/aov.h"
 #include "app/outputs.h"
 #include "app/progress.h"
 #include "core/alloc.h"
@@ -494,7 +495,7 @@ static int check_outputs(const rs_cli_options *o, render_run *r)
     if (o->output) {
         r->out = o->output;
     } else {
-        snprintf(r->out_default, sizeof r->out_default, "%s.png", r->name);
+        snprintf(r->out_default, sizeof r->out_default, "%s.%s", r->name, o->aovs ? "exr" : "png");
         r->out = r->out_default;
     }
     memset(r->outs, 0, sizeof r->outs);
@@ -986,8 +987,60 @@ static void make_image_meta(const rs_cli_options *o, const render_run *r, image_
  * renamed.  A failure before the image is in place replaces nothing; a --stats-json that is a
  * special file (/dev/stdout) is written last, in place.  Every name is tracked first, so a second
  * signal removes whichever exist.  Returns the exit code: `code`, or RS_EXIT_RUNTIME. */
+/* The --aov layers of the finished render (shading/aov.h) into layers[], their buffers in
+ * bufs[] (rs_free them); returns how many, or -1 after a message. */
+static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_layer *layers,
+                     float **bufs)
+{
+    size_t npix = (size_t)r->st.width * r->st.height;
+    rs_integrator it;
+    int n = 0;
+    uint32_t i;
+    bufs[0] = bufs[1] = bufs[2] = bufs[3] = NULL;
+    if (!o->aovs)
+        return 0;
+    if (o->aovs & RS_AOV_ALBEDO)
+        bufs[0] = (float *)rs_alloc(npix * 3, sizeof(float));
+    if (o->aovs & RS_AOV_NORMAL)
+        bufs[1] = (float *)rs_alloc(npix * 3, sizeof(float));
+    if (o->aovs & RS_AOV_DEPTH)
+        bufs[2] = (float *)rs_alloc(npix, sizeof(float));
+    if (o->aovs & RS_AOV_SAMPLES)
+        bufs[3] = (float *)rs_alloc(npix, sizeof(float));
+    if (((o->aovs & RS_AOV_ALBEDO) && !bufs[0]) || ((o->aovs & RS_AOV_NORMAL) && !bufs[1]) ||
+        ((o->aovs & RS_AOV_DEPTH) && !bufs[2]) || ((o->aovs & RS_AOV_SAMPLES) && !bufs[3])) {
+        rs_error_set(RS_ERR_NOMEM, "out of memory for the --aov layers");
+        return -1;
+    }
+    if (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH)) {
+        rs_bvh_view v = rs_bvh_view_of(r->bvh);
+        if (rs_render_constants(r->scene, &r->st, r->film, &it) != RS_OK)
+            return -1;
+        rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, bufs[0], bufs[1], bufs[2]);
+    }
+    if (bufs[3])
+        for (i = 0; i < npix; ++i)
+            bufs[3][i] = (float)r->film->count[i];
+    if (bufs[0]) {
+        layers[n].name = "albedo", layers[n].channels = "RGB", layers[n++].data = bufs[0];
+    }
+    if (bufs[1]) {
+        layers[n].name = "normal", layers[n].channels = "XYZ", layers[n++].data = bufs[1];
+    }
+    if (bufs[2]) {
+        layers[n].name = "depth", layers[n].channels = "Z", layers[n++].data = bufs[2];
+    }
+    if (bufs[3]) {
+        layers[n].name = "samples", layers[n].channels = "Y", layers[n++].data = bufs[3];
+    }
+    return n;
+}
+
 static int write_outputs(const rs_cli_options *o, render_run *r, int code)
 {
+    rs_image_layer layers[4];
+    float *aov_bufs[4];
+    int n_layers;
     device_rows rows;
     image_meta meta;
     char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
@@ -1011,11 +1064,20 @@ static int write_outputs(const rs_cli_options *o, render_run *r, int code)
         ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 0, &r->key, r->film,
                                  r->on_film);
     make_image_meta(o, r, &meta);
-    if (ok && rs_image_write_meta(r->out, r->st.width, r->st.height, r->rgb, meta.meta, META_N) !=
-                  RS_OK) {
+    n_layers = ok ? make_aovs(o, r, layers, aov_bufs) : 0;
+    if (n_layers < 0) {
+        fail(0, NULL);
+        ok = 0;
+        n_layers = 0;
+    }
+    if (ok && rs_image_write_layers(r->out, r->st.width, r->st.height, r->rgb, layers,
+                                    (size_t)n_layers, meta.meta, META_N) != RS_OK) {
         fail(0, NULL);
         ok = 0;
     }
+    for (i = 0; i < 4; ++i)
+        if (o->aovs)
+            rs_free(aov_bufs[i]);
     replaced = ok;
     for (i = 1; ok && i < r->n_outs; ++i)
         if (!r->outs[i].in_place)

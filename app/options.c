@@ -1,5 +1,7 @@
 /* app/options.c — parsing and help text for the command line. */
 #include "app/options.h"
+
+#include "shading/aov.h"
 #include "scenes/gltf.h"
 
 #include <errno.h>
@@ -7,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 static int usage_error(const char *fmt, const char *a, const char *b)
 {
@@ -192,6 +195,8 @@ void rs_cli_print_help(const char *command)
             "                      gpu where there is one; same image)\n"
             "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
             "                      tasks (the thesis's three OpenMP strategies)\n"
+            "  --aov LIST          extra EXR layers: albedo, normal, depth, samples or all\n"
+            "                      (comma-separated; -o must be a .exr, the default then)\n"
             "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
             "  --flatten-instances copy every instance's triangles into the scene instead of\n"
             "                      placing shared ones by a two-level BVH (same image)\n"
@@ -410,6 +415,28 @@ static int parse_engine_option(opt_arg *x, rs_cli_options *o)
         if (n < 5 || strcmp(v + n - 4, ".svg") != 0)
             return usage_error("--timeline writes an SVG picture: '%s'%s must end in .svg", v, "");
         o->timeline = v;
+    } else if (strcmp(name, "--aov") == 0) {
+        char list[128], *tok, *save = NULL;
+        NEEDS_VALUE();
+        snprintf(list, sizeof list, "%s", v);
+        for (tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+            if (strcmp(tok, "albedo") == 0)
+                o->aovs |= RS_AOV_ALBEDO;
+            else if (strcmp(tok, "normal") == 0)
+                o->aovs |= RS_AOV_NORMAL;
+            else if (strcmp(tok, "depth") == 0)
+                o->aovs |= RS_AOV_DEPTH;
+            else if (strcmp(tok, "samples") == 0)
+                o->aovs |= RS_AOV_SAMPLES;
+            else if (strcmp(tok, "all") == 0)
+                o->aovs |= RS_AOV_ALL;
+            else
+                return usage_error("--aov: '%s'%s is not a layer (use albedo, normal, depth, "
+                                   "samples or all, separated by commas)",
+                                   tok, "");
+        }
+        if (!o->aovs)
+            return usage_error("--aov needs a list of layers%s%s", "", "");
     } else if (strcmp(name, "--time-limit") == 0) {
         NEEDS_VALUE();
         rc = parse_seconds(name, v, &o->time_limit_s);
@@ -563,6 +590,10 @@ static int check_render_options(rs_cli_options *o)
         return usage_error("--camera picks a glTF scene's camera; '%s' is not a .gltf or .glb "
                            "file%s",
                            o->scene, "");
+    if (o->aovs && o->output &&
+        (strlen(o->output) < 4 || strcasecmp(o->output + strlen(o->output) - 4, ".exr") != 0))
+        return usage_error("--aov writes layers into an EXR file; '%s'%s is not a .exr", o->output,
+                           "");
     if (o->envmap_scale_given && !o->envmap)
         return usage_error("--envmap-scale needs --envmap FILE%s%s", "", "");
     if (!o->envmap_scale_given)

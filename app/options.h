@@ -71,6 +71,7 @@ typedef struct rs_cli_options {
     const char *timeline;     /* --timeline FILE.svg */
     int spp_given;            /* --spp was on the command line (--resume takes the file's) */
     double time_limit_s;      /* --time-limit SECONDS; 0: none */
+    unsigned aovs;            /* --aov LIST: RS_AOV_* layers in the EXR (shading/aov.h) */
     const char *checkpoint;   /* --checkpoint FILE */
     double ckpt_every_s;      /* --checkpoint-interval SECONDS (default 60) */
     const char *resume;       /* --resume FILE */

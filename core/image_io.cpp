@@ -100,21 +100,57 @@ extern "C" rs_status rs_image_write_meta(const char *path, uint32_t w, uint32_t 
                                          const float *rgb, const rs_image_meta *meta,
                                          size_t n_meta)
 {
+    return rs_image_write_layers(path, w, h, rgb, nullptr, 0, meta, n_meta);
+}
+
+extern "C" rs_status rs_image_write_layers(const char *path, uint32_t w, uint32_t h,
+                                           const float *rgb, const rs_image_layer *layers,
+                                           size_t n_layers, const rs_image_meta *meta,
+                                           size_t n_meta)
+{
     std::string tmp = temp_name(path);
     try {
         std::string e = lower_ext(path);
         size_t n = (size_t)w * h * 3;
+        if (n_layers > 0 && e != "exr")
+            return rs_error_set(RS_ERR_ARG, "%s: only an .exr file holds extra layers (AOVs)",
+                                path);
         auto out = OIIO::ImageOutput::create(path);
         if (!out)
             return rs_error_set(RS_ERR_ARG, "%s: OpenImageIO cannot write this format", path);
         bool ok;
         if (is_float_format(e)) {
-            OIIO::ImageSpec spec((int)w, (int)h, 3, OIIO::TypeDesc::FLOAT);
+            std::vector<std::string> names = {"R", "G", "B"};
+            for (size_t l = 0; l < n_layers; ++l)
+                for (const char *c = layers[l].channels; *c; ++c)
+                    names.push_back(std::string(layers[l].name) + "." + *c);
+            int nc = (int)names.size();
+            OIIO::ImageSpec spec((int)w, (int)h, nc, OIIO::TypeDesc::FLOAT);
+            spec.channelnames = names;
+            spec.alpha_channel = -1;
+            spec.z_channel = -1;
             spec.attribute("oiio:ColorSpace", "Linear");
             if (e == "exr")
                 for (size_t i = 0; i < n_meta; ++i)
                     spec.attribute(meta[i].key, meta[i].value);
-            ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb);
+            if (n_layers == 0) {
+                ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb);
+            } else {
+                // interleave: R G B, then each layer's channels
+                std::vector<float> px((size_t)w * h * (size_t)nc);
+                size_t npix = (size_t)w * h;
+                for (size_t i = 0; i < npix; ++i) {
+                    float *o = &px[i * (size_t)nc];
+                    o[0] = rgb[3 * i], o[1] = rgb[3 * i + 1], o[2] = rgb[3 * i + 2];
+                    int k = 3;
+                    for (size_t l = 0; l < n_layers; ++l) {
+                        size_t lc = std::strlen(layers[l].channels);
+                        for (size_t c = 0; c < lc; ++c)
+                            o[k++] = layers[l].data[i * lc + c];
+                    }
+                }
+                ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data());
+            }
         } else {
             std::vector<unsigned char> px(n);
             for (size_t i = 0; i < n; ++i)
@@ -247,6 +283,43 @@ extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t
             return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
         }
         *alpha = o;
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
+    } catch (...) {
+        return rs_error_set(RS_ERR_IO, "%s: unknown error reading the image", path);
+    }
+}
+
+extern "C" rs_status rs_image_read_channel(const char *path, const char *channel, uint32_t *w,
+                                           uint32_t *h, float **data)
+{
+    *data = nullptr;
+    try {
+        OIIO::ImageInput::unique_ptr in;
+        rs_status st = open_input(path, RS_ERR_IO, &in);
+        if (st != RS_OK)
+            return st;
+        const OIIO::ImageSpec &spec = in->spec();
+        int ch = -1;
+        for (int c = 0; c < spec.nchannels; ++c)
+            if (spec.channel_name(c) == channel)
+                ch = c;
+        if (ch < 0)
+            return rs_error_set(RS_ERR_ARG, "%s: no channel %s", path, channel);
+        if ((uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
+            return rs_error_set(RS_ERR_ARG, "%s: image too large", path);
+        size_t npix = (size_t)spec.width * (size_t)spec.height;
+        float *o = (float *)rs_alloc(npix ? npix : 1, sizeof(float));
+        if (!o)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
+        if (!in->read_image(0, 0, ch, ch + 1, OIIO::TypeDesc::FLOAT, o)) {
+            rs_free(o);
+            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
+        }
+        *w = (uint32_t)spec.width;
+        *h = (uint32_t)spec.height;
+        *data = o;
         return RS_OK;
     } catch (const std::exception &ex) {
         return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());

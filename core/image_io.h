@@ -34,6 +34,26 @@ typedef struct rs_image_meta {
 rs_status rs_image_write_meta(const char *path, uint32_t width, uint32_t height, const float *rgb,
                               const rs_image_meta *meta, size_t n_meta);
 
+/* An extra layer of an EXR file: channels "<name>.<c>" for each letter c of `channels`
+ * ("albedo" + "RGB": albedo.R, albedo.G, albedo.B), `data` holding strlen(channels) floats a
+ * pixel. */
+typedef struct rs_image_layer {
+    const char *name;
+    const char *channels;
+    const float *data;
+} rs_image_layer;
+
+/* rs_image_write_meta with n_layers extra layers after R, G, B (only an .exr can hold them:
+ * RS_ERR_ARG for another format when n_layers > 0). */
+rs_status rs_image_write_layers(const char *path, uint32_t width, uint32_t height,
+                                const float *rgb, const rs_image_layer *layers, size_t n_layers,
+                                const rs_image_meta *meta, size_t n_meta);
+
+/* Channel `channel` ("R", "albedo.G", "depth.Z") of image `path`: width * height floats
+ * (rs_alloc).  RS_ERR_ARG when the file has no such channel. */
+rs_status rs_image_read_channel(const char *path, const char *channel, uint32_t *width,
+                                uint32_t *height, float **data);
+
 /* The string attribute `key` of image `path` into value[n] (NUL-terminated, cut to fit).
  * RS_ERR_ARG when the file has no such attribute or cannot be read. */
 rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n);

@@ -1910,6 +1910,93 @@ static void test_resume_after_signal(void **state)
 
 /* The EXR header records the render: scene, spp done and asked for, seed, sampling, sampler,
  * max depth, devices, integrator, version. */
+/* One channel of an EXR this test wrote. */
+static float *read_channel(const proc *p, const fixture *f, const char *name, const char *ch,
+                           uint32_t *w, uint32_t *h)
+{
+    char path[256];
+    float *d = NULL;
+    path_in(f, name, path, sizeof path);
+    EXPECT(p, rs_image_read_channel(path, ch, w, h, &d) == RS_OK, "%s has no channel %s: %s",
+           name, ch, rs_error_message());
+    return d;
+}
+
+/* --aov: albedo, normal, depth and sample-count layers in the EXR beside an unchanged beauty
+ * image, the same on any device set; the Cornell box's tall block (the image's centre) is white
+ * (0.73), faces the camera and is 500..1500 away; pixels that see out of the box are black,
+ * without a normal and infinitely far; every pixel has the spp.  A PNG output or an unknown layer is a usage error
+ * before any work. */
+static void test_aov_layers(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const plain[] = {"render", "--width", "32", "--height", "32", "--spp", "4",
+                                        "-q", "-o", "plain.exr", NULL};
+    static const char *const aov[] = {"render", "--width", "32", "--height", "32", "--spp", "4",
+                                      "-q", "--aov", "all", "-o", "aov.exr", NULL};
+    static const char *const aov2[] = {"render", "--width", "32", "--height", "32", "--spp", "4",
+                                       "-q", "--aov", "albedo,normal,depth,samples",
+                                       "--devices", "cpu:1,gpu", "-o", "aov2.exr", NULL};
+    static const char *const png[] = {"render", "--aov", "all", "-o", "aov.png", NULL};
+    static const char *const bad[] = {"render", "--aov", "albedo,shadows", "-o", "x.exr", NULL};
+    static const char *const chans[] = {"albedo.R", "albedo.G", "albedo.B", "normal.X",
+                                        "normal.Y", "normal.Z", "depth.Z",  "samples.Y"};
+    float *c[8];
+    uint32_t w = 0, h = 0, i;
+    size_t k;
+    proc p;
+    run_expect(f, plain, 0, &p);
+    proc_free(&p);
+    run_expect(f, aov, 0, &p);
+    expect_same_image(&p, f, "plain.exr", "aov.exr"); /* R, G, B untouched */
+    for (k = 0; k < 8; ++k) {
+        c[k] = read_channel(&p, f, "aov.exr", chans[k], &w, &h);
+        EXPECT(&p, w == 32 && h == 32, "%s is %ux%u", chans[k], w, h);
+    }
+    {
+        uint32_t mid = 16 * 32 + 16, corner = 0;
+        float nz = c[5][mid], len = sqrtf(c[3][mid] * c[3][mid] + c[4][mid] * c[4][mid] +
+                                          nz * nz);
+        print_message("centre: albedo %.3f %.3f %.3f normal %.3f %.3f %.3f depth %.1f\n",
+                      c[0][mid], c[1][mid], c[2][mid], c[3][mid], c[4][mid], nz, c[6][mid]);
+        EXPECT(&p, fabsf(c[0][mid] - 0.73f) < 1e-3f && fabsf(c[2][mid] - 0.73f) < 1e-3f,
+               "the block's albedo is %.4f, not 0.73", c[0][mid]);
+        EXPECT(&p, fabsf(len - 1.0f) < 1e-3f && nz < -0.9f, "the block's normal (%g %g %g)",
+               c[3][mid], c[4][mid], nz);
+        EXPECT(&p, c[6][mid] > 500.0f && c[6][mid] < 1500.0f, "the block is %g away", c[6][mid]);
+        /* where every sample left the box's open front: black, no normal, infinitely far */
+        for (i = 0, corner = 0; i < 32 * 32; ++i) {
+            EXPECT(&p, c[7][i] == 4.0f, "pixel %u has %g samples, not 4", i, c[7][i]);
+            if (isinf(c[6][i])) {
+                EXPECT(&p, c[0][i] == 0.0f && c[3][i] == 0.0f && c[4][i] == 0.0f,
+                       "pixel %u sees nothing but has albedo %g, normal x %g", i, c[0][i],
+                       c[3][i]);
+                ++corner;
+            }
+        }
+        EXPECT(&p, corner > 0 && corner < 200, "%u pixels see nothing", corner);
+    }
+    proc_free(&p);
+    run_expect(f, aov2, 0, &p);
+    expect_same_image(&p, f, "aov.exr", "aov2.exr");
+    for (k = 0; k < 8; ++k) {
+        float *d = read_channel(&p, f, "aov2.exr", chans[k], &w, &h);
+        EXPECT(&p, memcmp(d, c[k], 32 * 32 * sizeof(float)) == 0,
+               "%s differs on cpu:1,gpu", chans[k]);
+        rs_free(d);
+        rs_free(c[k]);
+    }
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, png);
+    EXPECT(&p, exited_with(&p, 2) && one_line(&p.err) && strstr(p.err.data, "not a .exr"),
+           "--aov with a PNG: a usage error");
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, bad);
+    EXPECT(&p, exited_with(&p, 2) && one_line(&p.err) && strstr(p.err.data, "'shadows'"),
+           "--aov with an unknown layer: a usage error naming it");
+    proc_free(&p);
+}
+
 static void test_exr_metadata(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -2093,6 +2180,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_resume_after_signal, setup, teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_refused, setup, teardown),
         cmocka_unit_test_setup_teardown(test_exr_metadata, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_aov_layers, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }

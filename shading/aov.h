@@ -1,0 +1,75 @@
+/* shading/aov.h — the auxiliary images (AOVs) written beside the beauty image as EXR layers:
+ * the first hit's albedo, shading normal and distance, averaged over the pixel's first samples
+ * (the very camera rays the render traced first), and the samples each pixel got.  What a
+ * denoiser (Intel Open Image Denoise, OptiX) takes with the beauty image, and what a compositor
+ * wants for depth.
+ *
+ * They are made in a pass of their own after the render, on host threads, with the host BVH:
+ * camera rays and their first hits only, so a few percent of one sample's work.  Being a
+ * function of the scene, the settings and the seed only, they are the same for any device set,
+ * and for a render resumed from a checkpoint. */
+#ifndef RS_SHADING_AOV_H
+#define RS_SHADING_AOV_H
+
+#include "accel/bvh_traverse.h"
+#include "shading/path.h"
+
+#define RS_AOV_ALBEDO  1u /* layer "albedo" (R, G, B): the first hit's reflectance, textured */
+#define RS_AOV_NORMAL  2u /* "normal" (X, Y, Z): the shading normal, world space, toward the eye */
+#define RS_AOV_DEPTH   4u /* "depth" (Z): distance from the camera to the first hit; inf: none */
+#define RS_AOV_SAMPLES 8u /* "samples" (Y): the samples the pixel got */
+#define RS_AOV_ALL     15u
+
+/* Samples per pixel the albedo, normal and depth average over (at most the render's spp). */
+#define RS_AOV_SPP 16u
+
+/* What the first hit of camera ray r (hit h) gives: the material's albedo there (an emitter's
+ * emission held to [0, 1]; the background's radiance, held likewise, for a miss), the shading
+ * normal turned toward the ray's origin (zero for a miss), and the distance t |d| (a miss:
+ * infinity). */
+RS_HD void rs_path_aov(const rs_integrator *it, const rs_ray *r, const rs_hit *h, rs_vec3 *albedo,
+                       rs_vec3 *normal, float *depth)
+{
+    const rs_scene *sc = it->scene;
+    rs_vec3 x, ng, n_geo, wo;
+    const rs_material *m;
+    if (h->prim == RS_NO_HIT) {
+        rs_vec3 bg = rs_env_present(sc) ? rs_env_radiance(sc, r->d) : rs_scene_background(sc, r->d);
+        *albedo = rs_v3(rs_fminf(bg.x, 1.0f), rs_fminf(bg.y, 1.0f), rs_fminf(bg.z, 1.0f));
+        *normal = rs_v3_splat(0.0f);
+        *depth = INFINITY;
+        return;
+    }
+    m = rs_scene_prim_material(sc, h->prim);
+    x = rs_ray_at(r, h->t);
+    ng = rs_prim_normal(sc, h->prim, x, r->time);
+    wo = rs_v3_neg(r->d);
+    n_geo = rs_v3_dot(ng, r->d) < 0.0f ? ng : rs_v3_neg(ng);
+    *depth = h->t * rs_v3_length(r->d);
+    if (m->type == RS_MAT_DIFFUSE_LIGHT) {
+        *albedo = rs_v3(rs_fminf(m->emission.x, 1.0f), rs_fminf(m->emission.y, 1.0f),
+                        rs_fminf(m->emission.z, 1.0f));
+        *normal = n_geo;
+        return;
+    }
+    *normal = rs_shading_normal(sc, h->prim, h->u, h->v, n_geo, wo);
+    if (m->type >= RS_MAT_CONDUCTOR && m->normal_tex != RS_NO_TEXTURE)
+        *normal = rs_normal_mapped(sc, m, h->prim, h->u, h->v, x, *normal,
+                                   rs_v3_dot(ng, r->d) < 0.0f, wo);
+    *albedo = rs_surface_albedo(sc, m, h->prim, h->u, h->v, x, ng);
+}
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+/* The AOVs `which` (RS_AOV_* but SAMPLES) of the render whose constants are `it`, traced through
+ * `bvh` over `g` (host arrays, attached: rs_bvh_attach) on `threads` host threads: each pixel's
+ * first min(spp, RS_AOV_SPP) camera rays.  albedo and normal: 3 floats a pixel, depth: 1 (each
+ * may be NULL when not asked for); row-major from the top-left. */
+void rs_aov_render(const rs_integrator *it, const rs_bvh_view *bvh, const rs_geom *g,
+                   uint32_t spp, int threads, float *albedo, float *normal, float *depth);
+#ifdef __cplusplus
+}
+#endif
+
+#endif
