@@ -15,6 +15,7 @@
 #include "accel/bvh8.h"
 #include "app/checkpoint.h"
 #include "app/options.h"
+#include "scheduler/adaptive.h"
 #include "shading/aov.h"
 #include "app/outputs.h"
 #include "app/progress.h"
@@ -272,6 +273,8 @@ typedef struct render_run {
     int threads;
     rs_render_settings st;
     rs_render_stats stats;
+    rs_adaptive_stats adaptive; /* --adaptive: rounds, samples, pixels stopped */
+    double adaptive_t;          /* --adaptive's threshold, 0: off */
     char name[64]; /* the scene's stem: default output name */
     char out_default[96];
     const char *out;
@@ -700,10 +703,17 @@ static int run_render(const rs_cli_options *o, render_run *r)
         hooks.film_ready = on_film_ready;
         rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
     }
-    if (o->megakernel)
+    if (o->megakernel) {
         rst = rs_render_passes(r->scene, r->mk, &r->st, &hooks, r->film, &r->stats);
-    else
+    } else if (o->adaptive > 0) {
+        rs_adaptive a;
+        a.threshold = r->adaptive_t = o->adaptive;
+        a.min_spp = o->adaptive_min_spp;
+        rst = rs_render_adaptive(r->scene, r->sched, &r->st, &a, &hooks, r->film, &r->stats,
+                                 &r->adaptive);
+    } else {
         rst = rs_render(r->scene, r->sched, &r->st, &hooks, r->film, &r->stats);
+    }
     rs_progress_end(&r->progress);
     if (rst == RS_ERR_CANCELLED) {
         rs_error_clear();
@@ -797,10 +807,12 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
     fprintf(f,
             "{\n  \"seconds\": %.6f,\n  \"rays\": %llu,\n  \"spp\": %u,\n  \"spp_requested\": %u,\n"
             "  \"samples\": %llu,\n  \"resumed_samples\": %llu,\n  \"time_limited\": %s,\n"
-            "  \"interrupted\": %s,\n  \"stages\": {",
+            "  \"interrupted\": %s,\n  \"adaptive\": %g,\n  \"adaptive_rounds\": %u,\n"
+            "  \"pixels_stopped_early\": %u,\n  \"stages\": {",
             wall, (unsigned long long)t->total, rs_film_min_count(r->film), r->st.spp,
             (unsigned long long)(r->resumed + r->stats.paths_done), (unsigned long long)r->resumed,
-            r->stats.time_limited ? "true" : "false", r->interrupted ? "true" : "false");
+            r->stats.time_limited ? "true" : "false", r->interrupted ? "true" : "false",
+            r->adaptive_t, r->adaptive.rounds, r->adaptive.stopped);
     for (i = 0; i < RS_STAGE_COUNT; ++i)
         fprintf(f, "%s\"%s\": %.9f", i ? ", " : "", rs_stage_name((rs_stage)i),
                 r->stats.stage_s[i]);
@@ -860,7 +872,7 @@ static int write_timeline(const char *path, const rs_cli_options *o, const rende
 /* The summary line on stderr (or, with --quiet, only a word on an interruption). */
 static void print_summary(const rs_cli_options *o, const render_run *r)
 {
-    char sps[32], rps[32], rays[32], bvh_name[64], spp[96], inst[160] = "";
+    char sps[32], rps[32], rays[32], bvh_name[64], spp[200], inst[160] = "";
     double secs = r->stats.seconds > 0 ? r->stats.seconds : 1e-9;
     uint64_t rays_total = r->stats.rays_closest + r->stats.rays_shadow;
     const rs_render_settings *st = &r->st;
@@ -877,7 +889,16 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
     human((double)r->stats.paths_done / secs, sps, sizeof sps);
     human((double)rays_total / secs, rps, sizeof rps);
     human((double)rays_total, rays, sizeof rays);
-    if (r->stats.time_limited)
+    if (o->adaptive > 0) {
+        size_t npix = (size_t)st->width * st->height;
+        snprintf(spp, sizeof spp,
+                 "%.1f spp on average, %u to %u (adaptive to %g in %u rounds: %.1f%% of the "
+                 "pixels stopped early%s)",
+                 npix ? (double)r->adaptive.samples / (double)npix : 0.0,
+                 rs_film_min_count(r->film), st->spp, o->adaptive, r->adaptive.rounds,
+                 npix ? 100.0 * r->adaptive.stopped / (double)npix : 0.0,
+                 r->stats.time_limited ? "; stopped at the --time-limit" : "");
+    } else if (r->stats.time_limited)
         snprintf(spp, sizeof spp, "%u of %u spp (stopped at the --time-limit of %g s)",
                  rs_film_min_count(r->film), st->spp, o->time_limit_s);
     else
@@ -938,10 +959,11 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
 /* What the image's header records of the render (.exr only, core/image_io.h): the scene, the
  * spp every pixel has and the spp asked for, seed, sampling, sampler, max depth, devices,
  * integrator, version.  Strings into `text` (which must outlive meta). */
-enum { META_N = 10 };
+enum { META_N = 11 };
 typedef struct image_meta {
     rs_image_meta meta[META_N];
     char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];
+    char adaptive[32];
 } image_meta;
 
 static void make_image_meta(const rs_cli_options *o, const render_run *r, image_meta *m)
@@ -949,7 +971,7 @@ static void make_image_meta(const rs_cli_options *o, const render_run *r, image_
     static const char *const keys[META_N] = {
         "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
         "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
-        "raystream:integrator", "raystream:version"};
+        "raystream:integrator", "raystream:version", "raystream:adaptive"};
     const char *values[META_N];
     size_t used = 0;
     int i;
@@ -976,6 +998,11 @@ static void make_image_meta(const rs_cli_options *o, const render_run *r, image_
     values[7] = m->devices;
     values[8] = o->megakernel ? "megakernel" : "stream";
     values[9] = RS_VERSION;
+    if (o->adaptive > 0)
+        snprintf(m->adaptive, sizeof m->adaptive, "%g", o->adaptive);
+    else
+        snprintf(m->adaptive, sizeof m->adaptive, "off");
+    values[10] = m->adaptive;
     for (i = 0; i < META_N; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];

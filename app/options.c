@@ -195,6 +195,9 @@ void rs_cli_print_help(const char *command)
             "                      gpu where there is one; same image)\n"
             "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
             "                      tasks (the thesis's three OpenMP strategies)\n"
+            "  --adaptive T        adaptive sampling: a pixel stops once the relative error\n"
+            "                      of its mean is below T (e.g. 0.01); --spp is then the most\n"
+            "  --adaptive-min-spp N  samples every pixel gets first (default 16)\n"
             "  --aov LIST          extra EXR layers: albedo, normal, depth, samples or all\n"
             "                      (comma-separated; -o must be a .exr, the default then)\n"
             "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
@@ -415,6 +418,19 @@ static int parse_engine_option(opt_arg *x, rs_cli_options *o)
         if (n < 5 || strcmp(v + n - 4, ".svg") != 0)
             return usage_error("--timeline writes an SVG picture: '%s'%s must end in .svg", v, "");
         o->timeline = v;
+    } else if (strcmp(name, "--adaptive") == 0) {
+        char *end;
+        double val;
+        NEEDS_VALUE();
+        val = strtod(v, &end);
+        if (end == v || *end || !(val > 0) || !(val < 1))
+            return usage_error("--adaptive needs a relative error threshold in (0, 1), such as "
+                               "0.01, not '%s'%s",
+                               v, "");
+        o->adaptive = val;
+    } else if (strcmp(name, "--adaptive-min-spp") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 2, 1u << 20, &o->adaptive_min_spp);
     } else if (strcmp(name, "--aov") == 0) {
         char list[128], *tok, *save = NULL;
         NEEDS_VALUE();
@@ -590,6 +606,15 @@ static int check_render_options(rs_cli_options *o)
         return usage_error("--camera picks a glTF scene's camera; '%s' is not a .gltf or .glb "
                            "file%s",
                            o->scene, "");
+    if (o->adaptive_min_spp && o->adaptive == 0)
+        return usage_error("--adaptive-min-spp needs --adaptive THRESHOLD%s%s", "", "");
+    if (o->adaptive > 0 && o->megakernel)
+        return usage_error("--adaptive runs on the stream integrator, not the megakernel%s%s", "",
+                           "");
+    if (o->adaptive > 0 && (o->checkpoint || o->resume))
+        return usage_error("--adaptive cannot be checkpointed or resumed yet%s%s", "", "");
+    if (o->adaptive > 0 && !o->adaptive_min_spp)
+        o->adaptive_min_spp = 16;
     if (o->aovs && o->output &&
         (strlen(o->output) < 4 || strcasecmp(o->output + strlen(o->output) - 4, ".exr") != 0))
         return usage_error("--aov writes layers into an EXR file; '%s'%s is not a .exr", o->output,

@@ -72,6 +72,8 @@ typedef struct rs_cli_options {
     int spp_given;            /* --spp was on the command line (--resume takes the file's) */
     double time_limit_s;      /* --time-limit SECONDS; 0: none */
     unsigned aovs;            /* --aov LIST: RS_AOV_* layers in the EXR (shading/aov.h) */
+    double adaptive;          /* --adaptive THRESHOLD; 0: every pixel gets spp */
+    uint32_t adaptive_min_spp; /* --adaptive-min-spp N (default 16) */
     const char *checkpoint;   /* --checkpoint FILE */
     double ckpt_every_s;      /* --checkpoint-interval SECONDS (default 60) */
     const char *resume;       /* --resume FILE */

@@ -56,6 +56,9 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
         return status;
     if (!d->ops->render_pass)
         return rs_error_set(RS_ERR_ARG, "device %s cannot run the megakernel", d->name);
+    if (st->pixels || st->sample_base)
+        return rs_error_set(RS_ERR_ARG, "the megakernel renders whole images only: adaptive "
+                                        "sampling needs --integrator stream");
     if (st->path_begin % it.npix != 0)
         return rs_error_set(RS_ERR_ARG,
                             "the megakernel continues from whole passes only, and the film holds "

@@ -148,7 +148,8 @@ static uint8_t stage_compact(render_ctx *c, slot *sl, rs_status *status)
 typedef struct flush_ctx {
     const slot *sl;
     rs_film *film;
-    uint32_t npix;
+    const rs_integrator *it;
+    uint32_t npix; /* paths per pass */
 } flush_ctx;
 
 /* Paths k, k + npix, k + 2 npix, ... of the wave all land on one pixel, in sample order; distinct
@@ -160,7 +161,7 @@ static void flush_range(void *ctx, uint32_t begin, uint32_t end)
     uint32_t k, i;
     for (k = begin; k < end; ++k)
         for (i = k; i < f->sl->count; i += f->npix)
-            rs_film_add(f->film, (uint32_t)((f->sl->start + i) % f->npix),
+            rs_film_add(f->film, rs_path_pixel(f->it, f->sl->start + i),
                         f->sl->b.paths.radiance[i]);
 }
 
@@ -171,7 +172,8 @@ static uint8_t stage_film(render_ctx *c, slot *sl, rs_status *status)
     (void)status;
     f.sl = sl;
     f.film = c->film;
-    f.npix = c->it.npix;
+    f.it = &c->it;
+    f.npix = c->it.n_active;
     rs_parallel_range(RS_PAR_FOR_DYNAMIC, c->ex.threads, 0, sl->count < f.npix ? sl->count : f.npix,
                       4096, flush_range, &f);
     c->stats->paths_done += sl->count;
@@ -285,6 +287,13 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
         return rs_error_set(RS_ERR_ARG,
                             "the film already holds %llu samples, more than %ux%u at %u spp",
                             (unsigned long long)st->path_begin, st->width, st->height, st->spp);
+    if (st->pixels && (st->n_pixels == 0 || st->n_pixels > npix))
+        return rs_error_set(RS_ERR_ARG, "a pass over %u of %llu pixels", st->n_pixels,
+                            (unsigned long long)npix);
+    if ((uint64_t)st->sample_base + st->spp > (st->spp_total ? st->spp_total : st->spp) ||
+        (st->spp_total && st->spp_total < st->spp))
+        return rs_error_set(RS_ERR_ARG, "samples %u..%u of a %u spp render", st->sample_base,
+                            st->sample_base + st->spp, st->spp_total);
     memset(it, 0, sizeof *it);
     it->scene = scene;
     it->camera = rs_camera_make(scene->camera.from, scene->camera.at, scene->camera.up,
@@ -294,7 +303,10 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     it->width = st->width;
     it->height = st->height;
     it->npix = (uint32_t)npix;
-    it->spp = st->spp;
+    it->spp = st->spp_total ? st->spp_total : st->spp;
+    it->pixel_of = st->pixels;
+    it->n_active = st->pixels ? st->n_pixels : (uint32_t)npix;
+    it->sample_base = st->sample_base;
     it->max_depth = st->max_depth;
     it->rr_depth = st->rr_depth ? st->rr_depth : 3;
     it->sampling = (uint32_t)st->sampling;
@@ -366,7 +378,7 @@ static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint
  * started (at least the first pass this call adds to), so the film ends on a whole pass. */
 static void apply_time_limit(render_ctx *c)
 {
-    uint64_t npix = c->it.npix, end, first_pass_end;
+    uint64_t npix = c->it.n_active, end, first_pass_end; /* paths per pass */
     const rs_render_hooks *h = c->hooks;
     if (!h || h->time_limit_s <= 0 || c->stats->time_limited ||
         now_s() - c->t_start < h->time_limit_s)
@@ -432,7 +444,7 @@ rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_sett
     c = (render_ctx *)rs_calloc(1, sizeof *c);
     if (!c)
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the render loop");
-    total = (uint64_t)it.npix * st_in->spp - st_in->path_begin; /* this call's paths */
+    total = (uint64_t)it.n_active * st_in->spp - st_in->path_begin; /* this call's paths */
     c->it = it;
     c->st = *st_in;
     c->sched = sched;

@@ -56,6 +56,12 @@ typedef struct rs_render_settings {
     uint64_t path_begin;      /* the film already holds paths [0, path_begin) of this render
                                  (a resumed checkpoint, app/checkpoint.h); the render adds the
                                  rest, [path_begin, width * height * spp).  0: a fresh film */
+    /* A render of some pixels only, from a later sample on (adaptive sampling,
+     * scheduler/adaptive.h; the stream integrator only): samples [sample_base, sample_base +
+     * spp) of pixels[0, n_pixels) (distinct), of a render of spp_total samples per pixel (the
+     * zsobol sampler's block; 0: spp).  NULL pixels: every pixel, samples from sample_base. */
+    const uint32_t *pixels;
+    uint32_t n_pixels, sample_base, spp_total;
 } rs_render_settings;
 
 #define RS_RENDER_DEFAULT_WAVE (1u << 20)

@@ -12,6 +12,8 @@ typedef struct rs_film {
     uint32_t width, height;
     double *sum;        /* 3 per pixel, row-major from the top-left */
     uint32_t *count;    /* samples per pixel */
+    double *sum_l2;     /* per pixel, the sum of the samples' squared luminance (adaptive
+                           sampling's error estimate; not in checkpoints) */
     uint64_t nonfinite; /* samples that were NaN or infinite: counted, contributed zero */
 } rs_film;
 
@@ -27,6 +29,10 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 radiance);
 void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads);
 /* Writes width * height * 3 floats of mean radiance (0 where a pixel has no sample yet). */
 void rs_film_resolve(const rs_film *f, float *rgb);
+/* The relative standard error of pixel `pixel`'s mean luminance: sqrt(var / n) / mean, the
+ * sample variance from the sums, the mean held at least 1e-3 (dark pixels are not sampled for
+ * ever); infinity below two samples, 0 for a pixel whose samples are all alike. */
+double rs_film_rel_error(const rs_film *f, uint32_t pixel);
 /* Fewest samples any pixel has. */
 uint32_t rs_film_min_count(const rs_film *f);
 #ifdef __cplusplus

@@ -56,11 +56,12 @@ int rs_sampler_parse(const char *text, rs_sampler *out)
 /* Pixel and sample of paths wave_start + p, for p = path[i] (or p0 + i where path is NULL),
  * i < n.  A stream keeps its paths in increasing order, so after one division each entry is a
  * step from the one before (a step back or past a whole image divides again); the numbers are
- * those of g mod npix and g div npix. */
-static void locate(uint64_t wave_start, uint32_t npix, const uint32_t *path, uint32_t p0,
-                   uint32_t n, uint32_t *pixel, uint32_t *sample)
+ * those of g mod n_active and g div n_active (mapped through it->pixel_of, and sample_base
+ * added, for a pass over some pixels). */
+static void locate(const rs_integrator *it, uint64_t wave_start, const uint32_t *path,
+                   uint32_t p0, uint32_t n, uint32_t *pixel, uint32_t *sample)
 {
-    uint32_t i, prev = 0, px = 0, sm = 0;
+    uint32_t i, prev = 0, px = 0, sm = 0, npix = it->n_active;
     for (i = 0; i < n; ++i) {
         uint32_t p = path ? path[i] : p0 + i, step = p - prev;
         if (i == 0 || p < prev || step >= npix) {
@@ -77,6 +78,12 @@ static void locate(uint64_t wave_start, uint32_t npix, const uint32_t *path, uin
         pixel[i] = px;
         sample[i] = sm;
     }
+    /* a pass over some pixels only (adaptive sampling): their indices, from the pass's sample */
+    if (it->pixel_of || it->sample_base)
+        for (i = 0; i < n; ++i) {
+            pixel[i] = it->pixel_of ? it->pixel_of[pixel[i]] : pixel[i];
+            sample[i] += it->sample_base;
+        }
 }
 
 /* out[i] = rs_path_rand(it, pixel[i], sample[i], bounce, group), i < n. */
@@ -109,7 +116,7 @@ void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint
         uint32_t b = (uint32_t)blk * BATCH, n = count - b < BATCH ? count - b : BATCH, k;
         uint32_t pixel[BATCH], sample[BATCH];
         rs_rng_f4 cam[BATCH], tim[BATCH];
-        locate(wave_start, it->npix, NULL, b, n, pixel, sample);
+        locate(it, wave_start, NULL, b, n, pixel, sample);
         path_rand_batch(it, pixel, sample, 0, RS_DIM_CAMERA, n, cam);
         if (shutter)
             path_rand_batch(it, pixel, sample, 0, RS_DIM_TIME, n, tim);
@@ -150,7 +157,7 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
         uint32_t n = end - b < BATCH ? end - b : BATCH;
         uint32_t pixel[BATCH], sample[BATCH];
         rs_rng_f4 rb[BATCH], rl[BATCH], pre[2];
-        locate(c->wave_start, c->it->npix, c->rays->path + b, 0, n, pixel, sample);
+        locate(c->it, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
         if (draws) {
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_BSDF, n, rb);
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);

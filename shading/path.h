@@ -77,7 +77,23 @@ typedef struct rs_integrator {
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     uint32_t sampling;  /* rs_sampling */
     uint32_t sampler;   /* rs_sampler */
+    /* The pixels a pass covers (adaptive sampling, scheduler/adaptive.h): path g is pixel
+     * pixel_of[g mod n_active] (NULL: g mod n_active itself, n_active = npix), sample
+     * sample_base + g div n_active.  Host memory: only the stream engine's host stages read it. */
+    const uint32_t *pixel_of;
+    uint32_t n_active, sample_base;
 } rs_integrator;
+
+/* Pixel and sample of path g. */
+RS_HD uint32_t rs_path_pixel(const rs_integrator *it, uint64_t g)
+{
+    uint32_t k = (uint32_t)(g % it->n_active);
+    return it->pixel_of ? it->pixel_of[k] : k;
+}
+RS_HD uint32_t rs_path_sample(const rs_integrator *it, uint64_t g)
+{
+    return it->sample_base + (uint32_t)(g / it->n_active);
+}
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the
  * light's point (v[1], v[2]) is one stratified pair, the pick and the mixture choice (v[0],
@@ -141,7 +157,7 @@ RS_HD rs_ray rs_path_begin_at(const rs_integrator *it, uint32_t pixel, uint32_t 
 /* The camera ray of path g, and its state reset. */
 RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
 {
-    return rs_path_begin_at(it, (uint32_t)(g % it->npix), (uint32_t)(g / it->npix), NULL, ps);
+    return rs_path_begin_at(it, rs_path_pixel(it, g), rs_path_sample(it, g), NULL, ps);
 }
 
 /* Moves a ray origin off the surface along n (the side the new ray leaves from); the offset
@@ -607,7 +623,7 @@ RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounc
                              const rs_ray *ray, const rs_hit *h, rs_path_state *ps, rs_ray *next,
                              rs_ray *shadow)
 {
-    return rs_path_shade_at(it, (uint32_t)(g % it->npix), (uint32_t)(g / it->npix), bounce, NULL,
+    return rs_path_shade_at(it, rs_path_pixel(it, g), rs_path_sample(it, g), bounce, NULL,
                             ray, h, ps, next, shadow);
 }
 

@@ -508,6 +508,20 @@ static void test_usage_errors(void **state)
      * parser that let the bad argument through would write out.png (and fail the check). */
     static const usage_case cases[] = {
         {{"render", "-o", "out.png", "--spp", "1", "--bogus", NULL}, {"--bogus"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "0", NULL}, {"--adaptive", "'0'"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "1.5", NULL}, {"--adaptive"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "nan", NULL}, {"--adaptive"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive-min-spp", "8", NULL},
+         {"--adaptive-min-spp", "--adaptive"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "0.1", "--adaptive-min-spp", "1",
+          NULL},
+         {"--adaptive-min-spp"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "0.1", "--integrator",
+          "megakernel", NULL},
+         {"--adaptive", "megakernel"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "0.1", "--checkpoint", "c.ckpt",
+          NULL},
+         {"--adaptive", "checkpoint"}},
         {{"rendr", "-o", "out.png", NULL}, {"rendr", "command"}},
         {{"render", "-o", "out.png", "--spp", "abc", NULL}, {"--spp", "abc"}},
         {{"render", "-o", "out.png", "--spp", "1", "--width", "12x", NULL}, {"--width", "12x"}},
@@ -1997,6 +2011,36 @@ static void test_aov_layers(void **state)
     proc_free(&p);
 }
 
+/* --adaptive: pixels stop at different sample counts (the samples layer shows them, from 16 to
+ * the --spp), the summary says so, and the image is the same on cpu:1,gpu. */
+static void test_adaptive(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const one[] = {"render", "--width", "24", "--height", "24", "--spp", "48",
+                                      "--adaptive", "0.15", "--aov", "samples", "-o", "ad.exr",
+                                      NULL};
+    static const char *const two[] = {"render",   "--width",    "24",   "--height", "24",
+                                      "--spp",    "48",         "-q",   "--adaptive", "0.15",
+                                      "--devices", "cpu:1,gpu", "-o", "ad2.exr", NULL};
+    uint32_t w = 0, h = 0, i, lo = UINT32_MAX, hi = 0;
+    float *n;
+    proc p;
+    run_expect(f, one, 0, &p);
+    EXPECT(&p, strstr(p.err.data, "adaptive to 0.15 in ") && strstr(p.err.data, "spp on average"),
+           "the summary should say how adaptive sampling went");
+    n = read_channel(&p, f, "ad.exr", "samples.Y", &w, &h);
+    for (i = 0; i < w * h; ++i) {
+        lo = (uint32_t)n[i] < lo ? (uint32_t)n[i] : lo;
+        hi = (uint32_t)n[i] > hi ? (uint32_t)n[i] : hi;
+    }
+    rs_free(n);
+    EXPECT(&p, lo == 16 && hi == 48, "samples per pixel from %u to %u, not 16 to 48", lo, hi);
+    proc_free(&p);
+    run_expect(f, two, 0, &p);
+    expect_same_image(&p, f, "ad.exr", "ad2.exr");
+    proc_free(&p);
+}
+
 static void test_exr_metadata(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -2181,6 +2225,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_checkpoint_refused, setup, teardown),
         cmocka_unit_test_setup_teardown(test_exr_metadata, setup, teardown),
         cmocka_unit_test_setup_teardown(test_aov_layers, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_adaptive, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }

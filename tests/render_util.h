@@ -13,6 +13,7 @@
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/fault.h"
+#include "scheduler/adaptive.h"
 #include "scheduler/render.h"
 
 typedef struct rt_args {
@@ -36,6 +37,9 @@ typedef struct rt_args {
     int fail_after;    /* > 0: the second device fails after this many chunks (RS_FAULT) */
     int shared_cores;  /* devices and shading share a budget of `threads` cores */
     uint32_t bvh_width; /* the CPU device's traversal: 2, 4 or 8 (0: 4) */
+    rs_adaptive adaptive; /* threshold > 0: rs_render_adaptive (the stream integrator) */
+    rs_adaptive_stats *adaptive_out; /* its statistics, where not NULL */
+    uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -116,6 +120,12 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
          * (on host threads / on CUDA with real_gpu) */
         if (rs_render_passes(scene, devs[0], &st, NULL, film, &stats) != RS_OK)
             goto out;
+    } else if (a->adaptive.threshold > 0) {
+        rs_adaptive_stats as;
+        if (rs_render_adaptive(scene, sched, &st, &a->adaptive, NULL, film, &stats, &as) != RS_OK)
+            goto out;
+        if (a->adaptive_out)
+            *a->adaptive_out = as;
     } else if (rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK) {
         goto out;
     }
@@ -123,6 +133,8 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     if (!rgb)
         goto out;
     rs_film_resolve(film, rgb);
+    if (a->counts_out)
+        memcpy(a->counts_out, film->count, (size_t)a->width * a->height * sizeof *film->count);
     if (stats_out)
         *stats_out = stats;
     ok = 1;
