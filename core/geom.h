@@ -49,8 +49,10 @@ typedef struct rs_instance {
     uint32_t n_tris;
     uint32_t prim_base; /* global number of the instance's first triangle */
     uint32_t root;      /* the prototype's bottom-level root in blas_nodes (rs_bvh_attach) */
-    uint32_t reserved;  /* zero: the struct has no padding (scene hashes read every byte) */
 } rs_instance;
+
+/* No padding (the checkpoint's scene hash reads every byte of the instance table). */
+typedef char rs_instance_unpadded[sizeof(rs_instance) == 33 * 8 + 24 + 4 * 6 ? 1 : -1];
 
 /* Point p of an instance's object space in world space: each coordinate computed in double and
  * rounded to float once (what scenes/transform.c does to a copied object). */

@@ -1161,6 +1161,7 @@ static rs_status place_instance(ctx *c, group *g, const char *path, const rs_xfo
     if (!g->made) {
         const cJSON *it;
         rs_xform id = rs_xform_identity();
+        rs_scene_mark before = rs_scene_mark_now(c->scene);
         uint32_t from = c->scene->n_tris, k;
         int emits = 0;
         c->stack[c->depth++] = g;
@@ -1172,20 +1173,18 @@ static rs_status place_instance(ctx *c, group *g, const char *path, const rs_xfo
                 return FAIL(c, path, "the scene would pass %u primitives", MAX_PRIMS);
         }
         c->depth--;
-        /* emitters (lights, one per placed triangle) and cut-outs are copied */
+        /* emitters (lights, one per placed triangle) and cut-outs are copied, as is anything
+         * that is not a triangle (a mesh file's lights, should one bring them) */
         for (k = from; k < c->scene->n_tris && !emits; ++k)
             emits = rs_material_is_light(&c->scene->materials[c->scene->tri_mat[k]]) ||
                     c->scene->materials[c->scene->tri_mat[k]].alpha_mask;
+        emits |= c->scene->n_spheres != before.n_spheres || c->scene->n_quads != before.n_quads ||
+                 c->scene->n_punctuals != before.n_punctuals;
         if (emits) {
-            rs_scene_mark mark = rs_scene_mark_now(c->scene);
-            mark.n_tris = from;
-            mark.n_spheres = c->scene->n_spheres;
-            mark.n_quads = c->scene->n_quads;
-            mark.n_punctuals = c->scene->n_punctuals;
             g->shape = -1;
             *copied = 1;
             if (!rs_xform_is_identity(xf) &&
-                rs_scene_transform_since(c->scene, &mark, xf) != RS_OK) {
+                rs_scene_transform_since(c->scene, &before, xf) != RS_OK) {
                 char msg[400];
                 snprintf(msg, sizeof msg, "%s", rs_error_message());
                 rs_error_clear();
