@@ -118,6 +118,26 @@ RS_HD int rs_hit_better(float t, uint32_t prim, const rs_hit *best)
     return t < best->t || (t == best->t && prim < best->prim);
 }
 
+/* After the box tests of an interior node's children l and l + 1 (hit or not, their entry
+ * distances): the child to visit next in *node, the nearer, with the other pushed when both are
+ * hit.  0 when neither is (pop the stack). */
+RS_HD int rs_bvh_descend(uint32_t l, int hl, float tl, int hr, float tr, uint32_t *stack,
+                         uint32_t *sp, uint32_t *node)
+{
+    if (hl && hr) {
+        int right_first = tr < tl;
+        RS_ASSERT(*sp < RS_BVH_STACK);
+        stack[(*sp)++] = right_first ? l : l + 1;
+        *node = right_first ? l + 1 : l;
+        return 1;
+    }
+    if (hl || hr) {
+        *node = hl ? l : l + 1;
+        return 1;
+    }
+    return 0;
+}
+
 /* Instances (core/geom.h).  A bottom level's box test: node n widened by `margin` on every side
  * (the slab test with the margin above as well). */
 RS_HD int rs_blas_node_hit(const rs_bvh_node *n, float margin, rs_vec3 o, rs_vec3 inv_d,
@@ -190,21 +210,8 @@ RS_HD_COLD void rs_instance_closest(const rs_geom *g, uint32_t i, rs_ray *ray, r
             int hl = rs_blas_node_hit(&g->blas_nodes[l], margin, o, inv_d, ray->tmin, ray->tmax, &tl);
             int hr = rs_blas_node_hit(&g->blas_nodes[r], margin, o, inv_d, ray->tmin, ray->tmax, &tr);
             RS_COUNT(box_tests, 2);
-            if (hl && hr) {
-                if (tr < tl) {
-                    uint32_t tmp = l;
-                    l = r;
-                    r = tmp;
-                }
-                RS_ASSERT(sp < RS_BVH_STACK);
-                stack[sp++] = r;
-                node = l;
+            if (rs_bvh_descend(l, hl, tl, hr, tr, stack, &sp, &node))
                 continue;
-            }
-            if (hl || hr) {
-                node = hl ? l : r;
-                continue;
-            }
         }
         for (;;) {
             if (sp == 0)
@@ -314,25 +321,8 @@ RS_HD int rs_bvh_closest(const rs_bvh_view *b, const rs_geom *g, rs_ray ray, rs_
             hl = rs_bvh_node_hit(&b->nodes[l], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tl);
             int hr =
                 rs_bvh_node_hit(&b->nodes[r], g->aabb_algo, ray.o, inv_d, ray.tmin, ray.tmax, &tr);
-            if (hl && hr) {
-                if (tr < tl) {
-                    uint32_t tmp = l;
-                    l = r;
-                    r = tmp;
-                }
-                RS_ASSERT(sp < RS_BVH_STACK);
-                stack[sp++] = r;
-                node = l;
+            if (rs_bvh_descend(l, hl, tl, hr, tr, stack, &sp, &node))
                 continue;
-            }
-            if (hl) {
-                node = l;
-                continue;
-            }
-            if (hr) {
-                node = r;
-                continue;
-            }
         }
         /* pop the next subtree that can still hold a closer hit */
         for (;;) {

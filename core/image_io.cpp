@@ -207,24 +207,48 @@ static rs_status open_input(const char *path, rs_status fail, OIIO::ImageInput::
     return RS_OK;
 }
 
+// open_input, then the header checked: not empty, and bounded before anything is allocated (a
+// header may claim any size: a small file can decode to gigabytes).  May throw.
+static rs_status open_image(const char *path, OIIO::ImageInput::unique_ptr *in)
+{
+    rs_status st = open_input(path, RS_ERR_IO, in);
+    if (st != RS_OK)
+        return st;
+    const OIIO::ImageSpec &spec = (*in)->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+        return rs_error_set(RS_ERR_IO, "%s: empty image", path);
+    if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE ||
+        (uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
+        return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d is too large (at most %llu pixels)",
+                            path, spec.width, spec.height, (unsigned long long)RS_IMAGE_MAX_PIXELS);
+    return RS_OK;
+}
+
+// One channel of an open image into a new block of width * height floats at *out.
+static rs_status read_one_channel(const char *path, OIIO::ImageInput *in, int ch, float **out)
+{
+    const OIIO::ImageSpec &spec = in->spec();
+    size_t npix = (size_t)spec.width * (size_t)spec.height;
+    float *o = (float *)rs_alloc(npix, sizeof(float));
+    if (!o)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
+    if (!in->read_image(0, 0, ch, ch + 1, OIIO::TypeDesc::FLOAT, o)) {
+        rs_free(o);
+        return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
+    }
+    *out = o;
+    return RS_OK;
+}
+
 static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **rgb, bool linear)
 {
     *rgb = nullptr;
     try {
         OIIO::ImageInput::unique_ptr in;
-        rs_status st = open_input(path, RS_ERR_IO, &in);
+        rs_status st = open_image(path, &in);
         if (st != RS_OK)
             return st;
         const OIIO::ImageSpec &spec = in->spec();
-        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-            return rs_error_set(RS_ERR_IO, "%s: empty image", path);
-        // a header may claim any size: bound it before allocating (a small file can decode
-        // to gigabytes)
-        if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE ||
-            (uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
-            return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d is too large (at most %llu pixels)",
-                                path, spec.width, spec.height,
-                                (unsigned long long)RS_IMAGE_MAX_PIXELS);
         size_t npix = (size_t)spec.width * (size_t)spec.height;
         int nc = spec.nchannels < 3 ? spec.nchannels : 3; // only RGB is kept
         std::vector<float> all(npix * (size_t)nc);
@@ -256,17 +280,10 @@ extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t
     *alpha = nullptr;
     try {
         OIIO::ImageInput::unique_ptr in;
-        rs_status st = open_input(path, RS_ERR_IO, &in);
+        rs_status st = open_image(path, &in);
         if (st != RS_OK)
             return st;
         const OIIO::ImageSpec &spec = in->spec();
-        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-            return rs_error_set(RS_ERR_IO, "%s: empty image", path);
-        if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE ||
-            (uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
-            return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d is too large (at most %llu pixels)",
-                                path, spec.width, spec.height,
-                                (unsigned long long)RS_IMAGE_MAX_PIXELS);
         int ch = spec.alpha_channel;
         if (ch < 0 && (spec.nchannels == 2 || spec.nchannels == 4))
             ch = spec.nchannels - 1;
@@ -274,16 +291,7 @@ extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t
         *h = (uint32_t)spec.height;
         if (ch < 0 || ch >= spec.nchannels)
             return RS_OK; // no alpha: opaque
-        size_t npix = (size_t)spec.width * (size_t)spec.height;
-        float *o = (float *)rs_alloc(npix, sizeof(float));
-        if (!o)
-            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
-        if (!in->read_image(0, 0, ch, ch + 1, OIIO::TypeDesc::FLOAT, o)) {
-            rs_free(o);
-            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
-        }
-        *alpha = o;
-        return RS_OK;
+        return read_one_channel(path, in.get(), ch, alpha);
     } catch (const std::exception &ex) {
         return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
     } catch (...) {
@@ -297,7 +305,7 @@ extern "C" rs_status rs_image_read_channel(const char *path, const char *channel
     *data = nullptr;
     try {
         OIIO::ImageInput::unique_ptr in;
-        rs_status st = open_input(path, RS_ERR_IO, &in);
+        rs_status st = open_image(path, &in);
         if (st != RS_OK)
             return st;
         const OIIO::ImageSpec &spec = in->spec();
@@ -307,20 +315,9 @@ extern "C" rs_status rs_image_read_channel(const char *path, const char *channel
                 ch = c;
         if (ch < 0)
             return rs_error_set(RS_ERR_ARG, "%s: no channel %s", path, channel);
-        if ((uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
-            return rs_error_set(RS_ERR_ARG, "%s: image too large", path);
-        size_t npix = (size_t)spec.width * (size_t)spec.height;
-        float *o = (float *)rs_alloc(npix ? npix : 1, sizeof(float));
-        if (!o)
-            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
-        if (!in->read_image(0, 0, ch, ch + 1, OIIO::TypeDesc::FLOAT, o)) {
-            rs_free(o);
-            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
-        }
         *w = (uint32_t)spec.width;
         *h = (uint32_t)spec.height;
-        *data = o;
-        return RS_OK;
+        return read_one_channel(path, in.get(), ch, data);
     } catch (const std::exception &ex) {
         return rs_error_set(RS_ERR_IO, "%s: %s", path, ex.what());
     } catch (...) {

@@ -287,6 +287,14 @@ RS_HD rs_tri rs_scene_tri(const rs_scene *s, uint32_t prim)
     return rs_instance_tri(in, &s->inst_tris[k]);
 }
 
+/* tmp[6] = (0,0), (1,0), (0,1): the UVs of a triangle added without any. */
+RS_HD const float *rs_default_tri_uv(float *tmp)
+{
+    tmp[0] = tmp[1] = tmp[3] = tmp[4] = 0.0f;
+    tmp[2] = tmp[5] = 1.0f;
+    return tmp;
+}
+
 /* The UVs (u0, v0, u1, v1, u2, v2) of prototype triangle k (an inst_tris index) as instance
  * `in` places it, into tmp[6] (v1 and v2 swapped under a mirror), or (0,0), (1,0), (0,1) when no
  * prototype triangle has UVs. */
@@ -294,10 +302,8 @@ RS_HD const float *rs_instance_tri_uv(const rs_scene *s, const rs_instance *in, 
                                       float *tmp)
 {
     const float *src;
-    tmp[0] = tmp[1] = tmp[3] = tmp[4] = 0.0f;
-    tmp[2] = tmp[5] = 1.0f;
     if (!s->inst_tri_uv)
-        return tmp;
+        return rs_default_tri_uv(tmp);
     src = &s->inst_tri_uv[6 * (size_t)k];
     tmp[0] = src[0];
     tmp[1] = src[1];
@@ -349,11 +355,8 @@ RS_HD const float *rs_scene_tri_uv(const rs_scene *s, uint32_t prim, float *tmp)
         return &s->tri_uv[6 * (size_t)t];
     if (!s->tri_uv && !s->inst_tri_uv)
         return NULL;
-    if (t < s->n_tris) {
-        tmp[0] = tmp[1] = tmp[3] = tmp[4] = 0.0f;
-        tmp[2] = tmp[5] = 1.0f;
-        return tmp;
-    }
+    if (t < s->n_tris)
+        return rs_default_tri_uv(tmp);
     in = rs_scene_prim_instance(s, prim, &k);
     return rs_instance_tri_uv(s, in, k, tmp);
 }
