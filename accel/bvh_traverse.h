@@ -264,9 +264,8 @@ RS_HD_COLD int rs_instance_occluded(const rs_geom *g, uint32_t i, const rs_ray *
 RS_HD void rs_bvh_leaf_closest(const rs_geom *g, uint32_t prim, rs_ray *ray, rs_hit *hit)
 {
     float t, u, v;
-    uint32_t own = rs_geom_own_count(g);
-    if (prim >= own) {
-        rs_instance_closest(g, prim - own, ray, hit);
+    if (g->n_instances && prim >= rs_geom_own_count(g)) {
+        rs_instance_closest(g, prim - rs_geom_own_count(g), ray, hit);
         return;
     }
     if (rs_geom_intersect(g, prim, ray, &t, &u, &v) && rs_hit_better(t, prim, hit)) {
@@ -282,9 +281,8 @@ RS_HD void rs_bvh_leaf_closest(const rs_geom *g, uint32_t prim, rs_ray *ray, rs_
 RS_HD int rs_bvh_leaf_occluded(const rs_geom *g, uint32_t prim, const rs_ray *ray)
 {
     float t, u, v;
-    uint32_t own = rs_geom_own_count(g);
-    if (prim >= own)
-        return rs_instance_occluded(g, prim - own, ray);
+    if (g->n_instances && prim >= rs_geom_own_count(g))
+        return rs_instance_occluded(g, prim - rs_geom_own_count(g), ray);
     return rs_geom_intersect(g, prim, ray, &t, &u, &v);
 }
 

@@ -167,6 +167,14 @@ RS_HD_COLD int rs_geom_mask_opaque(const rs_geom *g, uint32_t t, float hu, float
     return g->mask_bits[m->offset + (size_t)(m->height - 1 - row) * m->width + col] != 0;
 }
 
+/* Own triangle t with an alpha cut-out: hit where the test hits and the mask is there. */
+RS_HD_COLD int rs_geom_tri_masked(const rs_geom *g, uint32_t t, const rs_ray *r, float *th,
+                                  float *u, float *v)
+{
+    return rs_isect_tri_by(g->tri_algo, &g->tris[t], r, th, u, v) &&
+           rs_geom_mask_opaque(g, t, *u, *v);
+}
+
 /* Intersects global primitive `prim` (one of the scene's own, < rs_geom_own_count; an instance's
  * triangles are accel/bvh_traverse.h's); on a hit writes t, u, v and returns 1. */
 RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, float *t, float *u,
@@ -186,9 +194,9 @@ RS_HD int rs_geom_intersect(const rs_geom *g, uint32_t prim, const rs_ray *r, fl
     if (prim < g->n_quads)
         return rs_isect_quad(&g->quads[prim], r, t, u, v);
     prim -= g->n_quads;
-    if (!rs_isect_tri_by(g->tri_algo, &g->tris[prim], r, t, u, v))
-        return 0;
-    return !g->tri_mask || !g->tri_mask[prim] || rs_geom_mask_opaque(g, prim, *u, *v);
+    if (g->tri_mask && g->tri_mask[prim]) /* a tail call: the common path keeps no frame */
+        return rs_geom_tri_masked(g, prim, r, t, u, v);
+    return rs_isect_tri_by(g->tri_algo, &g->tris[prim], r, t, u, v);
 }
 
 #endif
