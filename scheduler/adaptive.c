@@ -68,6 +68,8 @@ rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
         return rs_error_set(RS_ERR_ARG, "adaptive sampling starts from an empty film");
     if (hooks && hooks->film_ready)
         return rs_error_set(RS_ERR_ARG, "adaptive sampling cannot be checkpointed yet");
+    if ((st = rs_film_track_variance(film)) != RS_OK)
+        return st;
     running = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
     need = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
     list = (uint32_t *)rs_alloc(npix ? npix : 1, sizeof *list);

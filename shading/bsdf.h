@@ -163,7 +163,7 @@ RS_HD_COLD rs_vec3 rs_bsdf_eval_ggx(const rs_material *m, rs_vec3 albedo, rs_vec
 RS_HD_COLD float rs_bsdf_pdf_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
                                  rs_vec3 wi, int front);
 
-RS_HD rs_vec3 rs_bsdf_eval_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+RS_HD_HOT rs_vec3 rs_bsdf_eval_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
                                 rs_vec3 wi, int front)
 {
     float ci = rs_v3_dot(n, wi), co = rs_v3_dot(n, wo);

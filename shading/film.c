@@ -20,8 +20,7 @@ rs_status rs_film_create(uint32_t width, uint32_t height, rs_film **out)
     f->height = height;
     f->sum = (double *)rs_calloc(npix * 3, sizeof *f->sum);
     f->count = (uint32_t *)rs_calloc(npix, sizeof *f->count);
-    f->sum_l2 = (double *)rs_calloc(npix, sizeof *f->sum_l2);
-    if (!f->sum || !f->count || !f->sum_l2) {
+    if (!f->sum || !f->count) {
         rs_film_destroy(f);
         return rs_error_set(RS_ERR_NOMEM, "out of memory for a %ux%u film", width, height);
     }
@@ -52,10 +51,20 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
     s[0] += c.x;
     s[1] += c.y;
     s[2] += c.z;
-    {
+    if (f->sum_l2) {
         double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
         f->sum_l2[pixel] += l * l;
     }
+}
+
+rs_status rs_film_track_variance(rs_film *f)
+{
+    if (f->sum_l2)
+        return RS_OK;
+    f->sum_l2 = (double *)rs_calloc((size_t)f->width * f->height, sizeof *f->sum_l2);
+    if (!f->sum_l2)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for the film's variance");
+    return RS_OK;
 }
 
 double rs_film_rel_error(const rs_film *f, uint32_t pixel)
@@ -63,7 +72,7 @@ double rs_film_rel_error(const rs_film *f, uint32_t pixel)
     const double *s = &f->sum[3 * (size_t)pixel];
     uint32_t n = f->count[pixel];
     double mean, var;
-    if (n < 2)
+    if (n < 2 || !f->sum_l2)
         return INFINITY;
     mean = (0.2126 * s[0] + 0.7152 * s[1] + 0.0722 * s[2]) / n;
     var = (f->sum_l2[pixel] / n - mean * mean) * n / (n - 1);

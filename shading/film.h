@@ -13,7 +13,8 @@ typedef struct rs_film {
     double *sum;        /* 3 per pixel, row-major from the top-left */
     uint32_t *count;    /* samples per pixel */
     double *sum_l2;     /* per pixel, the sum of the samples' squared luminance (adaptive
-                           sampling's error estimate; not in checkpoints) */
+                           sampling's error estimate; not in checkpoints); NULL unless
+                           rs_film_track_variance asked for it */
     uint64_t nonfinite; /* samples that were NaN or infinite: counted, contributed zero */
 } rs_film;
 
@@ -29,9 +30,13 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 radiance);
 void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads);
 /* Writes width * height * 3 floats of mean radiance (0 where a pixel has no sample yet). */
 void rs_film_resolve(const rs_film *f, float *rgb);
+/* From now on keep each pixel's sum of squared luminance (for rs_film_rel_error): on an empty
+ * film, so that it covers every sample. */
+rs_status rs_film_track_variance(rs_film *f);
 /* The relative standard error of pixel `pixel`'s mean luminance: sqrt(var / n) / mean, the
  * sample variance from the sums, the mean held at least 1e-3 (dark pixels are not sampled for
- * ever); infinity below two samples, 0 for a pixel whose samples are all alike. */
+ * ever); infinity below two samples or without rs_film_track_variance, 0 for a pixel whose
+ * samples are all alike. */
 double rs_film_rel_error(const rs_film *f, uint32_t pixel);
 /* Fewest samples any pixel has. */
 uint32_t rs_film_min_count(const rs_film *f);
