@@ -1,16 +1,17 @@
 /* app/checkpoint.h — a render's film saved to a file (--checkpoint FILE) and read back
  * (--resume FILE), so that a render continued from it ends bit for bit as the uninterrupted one.
  *
- * Why that holds: paths are numbered sample-major (scheduler/render.h) and each pixel sums its
- * samples into a double in path order, on every device set; the film only ever holds a prefix
- * [0, paths) of the numbering (whole waves, in wave order; whole samples for the megakernel).
- * A checkpoint stores those exact sums and counts and `paths`; the resumed render starts at path
- * `paths` and adds the rest onto the same doubles in the same order.
+ * Why that holds: each path's radiance depends only on its number (paths are numbered
+ * sample-major, scheduler/render.h), on every device set, and the film's sums are exact integers
+ * (shading/film.h), so they do not depend on the order samples are added in.  The film holds a
+ * prefix [0, paths) of the numbering (whole waves; whole samples for the megakernel; whole passes
+ * of an MPI job); a checkpoint stores those exact sums and counts and `paths`, and the resumed
+ * render adds the rest.
  *
- * File format, version 1 (little-endian; a header of 92 bytes + the scene name):
+ * File format, version 2 (little-endian; a header of 92 bytes + the scene name):
  *   off  size  field
  *     0     8  magic "RSCKPT\r\n" (a text-mode transfer or a truncation shows)
- *     8     4  version (1)
+ *     8     4  version (2; version 1 held double sums)
  *    12     4  header bytes (from offset 0 to the first sum)
  *    16     8  scene content hash (rs_checkpoint_scene_hash: geometry, materials, textures,
  *              lights, camera, background; a mesh or texture file's content is in it)
@@ -20,7 +21,8 @@
  *    48    40  width, height, spp, max depth, rr depth, sampling, sampler, sphere test,
  *              triangle test, box test (u32 each)
  *    88     4  scene name bytes n (< 4096), then the name as given on the command line
- *  hdr   24*P  the sums, 3 doubles a pixel (P = width * height)
+ *  hdr   48*P  the sums, 3 signed 128-bit integers a pixel in film units (2^-40; P = width *
+ *              height)
  *         4*P  the counts, u32 a pixel (must be paths / P, plus 1 for the first paths % P)
  *           8  FNV-1a 64 of every byte before it
  * Everything that decides the image is in the header; the devices, threads, chunk and wave
@@ -35,7 +37,7 @@
 #include "scenes/scene.h"
 #include "shading/film.h"
 
-#define RS_CHECKPOINT_VERSION 1u
+#define RS_CHECKPOINT_VERSION 2u
 
 /* What decides the image, as the checkpoint records it. */
 typedef struct rs_checkpoint_key {

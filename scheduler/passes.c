@@ -47,7 +47,7 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
     pass_ctx p;
     rs_status status;
     double t_start = now_s();
-    uint32_t s0, s_begin, per;
+    uint32_t s0, s_begin, s_end, per;
     /* a time limit or a reader of the film needs the film on whole samples between calls */
     int consistent = hooks && (hooks->time_limit_s > 0 || hooks->film_ready);
 
@@ -56,7 +56,7 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
         return status;
     if (!d->ops->render_pass)
         return rs_error_set(RS_ERR_ARG, "device %s cannot run the megakernel", d->name);
-    if (st->pixels || st->sample_base)
+    if (st->pixels)
         return rs_error_set(RS_ERR_ARG, "the megakernel renders whole images only: adaptive "
                                         "sampling needs --integrator stream");
     if (st->path_begin % it.npix != 0)
@@ -64,7 +64,10 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
                             "the megakernel continues from whole passes only, and the film holds "
                             "%llu samples of %u pixels (use --integrator stream)",
                             (unsigned long long)st->path_begin, it.npix);
-    s_begin = (uint32_t)(st->path_begin / it.npix);
+    /* samples [sample_base + path_begin / npix, sample_base + spp) (a pass of an MPI job starts
+     * at a later sample) */
+    s_begin = st->sample_base + (uint32_t)(st->path_begin / it.npix);
+    s_end = st->sample_base + st->spp;
     stats->paths_total = (uint64_t)it.npix * st->spp - st->path_begin;
     if (d->ops->pass_begin && (status = d->ops->pass_begin(d, scene, &it)) != RS_OK)
         return status;
@@ -83,8 +86,8 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
     job.progress = pass_progress;
     job.user = &p;
     per = d->pass_samples ? d->pass_samples : (consistent ? 1 : st->spp);
-    for (s0 = s_begin; s0 < st->spp && status == RS_OK; s0 += per) {
-        uint32_t n = st->spp - s0 < per ? st->spp - s0 : per;
+    for (s0 = s_begin; s0 < s_end && status == RS_OK; s0 += per) {
+        uint32_t n = s_end - s0 < per ? s_end - s0 : per;
         double t0, t1;
         if (pass_cancelled(&p))
             break;

@@ -2,6 +2,7 @@
 #include "shading/film.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "core/alloc.h"
 #include "core/parallel.h"
@@ -38,19 +39,34 @@ void rs_film_destroy(rs_film *f)
     rs_free(f);
 }
 
+/* x (|x| <= RS_FILM_MAX_SAMPLE) in film units, rounded to the nearest (ties to even) */
+static inline rs_film_sum to_fixed(double x)
+{
+    double v = rint(x * RS_FILM_SCALE); /* exact scaling by a power of two, then one rounding */
+    if (fabs(v) < 0x1p62)
+        return (rs_film_sum)(int64_t)v;
+    return (rs_film_sum)v;
+}
+
+static inline double from_fixed(rs_film_sum s)
+{
+    return (double)s * (1.0 / RS_FILM_SCALE);
+}
+
 void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
 {
-    double *s = &f->sum[3 * (size_t)pixel];
+    rs_film_sum *s = &f->sum[3 * (size_t)pixel];
     f->count[pixel]++;
-    if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z))) {
+    if (!(fabs(c.x) <= RS_FILM_MAX_SAMPLE && fabs(c.y) <= RS_FILM_MAX_SAMPLE &&
+          fabs(c.z) <= RS_FILM_MAX_SAMPLE)) { /* NaN fails every comparison */
         /* the one counter shared by every pixel: the megakernel adds pixels from many threads */
 #pragma omp atomic
         f->nonfinite++;
         return;
     }
-    s[0] += c.x;
-    s[1] += c.y;
-    s[2] += c.z;
+    s[0] += to_fixed(c.x);
+    s[1] += to_fixed(c.y);
+    s[2] += to_fixed(c.z);
     if (f->sum_l2) {
         double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
         f->sum_l2[pixel] += l * l;
@@ -67,13 +83,49 @@ rs_status rs_film_track_variance(rs_film *f)
     return RS_OK;
 }
 
+rs_status rs_film_merge(rs_film *dst, const rs_film *src)
+{
+    size_t i, n = (size_t)dst->width * dst->height;
+    if (src->width != dst->width || src->height != dst->height)
+        return rs_error_set(RS_ERR_ARG, "merging a %ux%u film into a %ux%u one", src->width,
+                            src->height, dst->width, dst->height);
+    for (i = 0; i < 3 * n; ++i)
+        dst->sum[i] += src->sum[i];
+    for (i = 0; i < n; ++i)
+        dst->count[i] += src->count[i];
+    if (dst->sum_l2 && src->sum_l2)
+        for (i = 0; i < n; ++i)
+            dst->sum_l2[i] += src->sum_l2[i];
+    dst->nonfinite += src->nonfinite;
+    return RS_OK;
+}
+
+void rs_film_clear(rs_film *f)
+{
+    size_t n = (size_t)f->width * f->height;
+    memset(f->sum, 0, 3 * n * sizeof *f->sum);
+    memset(f->count, 0, n * sizeof *f->count);
+    if (f->sum_l2)
+        memset(f->sum_l2, 0, n * sizeof *f->sum_l2);
+    f->nonfinite = 0;
+}
+
+void rs_film_pixel_sum(const rs_film *f, uint32_t pixel, double out[3])
+{
+    const rs_film_sum *s = &f->sum[3 * (size_t)pixel];
+    out[0] = from_fixed(s[0]);
+    out[1] = from_fixed(s[1]);
+    out[2] = from_fixed(s[2]);
+}
+
 double rs_film_rel_error(const rs_film *f, uint32_t pixel)
 {
-    const double *s = &f->sum[3 * (size_t)pixel];
+    double s[3];
     uint32_t n = f->count[pixel];
     double mean, var;
     if (n < 2 || !f->sum_l2)
         return INFINITY;
+    rs_film_pixel_sum(f, pixel, s);
     mean = (0.2126 * s[0] + 0.7152 * s[1] + 0.0722 * s[2]) / n;
     var = (f->sum_l2[pixel] / n - mean * mean) * n / (n - 1);
     if (!(var > 0))
@@ -108,9 +160,9 @@ void rs_film_resolve(const rs_film *f, float *rgb)
     size_t i, n = (size_t)f->width * f->height;
     for (i = 0; i < n; ++i) {
         double inv = f->count[i] ? 1.0 / f->count[i] : 0.0;
-        rgb[3 * i + 0] = (float)(f->sum[3 * i + 0] * inv);
-        rgb[3 * i + 1] = (float)(f->sum[3 * i + 1] * inv);
-        rgb[3 * i + 2] = (float)(f->sum[3 * i + 2] * inv);
+        rgb[3 * i + 0] = (float)(from_fixed(f->sum[3 * i + 0]) * inv);
+        rgb[3 * i + 1] = (float)(from_fixed(f->sum[3 * i + 1]) * inv);
+        rgb[3 * i + 2] = (float)(from_fixed(f->sum[3 * i + 2]) * inv);
     }
 }
 
