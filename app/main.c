@@ -2,6 +2,7 @@
  * scheduler, runs the render with a progress bar, writes the image and prints a summary.
  * The only place that calls exit() (by returning from main) and that handles signals. */
 #include <errno.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -14,6 +15,7 @@
 
 #include "accel/bvh8.h"
 #include "app/checkpoint.h"
+#include "app/distributed.h"
 #include "app/options.h"
 #include "scheduler/adaptive.h"
 #include "shading/aov.h"
@@ -290,6 +292,10 @@ typedef struct render_run {
     double last_ckpt;                    /* when the last checkpoint was written (rs_now_s) */
     double ckpt_every_s;                 /* --checkpoint-interval */
     rs_progress progress;
+    rs_dist *dist;        /* under mpirun (app/distributed.h), or NULL */
+    int rank;             /* this process's rank (0 without MPI) */
+    int local_ranks;      /* ranks on this machine: they share its cores */
+    rs_dist_result dres;  /* rank 0: the job's result */
 } render_run;
 
 static void run_release(render_run *r)
@@ -477,6 +483,9 @@ static void make_settings(const rs_cli_options *o, render_run *r)
     st->wave_paths = o->wave_paths;
     st->waves_in_flight = o->waves;
     r->threads = o->threads ? o->threads : rs_cpu_count();
+    /* ranks on one machine share its cores */
+    if (!o->threads && r->local_ranks > 1)
+        r->threads = r->threads / r->local_ranks > 0 ? r->threads / r->local_ranks : 1;
     /* --integrator megakernel --devices cpu:N runs on N threads */
     if (o->megakernel && !o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads)
         r->threads = o->devices[0].threads;
@@ -772,6 +781,22 @@ static void print_stats_table(const render_run *r, const device_rows *t)
                 (unsigned long long)d->bytes_to_device, (unsigned long long)d->bytes_from_device,
                 t->alive[i] ? "ok" : "failed");
     }
+    if (r->dist) {
+        const rs_dist_result *d = &r->dres;
+        fprintf(stderr, "%-5s %-34s %7s %12s %9s %9s %10s %12s %s\n", "rank", "host: devices",
+                "passes", "samples", "busy s", "idle", "samples/s", "film bytes", "state");
+        for (i = 0; i < d->ranks; ++i) {
+            const rs_dist_rank_stats *k = &d->rank[i];
+            double idle = k->wall_s > 0 ? 1.0 - k->busy_s / k->wall_s : 0.0;
+            fprintf(stderr, "%-5d %-34.34s %7u %12llu %9.3f %8.1f%% %10.0f %12llu %s\n", i,
+                    k->desc, k->passes, (unsigned long long)k->paths, k->busy_s,
+                    100.0 * (idle > 0 ? idle : 0.0),
+                    k->busy_s > 0 ? (double)k->paths / k->busy_s : 0.0,
+                    (unsigned long long)k->film_bytes,
+                    !k->alive ? "lost" : k->failed ? "failed" : "ok");
+        }
+        fprintf(stderr, "(the device and stage rows are rank 0's)\n");
+    }
     fprintf(stderr, "%-24s %9s %7s\n", "stage (render thread)", "s", "share");
     for (i = 0; i < RS_STAGE_COUNT; ++i)
         if (r->stats.stage_s[i] > 0)
@@ -833,7 +858,34 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
                 (unsigned long long)d->failures, t->alive[i] ? "false" : "true",
                 i + 1 < t->n ? "," : "");
     }
-    fprintf(f, "  ]\n}\n");
+    fprintf(f, "  ]");
+    if (r->dist) {
+        const rs_dist_result *d = &r->dres;
+        fprintf(f,
+                ",\n  \"mpi\": {\"ranks\": %d, \"pass_spp\": %u, \"passes\": %u, "
+                "\"reissued\": %u, \"ranks_lost\": %d, \"bytes_received\": %llu, "
+                "\"rays\": %llu, \"prefix\": %s,\n    \"per_rank\": [\n",
+                d->ranks, d->pass_spp, d->passes_total, d->reissued, d->dead,
+                (unsigned long long)d->bytes_received,
+                (unsigned long long)(d->rays_closest + d->rays_shadow),
+                d->prefix ? "true" : "false");
+        for (i = 0; i < d->ranks; ++i) {
+            const rs_dist_rank_stats *k = &d->rank[i];
+            double idle = k->wall_s > 0 ? 1.0 - k->busy_s / k->wall_s : 0.0;
+            fprintf(f, "      {\"rank\": %d, \"desc\": ", i);
+            json_string(f, k->desc);
+            fprintf(f,
+                    ", \"passes\": %u, \"samples\": %llu, \"busy_s\": %.6f, "
+                    "\"wall_s\": %.6f, \"idle_share\": %.6f, \"samples_per_s\": %.3f, "
+                    "\"film_bytes\": %llu, \"lost\": %s, \"failed\": %s}%s\n",
+                    k->passes, (unsigned long long)k->paths, k->busy_s, k->wall_s,
+                    idle > 0 ? idle : 0.0, k->busy_s > 0 ? (double)k->paths / k->busy_s : 0.0,
+                    (unsigned long long)k->film_bytes, k->alive ? "false" : "true",
+                    k->failed ? "true" : "false", i + 1 < d->ranks ? "," : "");
+        }
+        fprintf(f, "    ]}");
+    }
+    fprintf(f, "\n}\n");
     ok = !ferror(f);
     if (fclose(f) != 0 || !ok) {
         fprintf(stderr, "raystream: %s: cannot write the stats (%s)\n", shown, strerror(errno));
@@ -938,6 +990,14 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
     else
         fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", r->stats.shade_s,
                 r->stats.trace_s);
+    if (r->dist)
+        fprintf(stderr,
+                "MPI: %d ranks took %u passes of %u spp (rank 0: %u)%s%s; %.1f MB of films "
+                "came to rank 0. ",
+                r->dres.ranks, r->dres.passes_total, r->dres.pass_spp, r->dres.rank[0].passes,
+                r->dres.dead ? ", ranks were lost" : "",
+                r->dres.reissued ? ", passes were handed out again" : "",
+                (double)r->dres.bytes_received / 1e6);
     if (r->film->nonfinite)
         fprintf(stderr, "%llu non-finite samples were dropped. ",
                 (unsigned long long)r->film->nonfinite);
@@ -1122,12 +1182,249 @@ static int write_outputs(const rs_cli_options *o, render_run *r, int code)
     return code;
 }
 
+/* ---- under mpirun (app/distributed.h) ------------------------------------------------------ */
+
+/* One pass of an MPI job: samples [s0, s0 + n) of every pixel onto `film`, on this rank's
+ * devices, from its render thread. */
+static rs_status dist_render_pass(void *user, uint32_t s0, uint32_t n, rs_film *film,
+                                  const atomic_int *cancel, rs_render_stats *stats)
+{
+    render_run *r = (render_run *)user;
+    rs_render_settings st = r->st;
+    rs_render_hooks h;
+    st.sample_base = s0;
+    st.spp = n;
+    st.spp_total = r->st.spp; /* the zsobol sampler's point set is the whole render's */
+    st.path_begin = 0;
+    memset(&h, 0, sizeof h);
+    h.cancel = cancel;
+    if (r->mk)
+        return rs_render_passes(r->scene, r->mk, &st, &h, film, stats);
+    return rs_render(r->scene, r->sched, &st, &h, film, stats);
+}
+
+/* "host: cpu (2 threads), gpu0" */
+static void dist_describe(const render_run *r, char *out, size_t n)
+{
+    char host[64] = "?";
+    size_t len;
+    int i;
+    gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = 0;
+    len = (size_t)snprintf(out, n, "%s:", host);
+    for (i = 0; i < (r->mk ? 1 : r->n_devs) && len < n; ++i) {
+        const rs_device *d = r->mk ? r->mk : r->devs[i];
+        len += (size_t)snprintf(out + len, n - len, "%s %s", i ? "," : "", d->name);
+    }
+}
+
+/* The options an MPI job cannot honour yet, refused by rank 0 (the others stay quiet). */
+static int dist_check_options(const rs_cli_options *o, int rank)
+{
+    const char *what = NULL;
+    if (o->adaptive > 0)
+        what = "--adaptive (its rounds depend on the whole film)";
+    else if (o->aovs)
+        what = "--aov";
+    if (!what)
+        return RS_EXIT_OK;
+    if (rank == 0)
+        fprintf(stderr, "raystream: %s is not supported under mpirun yet; run one process\n",
+                what);
+    return RS_EXIT_USAGE;
+}
+
+/* Every rank: scene, settings, BVH, devices; rank 0 also the outputs and the film (with
+ * --resume).  The others' messages are held back until the ranks agree: when rank 0 failed too
+ * it has said why, and only a rank that failed alone shows its own.  Returns the job's exit
+ * code, the same on every rank. */
+static int dist_setup(const rs_cli_options *o, render_run *r)
+{
+    int code, worst, who = 0, saved = -1;
+    FILE *held = NULL;
+    uint64_t begin = 0;
+    char desc[RS_DIST_DESC];
+    if ((code = dist_check_options(o, r->rank)) != RS_EXIT_OK)
+        return code;
+    if (r->rank > 0) {
+        fflush(stderr);
+        if ((held = tmpfile()) != NULL && (saved = dup(2)) >= 0)
+            dup2(fileno(held), 2);
+    }
+    code = load_scene_bounded(o, r);
+    if (code == RS_EXIT_OK) {
+        make_settings(o, r);
+        if (r->rank == 0) {
+            if ((code = check_outputs(o, r)) == RS_EXIT_OK)
+                code = make_film(o, r);
+        } else if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK) {
+            code = fail(RS_EXIT_RUNTIME, "starting the render");
+        }
+    }
+    if (code == RS_EXIT_OK && r->rank == 0) {
+        uint64_t npix = (uint64_t)r->st.width * r->st.height;
+        if (r->st.path_begin % npix != 0) {
+            fprintf(stderr,
+                    "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
+                    "pixels); under mpirun a render continues whole samples only (resume it "
+                    "on one process)\n",
+                    o->resume, (unsigned long long)r->st.path_begin, r->st.width, r->st.height);
+            code = RS_EXIT_USAGE;
+        }
+        begin = r->st.path_begin / npix;
+    }
+    if (code == RS_EXIT_OK && (code = build_bvh(o, r)) == RS_EXIT_OK)
+        code = start_devices(o, r);
+    desc[0] = 0;
+    if (code == RS_EXIT_OK)
+        dist_describe(r, desc, sizeof desc);
+    if (held) {
+        fflush(stderr);
+        if (saved >= 0) {
+            dup2(saved, 2);
+            close(saved);
+        }
+    }
+    worst = rs_dist_agree(r->dist, code, &who, &begin, desc);
+    if (held) {
+        if (code != RS_EXIT_OK && who == r->rank) { /* rank 0 started: say why this one did not */
+            char line[512];
+            rewind(held);
+            while (fgets(line, sizeof line, held))
+                fprintf(stderr, "raystream: rank %d: %s", r->rank,
+                        strncmp(line, "raystream: ", 11) == 0 ? line + 11 : line);
+        }
+        fclose(held);
+    }
+    if (worst != RS_EXIT_OK && r->rank == 0 && code == RS_EXIT_OK)
+        fprintf(stderr, "raystream: rank %d could not start (its message is above); no rank "
+                        "renders\n",
+                who);
+    r->st.path_begin = begin * r->st.width * r->st.height;
+    return worst;
+}
+
+static void on_dist_progress(void *user, uint64_t done, uint64_t total)
+{
+    rs_progress_update(&((render_run *)user)->progress, done, total);
+}
+
+/* The job: rank 0 hands out the passes and gathers the films, every rank renders.  Rank 0 then
+ * has the frame and the statistics in r.  Returns an exit code. */
+static int dist_run(const rs_cli_options *o, render_run *r)
+{
+    rs_dist_job job;
+    rs_status st;
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    install_stop_signals();
+    memset(&job, 0, sizeof job);
+    if (rs_dist_fault_parse(getenv("RS_MPI_FAULT"), &job.fault) != RS_OK)
+        return fail(RS_EXIT_USAGE, NULL);
+    job.width = r->st.width;
+    job.height = r->st.height;
+    job.sample_begin = (uint32_t)(r->st.path_begin / npix);
+    job.spp = r->st.spp;
+    job.pass_spp = o->mpi_pass_spp;
+    job.time_limit_s = o->time_limit_s;
+    job.timeout_s = o->mpi_timeout_s;
+    job.cancel = &g_cancel;
+    job.render = dist_render_pass;
+    job.user = r;
+    if (r->rank == 0)
+        job.progress = on_dist_progress;
+    r->on_film = r->st.path_begin;
+    if (r->rank == 0)
+        rs_progress_begin(&r->progress, !o->quiet);
+    st = rs_dist_render(r->dist, &job, r->film, &r->dres);
+    if (r->rank == 0)
+        rs_progress_end(&r->progress);
+    if (r->rank > 0)
+        return st == RS_OK ? RS_EXIT_OK : fail(RS_EXIT_RUNTIME, NULL);
+    /* rank 0: the job as one render's statistics */
+    r->stats = r->dres.local;
+    r->stats.seconds = r->dres.seconds;
+    r->stats.paths_total = npix * (r->st.spp - job.sample_begin);
+    r->stats.paths_done = npix * (r->dres.samples_done - job.sample_begin);
+    r->stats.rays_closest = r->dres.rays_closest;
+    r->stats.rays_shadow = r->dres.rays_shadow;
+    r->stats.max_bounce = r->dres.max_bounce;
+    r->stats.time_limited = r->dres.time_limited;
+    r->resumed = r->st.path_begin;
+    if (st != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "render failed");
+    if (r->dres.prefix) {
+        r->on_film = npix * r->dres.samples_done;
+    } else if (r->ckpt_out) {
+        fprintf(stderr, "raystream: the finished passes are not samples 0..k-1 (some were lost "
+                        "with a rank or a stop); no checkpoint written\n");
+        r->ckpt_out = NULL;
+    }
+    if (r->dres.stopped) {
+        r->interrupted = atomic_load(&g_signal) ? atomic_load(&g_signal) : SIGTERM;
+        return RS_EXIT_SIGNALLED(r->interrupted);
+    }
+    return RS_EXIT_OK;
+}
+
+static int cmd_render_dist(const rs_cli_options *o, render_run *r)
+{
+    int code = dist_setup(o, r);
+    if (code != RS_EXIT_OK)
+        return code;
+    code = dist_run(o, r);
+    if (r->rank == 0 && (code == RS_EXIT_OK || r->interrupted))
+        code = write_outputs(o, r, code);
+    rs_dist_result_free(&r->dres);
+    return code;
+}
+
+/* Whether an MPI launcher started this process: then r->dist (and 1), or an exit code. */
+static int start_dist(int *argc, char ***argv, render_run *r, int *code)
+{
+    int ranks = 1, rank = 0, local = 1;
+    *code = RS_EXIT_OK;
+    if (!rs_dist_launched(&ranks, &rank, &local))
+        return 0;
+    if (!rs_dist_built()) {
+        if (ranks <= 1)
+            return 0;
+        if (rank == 0)
+            fprintf(stderr, "raystream: started by mpirun as %d ranks, but this raystream was "
+                            "built without MPI (install libopenmpi-dev and rebuild; "
+                            "RS_MPI=AUTO finds it): every rank would render the whole frame\n",
+                    ranks);
+        *code = RS_EXIT_USAGE;
+        return 1;
+    }
+    if (rs_dist_init(argc, argv, &r->dist) != RS_OK) {
+        *code = fail(RS_EXIT_RUNTIME, "starting MPI");
+        return 1;
+    }
+    r->rank = rs_dist_rank(r->dist);
+    r->local_ranks = local;
+    return 1;
+}
+
 /* `raystream render`: scene, settings, outputs checked, BVH, devices, render, outputs. */
-static int cmd_render(const rs_cli_options *o)
+static int cmd_render(const rs_cli_options *o, int *argc, char ***argv)
 {
     render_run r;
     int code;
     memset(&r, 0, sizeof r);
+    if (start_dist(argc, argv, &r, &code)) {
+        if (r.dist) {
+            rs_cli_options wo = *o;
+            if (r.rank > 0)
+                wo.quiet = 1; /* rank 0 shows the progress and the summary */
+            if (rs_fault_parse(getenv("RS_FAULT"), &r.fault) != RS_OK)
+                code = fail(RS_EXIT_USAGE, NULL);
+            else
+                code = cmd_render_dist(&wo, &r);
+            run_release(&r);
+            rs_dist_finish(r.dist);
+        }
+        return code;
+    }
     /* RS_FAULT is input like the options: a bad value is a usage error, before any work */
     if (rs_fault_parse(getenv("RS_FAULT"), &r.fault) != RS_OK)
         return fail(RS_EXIT_USAGE, NULL);
@@ -1178,14 +1475,32 @@ int main(int argc, char **argv)
     /* A reader that goes away (`raystream render ... 2>&1 | head -1`) must not kill the render:
      * writes to stdout or stderr then fail with EPIPE, which nothing here treats as fatal. */
     signal(SIGPIPE, SIG_IGN);
-    rc = rs_cli_parse(argc, argv, &o);
+    {
+        /* under mpirun every rank parses the same line: only rank 0 tells what is wrong */
+        int ranks, rank = 0, local, saved = -1, quiet;
+        quiet = rs_dist_launched(&ranks, &rank, &local) && rank > 0;
+        if (quiet) {
+            int null = open("/dev/null", O_WRONLY);
+            fflush(stderr);
+            if (null >= 0 && (saved = dup(2)) >= 0)
+                dup2(null, 2);
+            if (null >= 0)
+                close(null);
+        }
+        rc = rs_cli_parse(argc, argv, &o);
+        if (saved >= 0) {
+            fflush(stderr);
+            dup2(saved, 2);
+            close(saved);
+        }
+    }
     if (rc != RS_EXIT_OK)
         return rc;
     switch (o.command) {
     case RS_CMD_HELP: rs_cli_print_help(o.scene); return RS_EXIT_OK;
     case RS_CMD_VERSION: return cmd_version();
     case RS_CMD_SCENES: return cmd_scenes();
-    case RS_CMD_RENDER: return cmd_render(&o);
+    case RS_CMD_RENDER: return cmd_render(&o, &argc, &argv);
     case RS_CMD_EXPORT: return cmd_export(&o);
     }
     return RS_EXIT_OK;

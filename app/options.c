@@ -236,6 +236,10 @@ void rs_cli_print_help(const char *command)
             "                      The scene, size, seed, sampling, sampler, max depth and\n"
             "                      intersection tests must be the same (and for zsobol the\n"
             "                      spp): a mismatch is refused with the field named\n"
+            "  --mpi-pass N        under mpirun: samples of every pixel per pass handed to a\n"
+            "                      rank (default: about 8 passes per rank)\n"
+            "  --mpi-timeout S     under mpirun: a rank silent for S seconds is dead and its\n"
+            "                      passes go to the others (default 60; docs/distributed.md)\n"
             "  -q, --quiet         no progress bar and no summary\n"
             "  -h, --help          this text\n"
             "\n"
@@ -243,6 +247,10 @@ void rs_cli_print_help(const char *command)
             "render: a folder, a file that cannot be written or a missing or read-only folder\n"
             "is a usage error.  Outputs are written to FILE.tmp-PID and renamed into place\n"
             "only when all of them are written: a run that fails replaces no file.\n"
+            "\n"
+            "Under mpirun (mpirun -n N raystream render ...) every rank loads the scene and\n"
+            "renders on its own --devices; rank 0 hands out passes, adds the films and\n"
+            "writes the outputs: the image is the one-process image, bit for bit.\n"
             "\n"
             "Ctrl-C (SIGINT), SIGTERM or SIGHUP writes the samples finished so far and exits\n"
             "with 128 + the signal: 130, 143, 129.  A second signal stops at once, also\n"
@@ -456,6 +464,12 @@ static int parse_engine_option(opt_arg *x, rs_cli_options *o)
     } else if (strcmp(name, "--time-limit") == 0) {
         NEEDS_VALUE();
         rc = parse_seconds(name, v, &o->time_limit_s);
+    } else if (strcmp(name, "--mpi-pass") == 0) {
+        NEEDS_VALUE();
+        rc = parse_u32(name, v, 1, 1u << 24, &o->mpi_pass_spp);
+    } else if (strcmp(name, "--mpi-timeout") == 0) {
+        NEEDS_VALUE();
+        rc = parse_seconds(name, v, &o->mpi_timeout_s);
     } else if (strcmp(name, "--checkpoint") == 0) {
         NEEDS_VALUE();
         if (!*v)

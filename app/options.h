@@ -77,6 +77,8 @@ typedef struct rs_cli_options {
     const char *checkpoint;   /* --checkpoint FILE */
     double ckpt_every_s;      /* --checkpoint-interval SECONDS (default 60) */
     const char *resume;       /* --resume FILE */
+    uint32_t mpi_pass_spp;    /* --mpi-pass N: samples per pass of an MPI job; 0: auto */
+    double mpi_timeout_s;     /* --mpi-timeout SECONDS: a rank silent this long is dead (60) */
 } rs_cli_options;
 
 /* Parses argv.  Returns RS_EXIT_OK, or RS_EXIT_USAGE after printing one line naming the

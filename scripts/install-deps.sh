@@ -11,7 +11,8 @@ set -eu
 # in) and its OpenMP (libomp-14-dev): scripts/fuzz.sh, which check-sanitizers.sh runs
 PACKAGES="gcc g++ make cmake pkg-config libc6-dev
 libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev gnuplot-nox
-clang libclang-rt-14-dev libomp-14-dev"
+clang libclang-rt-14-dev libomp-14-dev
+libopenmpi-dev openmpi-bin"
 
 for arg in "$@"; do
     case "$arg" in
