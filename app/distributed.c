@@ -438,9 +438,13 @@ static int wait_req(MPI_Request *req, double timeout_s)
     }
 }
 
+static uint64_t g_msgs, g_msg_bytes; /* this rank's small messages, sent and received */
+
 static int send_small(const uint64_t *v, int n, int to, int tag)
 {
     uint64_t none = 0;
+    g_msgs++;
+    g_msg_bytes += 8u * (uint64_t)n;
     return MPI_Send(v ? (void *)v : (void *)&none, n, MPI_UINT64_T, to, tag, MPI_COMM_WORLD) ==
            MPI_SUCCESS;
 }
@@ -882,6 +886,10 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
             int cnt = 0;
             r = ms.MPI_SOURCE;
             MPI_Get_count(&ms, MPI_UINT64_T, &cnt);
+            if (ms.MPI_TAG != T_FILM_SUMS && ms.MPI_TAG != T_FILM_COUNTS) {
+                g_msgs++;
+                g_msg_bytes += 8u * (uint64_t)cnt;
+            }
             memset(v, 0, sizeof v);
             if (ms.MPI_TAG == T_FILM_SUMS || ms.MPI_TAG == T_FILM_COUNTS) {
                 /* data of a film given up on: drop it */
@@ -1035,6 +1043,8 @@ finish:
     }
 out:
     res->seconds = now_s() - t0;
+    res->messages = g_msgs;
+    res->message_bytes = g_msg_bytes;
     rs_film_destroy(tmp);
     rs_free(c.state);
     rs_free(c.owner);

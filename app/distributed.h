@@ -104,6 +104,8 @@ typedef struct rs_dist_result {
     int dead;                  /* ranks found dead */
     uint32_t reissued;         /* passes handed out again */
     uint64_t bytes_received;   /* film data received by rank 0 */
+    uint64_t messages, message_bytes; /* rank 0's control messages (requests, passes, heartbeats)
+                                         sent and received, and their payload */
     double seconds;
     rs_render_stats local;     /* rank 0's own passes, summed (rays, stages) */
     uint64_t rays_closest, rays_shadow; /* every rank's */

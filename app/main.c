@@ -116,6 +116,10 @@ static int cmd_version(void)
     else
         printf("  OpenMP:      no (compiled out for ThreadSanitizer); %d cores\n", rs_cpu_count());
     printf("  OpenImageIO: %s\n", rs_image_library_version());
+    if (rs_dist_built())
+        printf("  MPI:         yes (mpirun -n N raystream render ...; docs/distributed.md)\n");
+    else
+        printf("  MPI:         no (built without MPI: RS_MPI, libopenmpi-dev)\n");
     return RS_EXIT_OK;
 }
 
@@ -864,9 +868,11 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
         fprintf(f,
                 ",\n  \"mpi\": {\"ranks\": %d, \"pass_spp\": %u, \"passes\": %u, "
                 "\"reissued\": %u, \"ranks_lost\": %d, \"bytes_received\": %llu, "
+                "\"messages\": %llu, \"message_bytes\": %llu, "
                 "\"rays\": %llu, \"prefix\": %s,\n    \"per_rank\": [\n",
                 d->ranks, d->pass_spp, d->passes_total, d->reissued, d->dead,
-                (unsigned long long)d->bytes_received,
+                (unsigned long long)d->bytes_received, (unsigned long long)d->messages,
+                (unsigned long long)d->message_bytes,
                 (unsigned long long)(d->rays_closest + d->rays_shadow),
                 d->prefix ? "true" : "false");
         for (i = 0; i < d->ranks; ++i) {
@@ -1355,8 +1361,17 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     if (r->dres.prefix) {
         r->on_film = npix * r->dres.samples_done;
     } else if (r->ckpt_out) {
+        /* a checkpoint holds samples [0, k) (app/checkpoint.h): this film has gaps */
+        int i;
         fprintf(stderr, "raystream: the finished passes are not samples 0..k-1 (some were lost "
-                        "with a rank or a stop); no checkpoint written\n");
+                        "with a rank or a stop); no checkpoint written (%s is left as it was)\n",
+                r->ckpt_out->path);
+        for (i = 0; i < r->n_outs; ++i)
+            if (&r->outs[i] == r->ckpt_out) {
+                memmove(&r->outs[i], &r->outs[i + 1], (size_t)(r->n_outs - i - 1) * sizeof *r->outs);
+                r->n_outs--;
+                break;
+            }
         r->ckpt_out = NULL;
     }
     if (r->dres.stopped) {

@@ -68,6 +68,7 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
      * at a later sample) */
     s_begin = st->sample_base + (uint32_t)(st->path_begin / it.npix);
     s_end = st->sample_base + st->spp;
+    it.sample_base = 0; /* the devices number paths by their absolute sample, s * npix + pixel */
     stats->paths_total = (uint64_t)it.npix * st->spp - st->path_begin;
     if (d->ops->pass_begin && (status = d->ops->pass_begin(d, scene, &it)) != RS_OK)
         return status;

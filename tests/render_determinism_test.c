@@ -327,6 +327,151 @@ static void test_wave_buffers_in_device_memory(void **state)
     free(img);
 }
 
+/* ---- film pieces: a film rendered in pieces and merged in any order is the one film ------ */
+
+typedef struct piece_rig {
+    rs_scene *scene;
+    rs_bvh *bvh;
+    rs_device *dev;
+    rs_sched *sched;
+} piece_rig;
+
+static void rig_up(piece_rig *g, const char *scene)
+{
+    rs_geom geom;
+    memset(g, 0, sizeof *g);
+    assert_int_equal(rs_builtin_create(scene, &g->scene), RS_OK);
+    geom = rs_scene_geom(g->scene);
+    assert_int_equal(rs_bvh_build(&geom, NULL, &g->bvh), RS_OK);
+    assert_int_equal(rs_cpu_device_create(1, "cpu", &g->dev), RS_OK);
+    assert_int_equal(rs_device_upload(g->dev, &geom, g->bvh), RS_OK);
+    assert_int_equal(rs_sched_create(&g->dev, 1, NULL, &g->sched), RS_OK);
+}
+
+static void rig_down(piece_rig *g)
+{
+    rs_sched_destroy(g->sched);
+    rs_device_destroy(g->dev);
+    rs_bvh_destroy(g->bvh);
+    rs_scene_destroy(g->scene);
+}
+
+/* samples [s0, s0 + n) of every pixel of a `spp`-sample render, onto a fresh film, by the stream
+ * engine (waves of `wave` paths) or the megakernel */
+static rs_film *render_piece(piece_rig *g, uint32_t s0, uint32_t n, uint32_t spp, uint32_t wave,
+                             int megakernel, rs_sampler sampler)
+{
+    rs_film *film = NULL;
+    rs_render_settings st;
+    rs_render_stats stats;
+    assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
+    memset(&st, 0, sizeof st);
+    st.width = st.height = SIZE;
+    st.spp = n;
+    st.sample_base = s0;
+    st.spp_total = spp;
+    st.max_depth = 8;
+    st.seed = 7;
+    st.sampler = sampler;
+    st.threads = 1;
+    st.wave_paths = wave;
+    if (megakernel)
+        assert_int_equal(rs_render_passes(g->scene, g->dev, &st, NULL, film, &stats), RS_OK);
+    else
+        assert_int_equal(rs_render(g->scene, g->sched, &st, NULL, film, &stats), RS_OK);
+    return film;
+}
+
+static void assert_films_equal(const rs_film *a, const rs_film *b)
+{
+    size_t n = (size_t)SIZE * SIZE;
+    assert_memory_equal(a->sum, b->sum, 3 * n * sizeof *a->sum);
+    assert_memory_equal(a->count, b->count, n * sizeof *a->count);
+    assert_int_equal(a->nonfinite, b->nonfinite);
+}
+
+/* The split over passes that an MPI job makes, on one process: 11 samples rendered as one film
+ * and as pieces [7, 11), [0, 3), [3, 7) (other wave sizes, the megakernel for one of them),
+ * merged in that order and in reverse, give the one film's sums and counts bit for bit, on both
+ * samplers.  Summing the pieces' resolved images in floating point instead does not (checked
+ * below), so the test sees a film that is not exact. */
+static void test_film_pieces_merge_exactly(void **state)
+{
+    static const rs_sampler samplers[] = {RS_SAMPLER_SOBOL, RS_SAMPLER_ZSOBOL};
+    size_t k;
+    piece_rig g;
+    (void)state;
+    rig_up(&g, "cornell");
+    for (k = 0; k < sizeof samplers / sizeof samplers[0]; ++k) {
+        rs_film *one = render_piece(&g, 0, 11, 11, 0, 0, samplers[k]);
+        rs_film *p[3], *fwd = NULL, *rev = NULL;
+        int i;
+        p[0] = render_piece(&g, 7, 4, 11, 999, 0, samplers[k]);
+        p[1] = render_piece(&g, 0, 3, 11, 0, 1, samplers[k]);
+        p[2] = render_piece(&g, 3, 4, 11, 4096, 0, samplers[k]);
+        assert_int_equal(rs_film_create(SIZE, SIZE, &fwd), RS_OK);
+        assert_int_equal(rs_film_create(SIZE, SIZE, &rev), RS_OK);
+        for (i = 0; i < 3; ++i)
+            assert_int_equal(rs_film_merge(fwd, p[i]), RS_OK);
+        for (i = 2; i >= 0; --i)
+            assert_int_equal(rs_film_merge(rev, p[i]), RS_OK);
+        assert_films_equal(one, fwd);
+        assert_films_equal(one, rev);
+        /* the pieces are not the same samples: any one of them differs from the whole */
+        assert_true(memcmp(p[0]->sum, one->sum, 3 * SIZE * SIZE * sizeof *one->sum) != 0);
+        /* the piece's samples are its own: clearing and re-rendering gives it again */
+        rs_film_clear(fwd);
+        assert_int_equal(rs_film_merge(fwd, p[1]), RS_OK);
+        assert_films_equal(p[1], fwd);
+        for (i = 0; i < 3; ++i)
+            rs_film_destroy(p[i]);
+        rs_film_destroy(one);
+        rs_film_destroy(fwd);
+        rs_film_destroy(rev);
+    }
+    rig_down(&g);
+}
+
+/* Why the sums are integers: the same samples summed as doubles in two groupings differ, where
+ * the film's fixed point does not (a check that the test above could fail with doubles). */
+static void test_film_fixed_point_is_order_free(void **state)
+{
+    rs_film *a = NULL, *b = NULL, *c = NULL;
+    double x[3] = {0.1, 0.2, 0.3}, dsum1, dsum2;
+    rs_vec3 v;
+    int i;
+    (void)state;
+    dsum1 = (x[0] + x[1]) + x[2];
+    dsum2 = x[0] + (x[1] + x[2]);
+    assert_true(dsum1 != dsum2); /* doubles: the grouping shows */
+    assert_int_equal(rs_film_create(1, 1, &a), RS_OK);
+    assert_int_equal(rs_film_create(1, 1, &b), RS_OK);
+    assert_int_equal(rs_film_create(1, 1, &c), RS_OK);
+    for (i = 0; i < 3; ++i) {
+        v.x = v.y = v.z = x[i];
+        rs_film_add(a, 0, v);
+        rs_film_add(i == 0 ? b : c, 0, v);
+    }
+    assert_int_equal(rs_film_merge(c, b), RS_OK); /* x0 + (x1 + x2) */
+    assert_memory_equal(a->sum, c->sum, 3 * sizeof *a->sum);
+    assert_int_equal(c->count[0], 3);
+    /* huge and non-finite samples: counted, not summed; a mismatched size is refused */
+    v.x = 1e300;
+    rs_film_add(c, 0, v);
+    v.x = 0.0 / 0.0;
+    rs_film_add(c, 0, v);
+    assert_int_equal(c->nonfinite, 2);
+    assert_int_equal(c->count[0], 5);
+    assert_memory_equal(a->sum, c->sum, 3 * sizeof *a->sum);
+    rs_film_destroy(b);
+    assert_int_equal(rs_film_create(2, 1, &b), RS_OK);
+    assert_int_equal(rs_film_merge(a, b), RS_ERR_ARG);
+    rs_error_clear();
+    rs_film_destroy(a);
+    rs_film_destroy(b);
+    rs_film_destroy(c);
+}
+
 /* rtiow-final, whose ground is a sphere of radius 1000 centred 1000 below the origin: hit points
  * near the origin carry errors of ~1e-4 there, and a bounce ray offset by less could hit the
  * ground again just above it — outside the ground's box, so found by brute force and culled by
@@ -395,6 +540,8 @@ int main(void)
         cmocka_unit_test(test_zsobol_settings),
         cmocka_unit_test(test_wave_buffers_in_device_memory),
         cmocka_unit_test(test_failure_with_waves_in_flight),
+        cmocka_unit_test(test_film_pieces_merge_exactly),
+        cmocka_unit_test(test_film_fixed_point_is_order_free),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

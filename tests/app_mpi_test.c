@@ -1,0 +1,360 @@
+/* tests/app_mpi_test.c — `mpirun -n N raystream render ...` (app/distributed.c), run for real
+ * with Open MPI's mpirun on this machine (--oversubscribe: more ranks than cores; and
+ * --allow-run-as-root when root, as in CI).  Skipped, saying why, where the binary was built
+ * without MPI or mpirun is missing.
+ *
+ * What is checked:
+ *   - 2 and 3 ranks, the stream engine and the megakernel, automatic and odd pass sizes, the
+ *     sobol and zsobol samplers: the image equals the one-process render bit for bit;
+ *   - a rank slowed on purpose (RS_MPI_FAULT=slow:1:4) finishes fewer passes than rank 0, and
+ *     the image is still the same;
+ *   - a rank that kills itself after one pass (RS_MPI_FAULT=die:1:1): with --enable-recovery it
+ *     is found dead after --mpi-timeout, its passes go to the others and the image is the same;
+ *     without it, mpirun ends the job, and the run neither hangs nor writes a broken image;
+ *   - --time-limit stops at whole passes: the image equals a one-process render of the samples
+ *     it says it holds;
+ *   - Ctrl-C on mpirun ends every rank within seconds, with 128 + the signal or mpirun's code;
+ *   - options the job cannot honour (--adaptive) are refused by rank 0 alone, in one line. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define RS_HARNESS_NAME "app_mpi_test.c"
+#include "cli_harness.h"
+
+#define TIMEOUT_S 120.0
+#define SIZE      "48"
+
+static char g_skip[256];
+
+/* mpirun with the flags this machine needs, then `args` (NULL-terminated), in f's folder */
+static void mpirun(proc *p, const fixture *f, int ranks, int recovery, const char *const *args)
+{
+    const char *argv[MAX_ARGS + 1];
+    char n[16];
+    int k = 0, i;
+    snprintf(n, sizeof n, "%d", ranks);
+    argv[k++] = "-n";
+    argv[k++] = n;
+    argv[k++] = "--oversubscribe";
+    if (geteuid() == 0)
+        argv[k++] = "--allow-run-as-root";
+    if (recovery)
+        argv[k++] = "--enable-recovery";
+    argv[k++] = "-x";
+    argv[k++] = "RS_MPI_FAULT";
+    argv[k++] = RS_BINARY;
+    for (i = 0; args[i] && k < MAX_ARGS; ++i)
+        argv[k++] = args[i];
+    argv[k] = NULL;
+    proc_start_prog(p, f->dir, "mpirun", argv);
+    proc_finish(p, TIMEOUT_S);
+}
+
+/* the one-process render of `args` into `out` */
+static image one_process(const fixture *f, const char *const *args, const char *out)
+{
+    const char *argv[MAX_ARGS + 1];
+    proc p;
+    image im;
+    int k = 0, i;
+    for (i = 0; args[i]; ++i)
+        argv[k++] = args[i];
+    argv[k++] = "-o";
+    argv[k++] = out;
+    argv[k] = NULL;
+    run(&p, f->dir, TIMEOUT_S, argv);
+    EXPECT(&p, exited_with(&p, 0), "the one-process render failed");
+    im = read_image(&p, f, out);
+    proc_free(&p);
+    return im;
+}
+
+/* A number after `"key": ` in a JSON text (the first one after `after`, if given), or -1. */
+static double json_number(const char *text, const char *after, const char *key)
+{
+    char pat[64];
+    const char *s = after ? strstr(text, after) : text;
+    if (!s)
+        return -1;
+    snprintf(pat, sizeof pat, "\"%s\": ", key);
+    s = strstr(s, pat);
+    return s ? atof(s + strlen(pat)) : -1;
+}
+
+static char *read_text(const fixture *f, const char *name)
+{
+    char path[256];
+    size_t n = 0;
+    path_in(f, name, path, sizeof path);
+    return read_bytes(path, &n);
+}
+
+/* ---- the same image for any ranks -------------------------------------------------------- */
+
+static void expect_same_as_one(const fixture *f, int ranks, const char *const *args,
+                               const char *extra1, const char *extra2)
+{
+    const char *argv[MAX_ARGS + 1];
+    image one, many;
+    proc p;
+    int k = 0, i;
+    one = one_process(f, args, "one.exr");
+    for (i = 0; args[i]; ++i)
+        argv[k++] = args[i];
+    argv[k++] = "-o";
+    argv[k++] = "many.exr";
+    if (extra1)
+        argv[k++] = extra1;
+    if (extra2)
+        argv[k++] = extra2;
+    argv[k] = NULL;
+    mpirun(&p, f, ranks, 0, argv);
+    EXPECT(&p, exited_with(&p, 0), "mpirun -n %d failed", ranks);
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many), "%d ranks did not give the one-process image", ranks);
+    rs_free(one.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
+}
+
+static void test_same_image_any_ranks(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const stream[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                         SIZE, "--spp", "12", "-q", NULL};
+    static const char *const mega[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                       SIZE, "--spp", "12", "--integrator", "megakernel", "-q",
+                                       NULL};
+    static const char *const zsobol[] = {"render", "builtin:rtiow-final", "--width", SIZE, "--height",
+                                         SIZE, "--spp", "16", "--sampler", "zsobol", "-q", NULL};
+    expect_same_as_one(f, 2, stream, NULL, NULL);
+    expect_same_as_one(f, 3, stream, "--mpi-pass", "5"); /* passes of 5, 5 and 2 samples */
+    expect_same_as_one(f, 2, mega, "--mpi-pass", "1");
+    expect_same_as_one(f, 3, zsobol, "--mpi-pass", "3");
+}
+
+/* ---- load balance ------------------------------------------------------------------------ */
+
+static void test_slow_rank_gets_fewer_passes(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "48", "--mpi-pass", "2", "--threads", "1",
+                                       "-q", "-o", "many.exr", "--stats-json", "s.json", NULL};
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                      "64", "--spp", "48", "-q", NULL};
+    image one, many;
+    proc p;
+    char *json;
+    double p0, p1;
+    setenv("RS_MPI_FAULT", "slow:1:4", 1);
+    mpirun(&p, f, 2, 0, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, exited_with(&p, 0), "the job with a slow rank failed");
+    json = read_text(f, "s.json");
+    EXPECT(&p, json != NULL, "no --stats-json");
+    p0 = json_number(json, "\"rank\": 0", "passes");
+    p1 = json_number(json, "\"rank\": 1", "passes");
+    EXPECT(&p, p0 + p1 == 24, "the passes do not add up: %g + %g of 24", p0, p1);
+    /* rank 1 takes 4x as long per pass: it should get about a fifth; well under half */
+    EXPECT(&p, p1 >= 1 && p1 < p0 / 2, "the slow rank got %g passes against %g", p1, p0);
+    one = one_process(f, ref, "one.exr");
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many), "the image changed with a slow rank");
+    free(json);
+    rs_free(one.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
+}
+
+/* ---- a rank that dies -------------------------------------------------------------------- */
+
+static void test_killed_rank_recovered(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "32", "--mpi-pass", "2", "--mpi-timeout",
+                                       "2", "-q", "-o", "many.exr", "--stats-json", "s.json",
+                                       NULL};
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                      "64", "--spp", "32", "-q", NULL};
+    image one, many;
+    proc p;
+    char *json;
+    setenv("RS_MPI_FAULT", "die:1:1", 1);
+    mpirun(&p, f, 3, 1, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, !p.timed_out && p.seconds < 60, "the job with a dead rank hung");
+    EXPECT(&p, exited_with(&p, 0), "the job did not survive the dead rank");
+    EXPECT(&p, strstr(p.err.data, "rank 1") && strstr(p.err.data, "silent"),
+           "the dead rank was not named");
+    json = read_text(f, "s.json");
+    EXPECT(&p, json != NULL, "no --stats-json");
+    EXPECT(&p, json_number(json, NULL, "ranks_lost") == 1, "ranks_lost is not 1");
+    EXPECT(&p, json_number(json, NULL, "reissued") >= 1, "no pass was handed out again");
+    one = one_process(f, ref, "one.exr");
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many), "the passes handed out again changed the image");
+    free(json);
+    rs_free(one.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
+}
+
+static void test_killed_rank_does_not_hang(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "400", "--mpi-pass", "2", "-q", "-o",
+                                       "many.exr", NULL};
+    proc p;
+    char path[256];
+    setenv("RS_MPI_FAULT", "die:1:1", 1);
+    mpirun(&p, f, 2, 0, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, !p.timed_out && p.seconds < 30, "the job with a dead rank hung");
+    EXPECT(&p, !exited_with(&p, 0), "mpirun said the job with a dead rank succeeded");
+    path_in(f, "many.exr", path, sizeof path);
+    if (file_exists(path)) { /* rank 0 had time to write what it had: a whole image */
+        image im = read_image(&p, f, "many.exr");
+        EXPECT(&p, im.w == 64 && im.h == 64, "a broken partial image");
+        rs_free(im.rgb);
+    }
+    proc_free(&p);
+}
+
+/* ---- stopping ---------------------------------------------------------------------------- */
+
+static void test_time_limit_whole_passes(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "100000", "--mpi-pass", "2",
+                                       "--time-limit", "1", "-q", "-o", "many.exr",
+                                       "--stats-json", "s.json", NULL};
+    const char *ref[12] = {"render", "builtin:cornell", "--width", "64", "--height", "64",
+                           "--spp", NULL, "-q", NULL};
+    char spp[32];
+    image one, many;
+    proc p;
+    char *json;
+    double got;
+    mpirun(&p, f, 2, 0, args);
+    EXPECT(&p, exited_with(&p, 0), "the time-limited job failed");
+    EXPECT(&p, p.seconds < 30, "the time limit did not stop the job");
+    json = read_text(f, "s.json");
+    EXPECT(&p, json != NULL, "no --stats-json");
+    got = json_number(json, NULL, "spp");
+    EXPECT(&p, got >= 2 && got < 100000 && (int)got % 2 == 0,
+           "the film holds %g samples per pixel, not whole passes of 2", got);
+    EXPECT(&p, strstr(json, "\"time_limited\": true") != NULL, "time_limited is not true");
+    EXPECT(&p, strstr(json, "\"prefix\": true") != NULL, "the samples are not 0..k-1");
+    snprintf(spp, sizeof spp, "%d", (int)got);
+    ref[7] = spp;
+    one = one_process(f, ref, "one.exr");
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many), "the time-limited image is not the %s-spp image", spp);
+    free(json);
+    rs_free(one.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
+}
+
+static void test_ctrl_c_stops_every_rank(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "100000", "-q", "-o", "many.exr", NULL};
+    const char *argv[MAX_ARGS + 1];
+    proc p;
+    char path[256];
+    int k = 0, i;
+    argv[k++] = "-n";
+    argv[k++] = "2";
+    argv[k++] = "--oversubscribe";
+    if (geteuid() == 0)
+        argv[k++] = "--allow-run-as-root";
+    argv[k++] = RS_BINARY;
+    for (i = 0; args[i]; ++i)
+        argv[k++] = args[i];
+    argv[k] = NULL;
+    proc_start_prog(&p, f->dir, "mpirun", argv);
+    while (now_s() - p.start < 3.0)
+        proc_pump(&p, 50);
+    kill(p.pid, SIGINT);
+    proc_finish(&p, 30.0);
+    EXPECT(&p, !p.timed_out, "Ctrl-C did not end the job");
+    EXPECT(&p, !exited_with(&p, 0), "an interrupted job exited 0");
+    path_in(f, "many.exr", path, sizeof path);
+    if (file_exists(path)) {
+        image im = read_image(&p, f, "many.exr");
+        EXPECT(&p, im.w == 64 && im.h == 64, "a broken partial image");
+        rs_free(im.rgb);
+    }
+    proc_free(&p);
+}
+
+static void test_unsupported_options(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--adaptive", "0.01", "-q",
+                                       NULL};
+    proc p;
+    const char *s;
+    int lines = 0;
+    mpirun(&p, f, 2, 0, args);
+    EXPECT(&p, !exited_with(&p, 0), "--adaptive under mpirun was not refused");
+    for (s = strstr(p.err.data, "raystream:"); s; s = strstr(s + 1, "raystream:"))
+        ++lines;
+    EXPECT(&p, lines == 1 && strstr(p.err.data, "--adaptive"),
+           "not one line from rank 0 naming --adaptive (%d lines)", lines);
+    proc_free(&p);
+}
+
+static int find_mpi(void)
+{
+    static const char *const version[] = {"--version", NULL};
+    fixture f;
+    proc p;
+    strcpy(f.dir, "/tmp");
+    run(&p, f.dir, TIMEOUT_S, version);
+    if (!strstr(p.out.data, "MPI:         yes"))
+        snprintf(g_skip, sizeof g_skip, "%s was built without MPI", RS_BINARY);
+    proc_free(&p);
+    if (!g_skip[0] && system("mpirun --version >/dev/null 2>&1") != 0)
+        snprintf(g_skip, sizeof g_skip, "mpirun is not on PATH (apt-get install openmpi-bin)");
+    return 0;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_same_image_any_ranks, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_slow_rank_gets_fewer_passes, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_killed_rank_recovered, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_killed_rank_does_not_hang, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_time_limit_whole_passes, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_ctrl_c_stops_every_rank, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_unsupported_options, setup, teardown),
+    };
+    find_mpi();
+    if (g_skip[0]) {
+        printf("app_mpi_test: skipped: %s\n", g_skip);
+        return 77;
+    }
+    setenv("RS_MPI_FAULT", "", 1);
+    /* Open MPI keeps some memory to the end on purpose: LeakSanitizer (the address build) is
+     * told so, by library, in tests/lsan-mpi.supp */
+    setenv("LSAN_OPTIONS", "suppressions=" RS_SOURCE_DIR "/tests/lsan-mpi.supp", 0);
+    return cmocka_run_group_tests(tests, group_setup, NULL);
+}
