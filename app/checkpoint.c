@@ -76,6 +76,73 @@ uint64_t rs_checkpoint_scene_hash(const rs_scene *s)
     return h;
 }
 
+/* ---- the set of paths held ---------------------------------------------------------------- */
+
+int rs_path_ranges_add(rs_path_ranges *s, uint64_t lo, uint64_t hi)
+{
+    uint32_t i, j;
+    if (lo >= hi)
+        return 1;
+    /* the first range that ends at or after lo: it and the following ones up to hi join */
+    for (i = 0; i < s->n && s->r[i][1] < lo; ++i) {
+    }
+    for (j = i; j < s->n && s->r[j][0] <= hi; ++j) {
+        if (s->r[j][0] < lo)
+            lo = s->r[j][0];
+        if (s->r[j][1] > hi)
+            hi = s->r[j][1];
+    }
+    if (j == i) { /* nothing joined: a new range at i */
+        if (s->n >= RS_CHECKPOINT_MAX_RANGES)
+            return 0;
+        if (s->n == s->cap) {
+            uint32_t cap = s->cap ? 2 * s->cap : 8;
+            void *r = realloc(s->r, cap * sizeof *s->r);
+            if (!r)
+                return 0;
+            s->r = (uint64_t(*)[2])r;
+            s->cap = cap;
+        }
+        memmove(s->r + i + 1, s->r + i, (s->n - i) * sizeof *s->r);
+        s->n++;
+    } else if (j > i + 1) { /* ranges i..j-1 became one */
+        memmove(s->r + i + 1, s->r + j, (s->n - j) * sizeof *s->r);
+        s->n -= j - i - 1;
+    }
+    s->r[i][0] = lo;
+    s->r[i][1] = hi;
+    return 1;
+}
+
+int rs_path_ranges_union(rs_path_ranges *a, const rs_path_ranges *b)
+{
+    uint32_t i;
+    for (i = 0; i < b->n; ++i)
+        if (!rs_path_ranges_add(a, b->r[i][0], b->r[i][1]))
+            return 0;
+    return 1;
+}
+
+uint64_t rs_path_ranges_total(const rs_path_ranges *s)
+{
+    uint64_t t = 0;
+    uint32_t i;
+    for (i = 0; i < s->n; ++i)
+        t += s->r[i][1] - s->r[i][0];
+    return t;
+}
+
+int rs_path_ranges_is_prefix(const rs_path_ranges *s)
+{
+    return s->n == 0 || (s->n == 1 && s->r[0][0] == 0);
+}
+
+void rs_path_ranges_free(rs_path_ranges *s)
+{
+    free(s->r);
+    memset(s, 0, sizeof *s);
+}
+
 static void put32(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
 static void put64(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
 static uint32_t get32(const unsigned char *p)
@@ -91,19 +158,25 @@ static uint64_t get64(const unsigned char *p)
     return v;
 }
 
-/* The header for `key` with `paths` and `nonfinite`; returns its size (at most FIXED_HEADER +
- * NAME_MAX_BYTES - 1). */
-static size_t make_header(unsigned char *h, const rs_checkpoint_key *key, uint64_t paths,
-                          uint64_t nonfinite)
+/* The header for `key` with `held` and `nonfinite`; returns its size (at most
+ * header_max(held)). */
+static size_t header_max(const rs_path_ranges *held)
 {
-    size_t name_len = strlen(key->scene);
+    return FIXED_HEADER + NAME_MAX_BYTES + 8 + 16 * (size_t)held->n;
+}
+
+static size_t make_header(unsigned char *h, const rs_checkpoint_key *key,
+                          const rs_path_ranges *held, uint64_t nonfinite)
+{
+    size_t name_len = strlen(key->scene), at;
+    uint64_t paths = rs_path_ranges_total(held);
     uint32_t u[10];
     int i;
     if (name_len >= NAME_MAX_BYTES)
         name_len = NAME_MAX_BYTES - 1;
     memcpy(h, k_magic, 8);
     put32(h + 8, RS_CHECKPOINT_VERSION);
-    put32(h + 12, (uint32_t)(FIXED_HEADER + name_len));
+    put32(h + 12, (uint32_t)(FIXED_HEADER + name_len + 8 + 16 * (size_t)held->n));
     put64(h + 16, key->scene_hash);
     put64(h + 24, key->seed);
     put64(h + 32, paths);
@@ -122,7 +195,14 @@ static size_t make_header(unsigned char *h, const rs_checkpoint_key *key, uint64
         put32(h + 48 + 4 * i, u[i]);
     put32(h + 88, (uint32_t)name_len);
     memcpy(h + FIXED_HEADER, key->scene, name_len);
-    return FIXED_HEADER + name_len;
+    at = FIXED_HEADER + name_len;
+    put32(h + at, held->n);
+    put32(h + at + 4, 0);
+    for (i = 0; i < (int)held->n; ++i) {
+        put64(h + at + 8 + 16 * (size_t)i, held->r[i][0]);
+        put64(h + at + 16 + 16 * (size_t)i, held->r[i][1]);
+    }
+    return at + 8 + 16 * (size_t)held->n;
 }
 
 /* fwrite of n bytes, folded into the checksum. */
@@ -133,9 +213,10 @@ static int put(FILE *f, const void *p, size_t n, uint64_t *sum)
 }
 
 int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
-                        const rs_checkpoint_key *key, const rs_film *film, uint64_t paths)
+                        const rs_checkpoint_key *key, const rs_film *film,
+                        const rs_path_ranges *held)
 {
-    unsigned char header[FIXED_HEADER + NAME_MAX_BYTES];
+    unsigned char *header;
     size_t npix = (size_t)film->width * film->height, n;
     uint64_t sum = FNV_OFFSET;
     FILE *f;
@@ -147,13 +228,15 @@ int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
                 path);
         return 0;
     }
-    f = fopen(staged, "wb");
+    header = (unsigned char *)malloc(header_max(held));
+    f = header ? fopen(staged, "wb") : NULL;
     if (!f) {
         fprintf(stderr, "raystream: --checkpoint %s: cannot write %s (%s)\n", path, staged,
-                strerror(errno));
+                header ? strerror(errno) : "out of memory");
+        free(header);
         return 0;
     }
-    n = make_header(header, key, paths, film->nonfinite);
+    n = make_header(header, key, held, film->nonfinite);
     ok = put(f, header, n, &sum) && put(f, film->sum, npix * 3 * sizeof *film->sum, &sum) &&
          put(f, film->count, npix * sizeof *film->count, &sum);
     ok = ok && fwrite(&sum, 1, sizeof sum, f) == sizeof sum;
@@ -161,6 +244,7 @@ int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
     ok = fsync(fileno(f)) == 0 && ok; /* on disk before it replaces the last good one */
     if (fclose(f) != 0)
         ok = 0;
+    free(header);
     if (ok && (!rename_now || rename(staged, path) == 0))
         return 1;
     fprintf(stderr, "raystream: --checkpoint %s: cannot write the checkpoint (%s)\n", path,
@@ -201,7 +285,7 @@ static int mismatch_s(const char *path, const char *field, const char *in_file, 
 
 /* The header against `want`.  Returns RS_EXIT_OK or the exit code after one line. */
 static int check_header(const char *path, const unsigned char *h, const char *name,
-                        rs_checkpoint_key *want)
+                        uint64_t end, rs_checkpoint_key *want)
 {
     uint32_t u[10];
     int i;
@@ -243,38 +327,61 @@ static int check_header(const char *path, const unsigned char *h, const char *na
     if (want->sampler == RS_SAMPLER_ZSOBOL && u[2] != want->spp)
         return mismatch_u(path, "--spp (the zsobol sampler's points depend on it)", u[2],
                           want->spp);
-    if (get64(h + 32) > (uint64_t)want->width * want->height * want->spp) {
+    if (end > (uint64_t)want->width * want->height * want->spp) {
         char a[48], b[48];
-        snprintf(a, sizeof a, "%llu", (unsigned long long)get64(h + 32));
+        snprintf(a, sizeof a, "%llu", (unsigned long long)end);
         snprintf(b, sizeof b, "%u", want->spp);
-        return refuse(RS_EXIT_USAGE, path, "holds %s samples, more than --spp %s asks for", a, b);
+        return refuse(RS_EXIT_USAGE, path, "holds paths up to %s, more than --spp %s asks for",
+                      a, b);
     }
     return RS_EXIT_OK;
 }
 
-/* Every pixel's count is what a prefix of `paths` paths gives it. */
-static int counts_agree(const rs_film *film, uint64_t paths)
+/* Every pixel's count is what the ranges give it: paths g of [lo, hi) with g mod P = i, which
+ * is (hi / P + (i < hi mod P)) - (lo / P + (i < lo mod P)). */
+static int counts_agree(const rs_film *film, const rs_path_ranges *held)
 {
     size_t i, npix = (size_t)film->width * film->height;
-    uint64_t base = paths / npix, extra = paths % npix;
-    for (i = 0; i < npix; ++i)
-        if (film->count[i] != base + (i < extra))
-            return 0;
-    return 1;
+    int64_t base = 0, run = 0, *d = (int64_t *)calloc(npix + 1, sizeof *d);
+    uint32_t k;
+    int ok = 1;
+    if (!d)
+        return 0;
+    for (k = 0; k < held->n; ++k) {
+        uint64_t lo = held->r[k][0], hi = held->r[k][1];
+        base += (int64_t)(hi / npix) - (int64_t)(lo / npix);
+        d[0] += 1; /* +1 below hi mod P, -1 below lo mod P */
+        d[hi % npix] -= 1;
+        d[0] -= 1;
+        d[lo % npix] += 1;
+    }
+    for (i = 0; i < npix && ok; ++i) {
+        run += d[i];
+        ok = (int64_t)film->count[i] == base + run;
+    }
+    free(d);
+    return ok;
 }
 
-int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film, uint64_t *paths)
+int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
+                       rs_path_ranges *held)
 {
-    unsigned char h[FIXED_HEADER + NAME_MAX_BYTES];
+    unsigned char *h = (unsigned char *)malloc(FIXED_HEADER + NAME_MAX_BYTES + 8 +
+                                               16 * (size_t)RS_CHECKPOINT_MAX_RANGES);
     char name[NAME_MAX_BYTES];
     size_t npix = (size_t)film->width * film->height, hdr, name_len;
-    uint64_t size, expect, sum = FNV_OFFSET, stored;
-    uint32_t fw, fh;
+    uint64_t size, expect, sum = FNV_OFFSET, stored, end = 0, prev = 0;
+    uint32_t fw, fh, n_ranges, k;
     FILE *f;
     int rc;
+    if (!h) {
+        fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
+        return RS_EXIT_RUNTIME;
+    }
     if (rs_file_open(path, (uint64_t)1 << 46, &f, &size) != RS_OK) {
         fprintf(stderr, "raystream: --resume %s\n", rs_error_message());
         rs_error_clear();
+        free(h);
         return RS_EXIT_USAGE;
     }
     rc = RS_EXIT_RUNTIME;
@@ -296,14 +403,30 @@ int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
     }
     name_len = get32(h + 88);
     hdr = get32(h + 12);
-    if (name_len >= NAME_MAX_BYTES || hdr != FIXED_HEADER + name_len ||
-        fread(h + FIXED_HEADER, 1, name_len, f) != name_len) {
+    if (name_len >= NAME_MAX_BYTES || fread(h + FIXED_HEADER, 1, name_len + 8, f) != name_len + 8) {
         refuse(rc, path, "corrupt header (scene name of %s bytes)%s",
                name_len >= NAME_MAX_BYTES ? "too many" : "a wrong number of", "");
         goto out;
     }
     memcpy(name, h + FIXED_HEADER, name_len);
     name[name_len] = '\0';
+    n_ranges = get32(h + FIXED_HEADER + name_len);
+    if (n_ranges > RS_CHECKPOINT_MAX_RANGES ||
+        hdr != FIXED_HEADER + name_len + 8 + 16 * (size_t)n_ranges ||
+        fread(h + FIXED_HEADER + name_len + 8, 16, n_ranges, f) != n_ranges) {
+        refuse(rc, path, "corrupt header (the list of paths held)%s%s", "", "");
+        goto out;
+    }
+    for (k = 0; k < n_ranges; ++k) {
+        const unsigned char *q = h + FIXED_HEADER + name_len + 8 + 16 * (size_t)k;
+        uint64_t lo = get64(q), hi = get64(q + 8);
+        if (lo >= hi || (k > 0 && lo <= prev) || hi > ((uint64_t)1 << 62)) {
+            refuse(rc, path, "corrupt header (the paths held are not sorted ranges)%s%s", "",
+                   "");
+            goto out;
+        }
+        prev = end = hi;
+    }
     /* the file's own size first: a mismatch is reported only for a file that is whole */
     fw = get32(h + 48);
     fh = get32(h + 52);
@@ -339,11 +462,22 @@ int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
         refuse(rc, path, "corrupt: the checksum does not match its content%s%s", "", "");
         goto out;
     }
-    if ((rc = check_header(path, h, name, want)) != RS_EXIT_OK)
+    if ((rc = check_header(path, h, name, end, want)) != RS_EXIT_OK)
         goto out;
     rc = RS_EXIT_RUNTIME;
-    *paths = get64(h + 32);
-    if (!counts_agree(film, *paths)) {
+    for (k = 0; k < n_ranges; ++k) {
+        const unsigned char *q = h + FIXED_HEADER + name_len + 8 + 16 * (size_t)k;
+        if (get64(q) % npix != 0) { /* every range starts at a whole sample */
+            refuse(rc, path, "corrupt header (a range of paths starts within a sample)%s%s", "",
+                   "");
+            goto out;
+        }
+        if (!rs_path_ranges_add(held, get64(q), get64(q + 8))) {
+            refuse(rc, path, "out of memory for its list of paths%s%s", "", "");
+            goto out;
+        }
+    }
+    if (rs_path_ranges_total(held) != get64(h + 32) || !counts_agree(film, held)) {
         refuse(rc, path, "corrupt: the sample counts do not match its header%s%s", "", "");
         goto out;
     }
@@ -351,7 +485,10 @@ int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
     rc = RS_EXIT_OK;
 out:
     fclose(f);
-    if (rc != RS_EXIT_OK)
+    free(h);
+    if (rc != RS_EXIT_OK) {
         memset(film->count, 0, npix * sizeof *film->count);
+        rs_path_ranges_free(held);
+    }
     return rc;
 }

@@ -3,10 +3,10 @@
  *
  * Why that holds: each path's radiance depends only on its number (paths are numbered
  * sample-major, scheduler/render.h), on every device set, and the film's sums are exact integers
- * (shading/film.h), so they do not depend on the order samples are added in.  The film holds a
- * prefix [0, paths) of the numbering (whole waves; whole samples for the megakernel; whole passes
- * of an MPI job); a checkpoint stores those exact sums and counts and `paths`, and the resumed
- * render adds the rest.
+ * (shading/film.h), so they do not depend on the order samples are added in.  A checkpoint
+ * stores the exact sums and counts and which paths they hold: ranges of the numbering, usually
+ * one prefix [0, paths) (whole waves; whole samples for the megakernel), several where an MPI
+ * job stopped with passes missing; the resumed render adds the paths between them.
  *
  * File format, version 2 (little-endian; a header of 92 bytes + the scene name):
  *   off  size  field
@@ -16,14 +16,17 @@
  *    16     8  scene content hash (rs_checkpoint_scene_hash: geometry, materials, textures,
  *              lights, camera, background; a mesh or texture file's content is in it)
  *    24     8  seed
- *    32     8  paths on the film
+ *    32     8  paths on the film (the ranges' total)
  *    40     8  non-finite samples dropped so far
  *    48    40  width, height, spp, max depth, rr depth, sampling, sampler, sphere test,
  *              triangle test, box test (u32 each)
  *    88     4  scene name bytes n (< 4096), then the name as given on the command line
+ *  92+n     4  ranges R (1..65536; 0 for an empty film), then 4 zero bytes
+ *  100+n 16*R  the paths held: R ranges [lo, hi) (u64 each), sorted, disjoint, not touching,
+ *              each starting at a whole sample (lo a multiple of P)
  *  hdr   48*P  the sums, 3 signed 128-bit integers a pixel in film units (2^-40; P = width *
  *              height)
- *         4*P  the counts, u32 a pixel (must be paths / P, plus 1 for the first paths % P)
+ *         4*P  the counts, u32 a pixel (must be the ranges' paths of that pixel)
  *           8  FNV-1a 64 of every byte before it
  * Everything that decides the image is in the header; the devices, threads, chunk and wave
  * sizes, the BVH builder and the integrator are not (they do not change the image).  spp matters
@@ -39,6 +42,24 @@
 
 #define RS_CHECKPOINT_VERSION 2u
 
+/* The paths a film holds: sorted, disjoint, non-touching ranges [lo, hi) of the sample-major
+ * numbering. */
+#define RS_CHECKPOINT_MAX_RANGES 65536u
+typedef struct rs_path_ranges {
+    uint64_t (*r)[2];
+    uint32_t n, cap;
+} rs_path_ranges;
+
+/* Adds [lo, hi) to the set (joined with what it overlaps or touches).  0 when out of memory or
+ * past RS_CHECKPOINT_MAX_RANGES. */
+int rs_path_ranges_add(rs_path_ranges *s, uint64_t lo, uint64_t hi);
+/* Adds every range of `b` to `a`; 0 as above. */
+int rs_path_ranges_union(rs_path_ranges *a, const rs_path_ranges *b);
+uint64_t rs_path_ranges_total(const rs_path_ranges *s);
+/* Whether the set is one range from 0 (or empty): a prefix [0, total). */
+int rs_path_ranges_is_prefix(const rs_path_ranges *s);
+void rs_path_ranges_free(rs_path_ranges *s);
+
 /* What decides the image, as the checkpoint records it. */
 typedef struct rs_checkpoint_key {
     uint64_t scene_hash;
@@ -52,18 +73,20 @@ typedef struct rs_checkpoint_key {
 /* FNV-1a 64 over every array and setting of a finalized scene that shading reads. */
 uint64_t rs_checkpoint_scene_hash(const rs_scene *s);
 
-/* Writes `key` and the film, which holds paths [0, paths), to `staged` (flushed to disk) and,
+/* Writes `key` and the film, which holds the paths `held`, to `staged` (flushed to disk) and,
  * if `rename_now`, renames it to `path` (else the caller does, with the other outputs).  A
  * reader never sees a partial file at `path`; on failure `staged` is removed and `path` left as
  * it was.  Returns 1, or 0 after printing one line naming `path`. */
 int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
-                        const rs_checkpoint_key *key, const rs_film *film, uint64_t paths);
+                        const rs_checkpoint_key *key, const rs_film *film,
+                        const rs_path_ranges *held);
 
 /* Reads checkpoint `path` for a render with settings `want` into `film` (want's size, fresh):
- * *paths gets the paths it holds.  want->spp == 0 takes the file's spp into want->spp.
+ * *held (empty) gets the paths it holds.  want->spp == 0 takes the file's spp into want->spp.
  * Returns 0 (RS_EXIT_OK); RS_EXIT_USAGE after one line naming the file when it is missing, not a
  * regular file or was made with other settings (the line names the field, its value in the
  * file and the one asked for); RS_EXIT_RUNTIME after one line when it is truncated or corrupt. */
-int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film, uint64_t *paths);
+int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
+                       rs_path_ranges *held);
 
 #endif

@@ -8,6 +8,8 @@
  *   0 -> worker   PASS  s0, n                render it
  *                 STOP  (nothing)            finish the passes you hold, then send the film
  *                 ABORT (nothing)            drop what is under way, send the film now
+ *                 FLUSH (nothing)            send what you finished (DONEs, then FILM flagged
+ *                                            H_FLUSH), and go on from an empty film
  * Messages between two ranks arrive in the order they were sent, so a worker's DONEs precede
  * its film. */
 #define _GNU_SOURCE /* usleep-free nanosleep is POSIX; gethostname */
@@ -25,7 +27,18 @@
 
 #include "core/alloc.h"
 
-enum { T_REQ = 1, T_HB, T_DONE, T_FILM, T_FILM_SUMS, T_FILM_COUNTS, T_PASS, T_STOP, T_ABORT };
+enum {
+    T_REQ = 1,
+    T_HB,
+    T_DONE,
+    T_FILM,
+    T_FILM_SUMS,
+    T_FILM_COUNTS,
+    T_PASS,
+    T_STOP,
+    T_ABORT,
+    T_FLUSH
+};
 
 /* FILM header fields (uint64; doubles by their bits) */
 enum {
@@ -38,6 +51,7 @@ enum {
     H_NONFINITE,
     H_BUSY,      /* double */
     H_FAILED,    /* the worker's render failed */
+    H_FLUSH,     /* a periodic flush: the worker goes on */
     H_COUNT
 };
 
@@ -282,6 +296,9 @@ static void *local_main(void *arg)
         t1 = now_s();
         if (st == RS_OK && job->fault.slow_factor > 1 && job->fault.slow_rank == l->rank)
             sleep_s((job->fault.slow_factor - 1) * (t1 - t0));
+        /* the merge and its report under one lock: a flush sees a film and the list of the
+         * passes in it that agree */
+        pthread_mutex_lock(&l->mu);
         if (st == RS_OK) {
             if (l->acc_mu)
                 pthread_mutex_lock(l->acc_mu);
@@ -289,7 +306,6 @@ static void *local_main(void *arg)
             if (l->acc_mu)
                 pthread_mutex_unlock(l->acc_mu);
         }
-        pthread_mutex_lock(&l->mu);
         l->busy = 0;
         l->busy_s += now_s() - t0;
         if (st == RS_OK) {
@@ -461,7 +477,7 @@ static int sums_fit_int64(const rs_film *f)
 }
 
 /* The film to rank 0: header, sums, counts.  Returns 1 once rank 0 took it all. */
-static int send_film(local *l, const rs_film *f, int failed, double timeout_s)
+static int send_film(local *l, const rs_film *f, int failed, int flush, double timeout_s)
 {
     size_t npix = (size_t)f->width * f->height, n_sum, i, off;
     uint64_t h[H_COUNT];
@@ -481,6 +497,7 @@ static int send_film(local *l, const rs_film *f, int failed, double timeout_s)
     pthread_mutex_unlock(&l->mu);
     h[H_NONFINITE] = f->nonfinite;
     h[H_FAILED] = (uint64_t)failed;
+    h[H_FLUSH] = (uint64_t)flush;
     if (!send_small(h, H_COUNT, 0, T_FILM))
         return 0;
     n_sum = npix * 3 * (enc ? 2 : 1);
@@ -512,15 +529,45 @@ static int send_film(local *l, const rs_film *f, int failed, double timeout_s)
     return ok;
 }
 
+/* A flush: the film so far and its passes to rank 0; the render thread goes on into `spare`
+ * (cleared), which becomes the rank's film. */
+static int worker_flush(local *l, rs_film **spare, double timeout_s)
+{
+    uint32_t s0[DONE_MAX], n[DONE_MAX];
+    rs_film *sent;
+    int k, i, ok;
+    rs_film_clear(*spare);
+    pthread_mutex_lock(&l->mu);
+    sent = l->acc;
+    l->acc = *spare;
+    k = l->done_len;
+    memcpy(s0, l->done_s0, (size_t)k * sizeof *s0);
+    memcpy(n, l->done_n, (size_t)k * sizeof *n);
+    l->done_len = 0;
+    pthread_mutex_unlock(&l->mu);
+    for (i = 0; i < k; ++i) {
+        uint64_t v[2] = {s0[i], n[i]};
+        send_small(v, 2, 0, T_DONE);
+    }
+    ok = send_film(l, sent, 0, 1, timeout_s);
+    *spare = sent;
+    return ok;
+}
+
 static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, double timeout_s)
 {
     local l;
+    rs_film *spare = NULL, *acc;
     double last_sent = now_s(), last_heard = now_s(), nap = 1e-4;
     int asked = 0, stopping = 0, aborting = 0, failed = 0;
     rs_status st;
     rs_film_clear(film);
-    if ((st = local_start(&l, job, d->rank, film, NULL)) != RS_OK)
+    if (rs_film_create(film->width, film->height, &spare) != RS_OK)
+        return RS_ERR_NOMEM;
+    if ((st = local_start(&l, job, d->rank, film, NULL)) != RS_OK) {
+        rs_film_destroy(spare);
         return st;
+    }
     for (;;) {
         int flag = 0, active = 0;
         MPI_Status ms;
@@ -568,7 +615,11 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
             } else if (ms.MPI_TAG == T_ABORT) {
                 aborting = 1;
                 local_signal(&l, 1);
+            } else if (ms.MPI_TAG == T_FLUSH && !worker_flush(&l, &spare, timeout_s)) {
+                fprintf(stderr, "raystream: rank %d: could not send its film to rank 0\n",
+                        d->rank);
             }
+            last_sent = now_s();
             active = 1;
         }
         if (now_s() - last_sent > 1.0) {
@@ -580,6 +631,7 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
                     d->rank, timeout_s);
             d->any_dead = 1;
             local_join(&l);
+            rs_film_destroy(spare);
             return rs_error_set(RS_ERR_IO, "rank 0 is gone");
         }
         if (active) {
@@ -604,10 +656,14 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
     if (failed)
         fprintf(stderr, "raystream: rank %d: %s; its passes go to the other ranks\n", d->rank,
                 rs_error_message());
-    if (!send_film(&l, film, failed, timeout_s)) {
+    pthread_mutex_lock(&l.mu);
+    acc = l.acc;
+    pthread_mutex_unlock(&l.mu);
+    if (!send_film(&l, acc, failed, 0, timeout_s)) {
         d->any_dead = 1;
         fprintf(stderr, "raystream: rank %d: could not send its film to rank 0\n", d->rank);
     }
+    rs_film_destroy(spare == film ? acc : spare); /* the one of the two that is not `film` */
     rs_film_destroy(l.scratch);
     pthread_mutex_destroy(&l.mu);
     pthread_cond_destroy(&l.cv);
@@ -621,9 +677,12 @@ enum { P_FREE, P_ASSIGNED, P_DONE, P_MERGED };
 typedef struct coord {
     rs_dist *d;
     const rs_dist_job *job;
-    uint32_t n_passes, pass_spp, first, limit;
+    uint32_t n_passes, pass_spp, limit;
+    uint32_t *ps0, *pn; /* pass p: samples [ps0[p], ps0[p] + pn[p]), ps0 increasing */
     uint8_t *state;
     int *owner;
+    uint64_t todo_paths;
+    int *flushing; /* a flush asked of it is not in yet */
     uint32_t npix;
     /* per rank */
     double *last_seen, *t_first;
@@ -635,18 +694,51 @@ typedef struct coord {
 
 static uint32_t pass_s0(const coord *c, uint32_t p)
 {
-    return c->job->sample_begin + p * c->pass_spp;
+    return c->ps0[p];
 }
 
 static uint32_t pass_n(const coord *c, uint32_t p)
 {
-    uint32_t s0 = pass_s0(c, p);
-    return c->job->spp - s0 < c->pass_spp ? c->job->spp - s0 : c->pass_spp;
+    return c->pn[p];
 }
 
+/* the pass that starts at sample s0, or n_passes */
 static uint32_t pass_of(const coord *c, uint32_t s0)
 {
-    return (s0 - c->job->sample_begin) / c->pass_spp;
+    uint32_t lo = 0, hi = c->n_passes;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->ps0[mid] < s0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < c->n_passes && c->ps0[lo] == s0 ? lo : c->n_passes;
+}
+
+/* The passes: each range of job->todo cut into pieces of pass_spp samples. */
+static int make_passes(coord *c)
+{
+    const rs_dist_job *job = c->job;
+    uint32_t i, n = 0, total = 0;
+    for (i = 0; i < job->n_todo; ++i) {
+        n += (job->todo[i][1] + c->pass_spp - 1) / c->pass_spp;
+        total += job->todo[i][1];
+    }
+    c->n_passes = n;
+    c->todo_paths = (uint64_t)total * c->npix;
+    c->ps0 = (uint32_t *)rs_calloc(n ? n : 1, sizeof *c->ps0);
+    c->pn = (uint32_t *)rs_calloc(n ? n : 1, sizeof *c->pn);
+    if (!c->ps0 || !c->pn)
+        return 0;
+    for (i = 0, n = 0; i < job->n_todo; ++i) {
+        uint32_t s0 = job->todo[i][0], end = s0 + job->todo[i][1];
+        for (; s0 < end; s0 += c->pass_spp, ++n) {
+            c->ps0[n] = s0;
+            c->pn[n] = end - s0 < c->pass_spp ? end - s0 : c->pass_spp;
+        }
+    }
+    return 1;
 }
 
 /* the lowest free pass below the limit, or n_passes */
@@ -694,7 +786,7 @@ static void progress(coord *c)
     for (p = 0; p < c->n_passes; ++p)
         if (c->state[p] == P_DONE || c->state[p] == P_MERGED)
             done += (uint64_t)pass_n(c, p) * c->npix;
-    c->job->progress(c->job->user, done, (uint64_t)c->npix * (c->job->spp - c->job->sample_begin));
+    c->job->progress(c->job->user, done, c->todo_paths);
 }
 
 static void mark_dead(coord *c, int r, const char *why)
@@ -704,6 +796,7 @@ static void mark_dead(coord *c, int r, const char *why)
         return;
     rk->alive = 0;
     c->finished[r] = 1;
+    c->flushing[r] = 0;
     c->d->any_dead = 1;
     c->res->dead++;
     fprintf(stderr, "\nraystream: rank %d (%s) %s; its passes go to the other ranks\n", r,
@@ -750,8 +843,52 @@ static int recv_film(coord *c, int r, const uint64_t *h, rs_film *tmp, rs_film *
     rs_film_merge(film, tmp);
     pthread_mutex_unlock(film_mu);
     c->res->bytes_received += H_COUNT * 8 + n_sum * 8 + npix * 4;
-    c->res->rank[r].film_bytes = H_COUNT * 8 + n_sum * 8 + npix * 4;
+    c->res->rank[r].film_bytes += H_COUNT * 8 + n_sum * 8 + npix * 4;
     return 1;
+}
+
+/* The merged passes as sorted ranges of samples, into *out (rs_alloc'd); their count. */
+static uint32_t merged_ranges(const coord *c, uint32_t (**out)[2], uint32_t *samples)
+{
+    uint32_t p, k = 0;
+    uint32_t(*r)[2] = (uint32_t(*)[2])rs_calloc(c->n_passes ? c->n_passes : 1, sizeof *r);
+    *samples = 0;
+    *out = r;
+    if (!r)
+        return 0;
+    for (p = 0; p < c->n_passes; ++p) {
+        if (c->state[p] != P_MERGED)
+            continue;
+        *samples += c->pn[p];
+        if (k && r[k - 1][0] + r[k - 1][1] == c->ps0[p])
+            r[k - 1][1] += c->pn[p];
+        else {
+            r[k][0] = c->ps0[p];
+            r[k++][1] = c->pn[p];
+        }
+    }
+    return k;
+}
+
+/* Every rank's finished passes are on the frame: job->saved, while rank 0's render thread
+ * cannot add to it (its lock, then the frame's). */
+static void call_saved(coord *c, local *l, rs_film *film, pthread_mutex_t *film_mu)
+{
+    uint32_t(*done)[2] = NULL, n_done, samples, i;
+    pthread_mutex_lock(&l->mu);
+    for (i = 0; i < (uint32_t)l->done_len; ++i) {
+        uint32_t q = pass_of(c, l->done_s0[i]);
+        if (q < c->n_passes)
+            c->state[q] = P_MERGED;
+    }
+    l->done_len = 0;
+    n_done = merged_ranges(c, &done, &samples);
+    pthread_mutex_lock(film_mu);
+    if (done)
+        c->job->saved(c->job->user, film, (const uint32_t(*)[2])done, n_done);
+    pthread_mutex_unlock(film_mu);
+    pthread_mutex_unlock(&l->mu);
+    rs_free(done);
 }
 
 static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *film,
@@ -761,8 +898,8 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     local l;
     pthread_mutex_t film_mu = PTHREAD_MUTEX_INITIALIZER;
     rs_film *tmp = NULL;
-    double t0 = now_s(), nap = 1e-4, t_signal = 0, last_hb = t0, grace_s;
-    int r, n = d->size, signalled = 0;
+    double t0 = now_s(), nap = 1e-4, t_signal = 0, last_hb = t0, grace_s, next_flush;
+    int r, n = d->size, signalled = 0, flush_round = 0;
     const char *kill_after = getenv("OMPI_MCA_odls_base_sigkill_timeout");
     uint32_t p;
     rs_status st = RS_OK;
@@ -774,13 +911,19 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     c.npix = job->width * job->height;
     c.pass_spp = job->pass_spp;
     if (!c.pass_spp) { /* about 8 passes a rank, so that a slow one costs little at the end */
-        uint32_t left = job->spp - job->sample_begin;
+        uint32_t left = 0, i;
+        for (i = 0; i < job->n_todo; ++i)
+            left += job->todo[i][1];
         c.pass_spp = left / (8u * (uint32_t)n);
         if (c.pass_spp < 1)
             c.pass_spp = 1;
     }
-    c.n_passes = (job->spp - job->sample_begin + c.pass_spp - 1) / c.pass_spp;
+    if (!make_passes(&c)) {
+        st = rs_error_set(RS_ERR_NOMEM, "out of memory for the MPI coordinator");
+        goto out;
+    }
     c.limit = c.n_passes;
+    next_flush = job->flush_every_s > 0 ? t0 + job->flush_every_s : 0;
     res->ranks = n;
     res->pass_spp = c.pass_spp;
     res->passes_total = c.n_passes;
@@ -791,9 +934,10 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     c.asked = (int *)rs_calloc((size_t)n, sizeof *c.asked);
     c.finished = (int *)rs_calloc((size_t)n, sizeof *c.finished);
     c.stopped = (int *)rs_calloc((size_t)n, sizeof *c.stopped);
+    c.flushing = (int *)rs_calloc((size_t)n, sizeof *c.flushing);
     res->rank = (rs_dist_rank_stats *)rs_calloc((size_t)n, sizeof *res->rank);
     if (!c.state || !c.owner || !c.last_seen || !c.t_first || !c.asked || !c.finished ||
-        !c.stopped || !res->rank || rs_film_create(job->width, job->height, &tmp) != RS_OK) {
+        !c.stopped || !c.flushing || !res->rank || rs_film_create(job->width, job->height, &tmp) != RS_OK) {
         st = rs_error_set(RS_ERR_NOMEM, "out of memory for the MPI coordinator");
         goto out;
     }
@@ -841,8 +985,8 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                 if (!c.finished[r]) {
                     c.finished[r] = 1;
                     res->rank[r].alive = 0;
-                    fprintf(stderr, "\nraystream: rank %d (%s): its film did not come within "
-                                    "%.1f s of the stop; left out\n",
+                    fprintf(stderr, "\nraystream: rank %d (%s) sent no film within %.1f s of "
+                                    "the stop (it may be dead); its passes are left out\n",
                             r, res->rank[r].desc, grace_s);
                 }
         if (!signalled && !res->time_limited && job->time_limit_s > 0 &&
@@ -893,8 +1037,11 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
             memset(v, 0, sizeof v);
             if (ms.MPI_TAG == T_FILM_SUMS || ms.MPI_TAG == T_FILM_COUNTS) {
                 /* data of a film given up on: drop it */
-                void *junk = rs_alloc((size_t)cnt + 1, 8);
-                MPI_Recv(junk, cnt, MPI_UINT64_T, r, ms.MPI_TAG, MPI_COMM_WORLD,
+                int bytes = 0;
+                void *junk;
+                MPI_Get_count(&ms, MPI_BYTE, &bytes);
+                junk = rs_alloc((size_t)bytes + 1, 1);
+                MPI_Recv(junk, bytes, MPI_BYTE, r, ms.MPI_TAG, MPI_COMM_WORLD,
                          MPI_STATUS_IGNORE);
                 rs_free(junk);
             } else {
@@ -931,20 +1078,24 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                             rk->passes++;
                             rk->paths += (uint64_t)pass_n(&c, p) * c.npix;
                         }
+                    /* the worker's totals so far (a flush sends them too) */
                     rk->busy_s = bitsd(v[H_BUSY]);
                     rk->wall_s = c.last_seen[r] - t0;
-                    res->rays_closest += v[H_RAYS_C];
-                    res->rays_shadow += v[H_RAYS_S];
+                    rk->rays_closest = v[H_RAYS_C];
+                    rk->rays_shadow = v[H_RAYS_S];
                     if (v[H_MAX_BOUNCE] > res->max_bounce)
                         res->max_bounce = (uint32_t)v[H_MAX_BOUNCE];
-                    c.finished[r] = 1;
-                    if (v[H_FAILED]) {
-                        rk->failed = 1;
-                        fprintf(stderr, "\nraystream: rank %d (%s) failed; its passes go to "
-                                        "the other ranks\n",
-                                r, rk->desc);
+                    c.flushing[r] = 0;
+                    if (!v[H_FLUSH]) { /* its last: after a flush it goes on */
+                        c.finished[r] = 1;
+                        if (v[H_FAILED]) {
+                            rk->failed = 1;
+                            fprintf(stderr, "\nraystream: rank %d (%s) failed; its passes go "
+                                            "to the other ranks\n",
+                                    r, rk->desc);
+                        }
+                        release(&c, r); /* what it held but did not finish */
                     }
-                    release(&c, r); /* what it held but did not finish */
                 } else {
                     mark_dead(&c, r, "sent a broken film");
                 }
@@ -970,6 +1121,32 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                 c.stopped[r] = 1;
                 if (!send_small(NULL, 0, r, T_STOP))
                     mark_dead(&c, r, "cannot be reached");
+            }
+        }
+
+        /* periodic flushes: every worker sends what it finished; once all are in, the frame
+         * holds every finished pass, and job->saved writes it */
+        now = now_s();
+        if (next_flush > 0 && !signalled && !flush_round && now >= next_flush) {
+            for (r = 1; r < n; ++r)
+                if (!c.finished[r]) {
+                    c.flushing[r] = 1;
+                    if (!send_small(NULL, 0, r, T_FLUSH))
+                        mark_dead(&c, r, "cannot be reached");
+                }
+            flush_round = 1;
+        }
+        if (flush_round) {
+            int waiting = 0;
+            for (r = 1; r < n; ++r)
+                waiting |= c.flushing[r] && !c.finished[r];
+            if (!waiting) {
+                if (job->saved)
+                    call_saved(&c, &l, film, &film_mu);
+                res->flushes++;
+                flush_round = 0;
+                next_flush = now_s() + job->flush_every_s;
+                active = 1;
             }
         }
 
@@ -1024,23 +1201,13 @@ finish:
     res->rays_shadow += l.sum.rays_shadow;
     if (l.sum.max_bounce > res->max_bounce)
         res->max_bounce = l.sum.max_bounce;
-    /* which samples the frame holds */
-    {
-        uint32_t merged = 0, prefix_end = 0;
-        int gap = 0;
-        for (p = 0; p < c.n_passes; ++p) {
-            if (c.state[p] == P_MERGED) {
-                merged += pass_n(&c, p);
-                if (!gap)
-                    prefix_end = p + 1;
-            } else {
-                gap = 1;
-            }
-        }
-        res->samples_done = job->sample_begin + merged;
-        res->prefix = count_state(&c, P_MERGED, prefix_end) == prefix_end &&
-                      count_state(&c, P_MERGED, c.n_passes) == prefix_end;
+    for (r = 1; r < n; ++r) {
+        res->rays_closest += res->rank[r].rays_closest;
+        res->rays_shadow += res->rank[r].rays_shadow;
     }
+    /* which samples the frame holds */
+    res->n_done = merged_ranges(&c, &res->done, &res->samples_done);
+    res->complete = count_state(&c, P_MERGED, c.n_passes) == c.n_passes;
 out:
     res->seconds = now_s() - t0;
     res->messages = g_msgs;
@@ -1053,6 +1220,9 @@ out:
     rs_free(c.asked);
     rs_free(c.finished);
     rs_free(c.stopped);
+    rs_free(c.flushing);
+    rs_free(c.ps0);
+    rs_free(c.pn);
     return st;
 }
 
@@ -1060,9 +1230,6 @@ rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_d
 {
     double timeout_s = job->timeout_s > 0 ? job->timeout_s : 60.0;
     memset(res, 0, sizeof *res);
-    if (job->sample_begin >= job->spp)
-        return rs_error_set(RS_ERR_ARG, "nothing to render: samples %u..%u", job->sample_begin,
-                            job->spp);
     if (d->rank == 0)
         return run_coordinator(d, job, film, res, timeout_s);
     return run_worker(d, job, film, timeout_s);
@@ -1071,5 +1238,7 @@ rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_d
 void rs_dist_result_free(rs_dist_result *res)
 {
     rs_free(res->rank);
+    rs_free(res->done);
     res->rank = NULL;
+    res->done = NULL;
 }

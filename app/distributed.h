@@ -71,10 +71,20 @@ rs_status rs_dist_fault_parse(const char *spec, rs_dist_fault *out);
 typedef rs_status (*rs_dist_render_fn)(void *user, uint32_t s0, uint32_t n, rs_film *film,
                                        const atomic_int *cancel, rs_render_stats *stats);
 
+/* rank 0, every `flush_every_s`: the film holds the samples it held before plus `done`
+ * (n_done ranges [s0, s0 + n) of every pixel, sorted); it may be read, not written */
+typedef void (*rs_dist_saved_fn)(void *user, const rs_film *film, const uint32_t (*done)[2],
+                                 uint32_t n_done);
+
 typedef struct rs_dist_job {
-    uint32_t width, height;
-    uint32_t sample_begin, spp; /* samples [sample_begin, spp) of every pixel are rendered */
+    uint32_t width, height, spp;
+    const uint32_t (*todo)[2];  /* rank 0: the samples to render, ranges [s0, s0 + n) of every
+                                   pixel (sorted, disjoint; what the film does not hold) */
+    uint32_t n_todo;
     uint32_t pass_spp;          /* samples per pass; 0: auto (about 8 passes per rank) */
+    double flush_every_s;       /* rank 0: > 0, every rank sends what it finished this often
+                                   (then `saved` is called); 0: only at the end */
+    rs_dist_saved_fn saved;
     double time_limit_s;        /* rank 0: > 0, no new pass after this many seconds */
     double timeout_s;           /* a rank silent this long is dead; 0: 60 */
     const atomic_int *cancel;   /* rank 0 and every rank: a stop signal */
@@ -90,7 +100,8 @@ typedef struct rs_dist_rank_stats {
     uint64_t paths;     /* their samples */
     double busy_s;      /* seconds its render thread spent rendering */
     double wall_s;      /* from the first request to its film's arrival */
-    uint64_t film_bytes; /* the film it sent */
+    uint64_t film_bytes; /* the films it sent */
+    uint64_t rays_closest, rays_shadow;
     int alive;          /* 0: found dead (its passes were handed out again) */
     int failed;         /* its render failed (its passes were handed out again) */
 } rs_dist_rank_stats;
@@ -98,8 +109,11 @@ typedef struct rs_dist_rank_stats {
 typedef struct rs_dist_result {
     int ranks;
     uint32_t pass_spp, passes_total;
-    uint32_t samples_done;     /* samples of every pixel on the film */
-    int prefix;                /* the film holds samples [0, samples_done) (else some are lost) */
+    uint32_t samples_done;     /* samples of every pixel this job added to the film */
+    uint32_t (*done)[2];       /* which: n_done ranges [s0, s0 + n), sorted */
+    uint32_t n_done;
+    int complete;              /* every sample of `todo` is on the film */
+    uint32_t flushes;          /* times every rank sent what it had finished */
     int time_limited, stopped; /* the time limit / a stop signal ended it early */
     int dead;                  /* ranks found dead */
     uint32_t reissued;         /* passes handed out again */
@@ -114,7 +128,7 @@ typedef struct rs_dist_result {
 } rs_dist_result;
 
 /* Collective: renders `job` over every rank into `film` (rank 0: the frame, which may already
- * hold samples [0, sample_begin); other ranks: scratch of the frame's size).  Rank 0 fills
+ * hold the samples outside job->todo; other ranks: scratch of the frame's size).  Rank 0 fills
  * *res.  RS_OK also when stopped early (res says so); an error when rank 0's own render failed
  * or every rank was lost. */
 rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_dist_result *res);

@@ -292,7 +292,10 @@ typedef struct render_run {
     int interrupted;                     /* the signal that stopped the render, or 0 */
     rs_checkpoint_key key;               /* what decides the image, for --checkpoint/--resume */
     uint64_t resumed;                    /* paths the --resume file held */
-    uint64_t on_film;                    /* the film holds paths [0, on_film) */
+    rs_path_ranges held;                 /* paths the film held before the render under way */
+    uint64_t piece_lo;                   /* the render under way adds paths from here */
+    uint64_t on_film;                    /* ... and has added [piece_lo, on_film) */
+    uint64_t progress_base;              /* paths done by earlier renders of this run */
     double last_ckpt;                    /* when the last checkpoint was written (rs_now_s) */
     double ckpt_every_s;                 /* --checkpoint-interval */
     rs_progress progress;
@@ -314,6 +317,32 @@ static void run_release(render_run *r)
     rs_free(r->rgb);
     rs_bvh_destroy(r->bvh);
     rs_scene_destroy(r->scene);
+    rs_path_ranges_free(&r->held);
+}
+
+/* What the film holds now: the paths held before and what the render under way added.  0 when
+ * out of memory (after a message). */
+static int film_ranges(const render_run *r, rs_path_ranges *out)
+{
+    memset(out, 0, sizeof *out);
+    if (rs_path_ranges_union(out, &r->held) && rs_path_ranges_add(out, r->piece_lo, r->on_film))
+        return 1;
+    fprintf(stderr, "raystream: out of memory for the checkpoint's list of paths\n");
+    rs_path_ranges_free(out);
+    return 0;
+}
+
+/* Writes the checkpoint of the film as it is now (see film_ranges). */
+static int write_checkpoint(const render_run *r, int rename_now)
+{
+    rs_path_ranges held;
+    int ok;
+    if (!film_ranges(r, &held))
+        return 0;
+    ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, rename_now, &r->key,
+                             r->film, &held);
+    rs_path_ranges_free(&held);
+    return ok;
 }
 
 /* The stem of a file name: dir/bunny.ply -> bunny. */
@@ -573,16 +602,26 @@ static int make_film(const rs_cli_options *o, render_run *r)
         return RS_EXIT_OK;
     if (!o->spp_given)
         k->spp = 0; /* the file's */
-    if ((rc = rs_checkpoint_read(o->resume, k, r->film, &r->resumed)) != RS_EXIT_OK)
+    if ((rc = rs_checkpoint_read(o->resume, k, r->film, &r->held)) != RS_EXIT_OK)
         return rc;
     r->st.spp = k->spp;
-    r->st.path_begin = r->resumed;
-    if (o->megakernel && r->resumed % ((uint64_t)r->st.width * r->st.height) != 0) {
-        fprintf(stderr,
-                "raystream: --resume %s: stopped within a pass (%llu samples of %ux%u pixels); "
-                "the megakernel continues whole passes only (use --integrator stream)\n",
-                o->resume, (unsigned long long)r->resumed, r->st.width, r->st.height);
-        return RS_EXIT_USAGE;
+    r->resumed = rs_path_ranges_total(&r->held);
+    /* a prefix continues from its end; other sets fill their gaps (render_gaps) */
+    if (rs_path_ranges_is_prefix(&r->held))
+        r->st.path_begin = r->piece_lo = r->on_film = r->resumed;
+    if (o->megakernel) {
+        uint64_t npix = (uint64_t)r->st.width * r->st.height;
+        uint32_t i;
+        for (i = 0; i < r->held.n; ++i)
+            if (r->held.r[i][1] % npix != 0) {
+                fprintf(stderr,
+                        "raystream: --resume %s: stopped within a pass (%llu samples of %ux%u "
+                        "pixels); the megakernel continues whole passes only (use "
+                        "--integrator stream)\n",
+                        o->resume, (unsigned long long)r->held.r[i][1], r->st.width,
+                        r->st.height);
+                return RS_EXIT_USAGE;
+            }
     }
     return RS_EXIT_OK;
 }
@@ -681,7 +720,12 @@ static int start_devices(const rs_cli_options *o, render_run *r)
  * Returns an exit code: 128 + the signal for an interrupted render. */
 static void on_progress(void *user, uint64_t done, uint64_t total)
 {
-    rs_progress_update(&((render_run *)user)->progress, done, total);
+    render_run *r = (render_run *)user;
+    uint64_t all = (uint64_t)r->st.width * r->st.height * r->st.spp - r->resumed;
+    if (r->progress_base || total < all) /* one of several renders (render_gaps) */
+        rs_progress_update(&r->progress, r->progress_base + done, all);
+    else
+        rs_progress_update(&r->progress, done, total);
 }
 
 /* The render thread, whenever the film holds a prefix of the paths: a periodic checkpoint.  A
@@ -690,12 +734,88 @@ static void on_film_ready(void *user, const rs_film *film, uint64_t paths)
 {
     render_run *r = (render_run *)user;
     double now;
+    (void)film;
     r->on_film = paths;
     if (!r->ckpt_out || (now = rs_now_s()) - r->last_ckpt < r->ckpt_every_s ||
-        paths == (uint64_t)r->st.width * r->st.height * r->st.spp) /* the last: at the end */
-        return;
+        (r->held.n == 0 && paths == (uint64_t)r->st.width * r->st.height * r->st.spp))
+        return; /* the last is written at the end */
     r->last_ckpt = now;
-    (void)rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 1, &r->key, film, paths);
+    (void)write_checkpoint(r, 1);
+}
+
+static void add_render_stats(rs_render_stats *a, const rs_render_stats *b)
+{
+    int i;
+    for (i = 0; i < RS_STAGE_COUNT; ++i)
+        a->stage_s[i] += b->stage_s[i];
+    a->seconds += b->seconds;
+    a->trace_s += b->trace_s;
+    a->shade_s += b->shade_s;
+    a->paths_total += b->paths_total;
+    a->paths_done += b->paths_done;
+    a->rays_closest += b->rays_closest;
+    a->rays_shadow += b->rays_shadow;
+    a->waves += b->waves;
+    a->time_limited |= b->time_limited;
+    if (b->max_bounce > a->max_bounce)
+        a->max_bounce = b->max_bounce;
+}
+
+/* A resumed film that holds several ranges of paths (an MPI job stopped with passes missing):
+ * each gap between them is rendered in turn, [q0, q1) as the render of q1 / npix samples from
+ * path q0 on (every range starts at a whole sample, app/checkpoint.h).  The film's sums are
+ * exact, so the order does not matter: the result is the uninterrupted render's. */
+static rs_status render_gaps(const rs_cli_options *o, render_run *r, rs_render_hooks *hooks)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height, end = npix * r->st.spp, cur = 0;
+    rs_path_ranges gaps;
+    rs_status rst = RS_OK;
+    double t0 = rs_now_s();
+    uint32_t i;
+    memset(&gaps, 0, sizeof gaps);
+    for (i = 0; i <= r->held.n; ++i) {
+        uint64_t lo = i < r->held.n ? r->held.r[i][0] : end;
+        if (lo > cur && !rs_path_ranges_add(&gaps, cur, lo < end ? lo : end))
+            return rs_error_set(RS_ERR_NOMEM, "out of memory");
+        if (i < r->held.n)
+            cur = r->held.r[i][1];
+    }
+    memset(&r->stats, 0, sizeof r->stats);
+    for (i = 0; i < gaps.n && rst == RS_OK; ++i) {
+        rs_render_settings st = r->st;
+        rs_render_stats one;
+        st.spp = (uint32_t)(gaps.r[i][1] / npix);
+        st.spp_total = r->st.spp;
+        st.path_begin = gaps.r[i][0];
+        r->piece_lo = r->on_film = gaps.r[i][0];
+        if (o->time_limit_s > 0) {
+            double left = o->time_limit_s - (rs_now_s() - t0);
+            if (left <= 0 && i > 0) {
+                r->stats.time_limited = 1;
+                break;
+            }
+            hooks->time_limit_s = left > 1e-6 ? left : 1e-6;
+        }
+        if (o->megakernel)
+            rst = rs_render_passes(r->scene, r->mk, &st, hooks, r->film, &one);
+        else
+            rst = rs_render(r->scene, r->sched, &st, hooks, r->film, &one);
+        add_render_stats(&r->stats, &one);
+        r->progress_base += one.paths_done;
+        r->on_film = r->piece_lo + one.paths_done;
+        if (i + 1 < gaps.n && !rs_path_ranges_add(&r->held, r->piece_lo, r->on_film))
+            rst = rs_error_set(RS_ERR_NOMEM, "out of memory");
+        else if (i + 1 < gaps.n)
+            r->piece_lo = r->on_film = 0; /* now in held */
+        if (one.time_limited)
+            break;
+    }
+    /* the paths_total of the gaps not begun */
+    for (; i + 1 < gaps.n; ++i)
+        r->stats.paths_total += gaps.r[i + 1][1] - gaps.r[i + 1][0];
+    rs_path_ranges_free(&gaps);
+    r->stats.seconds = rs_now_s() - t0;
+    return rst;
 }
 
 static int run_render(const rs_cli_options *o, render_run *r)
@@ -710,13 +830,14 @@ static int run_render(const rs_cli_options *o, render_run *r)
     hooks.cancel = &g_cancel;
     hooks.time_limit_s = o->time_limit_s;
     r->ckpt_every_s = o->ckpt_every_s;
-    r->on_film = r->st.path_begin;
     r->last_ckpt = rs_now_s();
     if (r->ckpt_out) {
         hooks.film_ready = on_film_ready;
         rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
     }
-    if (o->megakernel) {
+    if (!rs_path_ranges_is_prefix(&r->held)) {
+        rst = render_gaps(o, r, &hooks);
+    } else if (o->megakernel) {
         rst = rs_render_passes(r->scene, r->mk, &r->st, &hooks, r->film, &r->stats);
     } else if (o->adaptive > 0) {
         rs_adaptive a;
@@ -869,12 +990,12 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
                 ",\n  \"mpi\": {\"ranks\": %d, \"pass_spp\": %u, \"passes\": %u, "
                 "\"reissued\": %u, \"ranks_lost\": %d, \"bytes_received\": %llu, "
                 "\"messages\": %llu, \"message_bytes\": %llu, "
-                "\"rays\": %llu, \"prefix\": %s,\n    \"per_rank\": [\n",
+                "\"rays\": %llu, \"complete\": %s, \"flushes\": %u,\n    \"per_rank\": [\n",
                 d->ranks, d->pass_spp, d->passes_total, d->reissued, d->dead,
                 (unsigned long long)d->bytes_received, (unsigned long long)d->messages,
                 (unsigned long long)d->message_bytes,
                 (unsigned long long)(d->rays_closest + d->rays_shadow),
-                d->prefix ? "true" : "false");
+                d->complete ? "true" : "false", d->flushes);
         for (i = 0; i < d->ranks; ++i) {
             const rs_dist_rank_stats *k = &d->rank[i];
             double idle = k->wall_s > 0 ? 1.0 - k->busy_s / k->wall_s : 0.0;
@@ -1012,7 +1133,7 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
                 (unsigned long long)r->resumed);
     if (r->ckpt_out)
         fprintf(stderr, "Checkpoint %s holds %llu samples. ", r->ckpt_out->path,
-                (unsigned long long)r->on_film);
+                (unsigned long long)(rs_path_ranges_total(&r->held) + r->on_film - r->piece_lo));
     if (r->interrupted)
         fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", r->out,
                 (unsigned long long)(r->stats.paths_done + r->resumed),
@@ -1154,8 +1275,7 @@ static int write_outputs(const rs_cli_options *o, render_run *r, int code)
     if (ok && r->timeline_out)
         ok = write_timeline(r->timeline_out->staged, o, r, &rows);
     if (ok && r->ckpt_out) /* renamed below with the others */
-        ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 0, &r->key, r->film,
-                                 r->on_film);
+        ok = write_checkpoint(r, 0);
     make_image_meta(o, r, &meta);
     n_layers = ok ? make_aovs(o, r, layers, aov_bufs) : 0;
     if (n_layers < 0) {
@@ -1269,15 +1389,17 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
     }
     if (code == RS_EXIT_OK && r->rank == 0) {
         uint64_t npix = (uint64_t)r->st.width * r->st.height;
-        if (r->st.path_begin % npix != 0) {
-            fprintf(stderr,
-                    "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
-                    "pixels); under mpirun a render continues whole samples only (resume it "
-                    "on one process)\n",
-                    o->resume, (unsigned long long)r->st.path_begin, r->st.width, r->st.height);
-            code = RS_EXIT_USAGE;
-        }
-        begin = r->st.path_begin / npix;
+        uint32_t i;
+        for (i = 0; i < r->held.n && code == RS_EXIT_OK; ++i)
+            if (r->held.r[i][1] % npix != 0) {
+                fprintf(stderr,
+                        "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
+                        "pixels); under mpirun a render continues whole samples only (resume "
+                        "it on one process)\n",
+                        o->resume, (unsigned long long)r->held.r[i][1], r->st.width,
+                        r->st.height);
+                code = RS_EXIT_USAGE;
+            }
     }
     if (code == RS_EXIT_OK && (code = build_bvh(o, r)) == RS_EXIT_OK)
         code = start_devices(o, r);
@@ -1306,7 +1428,7 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
         fprintf(stderr, "raystream: rank %d could not start (its message is above); no rank "
                         "renders\n",
                 who);
-    r->st.path_begin = begin * r->st.width * r->st.height;
+    (void)begin;
     return worst;
 }
 
@@ -1315,21 +1437,69 @@ static void on_dist_progress(void *user, uint64_t done, uint64_t total)
     rs_progress_update(&((render_run *)user)->progress, done, total);
 }
 
+/* The film held r->held, plus the job's finished passes `done` (whole samples). */
+static int dist_held(render_run *r, const uint32_t (*done)[2], uint32_t n_done,
+                     rs_path_ranges *out)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    uint32_t i;
+    memset(out, 0, sizeof *out);
+    if (!rs_path_ranges_union(out, &r->held))
+        return 0;
+    for (i = 0; i < n_done; ++i)
+        if (!rs_path_ranges_add(out, npix * done[i][0], npix * (done[i][0] + done[i][1])))
+            return 0;
+    return 1;
+}
+
+/* rank 0, after each periodic flush of an MPI job: the --checkpoint */
+static void on_dist_saved(void *user, const rs_film *film, const uint32_t (*done)[2],
+                          uint32_t n_done)
+{
+    render_run *r = (render_run *)user;
+    rs_path_ranges held;
+    if (dist_held(r, done, n_done, &held))
+        (void)rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 1, &r->key, film,
+                                  &held);
+    rs_path_ranges_free(&held);
+}
+
 /* The job: rank 0 hands out the passes and gathers the films, every rank renders.  Rank 0 then
  * has the frame and the statistics in r.  Returns an exit code. */
 static int dist_run(const rs_cli_options *o, render_run *r)
 {
     rs_dist_job job;
     rs_status st;
-    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    uint64_t npix = (uint64_t)r->st.width * r->st.height, cur = 0;
+    uint32_t(*todo)[2] = NULL, n_todo = 0, i;
     install_stop_signals();
     memset(&job, 0, sizeof job);
     if (rs_dist_fault_parse(getenv("RS_MPI_FAULT"), &job.fault) != RS_OK)
         return fail(RS_EXIT_USAGE, NULL);
     job.width = r->st.width;
     job.height = r->st.height;
-    job.sample_begin = (uint32_t)(r->st.path_begin / npix);
     job.spp = r->st.spp;
+    /* the samples the film lacks (all of them, or the gaps of a --resume) */
+    if (r->rank == 0) {
+        todo = rs_calloc((size_t)r->held.n + 1, sizeof *todo);
+        if (!todo)
+            return fail(RS_EXIT_RUNTIME, "out of memory");
+        for (i = 0; i <= r->held.n; ++i) {
+            uint64_t lo = i < r->held.n ? r->held.r[i][0] / npix : r->st.spp;
+            if (lo > cur) {
+                todo[n_todo][0] = (uint32_t)cur;
+                todo[n_todo++][1] = (uint32_t)(lo - cur);
+            }
+            if (i < r->held.n)
+                cur = r->held.r[i][1] / npix;
+        }
+    }
+    job.todo = (const uint32_t(*)[2])todo;
+    job.n_todo = n_todo;
+    if (r->ckpt_out) {
+        job.flush_every_s = o->ckpt_every_s;
+        job.saved = on_dist_saved;
+    }
     job.pass_spp = o->mpi_pass_spp;
     job.time_limit_s = o->time_limit_s;
     job.timeout_s = o->mpi_timeout_s;
@@ -1338,10 +1508,10 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     job.user = r;
     if (r->rank == 0)
         job.progress = on_dist_progress;
-    r->on_film = r->st.path_begin;
     if (r->rank == 0)
         rs_progress_begin(&r->progress, !o->quiet);
     st = rs_dist_render(r->dist, &job, r->film, &r->dres);
+    rs_free(todo);
     if (r->rank == 0)
         rs_progress_end(&r->progress);
     if (r->rank > 0)
@@ -1349,30 +1519,24 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     /* rank 0: the job as one render's statistics */
     r->stats = r->dres.local;
     r->stats.seconds = r->dres.seconds;
-    r->stats.paths_total = npix * (r->st.spp - job.sample_begin);
-    r->stats.paths_done = npix * (r->dres.samples_done - job.sample_begin);
+    r->stats.paths_total = npix * r->st.spp - r->resumed;
+    r->stats.paths_done = npix * r->dres.samples_done;
     r->stats.rays_closest = r->dres.rays_closest;
     r->stats.rays_shadow = r->dres.rays_shadow;
     r->stats.max_bounce = r->dres.max_bounce;
     r->stats.time_limited = r->dres.time_limited;
-    r->resumed = r->st.path_begin;
     if (st != RS_OK)
         return fail(RS_EXIT_RUNTIME, "render failed");
-    if (r->dres.prefix) {
-        r->on_film = npix * r->dres.samples_done;
-    } else if (r->ckpt_out) {
-        /* a checkpoint holds samples [0, k) (app/checkpoint.h): this film has gaps */
-        int i;
-        fprintf(stderr, "raystream: the finished passes are not samples 0..k-1 (some were lost "
-                        "with a rank or a stop); no checkpoint written (%s is left as it was)\n",
-                r->ckpt_out->path);
-        for (i = 0; i < r->n_outs; ++i)
-            if (&r->outs[i] == r->ckpt_out) {
-                memmove(&r->outs[i], &r->outs[i + 1], (size_t)(r->n_outs - i - 1) * sizeof *r->outs);
-                r->n_outs--;
-                break;
-            }
-        r->ckpt_out = NULL;
+    {
+        /* what the film holds now, for the final checkpoint (app/checkpoint.h: any ranges) */
+        rs_path_ranges now;
+        if (!dist_held(r, (const uint32_t(*)[2])r->dres.done, r->dres.n_done, &now)) {
+            rs_path_ranges_free(&now);
+            return fail(RS_EXIT_RUNTIME, "out of memory");
+        }
+        rs_path_ranges_free(&r->held);
+        r->held = now;
+        r->piece_lo = r->on_film = 0;
     }
     if (r->dres.stopped) {
         r->interrupted = atomic_load(&g_signal) ? atomic_load(&g_signal) : SIGTERM;

@@ -13,6 +13,10 @@
  *     without it, mpirun ends the job, and the run neither hangs nor writes a broken image;
  *   - --time-limit stops at whole passes: the image equals a one-process render of the samples
  *     it says it holds;
+ *   - a rank killed without --enable-recovery: rank 0 writes a checkpoint of what the others
+ *     finished, with gaps where the dead rank's passes were; resuming it on one process, on
+ *     the megakernel and under mpirun gives the uninterrupted image bit for bit;
+ *   - --checkpoint-interval under mpirun flushes every rank's film to rank 0 on the way;
  *   - Ctrl-C on mpirun ends every rank within seconds, with 128 + the signal or mpirun's code;
  *   - options the job cannot honour (--adaptive) are refused by rank 0 alone, in one line. */
 #include <stdarg.h>
@@ -37,6 +41,8 @@
 static char g_skip[256];
 
 /* mpirun with the flags this machine needs, then `args` (NULL-terminated), in f's folder */
+/* recovery: 1 adds --enable-recovery; 2 gives the ranks 5 s from mpirun's SIGTERM to its
+ * SIGKILL (odls_base_sigkill_timeout) */
 static void mpirun(proc *p, const fixture *f, int ranks, int recovery, const char *const *args)
 {
     const char *argv[MAX_ARGS + 1];
@@ -48,8 +54,13 @@ static void mpirun(proc *p, const fixture *f, int ranks, int recovery, const cha
     argv[k++] = "--oversubscribe";
     if (geteuid() == 0)
         argv[k++] = "--allow-run-as-root";
-    if (recovery)
+    if (recovery == 1)
         argv[k++] = "--enable-recovery";
+    if (recovery == 2) {
+        argv[k++] = "--mca";
+        argv[k++] = "odls_base_sigkill_timeout";
+        argv[k++] = "5";
+    }
     argv[k++] = "-x";
     argv[k++] = "RS_MPI_FAULT";
     argv[k++] = RS_BINARY;
@@ -233,6 +244,106 @@ static void test_killed_rank_does_not_hang(void **state)
     proc_free(&p);
 }
 
+/* The number of path ranges a checkpoint holds (app/checkpoint.h: after the scene name), or
+ * -1. */
+static int checkpoint_ranges(const fixture *f, const char *name)
+{
+    char path[256];
+    size_t n = 0;
+    uint32_t name_len, ranges;
+    char *data;
+    path_in(f, name, path, sizeof path);
+    data = read_bytes(path, &n);
+    if (!data || n < 100) {
+        free(data);
+        return -1;
+    }
+    memcpy(&name_len, data + 88, 4);
+    if (92 + (size_t)name_len + 4 > n) {
+        free(data);
+        return -1;
+    }
+    memcpy(&ranges, data + 92 + name_len, 4);
+    free(data);
+    return (int)ranges;
+}
+
+static void expect_resumes_to(const fixture *f, const image *full, int ranks,
+                              const char *integrator)
+{
+    const char *args[16] = {"render", "builtin:cornell", "--width", "64", "--height", "64",
+                            "--spp", "200", "--resume", "ck.ckpt", "-q", "-o", "res.exr",
+                            "--integrator", integrator, NULL};
+    proc p;
+    image im;
+    if (ranks > 1)
+        mpirun(&p, f, ranks, 0, args);
+    else
+        run(&p, f->dir, TIMEOUT_S, args);
+    EXPECT(&p, exited_with(&p, 0), "resuming the checkpoint with gaps failed");
+    im = read_image(&p, f, "res.exr");
+    EXPECT(&p, same_image(full, &im), "the resumed image (%d rank%s, %s) is not the full one",
+           ranks, ranks > 1 ? "s" : "", integrator);
+    rs_free(im.rgb);
+    proc_free(&p);
+}
+
+static void test_checkpoint_with_gaps(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "200", "--mpi-pass", "2", "--checkpoint",
+                                       "ck.ckpt", "-q", "-o", "part.exr", NULL};
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                      "64", "--spp", "200", "-q", NULL};
+    image full;
+    proc p;
+    char path[256];
+    setenv("RS_MPI_FAULT", "die:1:2", 1);
+    mpirun(&p, f, 2, 2, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, !p.timed_out && !exited_with(&p, 0), "the job with a dead rank did not fail");
+    path_in(f, "ck.ckpt", path, sizeof path);
+    EXPECT(&p, file_exists(path), "no checkpoint of what the live ranks finished");
+    EXPECT(&p, checkpoint_ranges(f, "ck.ckpt") >= 2,
+           "the checkpoint has no gap (%d ranges): the dead rank's passes were not lost",
+           checkpoint_ranges(f, "ck.ckpt"));
+    EXPECT(&p, strstr(p.err.data, "rank 1") != NULL, "the lost rank was not named");
+    proc_free(&p);
+    full = one_process(f, ref, "full.exr");
+    expect_resumes_to(f, &full, 1, "stream");
+    expect_resumes_to(f, &full, 1, "megakernel");
+    expect_resumes_to(f, &full, 2, "stream");
+    rs_free(full.rgb);
+}
+
+static void test_periodic_checkpoints(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                       "64", "--spp", "64", "--mpi-pass", "1", "--checkpoint",
+                                       "ck.ckpt", "--checkpoint-interval", "0.05", "-q", "-o",
+                                       "many.exr", "--stats-json", "s.json", NULL};
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                      "64", "--spp", "64", "-q", NULL};
+    image one, many;
+    proc p;
+    char *json;
+    setenv("RS_MPI_FAULT", "slow:1:2", 1);
+    mpirun(&p, f, 2, 0, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, exited_with(&p, 0), "the job with periodic checkpoints failed");
+    json = read_text(f, "s.json");
+    EXPECT(&p, json && json_number(json, NULL, "flushes") >= 1, "no periodic flush happened");
+    one = one_process(f, ref, "one.exr");
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many), "the flushes changed the image");
+    free(json);
+    rs_free(one.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
+}
+
 /* ---- stopping ---------------------------------------------------------------------------- */
 
 static void test_time_limit_whole_passes(void **state)
@@ -258,7 +369,7 @@ static void test_time_limit_whole_passes(void **state)
     EXPECT(&p, got >= 2 && got < 100000 && (int)got % 2 == 0,
            "the film holds %g samples per pixel, not whole passes of 2", got);
     EXPECT(&p, strstr(json, "\"time_limited\": true") != NULL, "time_limited is not true");
-    EXPECT(&p, strstr(json, "\"prefix\": true") != NULL, "the samples are not 0..k-1");
+    EXPECT(&p, strstr(json, "\"complete\": false") != NULL, "the job says it is complete");
     snprintf(spp, sizeof spp, "%d", (int)got);
     ref[7] = spp;
     one = one_process(f, ref, "one.exr");
@@ -343,6 +454,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_slow_rank_gets_fewer_passes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_rank_recovered, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_rank_does_not_hang, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_checkpoint_with_gaps, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_periodic_checkpoints, setup, teardown),
         cmocka_unit_test_setup_teardown(test_time_limit_whole_passes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_ctrl_c_stops_every_rank, setup, teardown),
         cmocka_unit_test_setup_teardown(test_unsupported_options, setup, teardown),
