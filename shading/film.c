@@ -19,7 +19,7 @@ rs_status rs_film_create(uint32_t width, uint32_t height, rs_film **out)
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the film");
     f->width = width;
     f->height = height;
-    f->sum = (double *)rs_calloc(npix * 3, sizeof *f->sum);
+    f->sum = (rs_film_sum *)rs_calloc(npix * 3, sizeof *f->sum);
     f->count = (uint32_t *)rs_calloc(npix, sizeof *f->count);
     if (!f->sum || !f->count) {
         rs_film_destroy(f);
@@ -39,13 +39,15 @@ void rs_film_destroy(rs_film *f)
     rs_free(f);
 }
 
-/* x (|x| <= RS_FILM_MAX_SAMPLE) in film units, rounded to the nearest (ties to even) */
+/* x (|x| <= RS_FILM_MAX_SAMPLE) in film units, rounded to the nearest (ties away from zero):
+ * the scaling by a power of two is exact, and below 2^62 units (4.2e6 radiance) the rounding is
+ * one add and one truncating conversion, inline (rint is a libm call without SSE4.1) */
 static inline rs_film_sum to_fixed(double x)
 {
-    double v = rint(x * RS_FILM_SCALE); /* exact scaling by a power of two, then one rounding */
+    double v = x * RS_FILM_SCALE;
     if (fabs(v) < 0x1p62)
-        return (rs_film_sum)(int64_t)v;
-    return (rs_film_sum)v;
+        return (rs_film_sum)(int64_t)(v + (v >= 0 ? 0.5 : -0.5));
+    return (rs_film_sum)v; /* an integer already: 2^62 is past a double's fraction bits */
 }
 
 static inline double from_fixed(rs_film_sum s)
