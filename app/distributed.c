@@ -52,6 +52,7 @@ enum {
     H_BUSY,      /* double */
     H_FAILED,    /* the worker's render failed */
     H_FLUSH,     /* a periodic flush: the worker goes on */
+    H_COMM_CPU,  /* double: CPU seconds of its messaging thread so far */
     H_COUNT
 };
 
@@ -84,6 +85,15 @@ static uint64_t dbits(double v)
     uint64_t u;
     memcpy(&u, &v, sizeof u);
     return u;
+}
+
+/* CPU seconds the calling thread has used (the messaging loop's cost: it must not spin) */
+static double thread_cpu_s(void)
+{
+    struct timespec t;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) != 0)
+        return 0.0;
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 static double bitsd(uint64_t u)
@@ -152,7 +162,7 @@ int rs_dist_size(const rs_dist *d)
     return d->size;
 }
 
-int rs_dist_agree(rs_dist *d, int code, int *who, uint64_t *value, const char *desc)
+int rs_dist_agree(rs_dist *d, int code, int *who, const char *desc)
 {
     int mine[2], worst[2];
     char buf[RS_DIST_DESC];
@@ -163,7 +173,6 @@ int rs_dist_agree(rs_dist *d, int code, int *who, uint64_t *value, const char *d
     mine[1] = code == worst[0] ? d->rank : d->size;
     MPI_Allreduce(&mine[1], &worst[1], 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     *who = worst[1];
-    MPI_Bcast(value, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
     memset(buf, 0, sizeof buf);
     snprintf(buf, sizeof buf, "%s", desc ? desc : "");
     if (d->rank == 0 && !d->desc)
@@ -455,6 +464,7 @@ static int wait_req(MPI_Request *req, double timeout_s)
 }
 
 static uint64_t g_msgs, g_msg_bytes; /* this rank's small messages, sent and received */
+static double g_cpu0;                 /* the messaging thread's CPU seconds when the job began */
 
 static int send_small(const uint64_t *v, int n, int to, int tag)
 {
@@ -498,6 +508,7 @@ static int send_film(local *l, const rs_film *f, int failed, int flush, double t
     h[H_NONFINITE] = f->nonfinite;
     h[H_FAILED] = (uint64_t)failed;
     h[H_FLUSH] = (uint64_t)flush;
+    h[H_COMM_CPU] = dbits(thread_cpu_s() - g_cpu0); /* send_film runs on the messaging thread */
     if (!send_small(h, H_COUNT, 0, T_FILM))
         return 0;
     n_sum = npix * 3 * (enc ? 2 : 1);
@@ -1081,6 +1092,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                     /* the worker's totals so far (a flush sends them too) */
                     rk->busy_s = bitsd(v[H_BUSY]);
                     rk->wall_s = c.last_seen[r] - t0;
+                    rk->comm_cpu_s = bitsd(v[H_COMM_CPU]);
                     rk->rays_closest = v[H_RAYS_C];
                     rk->rays_shadow = v[H_RAYS_S];
                     if (v[H_MAX_BOUNCE] > res->max_bounce)
@@ -1186,6 +1198,9 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     goto finish;
 
 stop_all:
+    /* rank 0 failed: the others are told, and it does not wait for them (no MPI_Finalize,
+     * which would wait for films nobody receives: mpirun ends them) */
+    d->any_dead = 1;
     for (r = 1; r < n; ++r)
         if (!c.finished[r])
             send_small(NULL, 0, r, T_ABORT);
@@ -1196,6 +1211,7 @@ finish:
     res->rank[0].paths = l.paths;
     res->rank[0].busy_s = l.busy_s;
     res->rank[0].wall_s = now_s() - t0;
+    res->rank[0].comm_cpu_s = thread_cpu_s() - g_cpu0;
     res->local = l.sum;
     res->rays_closest += l.sum.rays_closest;
     res->rays_shadow += l.sum.rays_shadow;
@@ -1230,6 +1246,7 @@ rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_d
 {
     double timeout_s = job->timeout_s > 0 ? job->timeout_s : 60.0;
     memset(res, 0, sizeof *res);
+    g_cpu0 = thread_cpu_s();
     if (d->rank == 0)
         return run_coordinator(d, job, film, res, timeout_s);
     return run_worker(d, job, film, timeout_s);

@@ -48,9 +48,9 @@ rs_status rs_dist_init(int *argc, char ***argv, rs_dist **out);
 int rs_dist_rank(const rs_dist *d);
 int rs_dist_size(const rs_dist *d);
 /* Collective, once, after every rank's set-up: the worst exit code over the ranks (0: all
- * started), *who the lowest rank with it; rank 0's `value` broadcast into *value; each rank's
- * `desc` kept on rank 0 for the statistics. */
-int rs_dist_agree(rs_dist *d, int code, int *who, uint64_t *value, const char *desc);
+ * started), *who the lowest rank with it; each rank's `desc` kept on rank 0 for the
+ * statistics. */
+int rs_dist_agree(rs_dist *d, int code, int *who, const char *desc);
 /* MPI_Finalize when every rank is known to be alive; otherwise nothing (a finalize would wait
  * for the dead).  Frees d. */
 void rs_dist_finish(rs_dist *d);
@@ -102,6 +102,7 @@ typedef struct rs_dist_rank_stats {
     double wall_s;      /* from the first request to its film's arrival */
     uint64_t film_bytes; /* the films it sent */
     uint64_t rays_closest, rays_shadow;
+    double comm_cpu_s;  /* CPU seconds of its messaging thread (which sleeps between probes) */
     int alive;          /* 0: found dead (its passes were handed out again) */
     int failed;         /* its render failed (its passes were handed out again) */
 } rs_dist_rank_stats;

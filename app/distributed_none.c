@@ -46,10 +46,9 @@ int rs_dist_size(const rs_dist *d)
     return 1;
 }
 
-int rs_dist_agree(rs_dist *d, int code, int *who, uint64_t *value, const char *desc)
+int rs_dist_agree(rs_dist *d, int code, int *who, const char *desc)
 {
     (void)d;
-    (void)value;
     (void)desc;
     *who = 0;
     return code;

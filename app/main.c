@@ -1004,10 +1004,11 @@ static int write_stats_json(const char *path, const char *shown, const render_ru
             fprintf(f,
                     ", \"passes\": %u, \"samples\": %llu, \"busy_s\": %.6f, "
                     "\"wall_s\": %.6f, \"idle_share\": %.6f, \"samples_per_s\": %.3f, "
-                    "\"film_bytes\": %llu, \"lost\": %s, \"failed\": %s}%s\n",
+                    "\"film_bytes\": %llu, \"comm_cpu_s\": %.6f, \"lost\": %s, "
+                    "\"failed\": %s}%s\n",
                     k->passes, (unsigned long long)k->paths, k->busy_s, k->wall_s,
                     idle > 0 ? idle : 0.0, k->busy_s > 0 ? (double)k->paths / k->busy_s : 0.0,
-                    (unsigned long long)k->film_bytes, k->alive ? "false" : "true",
+                    (unsigned long long)k->film_bytes, k->comm_cpu_s, k->alive ? "false" : "true",
                     k->failed ? "true" : "false", i + 1 < d->ranks ? "," : "");
         }
         fprintf(f, "    ]}");
@@ -1368,7 +1369,6 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
 {
     int code, worst, who = 0, saved = -1;
     FILE *held = NULL;
-    uint64_t begin = 0;
     char desc[RS_DIST_DESC];
     if ((code = dist_check_options(o, r->rank)) != RS_EXIT_OK)
         return code;
@@ -1413,7 +1413,7 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
             close(saved);
         }
     }
-    worst = rs_dist_agree(r->dist, code, &who, &begin, desc);
+    worst = rs_dist_agree(r->dist, code, &who, desc);
     if (held) {
         if (code != RS_EXIT_OK && who == r->rank) { /* rank 0 started: say why this one did not */
             char line[512];
@@ -1428,7 +1428,6 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
         fprintf(stderr, "raystream: rank %d could not start (its message is above); no rank "
                         "renders\n",
                 who);
-    (void)begin;
     return worst;
 }
 

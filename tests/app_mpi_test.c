@@ -468,6 +468,6 @@ int main(void)
     setenv("RS_MPI_FAULT", "", 1);
     /* Open MPI keeps some memory to the end on purpose: LeakSanitizer (the address build) is
      * told so, by library, in tests/lsan-mpi.supp */
-    setenv("LSAN_OPTIONS", "suppressions=" RS_SOURCE_DIR "/tests/lsan-mpi.supp", 0);
+    setenv("LSAN_OPTIONS", "suppressions=" RS_SOURCE_DIR "/tests/lsan-mpi.supp", 1);
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
