@@ -303,6 +303,7 @@ typedef struct render_run {
     int rank;             /* this process's rank (0 without MPI) */
     int local_ranks;      /* ranks on this machine: they share its cores */
     rs_dist_result dres;  /* rank 0: the job's result */
+    rs_dist_fault dist_fault; /* RS_MPI_FAULT */
 } render_run;
 
 static void run_release(render_run *r)
@@ -1346,9 +1347,15 @@ static void dist_describe(const render_run *r, char *out, size_t n)
 }
 
 /* The options an MPI job cannot honour yet, refused by rank 0 (the others stay quiet). */
-static int dist_check_options(const rs_cli_options *o, int rank)
+static int dist_check_options(const rs_cli_options *o, int rank, rs_dist_fault *fault)
 {
     const char *what = NULL;
+    if (rs_dist_fault_parse(getenv("RS_MPI_FAULT"), fault) != RS_OK) {
+        if (rank == 0)
+            fail(0, NULL);
+        rs_error_clear();
+        return RS_EXIT_USAGE;
+    }
     if (o->adaptive > 0)
         what = "--adaptive (its rounds depend on the whole film)";
     else if (o->aovs)
@@ -1370,7 +1377,7 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
     int code, worst, who = 0, saved = -1;
     FILE *held = NULL;
     char desc[RS_DIST_DESC];
-    if ((code = dist_check_options(o, r->rank)) != RS_EXIT_OK)
+    if ((code = dist_check_options(o, r->rank, &r->dist_fault)) != RS_EXIT_OK)
         return code;
     if (r->rank > 0) {
         fflush(stderr);
@@ -1473,8 +1480,7 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     uint32_t(*todo)[2] = NULL, n_todo = 0, i;
     install_stop_signals();
     memset(&job, 0, sizeof job);
-    if (rs_dist_fault_parse(getenv("RS_MPI_FAULT"), &job.fault) != RS_OK)
-        return fail(RS_EXIT_USAGE, NULL);
+    job.fault = r->dist_fault;
     job.width = r->st.width;
     job.height = r->st.height;
     job.spp = r->st.spp;

@@ -18,7 +18,8 @@
  *     the megakernel and under mpirun gives the uninterrupted image bit for bit;
  *   - --checkpoint-interval under mpirun flushes every rank's film to rank 0 on the way;
  *   - Ctrl-C on mpirun ends every rank within seconds, with 128 + the signal or mpirun's code;
- *   - options the job cannot honour (--adaptive) are refused by rank 0 alone, in one line. */
+ *   - options the job cannot honour (--adaptive) and a bad RS_MPI_FAULT are refused by rank 0
+ *     alone, in one line. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -430,6 +431,19 @@ static void test_unsupported_options(void **state)
     EXPECT(&p, lines == 1 && strstr(p.err.data, "--adaptive"),
            "not one line from rank 0 naming --adaptive (%d lines)", lines);
     proc_free(&p);
+    /* a bad fault spec: one line too */
+    {
+        static const char *const plain[] = {"render", "builtin:cornell", "-q", NULL};
+        setenv("RS_MPI_FAULT", "die:0:x", 1);
+        mpirun(&p, f, 2, 0, plain);
+        setenv("RS_MPI_FAULT", "", 1);
+        lines = 0;
+        for (s = strstr(p.err.data, "raystream:"); s; s = strstr(s + 1, "raystream:"))
+            ++lines;
+        EXPECT(&p, !exited_with(&p, 0) && lines == 1 && strstr(p.err.data, "RS_MPI_FAULT"),
+               "a bad RS_MPI_FAULT is not one line (%d lines)", lines);
+        proc_free(&p);
+    }
 }
 
 static int find_mpi(void)

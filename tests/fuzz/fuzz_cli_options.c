@@ -53,8 +53,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (o.waves > 4 || o.chunk_size > (1u << 26) || o.wave_paths > (1u << 26))
             broken("waves, chunk or wave size out of range");
         if (!(o.ckpt_every_s > 0 && o.ckpt_every_s <= 1e9) ||
-            !(o.time_limit_s >= 0 && o.time_limit_s <= 1e9))
+            !(o.time_limit_s >= 0 && o.time_limit_s <= 1e9) ||
+            !(o.mpi_timeout_s >= 0 && o.mpi_timeout_s <= 1e9))
             broken("a time out of range");
+        if (o.mpi_pass_spp > (1u << 24))
+            broken("--mpi-pass out of range");
         if (o.megakernel && !o.devices_auto && o.n_devices > 1)
             broken("the megakernel on several devices");
         if (o.bvh_width != 0 && o.bvh_width != 2 && o.bvh_width != 4 && o.bvh_width != 8)
