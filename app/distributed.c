@@ -921,11 +921,16 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     c.res = res;
     c.npix = job->width * job->height;
     c.pass_spp = job->pass_spp;
-    if (!c.pass_spp) { /* about 8 passes a rank, so that a slow one costs little at the end */
-        uint32_t left = 0, i;
+    if (!c.pass_spp) {
+        /* about 8 passes a rank, so that a slow one costs little at the end, and at most about
+         * 2^21 paths (1-2 s on one core), so that a stop, which drops the passes under way,
+         * loses little */
+        uint32_t left = 0, i, most = (1u << 21) / c.npix;
         for (i = 0; i < job->n_todo; ++i)
             left += job->todo[i][1];
         c.pass_spp = left / (8u * (uint32_t)n);
+        if (c.pass_spp > most)
+            c.pass_spp = most;
         if (c.pass_spp < 1)
             c.pass_spp = 1;
     }

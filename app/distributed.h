@@ -81,7 +81,8 @@ typedef struct rs_dist_job {
     const uint32_t (*todo)[2];  /* rank 0: the samples to render, ranges [s0, s0 + n) of every
                                    pixel (sorted, disjoint; what the film does not hold) */
     uint32_t n_todo;
-    uint32_t pass_spp;          /* samples per pass; 0: auto (about 8 passes per rank) */
+    uint32_t pass_spp;          /* samples per pass; 0: auto (about 8 passes per rank, at
+                                   most about 2^22 paths a pass) */
     double flush_every_s;       /* rank 0: > 0, every rank sends what it finished this often
                                    (then `saved` is called); 0: only at the end */
     rs_dist_saved_fn saved;
