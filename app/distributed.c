@@ -10,6 +10,9 @@
  *                 ABORT (nothing)            drop what is under way, send the film now
  *                 FLUSH (nothing)            send what you finished (DONEs, then FILM flagged
  *                                            H_FLUSH), and go on from an empty film
+ *                 BYE   lost                 the job is over (after your film): call
+ *                                            MPI_Finalize unless a rank was lost (it would
+ *                                            wait for the dead)
  * Messages between two ranks arrive in the order they were sent, so a worker's DONEs precede
  * its film. */
 #define _GNU_SOURCE /* usleep-free nanosleep is POSIX; gethostname */
@@ -37,7 +40,8 @@ enum {
     T_PASS,
     T_STOP,
     T_ABORT,
-    T_FLUSH
+    T_FLUSH,
+    T_BYE
 };
 
 /* FILM header fields (uint64; doubles by their bits) */
@@ -698,6 +702,34 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
     if (!send_film(&l, acc, failed, 0, timeout_s)) {
         d->any_dead = 1;
         fprintf(stderr, "raystream: rank %d: could not send its film to rank 0\n", d->rank);
+    } else {
+        /* rank 0's word on how to end: MPI_Finalize waits for every rank, the dead too */
+        double t_bye = now_s(), nap = 1e-4;
+        int got = 0;
+        while (!got && now_s() - t_bye < timeout_s) {
+            int flag = 0;
+            MPI_Status ms;
+            if (MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms) != MPI_SUCCESS)
+                break;
+            if (flag) {
+                uint64_t v[2] = {0, 0};
+                int cnt = 0;
+                MPI_Get_count(&ms, MPI_UINT64_T, &cnt);
+                MPI_Recv(v, cnt > 2 ? 2 : cnt, MPI_UINT64_T, 0, ms.MPI_TAG, MPI_COMM_WORLD,
+                         MPI_STATUS_IGNORE);
+                if (ms.MPI_TAG == T_BYE) {
+                    got = 1;
+                    if (v[0])
+                        d->any_dead = 1;
+                }
+                continue;
+            }
+            sleep_s(nap);
+            if (nap < 2e-3)
+                nap *= 2;
+        }
+        if (!got)
+            d->any_dead = 1; /* rank 0 is gone: do not wait for it */
     }
     rs_film_destroy(spare == film ? acc : spare); /* the one of the two that is not `film` */
     rs_film_destroy(l.scratch);
@@ -1026,6 +1058,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                 if (!c.finished[r]) {
                     c.finished[r] = 1;
                     res->rank[r].alive = 0;
+                    d->any_dead = 1;
                     fprintf(stderr, "\nraystream: rank %d (%s) sent no film within %.1f s of "
                                     "the stop (it may be dead); its passes are left out\n",
                             r, res->rank[r].desc, grace_s);
@@ -1236,6 +1269,12 @@ stop_all:
             send_small(NULL, 0, r, T_ABORT);
 finish:
     local_join(&l);
+    /* the end, to every rank whose film came: finalize only if nobody was lost */
+    for (r = 1; r < n; ++r)
+        if (res->rank[r].alive) {
+            uint64_t lost = (uint64_t)d->any_dead;
+            send_small(&lost, 1, r, T_BYE);
+        }
     /* rank 0's row */
     res->rank[0].passes = l.passes;
     res->rank[0].paths = l.paths;
