@@ -15,7 +15,6 @@
  *                                            wait for the dead)
  * Messages between two ranks arrive in the order they were sent, so a worker's DONEs precede
  * its film. */
-#define _GNU_SOURCE /* usleep-free nanosleep is POSIX; gethostname */
 #include "app/distributed.h"
 
 #include <errno.h>
@@ -753,7 +752,7 @@ typedef struct coord {
     int *flushing; /* a flush asked of it is not in yet */
     uint32_t npix;
     /* per rank */
-    double *last_seen, *t_first;
+    double *last_seen;
     int *asked;    /* a request is waiting (no pass was free) */
     int *finished; /* its film arrived, or it is dead */
     int *stopped;  /* it was sent STOP or ABORT */
@@ -1003,13 +1002,12 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     c.state = (uint8_t *)rs_calloc(c.n_passes ? c.n_passes : 1, 1);
     c.owner = (int *)rs_calloc(c.n_passes ? c.n_passes : 1, sizeof *c.owner);
     c.last_seen = (double *)rs_calloc((size_t)n, sizeof *c.last_seen);
-    c.t_first = (double *)rs_calloc((size_t)n, sizeof *c.t_first);
     c.asked = (int *)rs_calloc((size_t)n, sizeof *c.asked);
     c.finished = (int *)rs_calloc((size_t)n, sizeof *c.finished);
     c.stopped = (int *)rs_calloc((size_t)n, sizeof *c.stopped);
     c.flushing = (int *)rs_calloc((size_t)n, sizeof *c.flushing);
     res->rank = (rs_dist_rank_stats *)rs_calloc((size_t)n, sizeof *res->rank);
-    if (!c.state || !c.owner || !c.last_seen || !c.t_first || !c.asked || !c.finished ||
+    if (!c.state || !c.owner || !c.last_seen || !c.asked || !c.finished ||
         !c.stopped || !c.flushing || !res->rank || rs_film_create(job->width, job->height, &tmp) != RS_OK) {
         st = rs_error_set(RS_ERR_NOMEM, "out of memory for the MPI coordinator");
         goto out;
@@ -1123,8 +1121,6 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                          MPI_COMM_WORLD, MPI_STATUS_IGNORE);
             }
             c.last_seen[r] = now_s();
-            if (!c.t_first[r])
-                c.t_first[r] = c.last_seen[r];
             active = 1;
             if (!res->rank[r].alive) {
                 /* a rank given up on, heard from again: its passes are out already */
@@ -1301,7 +1297,6 @@ out:
     rs_free(c.state);
     rs_free(c.owner);
     rs_free(c.last_seen);
-    rs_free(c.t_first);
     rs_free(c.asked);
     rs_free(c.finished);
     rs_free(c.stopped);
