@@ -1,6 +1,7 @@
 #!/bin/sh
-# scripts/check-sanitizers.sh — the test suite under AddressSanitizer + UBSan, the scheduler
-# and render tests (and the timeline, written from several threads) under ThreadSanitizer, and
+# scripts/check-sanitizers.sh — the test suite under AddressSanitizer + UBSan, the scheduler,
+# render, CLI and MPI tests (and the timeline, written from several threads) under
+# ThreadSanitizer, and
 # the libFuzzer harnesses (tests/fuzz, scripts/fuzz.sh) for a short bound each.  One command; run
 # it before resolving an issue.
 #   sh scripts/check-sanitizers.sh [address|thread|fuzz]   (default: all three)
@@ -31,8 +32,10 @@ if [ "$which" = all ] || [ "$which" = thread ]; then
     cmake -S . -B build-tsan -DRS_SANITIZE=thread -DRS_CUDA=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
     cmake --build build-tsan -j"$jobs"
     # OpenMP is compiled out of this build (core/parallel.h says why): no suppressions needed.
+    # app_mpi_test: the render thread against the messaging loop of every rank; Open MPI's own
+    # locks and threads are suppressed by the binary itself (app/distributed.c)
     TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-        ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli|app_timeline"
+        ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli|app_mpi|app_timeline"
 fi
 if [ "$which" = all ] || [ "$which" = fuzz ]; then
     # the scene reader, the mesh import and the option parser: no crash, hang, leak or
