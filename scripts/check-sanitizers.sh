@@ -2,8 +2,7 @@
 # scripts/check-sanitizers.sh — the test suite under AddressSanitizer + UBSan, the scheduler,
 # render, CLI and MPI tests (and the timeline, written from several threads) under
 # ThreadSanitizer, and the libFuzzer harnesses (tests/fuzz, scripts/fuzz.sh) for a short bound
-# each.  One command; run
-# it before resolving an issue.
+# each.  One command; run it before resolving an issue.
 #   sh scripts/check-sanitizers.sh [address|thread|fuzz]   (default: all three)
 # Builds in build-asan/, build-tsan/ and build-fuzz/ with RS_CUDA=OFF (device code is not
 # instrumented).  FUZZ_SECONDS (default 20) bounds each harness.
