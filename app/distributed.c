@@ -29,6 +29,19 @@
 
 #include "core/alloc.h"
 
+/* which sanitizer this is built with (gcc's macros, clang's __has_feature) */
+#if defined(__SANITIZE_ADDRESS__)
+#  define RS_ASAN 1
+#elif defined(__SANITIZE_THREAD__)
+#  define RS_TSAN 1
+#elif defined(__has_feature)
+#  if __has_feature(address_sanitizer)
+#    define RS_ASAN 1
+#  elif __has_feature(thread_sanitizer)
+#    define RS_TSAN 1
+#  endif
+#endif
+
 enum {
     T_REQ = 1,
     T_HB,
@@ -140,13 +153,6 @@ int rs_dist_launched(int *ranks, int *rank, int *local_ranks)
  * to one, their plug-ins stay loaded (below), and whoever runs the ranks under ASan sets
  * ASAN_OPTIONS=fast_unwind_on_malloc=0 (the libraries have no frame pointers; app_mpi_test and
  * mpi_bench do).  Nothing of raystream's own is suppressed. */
-#if defined(__SANITIZE_ADDRESS__)
-#  define RS_ASAN 1
-#elif defined(__has_feature)
-#  if __has_feature(address_sanitizer)
-#    define RS_ASAN 1
-#  endif
-#endif
 #ifdef RS_ASAN
 const char *__lsan_default_suppressions(void);
 const char *__lsan_default_suppressions(void)
@@ -160,13 +166,6 @@ const char *__lsan_default_suppressions(void)
  * transport takes two of its mutexes in both orders, its progress and PMIx threads share its
  * state) are not raystream's; reports inside them are suppressed, by library.  Our threads and
  * their locks (the render thread against the messaging loop) are checked in full. */
-#if defined(__SANITIZE_THREAD__)
-#  define RS_TSAN 1
-#elif defined(__has_feature)
-#  if __has_feature(thread_sanitizer)
-#    define RS_TSAN 1
-#  endif
-#endif
 #ifdef RS_TSAN
 const char *__tsan_default_suppressions(void);
 const char *__tsan_default_suppressions(void)
@@ -307,21 +306,6 @@ typedef struct local {
     rs_render_stats sum;             /* stages, summed */
 } local;
 
-static void add_stats(rs_render_stats *a, const rs_render_stats *b)
-{
-    int i;
-    for (i = 0; i < RS_STAGE_COUNT; ++i)
-        a->stage_s[i] += b->stage_s[i];
-    a->trace_s += b->trace_s;
-    a->shade_s += b->shade_s;
-    a->paths_total += b->paths_total;
-    a->paths_done += b->paths_done;
-    a->rays_closest += b->rays_closest;
-    a->rays_shadow += b->rays_shadow;
-    a->waves += b->waves;
-    if (b->max_bounce > a->max_bounce)
-        a->max_bounce = b->max_bounce;
-}
 
 static void *local_main(void *arg)
 {
@@ -371,7 +355,7 @@ static void *local_main(void *arg)
         if (st == RS_OK) {
             l->passes++;
             l->paths += rs.paths_done;
-            add_stats(&l->sum, &rs);
+            rs_render_stats_add(&l->sum, &rs);
             if (l->done_len < DONE_MAX) {
                 l->done_s0[l->done_len] = s0;
                 l->done_n[l->done_len++] = n;
@@ -528,6 +512,24 @@ static int send_small(const uint64_t *v, int n, int to, int tag)
 
 /* ---- a worker (rank > 0) ----------------------------------------------------------------- */
 
+/* A message from rank 0, if one is there: 1 with its tag and (up to two) values, 0 if none,
+ * -1 on an MPI error. */
+static int poll_rank0(int *tag, uint64_t v[2])
+{
+    int flag = 0, cnt = 0;
+    MPI_Status ms;
+    if (MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms) != MPI_SUCCESS)
+        return -1;
+    if (!flag)
+        return 0;
+    v[0] = v[1] = 0;
+    MPI_Get_count(&ms, MPI_UINT64_T, &cnt);
+    MPI_Recv(v, cnt > 2 ? 2 : cnt, MPI_UINT64_T, 0, ms.MPI_TAG, MPI_COMM_WORLD,
+             MPI_STATUS_IGNORE);
+    *tag = ms.MPI_TAG;
+    return 1;
+}
+
 static int sums_fit_int64(const rs_film *f)
 {
     size_t i, n = (size_t)f->width * f->height * 3;
@@ -631,8 +633,8 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
         return st;
     }
     for (;;) {
-        int flag = 0, active = 0;
-        MPI_Status ms;
+        int flag = 0, active = 0, tag = 0;
+        uint64_t v[2];
         uint32_t s0[DONE_MAX], n[DONE_MAX];
         int k, i;
         /* what the render thread finished */
@@ -658,26 +660,21 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
             last_sent = now_s();
             active = 1;
         }
-        if (MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms) != MPI_SUCCESS)
+        if ((flag = poll_rank0(&tag, v)) < 0)
             break;
         if (flag) {
-            uint64_t v[2] = {0, 0};
-            int cnt = 0;
-            MPI_Get_count(&ms, MPI_UINT64_T, &cnt);
-            MPI_Recv(v, cnt > 2 ? 2 : cnt, MPI_UINT64_T, 0, ms.MPI_TAG, MPI_COMM_WORLD,
-                     MPI_STATUS_IGNORE);
             last_heard = now_s();
-            if (ms.MPI_TAG == T_PASS) {
+            if (tag == T_PASS) {
                 local_push(&l, (uint32_t)v[0], (uint32_t)v[1]);
                 asked = 0;
-            } else if (ms.MPI_TAG == T_STOP) {
+            } else if (tag == T_STOP) {
                 stopping = 1;
                 asked = 0;
                 local_signal(&l, 0);
-            } else if (ms.MPI_TAG == T_ABORT) {
+            } else if (tag == T_ABORT) {
                 aborting = 1;
                 local_signal(&l, 1);
-            } else if (ms.MPI_TAG == T_FLUSH && !worker_flush(&l, &spare, timeout_s)) {
+            } else if (tag == T_FLUSH && !worker_flush(&l, &spare, timeout_s)) {
                 fprintf(stderr, "raystream: rank %d: could not send its film to rank 0\n",
                         d->rank);
             }
@@ -729,17 +726,12 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
         double t_bye = now_s(), nap = 1e-4;
         int got = 0;
         while (!got && now_s() - t_bye < timeout_s) {
-            int flag = 0;
-            MPI_Status ms;
-            if (MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &ms) != MPI_SUCCESS)
+            uint64_t v[2];
+            int tag = 0, flag = poll_rank0(&tag, v);
+            if (flag < 0)
                 break;
             if (flag) {
-                uint64_t v[2] = {0, 0};
-                int cnt = 0;
-                MPI_Get_count(&ms, MPI_UINT64_T, &cnt);
-                MPI_Recv(v, cnt > 2 ? 2 : cnt, MPI_UINT64_T, 0, ms.MPI_TAG, MPI_COMM_WORLD,
-                         MPI_STATUS_IGNORE);
-                if (ms.MPI_TAG == T_BYE) {
+                if (tag == T_BYE) {
                     got = 1;
                     if (v[0])
                         d->any_dead = 1;

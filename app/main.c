@@ -575,6 +575,24 @@ static int check_outputs(const rs_cli_options *o, render_run *r)
     return RS_EXIT_OK;
 }
 
+/* A --resume whose ranges all end on whole samples: RS_EXIT_OK, else one line ending in
+ * `what` and RS_EXIT_USAGE. */
+static int resume_whole_samples(const rs_cli_options *o, const render_run *r, const char *what)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    uint32_t i;
+    for (i = 0; i < r->held.n; ++i)
+        if (r->held.r[i][1] % npix != 0) {
+            fprintf(stderr,
+                    "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
+                    "pixels); %s\n",
+                    o->resume, (unsigned long long)r->held.r[i][1], r->st.width, r->st.height,
+                    what);
+            return RS_EXIT_USAGE;
+        }
+    return RS_EXIT_OK;
+}
+
 /* The film: a fresh one, or with --resume the checkpoint's (app/checkpoint.h), checked against
  * these settings before any work; the render then starts at the first path it does not hold.
  * --resume without --spp continues to the spp the checkpoint was started with.  Returns an exit
@@ -610,20 +628,9 @@ static int make_film(const rs_cli_options *o, render_run *r)
     /* a prefix continues from its end; other sets fill their gaps (render_gaps) */
     if (rs_path_ranges_is_prefix(&r->held))
         r->st.path_begin = r->piece_lo = r->on_film = r->resumed;
-    if (o->megakernel) {
-        uint64_t npix = (uint64_t)r->st.width * r->st.height;
-        uint32_t i;
-        for (i = 0; i < r->held.n; ++i)
-            if (r->held.r[i][1] % npix != 0) {
-                fprintf(stderr,
-                        "raystream: --resume %s: stopped within a pass (%llu samples of %ux%u "
-                        "pixels); the megakernel continues whole passes only (use "
-                        "--integrator stream)\n",
-                        o->resume, (unsigned long long)r->held.r[i][1], r->st.width,
-                        r->st.height);
-                return RS_EXIT_USAGE;
-            }
-    }
+    if (o->megakernel)
+        return resume_whole_samples(o, r, "the megakernel continues whole passes only (use "
+                                          "--integrator stream)");
     return RS_EXIT_OK;
 }
 
@@ -744,23 +751,6 @@ static void on_film_ready(void *user, const rs_film *film, uint64_t paths)
     (void)write_checkpoint(r, 1);
 }
 
-static void add_render_stats(rs_render_stats *a, const rs_render_stats *b)
-{
-    int i;
-    for (i = 0; i < RS_STAGE_COUNT; ++i)
-        a->stage_s[i] += b->stage_s[i];
-    a->seconds += b->seconds;
-    a->trace_s += b->trace_s;
-    a->shade_s += b->shade_s;
-    a->paths_total += b->paths_total;
-    a->paths_done += b->paths_done;
-    a->rays_closest += b->rays_closest;
-    a->rays_shadow += b->rays_shadow;
-    a->waves += b->waves;
-    a->time_limited |= b->time_limited;
-    if (b->max_bounce > a->max_bounce)
-        a->max_bounce = b->max_bounce;
-}
 
 /* A resumed film that holds several ranges of paths (an MPI job stopped with passes missing):
  * each gap between them is rendered in turn, [q0, q1) as the render of q1 / npix samples from
@@ -801,7 +791,7 @@ static rs_status render_gaps(const rs_cli_options *o, render_run *r, rs_render_h
             rst = rs_render_passes(r->scene, r->mk, &st, hooks, r->film, &one);
         else
             rst = rs_render(r->scene, r->sched, &st, hooks, r->film, &one);
-        add_render_stats(&r->stats, &one);
+        rs_render_stats_add(&r->stats, &one);
         r->progress_base += one.paths_done;
         r->on_film = r->piece_lo + one.paths_done;
         if (i + 1 < gaps.n && !rs_path_ranges_add(&r->held, r->piece_lo, r->on_film))
@@ -1394,20 +1384,9 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
             code = fail(RS_EXIT_RUNTIME, "starting the render");
         }
     }
-    if (code == RS_EXIT_OK && r->rank == 0) {
-        uint64_t npix = (uint64_t)r->st.width * r->st.height;
-        uint32_t i;
-        for (i = 0; i < r->held.n && code == RS_EXIT_OK; ++i)
-            if (r->held.r[i][1] % npix != 0) {
-                fprintf(stderr,
-                        "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
-                        "pixels); under mpirun a render continues whole samples only (resume "
-                        "it on one process)\n",
-                        o->resume, (unsigned long long)r->held.r[i][1], r->st.width,
-                        r->st.height);
-                code = RS_EXIT_USAGE;
-            }
-    }
+    if (code == RS_EXIT_OK && r->rank == 0)
+        code = resume_whole_samples(o, r, "under mpirun a render continues whole samples only "
+                                          "(resume it on one process)");
     if (code == RS_EXIT_OK && (code = build_bvh(o, r)) == RS_EXIT_OK)
         code = start_devices(o, r);
     desc[0] = 0;

@@ -27,22 +27,6 @@ static void round_progress(void *user, uint64_t done, uint64_t total)
     p->outer->progress(p->outer->user, p->done_before + done, p->total);
 }
 
-static void add_stats(rs_render_stats *sum, const rs_render_stats *r)
-{
-    int k;
-    for (k = 0; k < RS_STAGE_COUNT; ++k)
-        sum->stage_s[k] += r->stage_s[k];
-    sum->trace_s += r->trace_s;
-    sum->shade_s += r->shade_s;
-    sum->paths_total += r->paths_total;
-    sum->paths_done += r->paths_done;
-    sum->rays_closest += r->rays_closest;
-    sum->rays_shadow += r->rays_shadow;
-    sum->waves += r->waves;
-    if (r->max_bounce > sum->max_bounce)
-        sum->max_bounce = r->max_bounce;
-    sum->time_limited |= r->time_limited;
-}
 
 rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
                              const rs_render_settings *settings, const rs_adaptive *a,
@@ -140,7 +124,7 @@ rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
             rh.time_limit_s = left > 1e-6 ? left : 1e-6;
         }
         st = rs_render(scene, sched, &r, &rh, film, &one);
-        add_stats(stats, &one);
+        rs_render_stats_add(stats, &one);
         as->rounds++;
         as->samples += one.paths_done;
         pc.done_before += one.paths_done;

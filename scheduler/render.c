@@ -269,6 +269,23 @@ static rs_status flush_in_order(render_ctx *c, uint64_t *next_flush)
     }
 }
 
+void rs_render_stats_add(rs_render_stats *sum, const rs_render_stats *r)
+{
+    int k;
+    for (k = 0; k < RS_STAGE_COUNT; ++k)
+        sum->stage_s[k] += r->stage_s[k];
+    sum->trace_s += r->trace_s;
+    sum->shade_s += r->shade_s;
+    sum->paths_total += r->paths_total;
+    sum->paths_done += r->paths_done;
+    sum->rays_closest += r->rays_closest;
+    sum->rays_shadow += r->rays_shadow;
+    sum->waves += r->waves;
+    if (r->max_bounce > sum->max_bounce)
+        sum->max_bounce = r->max_bounce;
+    sum->time_limited |= r->time_limited;
+}
+
 rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *st,
                               const rs_film *film, rs_integrator *it)
 {

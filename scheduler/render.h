@@ -107,6 +107,11 @@ typedef struct rs_render_hooks {
     void (*film_ready)(void *user, const rs_film *film, uint64_t paths_on_film);
 } rs_render_hooks;
 
+/* Adds the counts and stage times of `r` to `sum` (a render made of several calls: adaptive
+ * rounds, the gaps of a resumed checkpoint, an MPI rank's passes); `seconds` is left to the
+ * caller, who knows the wall time of them all. */
+void rs_render_stats_add(rs_render_stats *sum, const rs_render_stats *r);
+
 /* Renders `scene` into `film` (whose size must match settings).  `hooks` may be NULL.  With
  * settings->path_begin > 0 the film must hold exactly paths [0, path_begin) of a render with
  * the same settings; the result is then the uninterrupted render's bit for bit, since each
