@@ -477,6 +477,19 @@ static void local_join(local *l)
 
 /* ---- messaging helpers -------------------------------------------------------------------- */
 
+/* Between probes of a messaging loop: after activity `nap` is reset to 0.1 ms; while nothing
+ * comes it sleeps and doubles up to 2 ms, so a waiting rank costs no core. */
+static void idle_nap(double *nap, int active)
+{
+    if (active) {
+        *nap = 1e-4;
+        return;
+    }
+    sleep_s(*nap);
+    if (*nap < 2e-3)
+        *nap *= 2;
+}
+
 /* Waits for `req` without spinning a core; gives up (cancelling it) after timeout_s. */
 static int wait_req(MPI_Request *req, double timeout_s)
 {
@@ -492,9 +505,7 @@ static int wait_req(MPI_Request *req, double timeout_s)
             MPI_Request_free(req);
             return 0;
         }
-        sleep_s(nap);
-        if (nap < 2e-3)
-            nap *= 2;
+        idle_nap(&nap, 0);
     }
 }
 
@@ -693,13 +704,7 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
             rs_film_destroy(spare);
             return rs_error_set(RS_ERR_IO, "rank 0 is gone");
         }
-        if (active) {
-            nap = 1e-4;
-        } else {
-            sleep_s(nap);
-            if (nap < 2e-3)
-                nap *= 2;
-        }
+        idle_nap(&nap, active);
     }
     pthread_join(l.thread, NULL);
     l.started = 0;
@@ -738,9 +743,7 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
                 }
                 continue;
             }
-            sleep_s(nap);
-            if (nap < 2e-3)
-                nap *= 2;
+            idle_nap(&nap, 0);
         }
         if (!got)
             d->any_dead = 1; /* rank 0 is gone: do not wait for it */
@@ -1260,14 +1263,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
         if (all_finished && local_idle(&l) &&
             (signalled || count_state(&c, P_MERGED, c.limit) == c.limit))
             break;
-        /* every worker is gone and passes are left: rank 0 does them (assigned above) */
-        if (active) {
-            nap = 1e-4;
-        } else {
-            sleep_s(nap);
-            if (nap < 2e-3)
-                nap *= 2;
-        }
+        idle_nap(&nap, active);
     }
     goto finish;
 
