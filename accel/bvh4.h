@@ -231,9 +231,10 @@ static inline uint32_t rs_bvh4_quad4_hit(const rs_bvh4_quad4 *b, const rs_bvh4_r
     /* denom = w . d, t = w . (q - o) / denom */
     __m128 denom = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, r->d[0]), _mm_mul_ps(wy, r->d[1])),
                               _mm_mul_ps(wz, r->d[2]));
-    __m128 num = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, _mm_sub_ps(qx, r->o[0])),
-                                       _mm_mul_ps(wy, _mm_sub_ps(qy, r->o[1]))),
-                            _mm_mul_ps(wz, _mm_sub_ps(qz, r->o[2])));
+    __m128 ox = _mm_sub_ps(qx, r->o[0]), oy = _mm_sub_ps(qy, r->o[1]);
+    __m128 oz = _mm_sub_ps(qz, r->o[2]);
+    __m128 num = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, ox), _mm_mul_ps(wy, oy)),
+                            _mm_mul_ps(wz, oz));
     __m128 tt = _mm_div_ps(num, denom);
     __m128 ok = _mm_and_ps(_mm_cmpneq_ps(denom, zero),
                            _mm_and_ps(_mm_cmpgt_ps(tt, _mm_set1_ps(tmin)),
@@ -241,12 +242,12 @@ static inline uint32_t rs_bvh4_quad4_hit(const rs_bvh4_quad4 *b, const rs_bvh4_r
     if (_mm_movemask_ps(ok) == 0)
         return 0;
     {
-        /* ph = (o + d t) - q; alpha = w . (ph x v), beta = w . (u x ph) */
+        /* ph = d t - (q - o); alpha = w . (ph x v), beta = w . (u x ph) */
         __m128 ux = RS_LD(b->u[0]), uy = RS_LD(b->u[1]), uz = RS_LD(b->u[2]);
         __m128 vx = RS_LD(b->v[0]), vy = RS_LD(b->v[1]), vz = RS_LD(b->v[2]);
-        __m128 hx = _mm_sub_ps(_mm_add_ps(r->o[0], _mm_mul_ps(r->d[0], tt)), qx);
-        __m128 hy = _mm_sub_ps(_mm_add_ps(r->o[1], _mm_mul_ps(r->d[1], tt)), qy);
-        __m128 hz = _mm_sub_ps(_mm_add_ps(r->o[2], _mm_mul_ps(r->d[2], tt)), qz);
+        __m128 hx = _mm_sub_ps(_mm_mul_ps(r->d[0], tt), ox);
+        __m128 hy = _mm_sub_ps(_mm_mul_ps(r->d[1], tt), oy);
+        __m128 hz = _mm_sub_ps(_mm_mul_ps(r->d[2], tt), oz);
         __m128 cx = _mm_sub_ps(_mm_mul_ps(hy, vz), _mm_mul_ps(hz, vy));
         __m128 cy = _mm_sub_ps(_mm_mul_ps(hz, vx), _mm_mul_ps(hx, vz));
         __m128 cz = _mm_sub_ps(_mm_mul_ps(hx, vy), _mm_mul_ps(hy, vx));

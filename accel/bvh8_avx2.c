@@ -147,8 +147,8 @@ static inline uint32_t quad8_hit(const rs_bvh8_quad8 *b, const ray8 *r, float tm
     __m256 qx = LD(b->q[0]), qy = LD(b->q[1]), qz = LD(b->q[2]);
     __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     __m256 denom = ADD(ADD(MUL(wx, r->d[0]), MUL(wy, r->d[1])), MUL(wz, r->d[2]));
-    __m256 num = ADD(ADD(MUL(wx, SUB(qx, r->o[0])), MUL(wy, SUB(qy, r->o[1]))),
-                     MUL(wz, SUB(qz, r->o[2])));
+    __m256 ox = SUB(qx, r->o[0]), oy = SUB(qy, r->o[1]), oz = SUB(qz, r->o[2]);
+    __m256 num = ADD(ADD(MUL(wx, ox), MUL(wy, oy)), MUL(wz, oz));
     __m256 tt = _mm256_div_ps(num, denom);
     __m256 ok = AND(CMP_NE(denom, zero),
                     AND(CMP_GT(tt, _mm256_set1_ps(tmin)), CMP_LT(tt, _mm256_set1_ps(tmax))));
@@ -157,9 +157,9 @@ static inline uint32_t quad8_hit(const rs_bvh8_quad8 *b, const ray8 *r, float tm
     {
         __m256 ux = LD(b->u[0]), uy = LD(b->u[1]), uz = LD(b->u[2]);
         __m256 vx = LD(b->v[0]), vy = LD(b->v[1]), vz = LD(b->v[2]);
-        __m256 hx = SUB(ADD(r->o[0], MUL(r->d[0], tt)), qx);
-        __m256 hy = SUB(ADD(r->o[1], MUL(r->d[1], tt)), qy);
-        __m256 hz = SUB(ADD(r->o[2], MUL(r->d[2], tt)), qz);
+        __m256 hx = SUB(MUL(r->d[0], tt), ox);
+        __m256 hy = SUB(MUL(r->d[1], tt), oy);
+        __m256 hz = SUB(MUL(r->d[2], tt), oz);
         __m256 cx = SUB(MUL(hy, vz), MUL(hz, vy));
         __m256 cy = SUB(MUL(hz, vx), MUL(hx, vz));
         __m256 cz = SUB(MUL(hx, vy), MUL(hy, vx));

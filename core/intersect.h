@@ -114,18 +114,23 @@ RS_HD int rs_isect_tri(const rs_tri *tr, const rs_ray *r, float *t, float *u, fl
 }
 
 /* Ray/parallelogram Q + a u + b v, 0 <= a, b <= 1 (Shirley, "Ray Tracing: The Next Week" §6).
- * On a hit: *t and the planar coordinates (*a, *b).  The scale of w cancels in t. */
+ * On a hit: *t and the planar coordinates (*a, *b).  The scale of w cancels in t.  Everything is
+ * computed from q - o, so the precision depends on the distance from the ray's origin, not from
+ * the world's origin. */
 RS_HD int rs_isect_quad(const rs_quad *qd, const rs_ray *r, float *t, float *a, float *b)
 {
     float denom = rs_v3_dot(qd->w, r->d);
     float tt, alpha, beta;
-    rs_vec3 ph;
+    rs_vec3 oq, ph;
     if (denom == 0.0f)
         return 0;
-    tt = rs_v3_dot(qd->w, rs_v3_sub(qd->q, r->o)) / denom;
+    oq = rs_v3_sub(qd->q, r->o);
+    tt = rs_v3_dot(qd->w, oq) / denom;
     if (!(tt > r->tmin && tt < r->tmax))
         return 0;
-    ph = rs_v3_sub(rs_ray_at(r, tt), qd->q);
+    /* the hit relative to q as t d - (q - o): no coordinate of the size of o or q is rounded, so
+     * the test is as precise far from the origin as at it */
+    ph = rs_v3_sub(rs_v3_scale(r->d, tt), oq);
     alpha = rs_v3_dot(qd->w, rs_v3_cross(ph, qd->v));
     beta = rs_v3_dot(qd->w, rs_v3_cross(qd->u, ph));
     if (!(alpha >= 0.0f && alpha <= 1.0f && beta >= 0.0f && beta <= 1.0f))

@@ -41,8 +41,11 @@ RS_HD void rs_path_aov(const rs_integrator *it, const rs_ray *r, const rs_hit *h
         return;
     }
     m = rs_scene_prim_material(sc, h->prim);
-    x = rs_ray_at(r, h->t);
-    ng = rs_prim_normal(sc, h->prim, x, r->time);
+    {
+        rs_surface_point sp = rs_surface_at(sc, h->prim, r, h->t, h->u, h->v); /* as shading */
+        x = sp.p;
+        ng = sp.ng;
+    }
     wo = rs_v3_neg(r->d);
     n_geo = rs_v3_dot(ng, r->d) < 0.0f ? ng : rs_v3_neg(ng);
     *depth = h->t * rs_v3_length(r->d);

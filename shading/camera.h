@@ -9,7 +9,9 @@
 
 typedef struct rs_camera {
     rs_vec3 origin;
-    rs_vec3 corner;         /* top-left corner of the image on the focus plane */
+    rs_vec3 corner;         /* top-left corner of the image on the focus plane, relative to
+                               origin (so that directions keep their precision far from the
+                               world's origin) */
     rs_vec3 du, dv;         /* one pixel to the right / one pixel down, on the focus plane */
     rs_vec3 lens_u, lens_v; /* lens-plane axes scaled by the lens radius */
     float lens_radius;
@@ -32,7 +34,7 @@ RS_HD rs_camera rs_camera_make(rs_vec3 from, rs_vec3 at, rs_vec3 up, float vfov_
     c.origin = from;
     c.du = rs_v3_scale(vu, 1.0f / (float)width);
     c.dv = rs_v3_scale(vv, 1.0f / (float)height);
-    c.corner = rs_v3_sub(rs_v3_sub(rs_v3_sub(from, rs_v3_scale(w, fd)), rs_v3_scale(vu, 0.5f)),
+    c.corner = rs_v3_sub(rs_v3_sub(rs_v3_scale(w, -fd), rs_v3_scale(vu, 0.5f)),
                          rs_v3_scale(vv, 0.5f));
     c.lens_radius = 0.5f * aperture;
     c.lens_u = rs_v3_scale(u, c.lens_radius);
@@ -47,14 +49,16 @@ RS_HD rs_ray rs_camera_ray(const rs_camera *c, uint32_t px, uint32_t py, float j
     rs_ray r;
     rs_vec3 target = rs_v3_add(rs_v3_add(c->corner, rs_v3_scale(c->du, (float)px + jx)),
                                rs_v3_scale(c->dv, (float)py + jy));
-    r.o = c->origin;
+    rs_vec3 lens = rs_v3_splat(0.0f);
     if (c->lens_radius > 0.0f) {
         /* uniform point on the unit disk by polar mapping */
         float rr = sqrtf(l1), phi = 2.0f * RS_PI * l2;
-        r.o = rs_v3_add(r.o, rs_v3_add(rs_v3_scale(c->lens_u, rr * cosf(phi)),
-                                       rs_v3_scale(c->lens_v, rr * sinf(phi))));
+        lens = rs_v3_add(rs_v3_scale(c->lens_u, rr * cosf(phi)),
+                         rs_v3_scale(c->lens_v, rr * sinf(phi)));
     }
-    r.d = rs_v3_normalize(rs_v3_sub(target, r.o));
+    /* the direction from camera-relative points: the origin's size never rounds it */
+    r.o = rs_v3_add(c->origin, lens);
+    r.d = rs_v3_normalize(rs_v3_sub(target, lens));
     r.tmin = 0.0f;
     r.time = 0.0f; /* the caller picks the time in the shutter interval */
     r.tmax = 3.402823466e38f;

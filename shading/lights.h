@@ -16,9 +16,12 @@
 #include "core/sampling.h"
 #include "scenes/scene.h"
 #include "shading/envmap.h"
+#include "shading/spawn.h"
 
 typedef struct rs_light_sample {
     rs_vec3 point; /* on the light */
+    rs_vec3 err;   /* point's error bound, and the light's unit normal there (emitters only: */
+    rs_vec3 n;     /* a shadow ray ends at the point moved off the emitter, shading/spawn.h) */
     rs_vec3 wi;    /* unit direction from the shading point toward `point` */
     float dist;    /* distance to `point` */
     float pdf;     /* solid-angle pdf, pick probability included */
@@ -158,6 +161,7 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
 {
     uint32_t l, prim, n = s->n_lights;
     const rs_light *lt;
+    rs_surface_point sp;
     rs_vec3 p, n_l, to;
     float d2, cos_l, env_pick = s->env_pick, inv_mass = 1.0f;
     if (!rs_scene_has_lights(s))
@@ -211,29 +215,29 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
             rs_vec3 perp = rs_v3_sub(rs_v3_scale(w, dc * ct), axis);
             float disc = r * r - rs_v3_dot(perp, perp);
             float t = dc * ct - sqrtf(rs_fmaxf(0.0f, disc));
+            sp = rs_sphere_point(c, r, rs_v3_madd(x, w, t));
             out->wi = w;
             out->dist = t;
-            out->point = rs_v3_madd(x, w, t);
+            out->point = sp.p;
+            out->err = sp.err;
+            out->n = sp.ng;
             out->pdf = lt->pick_pdf * rs_pdf_uniform_cone(omc);
-            n_l = rs_v3_scale(rs_v3_sub(out->point, c), 1.0f / r);
-            out->le = rs_emitted(rs_scene_prim_material(s, prim), n_l, w);
+            out->le = rs_emitted(rs_scene_prim_material(s, prim), sp.ng, w);
             if (inv_mass != 1.0f)
                 out->pdf *= inv_mass;
             return out->pdf > 0.0f && t > 0.0f;
         }
         /* inside (or on) the sphere: a point uniform on its surface */
-        p = rs_v3_madd(c, rs_sample_uniform_sphere(u1, u2), r);
+        sp = rs_sphere_point(c, r, rs_v3_madd(c, rs_sample_uniform_sphere(u1, u2), r));
     } else if (prim - s->n_spheres < s->n_quads) {
-        const rs_quad *q = &s->quads[prim - s->n_spheres];
-        p = rs_v3_add(q->q, rs_v3_add(rs_v3_scale(q->u, u1), rs_v3_scale(q->v, u2)));
+        sp = rs_quad_point(&s->quads[prim - s->n_spheres], u1, u2);
     } else {
-        const rs_tri *t = &s->tris[prim - s->n_spheres - s->n_quads];
         float b1, b2;
         rs_sample_triangle(u1, u2, &b1, &b2);
-        p = rs_v3_add(rs_v3_add(rs_v3_scale(t->v0, 1.0f - b1 - b2), rs_v3_scale(t->v1, b1)),
-                      rs_v3_scale(t->v2, b2));
+        sp = rs_tri_point(&s->tris[prim - s->n_spheres - s->n_quads], b1, b2);
     }
-    n_l = rs_prim_normal(s, prim, p, time);
+    p = sp.p;
+    n_l = sp.ng;
     to = rs_v3_sub(p, x);
     d2 = rs_v3_dot(to, to);
     if (!(d2 > 0.0f))
@@ -244,6 +248,8 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
     if (!(cos_l > 1e-7f))
         return 0;
     out->point = p;
+    out->err = sp.err;
+    out->n = n_l;
     out->pdf = lt->pick_pdf * d2 / (lt->area * cos_l);
     if (inv_mass != 1.0f)
         out->pdf *= inv_mass;

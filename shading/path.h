@@ -33,6 +33,7 @@
 #include "shading/camera.h"
 #include "shading/dims.h"
 #include "shading/lights.h"
+#include "shading/spawn.h"
 #include "shading/texture.h"
 #include "streams/paths.h"
 #if !defined(__CUDACC__)
@@ -158,31 +159,6 @@ RS_HD rs_ray rs_path_begin_at(const rs_integrator *it, uint32_t pixel, uint32_t 
 RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
 {
     return rs_path_begin_at(it, rs_path_pixel(it, g), rs_path_sample(it, g), NULL, ps);
-}
-
-/* Moves a ray origin off the surface along n (the side the new ray leaves from); the offset
- * scales with the coordinates so that it stays far above float rounding (~1e-7 relative) at any
- * scene scale. */
-RS_HD rs_vec3 rs_offset_origin(rs_vec3 x, rs_vec3 n, float prim_scale)
-{
-    float scale = rs_fmaxf(rs_fmaxf(fabsf(x.x), fabsf(x.y)), rs_fmaxf(fabsf(x.z), 1e-2f));
-    return rs_v3_madd(x, n, rs_fmaxf(1e-4f * scale, 1e-6f * prim_scale));
-}
-
-/* The size of the numbers a primitive's intersection test works with, which bounds the error of
- * its hit points: for a sphere, its centre's coordinates and its radius (the ground sphere of
- * rtiow-final, radius 1000 centred 1000 below the origin, puts hit points near the origin with
- * errors of ~1e-4: offset by the hit point's own size only, a bounce ray there could find the
- * ground again at t ~ 1e-5, a hit outside the ground's bounding box that a BVH culls and brute
- * force does not).  The origin moves by 1e-6 of it (~17 float ulps; 2e-3 for that ground).
- * Triangles and quads: their hit points' own size, 0 here. */
-RS_HD float rs_prim_scale(const rs_scene *sc, uint32_t prim)
-{
-    const rs_sphere *s;
-    if (prim >= sc->n_spheres)
-        return 0.0f;
-    s = &sc->spheres[prim];
-    return rs_fmaxf(rs_fmaxf(fabsf(s->center.x), fabsf(s->center.y)), fabsf(s->center.z)) + s->radius;
 }
 
 RS_HD float rs_power_heuristic(float a, float b)
@@ -347,7 +323,8 @@ typedef struct rs_vertex {
     rs_vec3 n;      /* the shading normal (rs_shading_normal) */
     rs_vec3 wo;     /* toward where the ray came from */
     rs_vec3 albedo; /* the material's albedo there (textured or not) */
-    rs_vec3 origin; /* where rays leaving the reflecting side start (rs_offset_origin) */
+    rs_vec3 err;    /* x's error bound (shading/spawn.h) */
+    rs_vec3 origin; /* where rays leaving the reflecting side start (rs_spawn_origin) */
 } rs_vertex;
 
 /* An emitter hit: its radiance, MIS-weighted against the light sampling that could also have
@@ -368,7 +345,7 @@ RS_HD void rs_shade_emitter(const rs_integrator *it, const rs_ray *r, float t, u
 
 /* Mirror or glass: the only direction that carries light is the sampled one.  0: the path ends
  * here. */
-RS_HD int rs_shade_delta(const rs_scene *sc, rs_vertex *v, rs_rng_f4 rb, rs_vec3 *beta, rs_vec3 *wi)
+RS_HD int rs_shade_delta(rs_vertex *v, rs_rng_f4 rb, rs_vec3 *beta, rs_vec3 *wi)
 {
     rs_scatter bs;
     if (!rs_bsdf_sample(v->m, v->albedo, v->n, v->wo, v->front, rb.v[0], rb.v[1], rb.v[2], &bs))
@@ -378,8 +355,7 @@ RS_HD int rs_shade_delta(const rs_scene *sc, rs_vertex *v, rs_rng_f4 rb, rs_vec3
     if ((rs_v3_dot(*wi, v->n_geo) > 0.0f) == (bs.transmit != 0))
         return 0;
     *beta = rs_v3_mul(*beta, bs.weight);
-    v->origin = rs_offset_origin(v->x, bs.transmit ? rs_v3_neg(v->n_geo) : v->n_geo,
-                                 rs_prim_scale(sc, v->prim));
+    v->origin = rs_spawn_origin(v->x, v->err, bs.transmit ? rs_v3_neg(v->n_geo) : v->n_geo);
     return 1;
 }
 
@@ -395,9 +371,9 @@ RS_HD int rs_vertex_side_ok(const rs_vertex *v, rs_vec3 w, float c, int through)
 }
 
 /* Where rays leaving v through the surface start: the hit point moved to the far side. */
-RS_HD rs_vec3 rs_vertex_far_origin(const rs_scene *sc, const rs_vertex *v)
+RS_HD rs_vec3 rs_vertex_far_origin(const rs_vertex *v)
 {
-    return rs_offset_origin(v->x, rs_v3_neg(v->n_geo), rs_prim_scale(sc, v->prim));
+    return rs_spawn_origin(v->x, v->err, rs_v3_neg(v->n_geo));
 }
 
 /* Next-event estimation (mis): a shadow ray toward a sampled point on a light, its MIS-weighted
@@ -426,14 +402,17 @@ RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, c
                                                                          v->wo, ls.wi, v->front));
         ps->pending = rs_v3_scale(rs_v3_mul(rs_v3_mul(beta, fl), ls.le), fabsf(c) * w / ls.pdf);
     }
-    shadow->o = through ? rs_vertex_far_origin(sc, v) : v->origin;
+    shadow->o = through ? rs_vertex_far_origin(v) : v->origin;
     shadow->tmin = 0.0f;
     if (ls.env) {
         shadow->d = ls.wi; /* toward the map: anything in the way occludes */
         shadow->tmax = FLT_MAX;
     } else {
-        shadow->d = rs_v3_sub(ls.point, shadow->o); /* unnormalised: the light at t = 1 */
-        shadow->tmax = 1.0f - 1e-4f;
+        /* unnormalised: the light's point (moved off an emitter toward the origin, as the
+         * origin is moved off the surface) at t = 1 */
+        rs_vec3 end = ls.delta ? ls.point : rs_spawn_end(ls.point, ls.err, ls.n, shadow->o);
+        shadow->d = rs_v3_sub(end, shadow->o);
+        shadow->tmax = 1.0f - RS_SHADOW_EPS;
     }
     shadow->time = r->time;
     return RS_SHADE_SHADOW;
@@ -537,8 +516,12 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
     }
     v.prim = h->prim;
     v.m = rs_scene_prim_material(sc, v.prim);
-    v.x = rs_ray_at(&r, h->t);
-    v.ng = rs_prim_normal(sc, v.prim, v.x, r.time);
+    {
+        rs_surface_point sp = rs_surface_at(sc, v.prim, &r, h->t, h->u, h->v);
+        v.x = sp.p;
+        v.err = sp.err;
+        v.ng = sp.ng;
+    }
     if (v.m->type == RS_MAT_DIFFUSE_LIGHT) {
         rs_shade_emitter(it, &r, h->t, v.prim, v.m, v.ng, beta, ps);
         return 0; /* emitters reflect nothing */
@@ -570,12 +553,12 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
     rb = pre ? pre[0] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
 
     if (rs_material_is_delta(v.m)) {
-        if (!rs_shade_delta(sc, &v, rb, &beta, &wi))
+        if (!rs_shade_delta(&v, rb, &beta, &wi))
             return out;
         specular = 1;
     } else {
         rs_rng_f4 rl = pre ? pre[1] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
-        v.origin = rs_offset_origin(v.x, v.n_geo, rs_prim_scale(sc, v.prim));
+        v.origin = rs_spawn_origin(v.x, v.err, v.n_geo);
         if (it->sampling == RS_SAMPLING_MIS && rs_scene_has_lights(sc))
             out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_ALL);
         else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > sc->n_area_lights)
@@ -590,7 +573,7 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
              * of the shading surface too), else a shading-normal artefact that carries nothing */
             if (!rs_vertex_side_ok(&v, wi, rs_v3_dot(wi, v.n), 1))
                 return out;
-            v.origin = rs_vertex_far_origin(sc, &v);
+            v.origin = rs_vertex_far_origin(&v);
         }
     }
     /* Russian roulette, then the next segment.  The survival probability follows the path's

@@ -1,0 +1,163 @@
+/* shading/spawn.h — where rays leave surfaces: points on primitives with a conservative bound on
+ * their rounding error, and ray origins moved just past that bound (pbrt-v4's OffsetRayOrigin:
+ * Pharr, Jakob & Humphreys, Physically Based Rendering 4th ed. §6.8), in place of a fixed
+ * epsilon.  Shared by the host and the CUDA device (every function RS_HD).
+ *
+ * A point on a primitive is recomputed from the primitive's own parameters (a triangle's
+ * barycentrics, a parallelogram's planar coordinates, a sphere's centre and radius), never from
+ * the ray as o + t d, whose error grows with the ray's origin and length.  Its error bound `err`
+ * (per coordinate, absolute) has two parts:
+ *   - the rounding of the point itself: a few ulps of its coordinates (gamma(n) |.|, Higham's
+ *     gamma_n = n u / (1 - n u), u = 2^-24);
+ *   - the rounding of the intersection tests (core/intersect.h), which evaluate the primitive
+ *     relative to the ray's origin: a ray starting at a distance d from the surface finds t of
+ *     the wrong sign only when d is below a few ulps of the primitive's own size (a sphere's
+ *     radius, a parallelogram's edges, a triangle's edges over the sine of its angle at v0).
+ * A ray leaving along unit normal n then starts at p + n (|n| . err), each coordinate rounded
+ * once more away from p, so that it is on the leaving side of every point the true surface and
+ * the test could put there.  Far from the origin the offset stays a few ulps of the coordinates
+ * (10^4 units: ~10^-2 of a unit... see docs/intersect.md#coordinate-range for the figures), and
+ * a primitive's size, not its position, sets the rest.  Shadow rays end at a point on the light
+ * moved the same way toward the shading point (rs_spawn_end). */
+#ifndef RS_SHADING_SPAWN_H
+#define RS_SHADING_SPAWN_H
+
+#include <float.h>
+#include <string.h>
+
+#include "scenes/scene.h"
+
+/* Higham's gamma_n: a bound on the relative error of n rounded operations. */
+#define RS_GAMMA(n) ((float)(n) * (0.5f * FLT_EPSILON) / (1.0f - (float)(n) * (0.5f * FLT_EPSILON)))
+
+/* A shadow ray stops this fraction of its length short of the light's point (pbrt's
+ * ShadowEpsilon): a margin on top of rs_spawn_end's offset. */
+#define RS_SHADOW_EPS 1e-4f
+
+/* A point on a surface: the point, its error bound (absolute, per coordinate, >= 0) and the
+ * unit geometric normal as the primitive defines it (rs_prim_normal's). */
+typedef struct rs_surface_point {
+    rs_vec3 p, err, ng;
+} rs_surface_point;
+
+RS_HD rs_vec3 rs_v3_abs(rs_vec3 a) { return rs_v3(fabsf(a.x), fabsf(a.y), fabsf(a.z)); }
+
+/* The next float above (dir > 0) or below (dir < 0) v; v itself for dir == 0, an infinity or a
+ * NaN.  By the bits, as pbrt's NextFloatUp/Down (glibc's nextafterf is a call). */
+RS_HD float rs_float_step(float v, float dir)
+{
+    uint32_t b;
+    if (dir == 0.0f || !(v - v == 0.0f)) /* zero step, infinity or NaN */
+        return v;
+    if (v == 0.0f) /* +0 or -0: the smallest subnormal of the step's sign */
+        v = 0.0f;
+    memcpy(&b, &v, sizeof b);
+    if ((dir > 0.0f) == (v >= 0.0f))
+        ++b; /* away from zero */
+    else
+        --b;
+    if (v == 0.0f)
+        b = dir > 0.0f ? 1u : 0x80000001u;
+    memcpy(&v, &b, sizeof v);
+    return v;
+}
+
+/* p moved along unit normal n (the side the new ray leaves toward) past the error bound err:
+ * p + n (|n| . err), each coordinate then stepped one float further from p (pbrt-v4's
+ * OffsetRayOrigin). */
+RS_HD rs_vec3 rs_spawn_origin(rs_vec3 p, rs_vec3 err, rs_vec3 n)
+{
+    float d = rs_v3_dot(rs_v3_abs(n), err);
+    rs_vec3 off = rs_v3_scale(n, d), po = rs_v3_add(p, off);
+    po.x = rs_float_step(po.x, off.x);
+    po.y = rs_float_step(po.y, off.y);
+    po.z = rs_float_step(po.z, off.z);
+    return po;
+}
+
+/* The end of a shadow ray at surface point (p, err) whose normal is ng, moved toward `from` (the
+ * ray's origin) as rs_spawn_origin moves an origin. */
+RS_HD rs_vec3 rs_spawn_end(rs_vec3 p, rs_vec3 err, rs_vec3 ng, rs_vec3 from)
+{
+    rs_vec3 n = rs_v3_dot(ng, rs_v3_sub(from, p)) < 0.0f ? rs_v3_neg(ng) : ng;
+    return rs_spawn_origin(p, err, n);
+}
+
+/* Sum of the absolute coordinates (>= the length). */
+RS_HD float rs_v3_norm1(rs_vec3 a) { return fabsf(a.x) + fabsf(a.y) + fabsf(a.z); }
+
+/* A point near a sphere (centre c, radius r) put onto it: c + r (x - c) / |x - c|.  The rounding
+ * of the projection is gamma(5) of (x - c) (PBR 4th ed. §6.8.5) and the final sum one rounding of
+ * the point; the algebraic and geometric tests find a sphere's roots to about gamma(16) r from an
+ * origin near it (the half-b discriminant's rounding, relative to r^2). */
+RS_HD rs_surface_point rs_sphere_point(rs_vec3 c, float r, rs_vec3 x)
+{
+    rs_surface_point s;
+    rs_vec3 rel = rs_v3_sub(x, c);
+    float len = rs_v3_length(rel);
+    if (len > 0.0f)
+        rel = rs_v3_scale(rel, r / len);
+    else
+        rel = rs_v3(0.0f, r, 0.0f);
+    s.p = rs_v3_add(c, rel);
+    s.ng = rs_v3_scale(rel, 1.0f / r);
+    s.err = rs_v3_add(rs_v3_add(rs_v3_scale(rs_v3_abs(rel), RS_GAMMA(5)),
+                                rs_v3_scale(rs_v3_abs(s.p), RS_GAMMA(1))),
+                      rs_v3_splat(RS_GAMMA(16) * r));
+    return s;
+}
+
+/* The point q + a u + b v of a parallelogram and its normal.  The point's rounding: gamma(3) of
+ * its terms; the ray test's (w . (q - o), then o + t d - q): gamma(8) of the edges. */
+RS_HD rs_surface_point rs_quad_point(const rs_quad *qd, float a, float b)
+{
+    rs_surface_point s;
+    rs_vec3 au = rs_v3_scale(qd->u, a), bv = rs_v3_scale(qd->v, b);
+    s.p = rs_v3_add(qd->q, rs_v3_add(au, bv));
+    s.ng = rs_v3_normalize(qd->w);
+    s.err = rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(qd->q),
+                                            rs_v3_add(rs_v3_abs(au), rs_v3_abs(bv))),
+                                  RS_GAMMA(3)),
+                      rs_v3_splat(RS_GAMMA(8) * (rs_v3_norm1(qd->u) + rs_v3_norm1(qd->v))));
+    return s;
+}
+
+/* The point of a triangle at barycentrics (b1, b2) of v1 and v2, v0 + b1 e1 + b2 e2, and its
+ * normal (along e1 x e2).  The point's rounding: gamma(4) of its terms (the edges' own rounding
+ * included).  The ray tests evaluate e2 . ((o - v0) x e1), whose rounding, as a distance from
+ * the plane, is about gamma(6) |o - v0| |e1| |e2| / |e1 x e2|: the edges over the sine of the
+ * angle at v0, held below 1024 (a sliver thinner than that keeps only this much margin). */
+RS_HD rs_surface_point rs_tri_point(const rs_tri *t, float b1, float b2)
+{
+    rs_surface_point s;
+    rs_vec3 e1 = rs_v3_sub(t->v1, t->v0), e2 = rs_v3_sub(t->v2, t->v0);
+    rs_vec3 n = rs_v3_cross(e1, e2), t1 = rs_v3_scale(e1, b1), t2 = rs_v3_scale(e2, b2);
+    float len = rs_v3_length(n), l1 = rs_v3_norm1(e1), l2 = rs_v3_norm1(e2);
+    float slim = len > 0.0f ? rs_fminf(l1 * l2 / len, 1024.0f) : 1024.0f;
+    s.p = rs_v3_add(t->v0, rs_v3_add(t1, t2));
+    s.ng = rs_v3_scale(n, 1.0f / len);
+    s.err = rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(t->v0),
+                                            rs_v3_add(rs_v3_abs(t1), rs_v3_abs(t2))),
+                                  RS_GAMMA(4)),
+                      rs_v3_splat(RS_GAMMA(12) * (l1 + l2) * slim));
+    return s;
+}
+
+/* The hit (t, hu, hv) of ray r on global primitive `prim` as a surface point. */
+RS_HD rs_surface_point rs_surface_at(const rs_scene *sc, uint32_t prim, const rs_ray *r, float t,
+                                     float hu, float hv)
+{
+    if (prim < sc->n_spheres) {
+        rs_geom g = rs_scene_geom(sc);
+        return rs_sphere_point(rs_geom_sphere_center(&g, prim, r->time), sc->spheres[prim].radius,
+                               rs_ray_at(r, t));
+    }
+    if (prim - sc->n_spheres < sc->n_quads)
+        return rs_quad_point(&sc->quads[prim - sc->n_spheres], hu, hv);
+    {
+        rs_tri tr = rs_scene_tri(sc, prim);
+        return rs_tri_point(&tr, hu, hv);
+    }
+}
+
+#endif
