@@ -108,17 +108,22 @@ RS_HD rs_surface_point rs_sphere_point(rs_vec3 c, float r, rs_vec3 x)
 }
 
 /* The point q + a u + b v of a parallelogram and its normal.  The point's rounding: gamma(3) of
- * its terms; the ray test's (w . (q - o), then o + t d - q): gamma(8) of the edges. */
+ * its terms.  The ray test takes the plane as w . (x - q) = 0 with w = n / (n . n), n = u x v
+ * rounded: its tilt is a few ulps times |u| |v| / |u x v| (the sine of the angle between the
+ * edges, as for triangles), so a point an edge away from q can be off that plane by
+ * about gamma(12) (|u| + |v|) |u| |v| / |u x v|; |u x v| = 1 / |w|. */
 RS_HD rs_surface_point rs_quad_point(const rs_quad *qd, float a, float b)
 {
     rs_surface_point s;
     rs_vec3 au = rs_v3_scale(qd->u, a), bv = rs_v3_scale(qd->v, b);
+    float l1 = rs_v3_norm1(qd->u), l2 = rs_v3_norm1(qd->v);
+    float slim = rs_fminf(l1 * l2 * rs_v3_length(qd->w), 1024.0f);
     s.p = rs_v3_add(qd->q, rs_v3_add(au, bv));
     s.ng = rs_v3_normalize(qd->w);
     s.err = rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(qd->q),
                                             rs_v3_add(rs_v3_abs(au), rs_v3_abs(bv))),
                                   RS_GAMMA(3)),
-                      rs_v3_splat(RS_GAMMA(8) * (rs_v3_norm1(qd->u) + rs_v3_norm1(qd->v))));
+                      rs_v3_splat(RS_GAMMA(12) * (l1 + l2) * slim));
     return s;
 }
 
