@@ -15,9 +15,10 @@
  *     radius, a parallelogram's edges, a triangle's edges over the sine of its angle at v0).
  * A ray leaving along unit normal n then starts at p + n (|n| . err), each coordinate rounded
  * once more away from p, so that it is on the leaving side of every point the true surface and
- * the test could put there.  Far from the origin the offset stays a few ulps of the coordinates
- * (10^4 units: ~10^-2 of a unit... see docs/intersect.md#coordinate-range for the figures), and
- * a primitive's size, not its position, sets the rest.  Shadow rays end at a point on the light
+ * the test could put there.  The offset is 3-4 ulps of the coordinates far from the origin
+ * (3e-3 units at 10^4; the 1e-4-of-the-coordinates epsilon this replaced moved origins by 1 unit
+ * there, and light leaked past contact shadows), plus a few ulps of the primitive's size:
+ * docs/intersect.md#coordinate-range has the figures.  Shadow rays end at a point on the light
  * moved the same way toward the shading point (rs_spawn_end). */
 #ifndef RS_SHADING_SPAWN_H
 #define RS_SHADING_SPAWN_H
