@@ -215,7 +215,7 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
             rs_vec3 perp = rs_v3_sub(rs_v3_scale(w, dc * ct), axis);
             float disc = r * r - rs_v3_dot(perp, perp);
             float t = dc * ct - sqrtf(rs_fmaxf(0.0f, disc));
-            sp = rs_sphere_point(c, r, rs_v3_madd(x, w, t));
+            sp = rs_sphere_point(c, r, rs_v3_sub(rs_v3_scale(w, t), axis));
             out->wi = w;
             out->dist = t;
             out->point = sp.p;
@@ -228,7 +228,7 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
             return out->pdf > 0.0f && t > 0.0f;
         }
         /* inside (or on) the sphere: a point uniform on its surface */
-        sp = rs_sphere_point(c, r, rs_v3_madd(c, rs_sample_uniform_sphere(u1, u2), r));
+        sp = rs_sphere_point(c, r, rs_v3_scale(rs_sample_uniform_sphere(u1, u2), r));
     } else if (prim - s->n_spheres < s->n_quads) {
         sp = rs_quad_point(&s->quads[prim - s->n_spheres], u1, u2);
     } else {

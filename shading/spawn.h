@@ -13,8 +13,8 @@
  *     relative to the ray's origin: a ray starting at a distance d from the surface finds t of
  *     the wrong sign only when d is below a few ulps of the primitive's own size (a sphere's
  *     radius, a parallelogram's edges, a triangle's edges over the sine of its angle at v0).
- * A ray leaving along unit normal n then starts at p + n (|n| . err), each coordinate rounded
- * once more away from p, so that it is on the leaving side of every point the true surface and
+ * A ray leaving along unit normal n then starts at p + n (|n| . err), with a little more for the
+ * rounding of that sum, so that it is on the leaving side of every point the true surface and
  * the test could put there.  The offset is 3-4 ulps of the coordinates far from the origin
  * (3e-3 units at 10^4; the 1e-4-of-the-coordinates epsilon this replaced moved origins by 1 unit
  * there, and light leaked past contact shadows), plus a few ulps of the primitive's size:
@@ -43,42 +43,21 @@ typedef struct rs_surface_point {
 
 RS_HD rs_vec3 rs_v3_abs(rs_vec3 a) { return rs_v3(fabsf(a.x), fabsf(a.y), fabsf(a.z)); }
 
-/* The next float above (dir > 0) or below (dir < 0) v; v itself for dir == 0, an infinity or a
- * NaN.  By the bits, as pbrt's NextFloatUp/Down (glibc's nextafterf is a call). */
-RS_HD float rs_float_step(float v, float dir)
-{
-    uint32_t b;
-    if (dir == 0.0f || !(v - v == 0.0f)) /* zero step, infinity or NaN */
-        return v;
-    if (v == 0.0f) /* +0 or -0: the smallest subnormal of the step's sign */
-        v = 0.0f;
-    memcpy(&b, &v, sizeof b);
-    if ((dir > 0.0f) == (v >= 0.0f))
-        ++b; /* away from zero */
-    else
-        --b;
-    if (v == 0.0f)
-        b = dir > 0.0f ? 1u : 0x80000001u;
-    memcpy(&v, &b, sizeof v);
-    return v;
-}
-
 /* p moved along unit normal n (the side the new ray leaves toward) past the error bound err:
- * p + n (|n| . err), each coordinate then stepped one float further from p (pbrt-v4's
- * OffsetRayOrigin). */
-RS_HD rs_vec3 rs_spawn_origin(rs_vec3 p, rs_vec3 err, rs_vec3 n)
+ * p + n d with d = |n| . err (pbrt-v4's OffsetRayOrigin) plus 2^-23 of |n| . |p|, which covers
+ * the rounding of the sum itself (at most 2^-24 of each coordinate), so the new origin is at
+ * least |n| . err from p along n without stepping each coordinate to the next float as pbrt
+ * does (no branches). */
+RS_HD_HOT rs_vec3 rs_spawn_origin(rs_vec3 p, rs_vec3 err, rs_vec3 n)
 {
-    float d = rs_v3_dot(rs_v3_abs(n), err);
-    rs_vec3 off = rs_v3_scale(n, d), po = rs_v3_add(p, off);
-    po.x = rs_float_step(po.x, off.x);
-    po.y = rs_float_step(po.y, off.y);
-    po.z = rs_float_step(po.z, off.z);
-    return po;
+    rs_vec3 an = rs_v3_abs(n);
+    float d = rs_v3_dot(an, rs_v3_add(err, rs_v3_scale(rs_v3_abs(p), 2.0f * RS_GAMMA(1))));
+    return rs_v3_madd(p, n, d);
 }
 
 /* The end of a shadow ray at surface point (p, err) whose normal is ng, moved toward `from` (the
  * ray's origin) as rs_spawn_origin moves an origin. */
-RS_HD rs_vec3 rs_spawn_end(rs_vec3 p, rs_vec3 err, rs_vec3 ng, rs_vec3 from)
+RS_HD_HOT rs_vec3 rs_spawn_end(rs_vec3 p, rs_vec3 err, rs_vec3 ng, rs_vec3 from)
 {
     rs_vec3 n = rs_v3_dot(ng, rs_v3_sub(from, p)) < 0.0f ? rs_v3_neg(ng) : ng;
     return rs_spawn_origin(p, err, n);
@@ -87,14 +66,16 @@ RS_HD rs_vec3 rs_spawn_end(rs_vec3 p, rs_vec3 err, rs_vec3 ng, rs_vec3 from)
 /* Sum of the absolute coordinates (>= the length). */
 RS_HD float rs_v3_norm1(rs_vec3 a) { return fabsf(a.x) + fabsf(a.y) + fabsf(a.z); }
 
-/* A point near a sphere (centre c, radius r) put onto it: c + r (x - c) / |x - c|.  The rounding
- * of the projection is gamma(5) of (x - c) (PBR 4th ed. §6.8.5) and the final sum one rounding of
- * the point; the algebraic and geometric tests find a sphere's roots to about gamma(16) r from an
- * origin near it (the half-b discriminant's rounding, relative to r^2). */
-RS_HD rs_surface_point rs_sphere_point(rs_vec3 c, float r, rs_vec3 x)
+/* The point of a sphere (centre c, radius r) in the direction of `rel` from its centre (a
+ * vector near the surface, relative to c: c + rel itself is where a ray found it), put onto it:
+ * c + r rel / |rel|.  Taking rel relative to the centre, not a point in world coordinates, keeps
+ * the normal as precise far from the origin as at it.  The rounding of the projection is
+ * gamma(5) of rel (PBR 4th ed. §6.8.5) and the final sum one rounding of the point; the
+ * algebraic and geometric tests find a sphere's roots to about gamma(16) r from an origin near
+ * it (the half-b discriminant's rounding, relative to r^2). */
+RS_HD rs_surface_point rs_sphere_point(rs_vec3 c, float r, rs_vec3 rel)
 {
     rs_surface_point s;
-    rs_vec3 rel = rs_v3_sub(x, c);
     float len = rs_v3_length(rel);
     if (len > 0.0f)
         rel = rs_v3_scale(rel, r / len);
@@ -117,10 +98,10 @@ RS_HD rs_surface_point rs_quad_point(const rs_quad *qd, float a, float b)
 {
     rs_surface_point s;
     rs_vec3 au = rs_v3_scale(qd->u, a), bv = rs_v3_scale(qd->v, b);
-    float l1 = rs_v3_norm1(qd->u), l2 = rs_v3_norm1(qd->v);
-    float slim = rs_fminf(l1 * l2 * rs_v3_length(qd->w), 1024.0f);
+    float l1 = rs_v3_norm1(qd->u), l2 = rs_v3_norm1(qd->v), len = rs_v3_length(qd->w);
+    float slim = rs_fminf(l1 * l2 * len, 1024.0f);
     s.p = rs_v3_add(qd->q, rs_v3_add(au, bv));
-    s.ng = rs_v3_normalize(qd->w);
+    s.ng = rs_v3_scale(qd->w, 1.0f / len); /* rs_v3_normalize(w), rs_prim_normal's */
     s.err = rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(qd->q),
                                             rs_v3_add(rs_v3_abs(au), rs_v3_abs(bv))),
                                   RS_GAMMA(3)),
@@ -155,8 +136,11 @@ RS_HD rs_surface_point rs_surface_at(const rs_scene *sc, uint32_t prim, const rs
 {
     if (prim < sc->n_spheres) {
         rs_geom g = rs_scene_geom(sc);
-        return rs_sphere_point(rs_geom_sphere_center(&g, prim, r->time), sc->spheres[prim].radius,
-                               rs_ray_at(r, t));
+        rs_vec3 c = rs_geom_sphere_center(&g, prim, r->time);
+        /* (o - c) + t d: the ray's origin and the centre are near each other, so no rounding at
+         * the size of their coordinates */
+        return rs_sphere_point(c, sc->spheres[prim].radius,
+                               rs_v3_madd(rs_v3_sub(r->o, c), r->d, t));
     }
     if (prim - sc->n_spheres < sc->n_quads)
         return rs_quad_point(&sc->quads[prim - sc->n_spheres], hu, hv);
