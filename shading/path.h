@@ -386,7 +386,9 @@ RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, c
     float c;
     rs_vec3 fl;
     int through;
-    if (!rs_light_sample_in(sc, subset, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+    /* the light seen from the surface point itself (its distance, direction and pdf); only the
+     * shadow ray starts at the offset origin */
+    if (!rs_light_sample_in(sc, subset, v->x, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
         return 0;
     c = rs_v3_dot(v->n, ls.wi);
     through = !(rs_v3_dot(v->n_geo, ls.wi) > 0.0f); /* beyond a transmitting surface */
@@ -447,7 +449,7 @@ RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, co
          * map and the emitters; punctual lights have a shadow ray of their own) */
         if (rl.v[3] < 0.5f) {
             rs_light_sample ls;
-            if (!rs_light_sample_in(sc, RS_LIGHTS_AREA, v->origin, r->time, rl.v[0], rl.v[1],
+            if (!rs_light_sample_in(sc, RS_LIGHTS_AREA, v->x, r->time, rl.v[0], rl.v[1],
                                     rl.v[2], &ls))
                 return 0;
             *wi = ls.wi;
@@ -461,7 +463,7 @@ RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, co
         ci = rs_v3_dot(v->n, *wi);
         if (!rs_vertex_side_ok(v, *wi, ci, !(rs_v3_dot(v->n_geo, *wi) > 0.0f)))
             return 0; /* f = 0 below the surface: the path carries nothing further */
-        *pdf = 0.5f * rs_lights_pdf_dir(sc, v->origin, r->time, *wi) +
+        *pdf = 0.5f * rs_lights_pdf_dir(sc, v->x, r->time, *wi) +
                0.5f * rs_bsdf_pdf_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
         f = rs_bsdf_eval_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
         if (!(*pdf > 0.0f))
