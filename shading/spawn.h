@@ -102,10 +102,10 @@ RS_HD rs_surface_point rs_quad_point(const rs_quad *qd, float a, float b)
     float slim = rs_fminf(l1 * l2 * len, 1024.0f);
     s.p = rs_v3_add(qd->q, rs_v3_add(au, bv));
     s.ng = rs_v3_scale(qd->w, 1.0f / len); /* rs_v3_normalize(w), rs_prim_normal's */
-    s.err = rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(qd->q),
-                                            rs_v3_add(rs_v3_abs(au), rs_v3_abs(bv))),
-                                  RS_GAMMA(3)),
-                      rs_v3_splat(RS_GAMMA(12) * (l1 + l2) * slim));
+    s.err =
+        rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(qd->q), rs_v3_add(rs_v3_abs(au), rs_v3_abs(bv))),
+                              RS_GAMMA(3)),
+                  rs_v3_splat(RS_GAMMA(12) * (l1 + l2) * slim));
     return s;
 }
 
@@ -123,10 +123,10 @@ RS_HD rs_surface_point rs_tri_point(const rs_tri *t, float b1, float b2)
     float slim = len > 0.0f ? rs_fminf(l1 * l2 / len, 1024.0f) : 1024.0f;
     s.p = rs_v3_add(t->v0, rs_v3_add(t1, t2));
     s.ng = rs_v3_scale(n, 1.0f / len);
-    s.err = rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(t->v0),
-                                            rs_v3_add(rs_v3_abs(t1), rs_v3_abs(t2))),
-                                  RS_GAMMA(4)),
-                      rs_v3_splat(RS_GAMMA(12) * (l1 + l2) * slim));
+    s.err =
+        rs_v3_add(rs_v3_scale(rs_v3_add(rs_v3_abs(t->v0), rs_v3_add(rs_v3_abs(t1), rs_v3_abs(t2))),
+                              RS_GAMMA(4)),
+                  rs_v3_splat(RS_GAMMA(12) * (l1 + l2) * slim));
     return s;
 }
 

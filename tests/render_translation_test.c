@@ -67,10 +67,7 @@ static void get3(const cJSON *a, double v[3])
         v[i] = cJSON_GetArrayItem(a, i)->valuedouble;
 }
 
-static cJSON *make3(const double v[3])
-{
-    return cJSON_CreateDoubleArray(v, 3);
-}
+static cJSON *make3(const double v[3]) { return cJSON_CreateDoubleArray(v, 3); }
 
 /* The steps of placement pl, appended to an object's transform (none, one step or steps). */
 static void add_steps(cJSON *obj, const placement *pl)
@@ -201,8 +198,8 @@ static void check_text(const char *label, const char *text, const char *base_dir
         rs_scene *s = load_placed(text, base_dir, &places[k]);
         float *img = render(s, spp, 2 + k);
         double rel, z = mean_z(ref, img, &rel);
-        print_message("%-22s %-26s mean %+8.4f%%  z %+6.2f%s\n", label, places[k].name,
-                      100.0 * rel, z, fabs(z) < Z_MAX || fabs(rel) < 1e-6 ? "" : "  <- beyond noise");
+        print_message("%-22s %-26s mean %+8.4f%%  z %+6.2f%s\n", label, places[k].name, 100.0 * rel,
+                      z, fabs(z) < Z_MAX || fabs(rel) < 1e-6 ? "" : "  <- beyond noise");
         /* a scene without noise (the furnace: every sample is 0.5) differs by rounding only */
         bad += !(fabs(z) < Z_MAX || fabs(rel) < 1e-6);
         rs_scene_destroy(s);
@@ -250,56 +247,31 @@ static void check_builtin(const char *name, uint32_t spp)
     }
 }
 
-static void test_cornell(void **state)
-{
-    (void)state;
-    check_builtin("cornell", 256);
-}
+/* A built-in scene and the spp its comparisons need (the noisier, the more). */
+typedef struct builtin_case {
+    const char *name;
+    uint32_t spp;
+} builtin_case;
 
-static void test_cornell_glass(void **state)
-{
-    (void)state;
-    check_builtin("cornell-glass", 256);
-}
+static builtin_case builtins[] = {
+    {"cornell", 256},         {"cornell-glass", 256}, {"materials", 64},       {"rtiow-final", 32},
+    {"bouncing-spheres", 32}, {"furnace", 16},        {"cornell-teapot", 128},
+};
 
-static void test_materials(void **state)
+static void test_builtin(void **state)
 {
-    (void)state;
-    check_builtin("materials", 64);
-}
-
-static void test_rtiow_final(void **state)
-{
-    (void)state;
-    check_builtin("rtiow-final", 32);
-}
-
-static void test_bouncing_spheres(void **state)
-{
-    (void)state;
-    check_builtin("bouncing-spheres", 32);
-}
-
-static void test_furnace(void **state)
-{
-    (void)state;
-    check_builtin("furnace", 16);
-}
-
-static void test_cornell_teapot(void **state)
-{
-    (void)state;
-    check_builtin("cornell-teapot", 128);
+    const builtin_case *c = (const builtin_case *)*state;
+    check_builtin(c->name, c->spp);
 }
 
 /* The scene of the report: a diffuse floor, a diffuse sphere resting on it (the contact shadow
  * is where a leaking offset shows first) and one light, the camera 4.5 units away. */
 #define SMALL_SCENE_HEAD                                                                           \
   "{\"camera\": {\"from\": [0, 2, 4.5], \"at\": [0, 0.5, 0], \"vfov\": 40},"                       \
-  " \"background\": {\"horizon\": [0, 0, 0], \"zenith\": [0, 0, 0]},"                             \
+  " \"background\": {\"horizon\": [0, 0, 0], \"zenith\": [0, 0, 0]},"                              \
   " \"materials\": {\"floor\": {\"type\": \"lambertian\", \"albedo\": [0.7, 0.7, 0.7]},"           \
   "   \"ball\": {\"type\": \"lambertian\", \"albedo\": [0.6, 0.5, 0.4]},"                          \
-  "   \"lamp\": {\"type\": \"light\", \"emission\": [8, 8, 8]}},"                                   \
+  "   \"lamp\": {\"type\": \"light\", \"emission\": [8, 8, 8]}},"                                  \
   " \"objects\": ["                                                                                \
   "   {\"type\": \"quad\", \"q\": [-3, 0, 3], \"u\": [6, 0, 0], \"v\": [0, 0, -6],"                \
   "    \"material\": \"floor\"},"                                                                  \
@@ -344,8 +316,10 @@ static void box_tris(char *buf, size_t cap, const double lo[3], const double hi[
         for (k = 0; k < 2; ++k) {
             int c[3] = {faces[f][0], faces[f][k + 1], faces[f][k + 2]}, j;
             size_t n = strlen(buf);
-            snprintf(buf + n, cap - n, "%s{\"type\": \"triangle\", \"material\": \"wood\", "
-                     "\"vertices\": [", buf[n - 1] == '[' ? "" : ", ");
+            snprintf(buf + n, cap - n,
+                     "%s{\"type\": \"triangle\", \"material\": \"wood\", "
+                     "\"vertices\": [",
+                     buf[n - 1] == '[' ? "" : ", ");
             for (j = 0; j < 3; ++j) {
                 n = strlen(buf);
                 snprintf(buf + n, cap - n, "%s[%g, %g, %g]", j ? ", " : "",
@@ -393,12 +367,17 @@ static void test_instances(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_point_light),      cmocka_unit_test(test_spot_light),
-        cmocka_unit_test(test_area_light),       cmocka_unit_test(test_instances),
-        cmocka_unit_test(test_cornell),          cmocka_unit_test(test_cornell_glass),
-        cmocka_unit_test(test_materials),        cmocka_unit_test(test_rtiow_final),
-        cmocka_unit_test(test_bouncing_spheres), cmocka_unit_test(test_furnace),
-        cmocka_unit_test(test_cornell_teapot),
+        cmocka_unit_test(test_point_light),
+        cmocka_unit_test(test_spot_light),
+        cmocka_unit_test(test_area_light),
+        cmocka_unit_test(test_instances),
+        cmocka_unit_test_prestate(test_builtin, &builtins[0]),
+        cmocka_unit_test_prestate(test_builtin, &builtins[1]),
+        cmocka_unit_test_prestate(test_builtin, &builtins[2]),
+        cmocka_unit_test_prestate(test_builtin, &builtins[3]),
+        cmocka_unit_test_prestate(test_builtin, &builtins[4]),
+        cmocka_unit_test_prestate(test_builtin, &builtins[5]),
+        cmocka_unit_test_prestate(test_builtin, &builtins[6]),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

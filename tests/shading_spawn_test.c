@@ -146,8 +146,8 @@ static void test_quad(void **state)
                 float h = (float)sizes[si];
                 rs_quad q = rs_quad_make(rs_v3_add(place(&seed, dists[di]), rnd_box(&seed, h)),
                                          rnd_box(&seed, h), rnd_box(&seed, h));
-                rs_surface_point s = rs_quad_point(&q, rnd_range(&seed, 0, 1),
-                                                   rnd_range(&seed, 0, 1));
+                rs_surface_point s =
+                    rs_quad_point(&q, rnd_range(&seed, 0, 1), rnd_range(&seed, 0, 1));
                 rs_vec3 n = (i & 1) ? rs_v3_neg(s.ng) : s.ng, dir, po;
                 rs_ray r;
                 float t, a, b;
@@ -160,8 +160,8 @@ static void test_quad(void **state)
                     float slim = l1 * l2 * rs_v3_length(q.w);
                     if (!(slim < 1024.0f))
                         continue; /* a sliver beyond what the margin covers */
-                    check_offset(s.p, po, 24.0f * FLT_EPSILON * (l1 + l2) * slim, "quad",
-                                 dists[di], sizes[si]);
+                    check_offset(s.p, po, 24.0f * FLT_EPSILON * (l1 + l2) * slim, "quad", dists[di],
+                                 sizes[si]);
                 }
                 if (!(plane_side(q.q, q.u, q.v, po) * rs_v3_dot(n, s.ng) > 0.0))
                     fail_msg("quad at %g, size %g: the origin is not on the leaving side",
@@ -212,8 +212,8 @@ static void test_triangle(void **state)
                     if (rs_isect_tri_by((uint32_t)algo, &tr, &r, &t, &u, &v))
                         fail_msg("triangle (%s) at %g, size %g, slim %g: a leaving ray hit it "
                                  "at t %g",
-                                 rs_isect_tri_algo_name((uint32_t)algo), dists[di], sizes[si],
-                                 slim, t);
+                                 rs_isect_tri_algo_name((uint32_t)algo), dists[di], sizes[si], slim,
+                                 t);
                 }
             }
 }
@@ -229,8 +229,8 @@ static void test_shadow_end(void **state)
         for (i = 0; i < TRIALS; ++i) {
             float h = 1.0f, t, a, b, u, v;
             rs_vec3 c = place(&seed, dists[di]);
-            rs_quad q = rs_quad_make(rs_v3_add(c, rnd_box(&seed, h)), rnd_box(&seed, h),
-                                     rnd_box(&seed, h));
+            rs_quad q =
+                rs_quad_make(rs_v3_add(c, rnd_box(&seed, h)), rnd_box(&seed, h), rnd_box(&seed, h));
             rs_tri tr;
             rs_surface_point lq = rs_quad_point(&q, rnd_range(&seed, 0, 1), rnd_range(&seed, 0, 1));
             rs_surface_point lt;
@@ -243,12 +243,14 @@ static void test_shadow_end(void **state)
                 continue;
             end = rs_spawn_end(lq.p, lq.err, lq.ng, from);
             r = mk_ray(from, rs_v3_sub(end, from), 0.0f, 1.0f);
-            if (rs_isect_quad(&q, &r, &t, &a, &b) && fabsf(rs_v3_dot(lq.ng, rs_v3_normalize(r.d))) > 1e-3f)
+            if (rs_isect_quad(&q, &r, &t, &a, &b) &&
+                fabsf(rs_v3_dot(lq.ng, rs_v3_normalize(r.d))) > 1e-3f)
                 fail_msg("a shadow ray at %g reached its quad light at t %.9g", dists[di], t);
             lt = rs_tri_point(&tr, 0.3f * rnd_range(&seed, 0, 1), 0.3f * rnd_range(&seed, 0, 1));
             end = rs_spawn_end(lt.p, lt.err, lt.ng, from);
             r = mk_ray(from, rs_v3_sub(end, from), 0.0f, 1.0f);
-            if (rs_isect_tri(&tr, &r, &t, &u, &v) && fabsf(rs_v3_dot(lt.ng, rs_v3_normalize(r.d))) > 1e-3f)
+            if (rs_isect_tri(&tr, &r, &t, &u, &v) &&
+                fabsf(rs_v3_dot(lt.ng, rs_v3_normalize(r.d))) > 1e-3f)
                 fail_msg("a shadow ray at %g reached its triangle light at t %.9g", dists[di], t);
         }
 }
@@ -257,7 +259,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere),
-        cmocka_unit_test(test_quad),       cmocka_unit_test(test_triangle),
+        cmocka_unit_test(test_quad),
+        cmocka_unit_test(test_triangle),
         cmocka_unit_test(test_shadow_end),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
