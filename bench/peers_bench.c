@@ -95,9 +95,10 @@ static int pin_to_one_core(int on)
     }
     if (!on)
         return sched_setaffinity(0, sizeof all, &all);
-    /* the last allowed core: core 0 takes most interrupts */
+    /* the first allowed core (core 0 where allowed), as every other one-thread figure of the
+     * project is taken (`taskset -c 0`), so that the tables compare like with like */
     CPU_ZERO(&set);
-    for (int c = CPU_SETSIZE - 1; c >= 0; --c)
+    for (int c = 0; c < CPU_SETSIZE; ++c)
         if (CPU_ISSET(c, &all)) {
             CPU_SET(c, &set);
             break;
@@ -681,9 +682,11 @@ int main(int argc, char **argv)
            W, H, runs, ref_spp);
     if (!peers)
         printf("peers: skipped (%s)\n", quick ? "--quick" : "--no-peers");
-    if (peers && !peer_available(venv, "mitsuba")) {
-        printf("Mitsuba 3: skipped: %s/bin/python cannot import mitsuba (make the venv with `sh "
-               "scripts/install-peers.sh %s`)\n",
+    if (peers && !peer_available(venv, "mitsuba, numpy")) {
+        /* bench/peers/mitsuba_peer.py hands the image over through numpy: without it every
+         * Mitsuba render would fail */
+        printf("Mitsuba 3: skipped: %s/bin/python cannot import mitsuba and numpy (make the venv "
+               "with `sh scripts/install-peers.sh %s`)\n",
                venv, venv);
     } else if (peers) {
         const char *llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so";

@@ -12,7 +12,7 @@ DIR=${1:-build/peers-venv}
 MITSUBA=mitsuba==3.9.1
 LUXCORE=pyluxcore==2.11.2
 
-if [ -x "$DIR/bin/python" ] && "$DIR/bin/python" -c "import mitsuba, pyluxcore" 2>/dev/null; then
+if [ -x "$DIR/bin/python" ] && "$DIR/bin/python" -c "import mitsuba, pyluxcore, numpy" 2>/dev/null; then
     exit 0
 fi
 
@@ -40,6 +40,8 @@ fi
 
 echo "install-peers.sh: making $DIR with $MITSUBA $LUXCORE" >&2
 [ -x "$DIR/bin/python" ] || /usr/bin/python3 -m venv "$DIR"
-"$DIR/bin/pip" install -q "$MITSUBA" "$LUXCORE"
+# numpy: bench/peers/mitsuba_peer.py hands Mitsuba's image over as a numpy array (without it
+# every Mitsuba row of peers_bench was dropped)
+"$DIR/bin/pip" install -q "$MITSUBA" "$LUXCORE" numpy
 "$DIR/bin/python" -c "import mitsuba; print('install-peers.sh: Mitsuba', mitsuba.__version__, 'in $DIR')"
 "$DIR/bin/python" -c "import pyluxcore; print('install-peers.sh: LuxCoreRender', pyluxcore.Version())" | tail -1
