@@ -81,6 +81,8 @@ rs_status rs_scene_env_build(rs_scene *s, double *power)
     rs_free(s->env_cond_cdf);
     s->env_marg_cdf = s->env_cond_cdf = NULL;
     s->env_pick = 0.0f;
+    s->env_uniform = 0;
+    s->env_uniform_le = rs_v3_splat(0.0f);
     if (s->env_image == RS_NO_TEXTURE)
         return RS_OK;
     if (s->env_image >= s->n_images)
@@ -94,6 +96,14 @@ rs_status rs_scene_env_build(rs_scene *s, double *power)
                                 "environment map: texel (%u, %u) is %s (texels must be finite "
                                 "and >= 0)",
                                 (i / 3) % w, (i / 3) / w, isfinite(im->rgb[i]) ? "negative" : "not finite");
+    /* a map whose texels are all alike lights the scene from every direction the same: sampled
+     * uniformly over the sphere with no table search and no trigonometry per lookup */
+    for (i = 3; i < 3 * w * h && im->rgb[i] == im->rgb[i % 3]; ++i)
+        ;
+    if (i == 3 * w * h) {
+        s->env_uniform = 1;
+        s->env_uniform_le = rs_v3_mul(rs_v3(im->rgb[0], im->rgb[1], im->rgb[2]), s->env_scale);
+    }
     row_sum = (double *)rs_alloc(h, sizeof *row_sum);
     s->env_marg_cdf = (float *)rs_alloc((size_t)h + 1, sizeof *s->env_marg_cdf);
     s->env_cond_cdf = (float *)rs_alloc((size_t)h * ((size_t)w + 1), sizeof *s->env_cond_cdf);

@@ -8,7 +8,9 @@
  * so the middle of the image lies straight ahead of a camera looking down -z, +x to its right.
  * The radiance is the texel's (nearest, no filtering: the pdf is constant over a texel, and so
  * the estimate is exact for any map), times the scene's env_scale.
- * The distribution is built by rs_scene_finalize (scenes/scene_env.c). */
+ * The distribution is built by rs_scene_finalize (scenes/scene_env.c).  A map whose texels are
+ * all alike (a uniform sky, env_uniform) is sampled uniformly over the sphere, pdf 1 / 4 pi, and
+ * its radiance and pdf are constants: no table search, no trigonometry but the sample's own. */
 #ifndef RS_SHADING_ENVMAP_H
 #define RS_SHADING_ENVMAP_H
 
@@ -47,10 +49,13 @@ RS_HD void rs_env_texel_of(const rs_image *im, rs_vec3 m, uint32_t *i, uint32_t 
 RS_HD_COLD rs_vec3 rs_env_radiance(const rs_scene *s, rs_vec3 d)
 {
     const rs_image *im = &s->images[s->env_image];
-    rs_vec3 m = rs_env_rot(s->env_rot, rs_v3_normalize(d));
+    rs_vec3 m;
     uint32_t i, j;
     float st;
     const float *t;
+    if (s->env_uniform)
+        return s->env_uniform_le;
+    m = rs_env_rot(s->env_rot, rs_v3_normalize(d));
     rs_env_texel_of(im, m, &i, &j, &st);
     t = &im->rgb[3 * ((size_t)j * im->width + i)];
     return rs_v3_mul(rs_v3(t[0], t[1], t[2]), s->env_scale);
@@ -89,6 +94,8 @@ RS_HD_COLD float rs_env_pdf(const rs_scene *s, rs_vec3 d)
     float st;
     if (!s->env_marg_cdf)
         return 0.0f;
+    if (s->env_uniform)
+        return 0.25f * RS_INV_PI;
     rs_env_texel_of(im, rs_env_rot(s->env_rot, rs_v3_normalize(d)), &i, &j, &st);
     if (!(st > 0.0f))
         return 0.0f;
@@ -107,6 +114,13 @@ RS_HD_COLD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi,
     rs_vec3 m;
     if (!s->env_marg_cdf)
         return 0;
+    if (s->env_uniform) {
+        /* a uniform map: uniform over the sphere (the rotation changes nothing) */
+        *wi = rs_sample_uniform_sphere(u1, u2);
+        *pdf = 0.25f * RS_INV_PI;
+        *le = s->env_uniform_le;
+        return 1;
+    }
     im = &s->images[s->env_image];
     j = rs_env_cdf_find(s->env_marg_cdf, im->height, u1);
     span = s->env_marg_cdf[j + 1] - s->env_marg_cdf[j];

@@ -8,6 +8,8 @@
  *     (within 1%, at least 5 standard errors);
  *   - the map's orientation and its rotation are as documented (-z is the image's middle, +y its
  *     top row);
+ *   - a uniform map (every texel alike) is sampled uniformly over the sphere with constant pdf
+ *     and radiance, turned or not (chi-square);
  *   - a furnace: an albedo-0.5 diffuse sphere under a uniform map renders 0.5 with every
  *     strategy (mis, mixture, bsdf, uniform), on the CPU device and the GPU fallback;
  *   - under a map with a small bright sun the four strategies agree on the image mean (as
@@ -303,6 +305,54 @@ static void test_orientation(void **state)
     print_message("rotated: (%.3f, %.3f, %.3f)\n", wi.x, wi.y, wi.z);
     assert_true(wi.x < -0.98f);
     rs_scene_destroy(s);
+}
+
+/* A map whose texels are all alike is a uniform sky (env_uniform): its samples are uniform over
+ * the sphere (chi-square on 8 bands of z by 16 sectors of phi, alpha = 0.001, 127 dof: critical
+ * 181.99), turned or not, with pdf 1 / 4 pi and the texel's radiance, as rs_env_pdf and
+ * rs_env_radiance say for every direction; one texel off and the table is used again. */
+static void test_uniform_map(void **state)
+{
+    static const float rot_y90[9] = {0, 0, 1, 0, 1, 0, -1, 0, 0};
+    float rgb[8 * 4 * 3];
+    int i, r;
+    (void)state;
+    for (i = 0; i < 8 * 4; ++i)
+        rgb[3 * i] = 0.5f, rgb[3 * i + 1] = 1.0f, rgb[3 * i + 2] = 2.0f;
+    for (r = 0; r < 2; ++r) {
+        rs_scene *s = env_scene(rgb, 8, 4, r ? rot_y90 : NULL, -1, 0);
+        uint64_t seed = 77;
+        double bins[128] = {0}, chi;
+        const int n = 128000;
+        assert_int_equal(s->env_uniform, 1);
+        for (i = 0; i < n; ++i) {
+            rs_vec3 wi, le, d = rnd_unit(&seed);
+            float pdf;
+            int zb, pb;
+            assert_true(rs_env_sample(s, rnd_f(&seed), rnd_f(&seed), &wi, &pdf, &le));
+            assert_true(pdf == 0.25f * (float)RS_INV_PI && rs_env_pdf(s, wi) == pdf);
+            assert_true(le.x == 0.5f && le.y == 1.0f && le.z == 2.0f);
+            assert_true(fabsf(rs_v3_length(wi) - 1.0f) < 1e-5f);
+            zb = (int)((wi.z + 1.0f) * 4.0f);
+            pb = (int)((atan2(wi.y, wi.x) + PI_D) / (2 * PI_D) * 16.0);
+            bins[(zb > 7 ? 7 : zb) * 16 + (pb > 15 ? 15 : pb)] += 1.0;
+            /* any direction: the same radiance and pdf */
+            le = rs_env_radiance(s, d);
+            assert_true(le.x == 0.5f && le.y == 1.0f && le.z == 2.0f);
+            assert_true(rs_env_pdf(s, d) == 0.25f * (float)RS_INV_PI);
+        }
+        chi = chi_square(bins, 128, n / 128.0);
+        print_message("uniform map%s: chi-square %.1f (127 dof, critical 181.99)\n",
+                      r ? " turned" : "", chi);
+        assert_true(chi < 181.99);
+        rs_scene_destroy(s);
+    }
+    rgb[3 * 13 + 1] = 1.001f;
+    {
+        rs_scene *s = env_scene(rgb, 8, 4, NULL, -1, 0);
+        assert_int_equal(s->env_uniform, 0);
+        rs_scene_destroy(s);
+    }
 }
 
 /* The furnace under a uniform map: the sphere renders its albedo, 0.5, with every strategy. */
@@ -647,7 +697,7 @@ int main(void)
         cmocka_unit_test(test_orientation),        cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_strategies_agree),   cmocka_unit_test(test_furnace_ggx),
         cmocka_unit_test(test_mixed_lights_agree), cmocka_unit_test(test_pbr_emitter),
-        cmocka_unit_test(test_bad_maps),
+        cmocka_unit_test(test_bad_maps),          cmocka_unit_test(test_uniform_map),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
