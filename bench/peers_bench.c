@@ -1,30 +1,38 @@
-/* bench/peers_bench.c — time to a clean image, raystream against other renderers on one core.
+/* bench/peers_bench.c — time to a clean image, raystream against other renderers.
  *
- * Renders builtin:cornell (256x256, max depth 50, a 1-pixel box filter everywhere) with
- * raystream's stream engine (each sampler) and megakernel, with Mitsuba 3 (scalar_rgb and
- * llvm_ad_rgb, its independent sampler and its low-discrepancy `ldsampler`) and with
- * LuxCoreRender (PATHCPU, its Sobol sampler), one thread each pinned to one core, interleaved in
- * rounds.  The peers get raystream's own scene: every quad and triangle exported to OBJ files,
- * one per material, with the same camera, lights and diffuse materials, as a Mitsuba scene file
- * and as a JSON description for LuxCore (bench/peers/mitsuba_peer.py and luxcore_peer.py render
- * them in the peers' Python virtual environment).
+ * Two scenes: builtin:cornell (256x256, max depth 50) and an interior (the living room's
+ * geometry from ../shared/models, 143k triangles, every surface Lambertian 0.5, its glass left
+ * out, lit through its windows by a uniform sky of radiance 1; max depth 16; skipped with a
+ * message where the models are missing).  Each is rendered with raystream's stream engine (each
+ * sampler) and megakernel, with Mitsuba 3 (llvm_ad_rgb with its independent sampler and its
+ * low-discrepancy `ldsampler`; scalar_rgb on the box), with Blender's Cycles (bpy, its default
+ * sampler) and, on the box, LuxCoreRender (PATHCPU, Sobol): a 1-pixel box filter everywhere, at
+ * one and at two threads pinned to the first cores, renderers interleaved in rounds.  The peers
+ * get raystream's own scene: every quad and triangle exported to OBJ files, one per material,
+ * with the same camera, lights, background and diffuse materials, as a Mitsuba scene file and as
+ * a JSON description for LuxCore and Cycles (bench/peers/*_peer.py render them in the peers'
+ * Python virtual environments).
  *
  * First it checks that the peers render the same picture: each renderer's converged reference is
  * the mean of two independent halves (whose difference also measures the reference's own noise),
  * and a block-mean z-test over 16x16-pixel blocks compares the peer's reference with ours.  Then,
- * per renderer, for each sample count: the median time of mi.render / rs_render over the rounds,
- * and the RMSE over all pixels and channels against that renderer's own reference, with the
- * reference's noise removed (E|img - ref|^2 = err^2 + var_ref, var_ref = |A - B|^2 / 4).  A line
- * log RMSE = a + b log spp fitted through the levels gives the samples needed for RMSE 0.02 and
- * 0.01 and, at the measured seconds per sample pass, the time, with the ratio to raystream's.
+ * per renderer, for each sample count: the median time of the render alone over the rounds (no
+ * scene loading, BVH building or JIT compiling for anyone), and the RMSE over all pixels and
+ * channels against that renderer's own reference, with the reference's noise removed
+ * (E|img - ref|^2 = err^2 + var_ref, var_ref = |A - B|^2 / 4).  A line log RMSE = a + b log spp
+ * fitted through the levels gives the samples needed for RMSE 0.02 and 0.01 and, at the
+ * measured seconds per sample pass, the time, with the ratio to raystream's.
  *
- *   peers_bench [--quick] [--size N] [--levels A,B,...] [--ref-spp N] [--runs N]
- *               [--venv DIR] [--no-peers] [--keep DIR]
+ *   peers_bench [--quick] [--scenes cornell,interior] [--threads 1,2] [--size N]
+ *               [--levels A,B,...] [--ref-spp N] [--runs N] [--venv DIR] [--cycles-venv DIR]
+ *               [--no-peers] [--keep DIR]
  *
- * --quick (the test suite's smoke test) renders raystream's part only, small, and exports the
- * scene without running any peer.  Each peer runs when DIR/bin/python (--venv, else
- * $RS_PEERS_VENV, else peers-venv in the build folder) imports it (mitsuba, pyluxcore): make it
- * with `sh scripts/install-peers.sh DIR`.  A peer that is missing is skipped with a message. */
+ * --quick (the test suite's smoke test) renders raystream's part only, small, at one thread,
+ * and exports the scenes without running any peer.  Mitsuba and LuxCore run when DIR/bin/python
+ * (--venv, else $RS_PEERS_VENV, else peers-venv in the build folder) imports them, Cycles when
+ * DIR-cycles/bin/python (--cycles-venv, else $RS_CYCLES_VENV) imports bpy: make them with
+ * `sh scripts/install-peers.sh DIR`.  A peer that is missing is skipped with a message.  The
+ * interior's levels are 4, 16, 64 unless --levels is given (a sample costs 5x the box's). */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <math.h>
@@ -37,12 +45,14 @@
 #include <unistd.h>
 
 #include "core/parallel.h"
+#include "scenes/builtin.h"
+#include "scenes/scene_json.h"
 #include "machine.h"
 #include "render_util.h"
 
 #define MAX_LEVELS 12
 #define MAX_RUNS   9
-#define MAX_ROWS   8
+#define MAX_ROWS   12
 #define BLOCK      16
 
 typedef enum row_kind { ROW_RAYSTREAM, ROW_PEER } row_kind;
@@ -54,7 +64,7 @@ typedef struct row {
     rs_sampler sampler;
     int megakernel;
     /* a peer: bench/peers/SCRIPT SCENE VARIANT SAMPLER ... */
-    const char *script, *scene_file, *variant, *mi_sampler, *name;
+    const char *script, *scene_file, *variant, *mi_sampler, *name, *python;
     /* results */
     int ref_row; /* whose reference it is measured against (the same renderer's) */
     double secs[MAX_LEVELS][MAX_RUNS], err2[MAX_LEVELS];
@@ -70,8 +80,10 @@ typedef struct reference {
 
 static const char *prog = "peers_bench";
 static uint32_t W = 256, H = 256;
+static uint32_t DEPTH = 50; /* the scene's max depth (ray segments, camera ray included) */
 static char tmp_dir[512];
-static char python[1100];
+static char py_peers[1100];  /* the venv's Python: Mitsuba and LuxCore */
+static char py_cycles[1100]; /* the Cycles venv's (bpy needs its own Python, 3.13) */
 
 /* ---- small helpers ---------------------------------------------------------------------- */
 
@@ -83,7 +95,7 @@ static double sq_dist(const float *a, const float *b, size_t n)
     return s / (double)n;
 }
 
-static int pin_to_one_core(int on)
+static int pin_to_cores(int n)
 {
     cpu_set_t set;
     static cpu_set_t all;
@@ -93,16 +105,20 @@ static int pin_to_one_core(int on)
             return -1;
         saved = 1;
     }
-    if (!on)
+    if (n <= 0)
         return sched_setaffinity(0, sizeof all, &all);
-    /* the first allowed core (core 0 where allowed), as every other one-thread figure of the
-     * project is taken (`taskset -c 0`), so that the tables compare like with like */
+    /* the first n allowed cores (core 0 first where allowed), as every other one-thread figure
+     * of the project is taken (`taskset -c 0`), so that the tables compare like with like */
     CPU_ZERO(&set);
-    for (int c = 0; c < CPU_SETSIZE; ++c)
+    for (int c = 0, k = 0; c < CPU_SETSIZE && k < n; ++c)
         if (CPU_ISSET(c, &all)) {
             CPU_SET(c, &set);
-            break;
+            k++;
         }
+    if (CPU_COUNT(&set) < n) {
+        errno = EINVAL;
+        return -1;
+    }
     return sched_setaffinity(0, sizeof set, &set);
 }
 
@@ -147,21 +163,36 @@ static void obj_vertex(FILE *f, rs_vec3 p) { fprintf(f, "v %.9g %.9g %.9g\n", p.
  * raystream, so wrapped in `twosided`) and one-sided diffuse lights, a pinhole camera. */
 static int export_mitsuba(const rs_scene *s, const char *path_xml, const char *path_json)
 {
-    FILE *x = fopen(path_xml, "w"), *js = fopen(path_json, "w");
+    FILE *x, *js;
     int first_mesh = 1;
     uint32_t m, i;
     const rs_camera_desc *c = &s->camera;
+    rs_vec3 bg = s->background;
+    /* what lights the scene from outside: a constant (a uniform map or a plain colour) */
+    if (s->env_image != RS_NO_TEXTURE && s->env_uniform) {
+        bg = s->env_uniform_le;
+    } else if (s->env_image != RS_NO_TEXTURE || s->background_sky) {
+        fprintf(stderr, "%s: %s: only a constant background is exported\n", prog, s->name);
+        return 0;
+    }
+    x = fopen(path_xml, "w");
+    js = fopen(path_json, "w");
     if (!x || !js) {
         fprintf(stderr, "%s: cannot write %s: %s\n", prog, x ? path_json : path_xml,
                 strerror(errno));
+        if (x)
+            fclose(x);
+        if (js)
+            fclose(js);
         return 0;
     }
     /* the same for LuxCore's script, which builds its scene in Python */
     fprintf(js,
-            "{\"width\": %u, \"height\": %u, \"vfov\": %.9g, \"max_depth\": 50,\n"
+            "{\"width\": %u, \"height\": %u, \"vfov\": %.9g, \"max_depth\": %u,\n"
+            " \"background\": [%.9g, %.9g, %.9g],\n"
             " \"from\": [%.9g, %.9g, %.9g], \"at\": [%.9g, %.9g, %.9g], \"up\": [%.9g, %.9g, "
             "%.9g],\n \"meshes\": [",
-            W, H, c->vfov_deg, c->from.x, c->from.y, c->from.z, c->at.x, c->at.y, c->at.z,
+            W, H, c->vfov_deg, DEPTH, bg.x, bg.y, bg.z, c->from.x, c->from.y, c->from.z, c->at.x, c->at.y, c->at.z,
             c->up.x, c->up.y, c->up.z);
     if (s->n_spheres > 0) {
         fprintf(stderr, "%s: %s: spheres are not exported\n", prog, s->name);
@@ -171,7 +202,7 @@ static int export_mitsuba(const rs_scene *s, const char *path_xml, const char *p
     }
     fprintf(x, "<scene version=\"3.0.0\">\n"
                "  <default name=\"sampler\" value=\"independent\"/>\n"
-               "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"50\"/>"
+               "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"%u\"/>"
                "</integrator>\n"
                "  <sensor type=\"perspective\">\n"
                "    <float name=\"fov\" value=\"%.9g\"/><string name=\"fov_axis\" value=\"y\"/>\n"
@@ -184,8 +215,13 @@ static int export_mitsuba(const rs_scene *s, const char *path_xml, const char *p
                "<string name=\"component_format\" value=\"float32\"/>"
                "<rfilter type=\"box\"/></film>\n"
                "  </sensor>\n",
-            c->vfov_deg, c->from.x, c->from.y, c->from.z, c->at.x, c->at.y, c->at.z, c->up.x,
+            DEPTH, c->vfov_deg, c->from.x, c->from.y, c->from.z, c->at.x, c->at.y, c->at.z, c->up.x,
             c->up.y, c->up.z, W, H);
+    if (bg.x > 0 || bg.y > 0 || bg.z > 0)
+        fprintf(x,
+                "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"%.9g,%.9g,%.9g\"/>"
+                "</emitter>\n",
+                bg.x, bg.y, bg.z);
     for (m = 0; m < s->n_materials; ++m) {
         const rs_material *mat = &s->materials[m];
         char path[600];
@@ -288,6 +324,7 @@ static float *render_raystream(const rs_scene *scene, const row *r, uint32_t spp
     a.sampler = r->sampler;
     a.megakernel = r->megakernel;
     a.bvh = RS_BVH_SAH;
+    a.max_depth = DEPTH;
     img = rt_render_scene(scene, &a, &st);
     if (img && secs)
         *secs = st.seconds;
@@ -329,7 +366,7 @@ static int render_peer(const row *r, const uint32_t *levels, int n_levels, uint6
     for (i = 0; i < n_levels; ++i)
         snprintf(spps + strlen(spps), sizeof spps - strlen(spps), "%s%u", i ? "," : "",
                  levels[i]);
-    argv[n++] = python;
+    argv[n++] = (char *)r->python;
     argv[n++] = script;
     argv[n++] = xml;
     argv[n++] = (char *)r->variant;
@@ -490,11 +527,12 @@ static double time_to(const row *r, int n_levels, int runs, double target, doubl
     return spp * per_spp;
 }
 
-static void print_table(row *rows, int n_rows, const uint32_t *levels, int n_levels, int runs)
+static void print_table(row *rows, int n_rows, const uint32_t *levels, int n_levels, int runs,
+                        int threads)
 {
     int k, l;
     double base01 = -1.0;
-    printf("\n| renderer | samples/s (1 thread) |");
+    printf("\n| renderer | samples/s (%d thread%s) |", threads, threads == 1 ? "" : "s");
     for (l = 0; l < n_levels; ++l)
         printf(" RMSE %u spp |", levels[l]);
     printf(" slope | time to RMSE 0.02 | time to RMSE 0.01 | vs raystream at 0.01 |\n|---|---:|");
@@ -552,12 +590,12 @@ static int parse_levels(const char *s, uint32_t *levels, int *n)
 }
 
 /* Whether the venv's Python imports `module` (python[] is set to the venv's interpreter). */
-static int peer_available(const char *venv, const char *module)
+static int peer_available(const char *venv, const char *module, char *python, size_t size)
 {
     char *argv[4];
     char code[128];
     struct stat sb;
-    snprintf(python, sizeof python, "%s/bin/python", venv);
+    snprintf(python, size, "%s/bin/python", venv);
     if (stat(python, &sb) != 0)
         return 0;
     snprintf(code, sizeof code, "import %s", module);
@@ -570,9 +608,10 @@ static int peer_available(const char *venv, const char *module)
 
 static row *add_peer(row *rows, int *n_rows, const char *label, const char *name,
                      const char *script, const char *scene_file, const char *variant,
-                     const char *sampler)
+                     const char *sampler, const char *python)
 {
     row *r = &rows[(*n_rows)++];
+    r->python = python;
     r->label = label;
     r->name = name;
     r->kind = ROW_PEER;
@@ -584,61 +623,101 @@ static row *add_peer(row *rows, int *n_rows, const char *label, const char *name
     return r;
 }
 
-int main(int argc, char **argv)
+/* The interior: the living room's geometry (../shared/models/living-room, 143k triangles) with
+ * every surface one two-sided Lambertian of albedo 0.5 and its glass left out (so that the
+ * windows are open), lit only by a uniform environment of radiance 1 given as a constant map:
+ * the setting of the issue's held-out atrium, on a real interior that every peer renders the
+ * same.  NULL (after a message) where the models folder or the JSON reader is missing. */
+static rs_scene *make_interior(void)
 {
-    uint32_t levels[MAX_LEVELS] = {4, 16, 64, 256}, ref_spp = 1024;
-    int n_levels = 4, runs = 3, quick = 0, peers = 1, i, k, l, round, n_rows = 0, n_ray;
-    const char *venv = getenv("RS_PEERS_VENV"), *keep = NULL;
-    char default_venv[1024], xml[600], json[600];
-    size_t nf;
-    rs_scene *scene = NULL;
+    char path[1200];
+    const char *dir = rs_builtin_models_dir(NULL);
+    rs_scene *src = NULL, *s = NULL;
+    rs_material grey;
+    uint32_t mat, img, i, dropped = 0;
+    const float one[3] = {1.0f, 1.0f, 1.0f};
+    struct stat sb;
+    snprintf(path, sizeof path, "%s/living-room/living-room.raystream.json", dir ? dir : ".");
+    if (stat(path, &sb) != 0) {
+        printf("interior: skipped: no %s (the shared models folder; set RS_MODELS_DIR or "
+               "build beside ../shared/models)\n",
+               path);
+        return NULL;
+    }
+    if (rs_scene_load_json(path, &src) != RS_OK) {
+        printf("interior: skipped: %s\n", rs_error_message());
+        return NULL;
+    }
+    if (src->n_instances > 0 || src->n_spheres > 0 || src->n_quads > 0 ||
+        rs_scene_create("interior", &s) != RS_OK) {
+        printf("interior: skipped: %s is not the triangle scene expected\n", path);
+        rs_scene_destroy(src);
+        return NULL;
+    }
+    grey = rs_mat_lambertian(rs_v3(0.5f, 0.5f, 0.5f));
+    if (rs_scene_add_material(s, &grey, &mat) != RS_OK)
+        goto fail;
+    for (i = 0; i < src->n_tris; ++i) {
+        const rs_tri *t = &src->tris[i];
+        if (src->materials[src->tri_mat[i]].type == RS_MAT_DIELECTRIC) {
+            dropped++;
+            continue;
+        }
+        if (rs_scene_add_triangle(s, t->v0, t->v1, t->v2, mat) != RS_OK)
+            goto fail;
+    }
+    s->camera = src->camera;
+    if (rs_scene_add_image(s, 1, 1, one, &img) != RS_OK ||
+        rs_scene_set_environment(s, img, rs_v3(1, 1, 1), NULL) != RS_OK ||
+        rs_scene_finalize(s) != RS_OK)
+        goto fail;
+    printf("interior: %s: %u triangles, every one Lambertian 0.5 with face normals, the glass "
+           "(%u triangles) left out; a uniform sky of radiance 1 (a constant map)\n",
+           path, s->n_tris, dropped);
+    rs_scene_destroy(src);
+    return s;
+fail:
+    printf("interior: skipped: %s\n", rs_error_message());
+    rs_scene_destroy(src);
+    rs_scene_destroy(s);
+    return NULL;
+}
+
+static int parse_threads(const char *s, int *threads, int *n)
+{
+    *n = 0;
+    while (*s && *n < 4) {
+        char *end;
+        long v = strtol(s, &end, 10);
+        if (end == s || v < 1 || v > 256)
+            return 0;
+        threads[(*n)++] = (int)v;
+        s = *end == ',' ? end + 1 : end;
+        if (end == s && *s)
+            return 0;
+    }
+    return *n >= 1 && !*s;
+}
+
+typedef struct options {
+    uint32_t levels[MAX_LEVELS], ref_spp;
+    int n_levels, levels_given, runs, peers, quick;
+    int threads[4], n_threads;
+    const char *venv, *cycles_venv;
+} options;
+
+/* One scene: export, references, the same-picture check, then the timed rounds at each thread
+ * count.  Returns 0 when raystream itself failed. */
+static int race(rs_scene *scene, const char *title, const options *o)
+{
+    const uint32_t *levels = o->levels;
+    int n_levels = o->n_levels, runs = o->runs, i, k, l, round, n_rows = 0, n_ray, t;
+    int interior = strcmp(scene->name, "interior") == 0;
+    char xml[600], json[600];
+    size_t nf = (size_t)W * H * 3;
     row rows[MAX_ROWS];
     reference refs[MAX_ROWS];
-    snprintf(default_venv, sizeof default_venv, "%s/peers-venv", RS_BINARY_DIR);
-    if (!venv || !*venv)
-        venv = default_venv;
-    for (i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--quick") == 0) {
-            quick = 1;
-        } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
-            W = H = (uint32_t)atoi(argv[++i]);
-        } else if (strcmp(argv[i], "--levels") == 0 && i + 1 < argc) {
-            if (!parse_levels(argv[++i], levels, &n_levels)) {
-                fprintf(stderr, "%s: --levels takes two or more increasing counts: 4,16,64\n",
-                        prog);
-                return 2;
-            }
-        } else if (strcmp(argv[i], "--ref-spp") == 0 && i + 1 < argc) {
-            ref_spp = (uint32_t)atoi(argv[++i]);
-        } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
-            runs = atoi(argv[++i]);
-        } else if (strcmp(argv[i], "--venv") == 0 && i + 1 < argc) {
-            venv = argv[++i];
-        } else if (strcmp(argv[i], "--no-peers") == 0) {
-            peers = 0;
-        } else if (strcmp(argv[i], "--keep") == 0 && i + 1 < argc) {
-            keep = argv[++i];
-        } else {
-            fprintf(stderr, "usage: peers_bench [--quick] [--size N] [--levels A,B,...] "
-                            "[--ref-spp N] [--runs N] [--venv DIR] [--no-peers] [--keep DIR]\n");
-            return 2;
-        }
-    }
-    if (quick) {
-        W = H = 32;
-        levels[0] = 1, levels[1] = 4, n_levels = 2;
-        ref_spp = 64;
-        runs = 1;
-        peers = 0;
-    }
-    if (W < BLOCK || W > 4096 || ref_spp < 2 || runs < 1 || runs > MAX_RUNS) {
-        fprintf(stderr, "%s: --size %u..4096, --ref-spp >= 2, --runs 1..%d\n", prog, BLOCK,
-                MAX_RUNS);
-        return 2;
-    }
-    nf = (size_t)W * H * 3;
 
-    /* the rows: raystream's first (the baseline), then the peers */
     memset(rows, 0, sizeof rows);
     memset(refs, 0, sizeof refs);
     rows[n_rows].label = "raystream stream, sobol (default)";
@@ -651,6 +730,231 @@ int main(int argc, char **argv)
     rows[n_rows].label = "raystream stream, independent";
     rows[n_rows++].sampler = RS_SAMPLER_INDEPENDENT;
     n_ray = n_rows;
+
+    snprintf(xml, sizeof xml, "%s/scene.xml", tmp_dir);
+    snprintf(json, sizeof json, "%s/peers.json", tmp_dir);
+    if (!export_mitsuba(scene, xml, json))
+        return 0;
+    printf("\n## %s\n\nsettings: %ux%u, max depth %u, 1-pixel box filter, MIS (power heuristic) "
+           "everywhere; threads pinned to the first cores, %d interleaved rounds; references "
+           "%u spp (two halves, every core)\n",
+           title, W, H, DEPTH, runs, o->ref_spp);
+    if (!o->peers)
+        printf("peers: skipped (%s)\n", o->quick ? "--quick" : "--no-peers");
+    if (o->peers && !peer_available(o->venv, "mitsuba, numpy", py_peers, sizeof py_peers)) {
+        /* bench/peers/mitsuba_peer.py hands the image over through numpy: without it every
+         * Mitsuba render would fail */
+        printf("Mitsuba 3: skipped: %s/bin/python cannot import mitsuba and numpy (make the venv "
+               "with `sh scripts/install-peers.sh %s`)\n",
+               o->venv, o->venv);
+    } else if (o->peers) {
+        const char *llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so";
+        struct stat sb;
+        int have_llvm = getenv("DRJIT_LIBLLVM_PATH") != NULL || stat(llvm, &sb) == 0, first;
+        if (!getenv("DRJIT_LIBLLVM_PATH") && have_llvm)
+            setenv("DRJIT_LIBLLVM_PATH", llvm, 1);
+        first = n_rows;
+        if (!interior || !have_llvm) /* scalar_rgb: 3x slower than llvm; the box keeps it */
+            add_peer(rows, &n_rows, "Mitsuba 3 scalar_rgb, independent", "Mitsuba 3",
+                     "mitsuba_peer.py", "scene.xml", "scalar_rgb", "independent", py_peers);
+        if (have_llvm) {
+            add_peer(rows, &n_rows, "Mitsuba 3 llvm_ad_rgb, independent", "Mitsuba 3",
+                     "mitsuba_peer.py", "scene.xml", "llvm_ad_rgb", "independent", py_peers);
+            add_peer(rows, &n_rows, "Mitsuba 3 llvm_ad_rgb, ldsampler", "Mitsuba 3",
+                     "mitsuba_peer.py", "scene.xml", "llvm_ad_rgb", "ldsampler", py_peers);
+            /* the JIT renders the reference 3x faster than scalar_rgb */
+            for (k = first; k < n_rows; ++k)
+                rows[k].ref_row = interior ? first : first + 1;
+        } else {
+            printf("Mitsuba 3 llvm_ad_rgb: skipped: no %s (Debian's libllvm19) and no "
+                   "DRJIT_LIBLLVM_PATH\n",
+                   llvm);
+        }
+    }
+    if (o->peers && !peer_available(o->cycles_venv, "bpy, numpy", py_cycles, sizeof py_cycles))
+        printf("Cycles: skipped: %s/bin/python cannot import bpy and numpy (bpy 5.2 needs Python "
+               "3.13; `sh scripts/install-peers.sh` makes that venv where it finds one)\n",
+               o->cycles_venv);
+    else if (o->peers)
+        add_peer(rows, &n_rows, "Cycles 5.2 CPU (its default sampler)", "Cycles",
+                 "cycles_peer.py", "peers.json", "CPU", "default", py_cycles);
+    if (o->peers && interior)
+        printf("LuxCoreRender: skipped on the interior (8x slower than raystream on the box; it "
+               "would double the bench's time)\n");
+    else if (o->peers && !peer_available(o->venv, "pyluxcore", py_peers, sizeof py_peers))
+        printf("LuxCoreRender: skipped: %s/bin/python cannot import pyluxcore (`sh "
+               "scripts/install-peers.sh %s` installs it)\n",
+               o->venv, o->venv);
+    else if (o->peers)
+        add_peer(rows, &n_rows, "LuxCoreRender 2.11 PATHCPU, sobol", "LuxCoreRender",
+                 "luxcore_peer.py", "peers.json", "PATHCPU", "SOBOL", py_peers);
+    fflush(stdout);
+
+    /* references, every core, one per renderer (its other rows converge to the same image);
+     * the same-picture check */
+    for (k = 0; k < n_rows; ++k) {
+        row *r = &rows[k];
+        if (r->ref_row != k)
+            continue;
+        r->ok = make_reference(scene, r, o->ref_spp, &refs[k]);
+        if (!r->ok) {
+            if (k < n_ray)
+                return 0;
+            printf("%s: skipped: its reference could not be made\n", r->label);
+            continue;
+        }
+        if (k >= n_ray && !same_picture(r->name, &refs[k], &refs[0])) {
+            printf("%s: skipped: it does not render the same picture\n", r->name);
+            r->ok = 0;
+        }
+    }
+    for (k = 0; k < n_rows; ++k)
+        rows[k].ok = rows[rows[k].ref_row].ok;
+    fflush(stdout);
+
+    /* the timed rounds: `threads` cores, renderers interleaved */
+    for (t = 0; t < o->n_threads; ++t) {
+        int threads = o->threads[t];
+        for (k = 0; k < n_rows; ++k) {
+            memset(rows[k].secs, 0, sizeof rows[k].secs);
+            memset(rows[k].err2, 0, sizeof rows[k].err2);
+            memset(rows[k].done, 0, sizeof rows[k].done);
+        }
+        if (pin_to_cores(threads) != 0) {
+            printf("(%d threads: could not pin to %d cores: %s; skipped)\n", threads, threads,
+                   strerror(errno));
+            continue;
+        }
+        for (round = 0; round < runs; ++round)
+            for (k = 0; k < n_rows; ++k) {
+                row *r = &rows[k];
+                uint64_t seed = 1 + (uint64_t)round * 1000;
+                if (!r->ok)
+                    continue;
+                if (r->kind == ROW_RAYSTREAM) {
+                    for (l = 0; l < n_levels; ++l) {
+                        float *img = render_raystream(scene, r, levels[l], seed + (uint64_t)l,
+                                                      threads, &r->secs[l][round]);
+                        if (!img) {
+                            pin_to_cores(0);
+                            return 0;
+                        }
+                        r->done[l] += (double)levels[l] / runs;
+                        r->err2[l] += (sq_dist(img, refs[r->ref_row].img, nf) -
+                                       refs[r->ref_row].var_ref) / runs;
+                        free(img);
+                    }
+                } else {
+                    float *imgs[MAX_LEVELS];
+                    double secs[MAX_LEVELS], done[MAX_LEVELS];
+                    if (!render_peer(r, levels, n_levels, seed, threads, 1, secs, done, imgs)) {
+                        r->ok = 0;
+                        continue;
+                    }
+                    for (l = 0; l < n_levels; ++l) {
+                        r->secs[l][round] = secs[l];
+                        r->done[l] += done[l] / runs;
+                        r->err2[l] += (sq_dist(imgs[l], refs[r->ref_row].img, nf) -
+                                       refs[r->ref_row].var_ref) / runs;
+                        free(imgs[l]);
+                    }
+                }
+            }
+        pin_to_cores(0);
+        printf("\n### %s, %d thread%s\n", title, threads, threads == 1 ? "" : "s");
+        print_table(rows, n_rows, levels, n_levels, runs, threads);
+        fflush(stdout);
+    }
+
+    for (k = 0; k < n_rows; ++k) {
+        if (rows[k].ref_row != k)
+            continue;
+        free(refs[k].img);
+        free(refs[k].a);
+        free(refs[k].b);
+    }
+    (void)i;
+    return 1;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    const char *keep = NULL, *which = "cornell,interior";
+    char default_venv[1024], default_cycles[1100];
+    uint32_t size = 256;
+    int i, ok = 1;
+    memset(&o, 0, sizeof o);
+    o.levels[0] = 4, o.levels[1] = 16, o.levels[2] = 64, o.levels[3] = 256;
+    o.n_levels = 4;
+    o.ref_spp = 1024;
+    o.runs = 3;
+    o.peers = 1;
+    o.threads[0] = 1, o.threads[1] = 2, o.n_threads = 2;
+    o.venv = getenv("RS_PEERS_VENV");
+    snprintf(default_venv, sizeof default_venv, "%s/peers-venv", RS_BINARY_DIR);
+    if (!o.venv || !*o.venv)
+        o.venv = default_venv;
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--quick") == 0) {
+            o.quick = 1;
+        } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
+            size = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--levels") == 0 && i + 1 < argc) {
+            if (!parse_levels(argv[++i], o.levels, &o.n_levels)) {
+                fprintf(stderr, "%s: --levels takes two or more increasing counts: 4,16,64\n",
+                        prog);
+                return 2;
+            }
+            o.levels_given = 1;
+        } else if (strcmp(argv[i], "--ref-spp") == 0 && i + 1 < argc) {
+            o.ref_spp = (uint32_t)atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
+            o.runs = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+            if (!parse_threads(argv[++i], o.threads, &o.n_threads)) {
+                fprintf(stderr, "%s: --threads takes one to four counts: 1,2\n", prog);
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--scenes") == 0 && i + 1 < argc) {
+            which = argv[++i];
+        } else if (strcmp(argv[i], "--venv") == 0 && i + 1 < argc) {
+            o.venv = argv[++i];
+        } else if (strcmp(argv[i], "--cycles-venv") == 0 && i + 1 < argc) {
+            o.cycles_venv = argv[++i];
+        } else if (strcmp(argv[i], "--no-peers") == 0) {
+            o.peers = 0;
+        } else if (strcmp(argv[i], "--keep") == 0 && i + 1 < argc) {
+            keep = argv[++i];
+        } else {
+            fprintf(stderr,
+                    "usage: peers_bench [--quick] [--scenes cornell,interior] [--threads 1,2] "
+                    "[--size N] [--levels A,B,...] [--ref-spp N] [--runs N] [--venv DIR] "
+                    "[--cycles-venv DIR] [--no-peers] [--keep DIR]\n");
+            return 2;
+        }
+    }
+    /* Cycles' venv: --cycles-venv, else $RS_CYCLES_VENV, else the peers' venv's name + -cycles
+     * (where scripts/install-peers.sh makes it) */
+    snprintf(default_cycles, sizeof default_cycles, "%s-cycles", o.venv);
+    if (!o.cycles_venv)
+        o.cycles_venv = getenv("RS_CYCLES_VENV") && *getenv("RS_CYCLES_VENV")
+                            ? getenv("RS_CYCLES_VENV")
+                            : default_cycles;
+    if (o.quick) {
+        size = 32;
+        o.levels[0] = 1, o.levels[1] = 4, o.n_levels = 2, o.levels_given = 1;
+        o.ref_spp = 64;
+        o.runs = 1;
+        o.peers = 0;
+        o.threads[0] = 1, o.n_threads = 1;
+    }
+    W = H = size;
+    if (W < BLOCK || W > 4096 || o.ref_spp < 2 || o.runs < 1 || o.runs > MAX_RUNS) {
+        fprintf(stderr, "%s: --size %u..4096, --ref-spp >= 2, --runs 1..%d\n", prog, BLOCK,
+                MAX_RUNS);
+        return 2;
+    }
 
     if (keep) {
         if (mkdir(keep, 0777) != 0 && errno != EEXIST) {
@@ -666,133 +970,37 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    if (rs_builtin_create("cornell", &scene) != RS_OK) {
-        fprintf(stderr, "%s: %s\n", prog, rs_error_message());
-        return 1;
-    }
-    snprintf(xml, sizeof xml, "%s/scene.xml", tmp_dir);
-    snprintf(json, sizeof json, "%s/peers.json", tmp_dir);
-    if (!export_mitsuba(scene, xml, json))
-        return 1;
 
     rs_bench_print_machine(stdout);
-    printf("settings: builtin:cornell %ux%u, max depth 50, 1-pixel box filter, MIS (power "
-           "heuristic) everywhere; one thread pinned to one core, %d interleaved rounds; "
-           "references %u spp (two halves, every core)\n",
-           W, H, runs, ref_spp);
-    if (!peers)
-        printf("peers: skipped (%s)\n", quick ? "--quick" : "--no-peers");
-    if (peers && !peer_available(venv, "mitsuba, numpy")) {
-        /* bench/peers/mitsuba_peer.py hands the image over through numpy: without it every
-         * Mitsuba render would fail */
-        printf("Mitsuba 3: skipped: %s/bin/python cannot import mitsuba and numpy (make the venv "
-               "with `sh scripts/install-peers.sh %s`)\n",
-               venv, venv);
-    } else if (peers) {
-        const char *llvm = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so";
-        struct stat sb;
-        int have_llvm = getenv("DRJIT_LIBLLVM_PATH") != NULL || stat(llvm, &sb) == 0, first;
-        if (!getenv("DRJIT_LIBLLVM_PATH") && have_llvm)
-            setenv("DRJIT_LIBLLVM_PATH", llvm, 1);
-        first = n_rows;
-        add_peer(rows, &n_rows, "Mitsuba 3 scalar_rgb, independent", "Mitsuba 3",
-                 "mitsuba_peer.py", "scene.xml", "scalar_rgb", "independent");
-        if (have_llvm) {
-            add_peer(rows, &n_rows, "Mitsuba 3 llvm_ad_rgb, independent", "Mitsuba 3",
-                     "mitsuba_peer.py", "scene.xml", "llvm_ad_rgb", "independent");
-            add_peer(rows, &n_rows, "Mitsuba 3 llvm_ad_rgb, ldsampler", "Mitsuba 3",
-                     "mitsuba_peer.py", "scene.xml", "llvm_ad_rgb", "ldsampler");
-            /* the JIT renders the reference 3x faster than scalar_rgb */
-            for (k = first; k < n_rows; ++k)
-                rows[k].ref_row = first + 1;
-        } else {
-            printf("Mitsuba 3 llvm_ad_rgb: skipped: no %s (Debian's libllvm19) and no "
-                   "DRJIT_LIBLLVM_PATH\n",
-                   llvm);
+    if (strstr(which, "cornell")) {
+        rs_scene *scene = NULL;
+        if (rs_builtin_create("cornell", &scene) != RS_OK) {
+            fprintf(stderr, "%s: %s\n", prog, rs_error_message());
+            return 1;
         }
+        DEPTH = 50;
+        ok = race(scene, "The Cornell box (builtin:cornell)", &o) && ok;
+        rs_scene_destroy(scene);
     }
-    if (peers && !peer_available(venv, "pyluxcore"))
-        printf("LuxCoreRender: skipped: %s/bin/python cannot import pyluxcore (`sh "
-               "scripts/install-peers.sh %s` installs it)\n",
-               venv, venv);
-    else if (peers)
-        add_peer(rows, &n_rows, "LuxCoreRender 2.11 PATHCPU, sobol", "LuxCoreRender",
-                 "luxcore_peer.py", "peers.json", "PATHCPU", "SOBOL");
-    fflush(stdout);
-
-    /* references, every core, one per renderer (its other rows converge to the same image);
-     * the same-picture check */
-    for (k = 0; k < n_rows; ++k) {
-        row *r = &rows[k];
-        if (r->ref_row != k)
-            continue;
-        r->ok = make_reference(scene, r, ref_spp, &refs[k]);
-        if (!r->ok) {
-            if (k < n_ray)
-                return 1;
-            printf("%s: skipped: its reference could not be made\n", r->label);
-            continue;
-        }
-        if (k >= n_ray && !same_picture(r->name, &refs[k], &refs[0])) {
-            printf("%s: skipped: it does not render the same picture\n", r->name);
-            r->ok = 0;
-        }
-    }
-    for (k = 0; k < n_rows; ++k)
-        rows[k].ok = rows[rows[k].ref_row].ok;
-    fflush(stdout);
-
-    /* the timed rounds: one core, renderers interleaved */
-    if (pin_to_one_core(1) != 0)
-        printf("(could not pin to one core: %s)\n", strerror(errno));
-    for (round = 0; round < runs; ++round)
-        for (k = 0; k < n_rows; ++k) {
-            row *r = &rows[k];
-            uint64_t seed = 1 + (uint64_t)round * 1000;
-            if (!r->ok)
-                continue;
-            if (r->kind == ROW_RAYSTREAM) {
-                for (l = 0; l < n_levels; ++l) {
-                    float *img = render_raystream(scene, r, levels[l], seed + (uint64_t)l, 1,
-                                                  &r->secs[l][round]);
-                    if (!img)
-                        return 1;
-                    r->done[l] += (double)levels[l] / runs;
-                    r->err2[l] += (sq_dist(img, refs[r->ref_row].img, nf) - refs[r->ref_row].var_ref) / runs;
-                    free(img);
-                }
-            } else {
-                float *imgs[MAX_LEVELS];
-                double secs[MAX_LEVELS], done[MAX_LEVELS];
-                if (!render_peer(r, levels, n_levels, seed, 1, 1, secs, done, imgs)) {
-                    r->ok = 0;
-                    continue;
-                }
-                for (l = 0; l < n_levels; ++l) {
-                    r->secs[l][round] = secs[l];
-                    r->done[l] += done[l] / runs;
-                    r->err2[l] += (sq_dist(imgs[l], refs[r->ref_row].img, nf) -
-                                  refs[r->ref_row].var_ref) / runs;
-                    free(imgs[l]);
-                }
+    if (ok && strstr(which, "interior")) {
+        rs_scene *scene = make_interior();
+        if (scene) {
+            options oi = o;
+            if (!oi.levels_given) { /* 5x the box's time per sample: one level less */
+                oi.n_levels = 3;
             }
+            DEPTH = 16;
+            ok = race(scene, "An interior (the living room's geometry, Lambertian 0.5, "
+                             "a uniform sky)",
+                      &oi) && ok;
+            rs_scene_destroy(scene);
         }
-    pin_to_one_core(0);
-    print_table(rows, n_rows, levels, n_levels, runs);
-
-    for (k = 0; k < n_rows; ++k) {
-        if (rows[k].ref_row != k)
-            continue;
-        free(refs[k].img);
-        free(refs[k].a);
-        free(refs[k].b);
     }
-    rs_scene_destroy(scene);
     if (!keep) {
         char cmd[700];
         snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmp_dir);
         if (system(cmd) != 0)
             fprintf(stderr, "%s: could not remove %s\n", prog, tmp_dir);
     }
-    return 0;
+    return ok ? 0 : 1;
 }

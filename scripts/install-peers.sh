@@ -4,15 +4,42 @@
 #   sh scripts/install-peers.sh [DIR]     (default: build/peers-venv)
 # Installs Debian's python3, python3-venv and libllvm19 (Mitsuba's llvm_ad_rgb variant JIT-compiles
 # with it; peers_bench points DRJIT_LIBLLVM_PATH at it) where they are missing, then Mitsuba 3
-# and LuxCoreRender (pyluxcore) from PyPI into DIR.  Idempotent: a DIR that already imports both
-# is left as it is.
+# and LuxCoreRender (pyluxcore) from PyPI into DIR, and Blender's Cycles (bpy) into DIR-cycles:
+# bpy 5.2 is built for Python 3.13 only, so that venv is made where a python3.13 is found (on
+# PATH, or pyenv's under ~/.pyenv/versions/3.13.*), and skipped with a message otherwise.
+# Idempotent: a venv that already imports its peers is left as it is.
 set -eu
 
 DIR=${1:-build/peers-venv}
 MITSUBA=mitsuba==3.9.1
 LUXCORE=pyluxcore==2.11.2
+BPY=bpy==5.2.3
 
-if [ -x "$DIR/bin/python" ] && "$DIR/bin/python" -c "import mitsuba, pyluxcore, numpy" 2>/dev/null; then
+cycles_venv() {
+    CY="$DIR-cycles"
+    if [ -x "$CY/bin/python" ] && "$CY/bin/python" -c "import bpy, numpy" 2>/dev/null; then
+        return 0
+    fi
+    PY313=$(command -v python3.13 2>/dev/null || true)
+    if [ -z "$PY313" ]; then
+        for p in "$HOME"/.pyenv/versions/3.13*/bin/python3.13; do
+            [ -x "$p" ] && PY313=$p
+        done
+    fi
+    if [ -z "$PY313" ]; then
+        echo "install-peers.sh: no python3.13 found: Cycles (bpy 5.2 needs Python 3.13) is skipped" >&2
+        return 0
+    fi
+    echo "install-peers.sh: making $CY with $BPY ($PY313)" >&2
+    [ -x "$CY/bin/python" ] || "$PY313" -m venv "$CY"
+    "$CY/bin/pip" install -q "$BPY" numpy
+    "$CY/bin/python" -c "import bpy; print('install-peers.sh: Blender', bpy.app.version_string, 'in $CY')" 2>/dev/null | tail -1
+}
+
+# one import per process: mitsuba and pyluxcore in one process abort (their TBBs clash)
+if [ -x "$DIR/bin/python" ] && "$DIR/bin/python" -c "import mitsuba, numpy" 2>/dev/null &&
+    "$DIR/bin/python" -c "import pyluxcore" >/dev/null 2>&1; then
+    cycles_venv
     exit 0
 fi
 
@@ -45,3 +72,4 @@ echo "install-peers.sh: making $DIR with $MITSUBA $LUXCORE" >&2
 "$DIR/bin/pip" install -q "$MITSUBA" "$LUXCORE" numpy
 "$DIR/bin/python" -c "import mitsuba; print('install-peers.sh: Mitsuba', mitsuba.__version__, 'in $DIR')"
 "$DIR/bin/python" -c "import pyluxcore; print('install-peers.sh: LuxCoreRender', pyluxcore.Version())" | tail -1
+cycles_venv
