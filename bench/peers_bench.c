@@ -10,7 +10,7 @@
  * one and at two threads pinned to the first cores, renderers interleaved in rounds.  The peers
  * get raystream's own scene: every quad and triangle exported to OBJ files, one per material,
  * with the same camera, lights, background and diffuse materials, as a Mitsuba scene file and as
- * a JSON description for LuxCore and Cycles (bench/peers/*_peer.py render them in the peers'
+ * a JSON description for LuxCore and Cycles (bench/peers/NAME_peer.py render them in the peers'
  * Python virtual environments).
  *
  * First it checks that the peers render the same picture: each renderer's converged reference is
