@@ -24,7 +24,8 @@
  * measured seconds per sample pass, the time, with the ratio to raystream's.
  *
  *   peers_bench [--quick] [--scenes cornell,interior] [--threads 1,2] [--size N]
- *               [--levels A,B,...] [--ref-spp N] [--runs N] [--venv DIR] [--cycles-venv DIR]
+ *               [--levels A,B,...] [--ref-spp N] [--runs N] [--depth N] [--venv DIR]
+ *               [--cycles-venv DIR]
  *               [--no-peers] [--keep DIR]
  *
  * --quick (the test suite's smoke test) renders raystream's part only, small, at one thread,
@@ -32,7 +33,8 @@
  * (--venv, else $RS_PEERS_VENV, else peers-venv in the build folder) imports them, Cycles when
  * DIR-cycles/bin/python (--cycles-venv, else $RS_CYCLES_VENV) imports bpy: make them with
  * `sh scripts/install-peers.sh DIR`.  A peer that is missing is skipped with a message.  The
- * interior's levels are 4, 16, 64 unless --levels is given (a sample costs 5x the box's). */
+ * interior's levels are 4, 16, 64 unless --levels is given (a sample costs 5x the box's);
+ * --depth N sets both scenes' max depth (2: direct light only). */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <math.h>
@@ -324,6 +326,7 @@ static float *render_raystream(const rs_scene *scene, const row *r, uint32_t spp
     a.sampler = r->sampler;
     a.megakernel = r->megakernel;
     a.bvh = RS_BVH_SAH;
+    a.cli_bvh = 1; /* the renderer's own tree: 8-wide where AVX2 runs */
     a.max_depth = DEPTH;
     img = rt_render_scene(scene, &a, &st);
     if (img && secs)
@@ -703,6 +706,7 @@ typedef struct options {
     uint32_t levels[MAX_LEVELS], ref_spp;
     int n_levels, levels_given, runs, peers, quick;
     int threads[4], n_threads;
+    uint32_t depth; /* 0: each scene's own */
     const char *venv, *cycles_venv;
 } options;
 
@@ -916,6 +920,8 @@ int main(int argc, char **argv)
                 fprintf(stderr, "%s: --threads takes one to four counts: 1,2\n", prog);
                 return 2;
             }
+        } else if (strcmp(argv[i], "--depth") == 0 && i + 1 < argc) {
+            o.depth = (uint32_t)atoi(argv[++i]);
         } else if (strcmp(argv[i], "--scenes") == 0 && i + 1 < argc) {
             which = argv[++i];
         } else if (strcmp(argv[i], "--venv") == 0 && i + 1 < argc) {
@@ -929,7 +935,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr,
                     "usage: peers_bench [--quick] [--scenes cornell,interior] [--threads 1,2] "
-                    "[--size N] [--levels A,B,...] [--ref-spp N] [--runs N] [--venv DIR] "
+                    "[--size N] [--levels A,B,...] [--ref-spp N] [--runs N] [--depth N] [--venv DIR] "
                     "[--cycles-venv DIR] [--no-peers] [--keep DIR]\n");
             return 2;
         }
@@ -978,7 +984,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s: %s\n", prog, rs_error_message());
             return 1;
         }
-        DEPTH = 50;
+        DEPTH = o.depth ? o.depth : 50;
         ok = race(scene, "The Cornell box (builtin:cornell)", &o) && ok;
         rs_scene_destroy(scene);
     }
@@ -989,7 +995,7 @@ int main(int argc, char **argv)
             if (!oi.levels_given) { /* 5x the box's time per sample: one level less */
                 oi.n_levels = 3;
             }
-            DEPTH = 16;
+            DEPTH = o.depth ? o.depth : 16;
             ok = race(scene, "An interior (the living room's geometry, Lambertian 0.5, "
                              "a uniform sky)",
                       &oi) && ok;

@@ -37,6 +37,8 @@ typedef struct rt_args {
     int fail_after;    /* > 0: the second device fails after this many chunks (RS_FAULT) */
     int shared_cores;  /* devices and shading share a budget of `threads` cores */
     uint32_t bvh_width; /* the CPU device's traversal: 2, 4 or 8 (0: 4) */
+    int cli_bvh; /* the CLI's tree instead: the widest traversal this CPU runs (bvh_width is
+                    ignored) over leaves the size of its blocks (rs_bvh_wide_leaf_size) */
     rs_adaptive adaptive; /* threshold > 0: rs_render_adaptive (the stream integrator) */
     rs_adaptive_stats *adaptive_out; /* its statistics, where not NULL */
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
@@ -81,9 +83,11 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     co.threads = a->threads;
     co.cores = budget;
     co.strategy = a->strategy;
-    co.bvh_width = a->no_bvh ? 2 : a->bvh_width ? a->bvh_width : 4;
+    co.bvh_width = a->no_bvh ? 2 : a->cli_bvh ? 0 : a->bvh_width ? a->bvh_width : 4;
     memset(&bo, 0, sizeof bo);
     bo.max_leaf = a->no_bvh ? UINT32_MAX : 0;
+    if (a->cli_bvh && !a->no_bvh)
+        bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, &g);
     bo.builder.method = a->bvh;
     if (rs_bvh_build(&g, &bo, &bvh) != RS_OK ||
         (a->fallback_only ? (a->real_gpu ? rs_gpu_device_create(0, &devs[0])
