@@ -216,9 +216,11 @@ typedef struct rs_scene {
     float env_pick;       /* probability that light sampling picks the map (0 without one) */
     float *env_marg_cdf;  /* image height + 1 entries: the rows' CDF */
     float *env_cond_cdf;  /* height x (width + 1): each row's CDF over its texels */
-    uint32_t env_uniform; /* every texel the same (a uniform sky): shading/envmap.h samples
+    uint32_t env_uniform; /* every texel the same (a uniform sky), or no map and a constant
+                             background colour that is not black: shading/envmap.h samples
                              the sphere uniformly and looks nothing up (built by finalize) */
-    rs_vec3 env_uniform_le; /* then: the radiance from every direction (texel times scale) */
+    rs_vec3 env_uniform_le; /* then: the radiance from every direction (texel times scale, or
+                               the background colour) */
 
     rs_camera_desc camera;
     rs_vec3 background;     /* radiance of rays that leave the scene (the horizon's, when

@@ -83,8 +83,22 @@ rs_status rs_scene_env_build(rs_scene *s, double *power)
     s->env_pick = 0.0f;
     s->env_uniform = 0;
     s->env_uniform_le = rs_v3_splat(0.0f);
-    if (s->env_image == RS_NO_TEXTURE)
+    if (s->env_image == RS_NO_TEXTURE) {
+        /* a constant background colour is a uniform sky: light-sampled as one (over the sphere,
+         * MIS-weighted against BSDF rays that escape), as pbrt's and Mitsuba's constant
+         * emitters are; before, only BSDF rays that escaped saw it.  The RTIOW gradient
+         * (background_sky) is not sampled. */
+        const rs_vec3 b = s->background;
+        const float rgb[3] = {b.x, b.y, b.z};
+        if (!s->background_sky && isfinite(b.x) && isfinite(b.y) && isfinite(b.z) && b.x >= 0 &&
+            b.y >= 0 && b.z >= 0 && luminance(rgb) > 0) {
+            double r = rs_scene_bound_radius(s);
+            s->env_uniform = 1;
+            s->env_uniform_le = b;
+            *power = PI * r * r * (double)luminance(rgb) * 4.0 * PI;
+        }
         return RS_OK;
+    }
     if (s->env_image >= s->n_images)
         return rs_error_set(RS_ERR_ARG, "environment map: no image %u", s->env_image);
     im = &s->images[s->env_image];

@@ -10,14 +10,20 @@
  * the estimate is exact for any map), times the scene's env_scale.
  * The distribution is built by rs_scene_finalize (scenes/scene_env.c).  A map whose texels are
  * all alike (a uniform sky, env_uniform) is sampled uniformly over the sphere, pdf 1 / 4 pi, and
- * its radiance and pdf are constants: no table search, no trigonometry but the sample's own. */
+ * its radiance and pdf are constants: no table search, no trigonometry but the sample's own.  A
+ * constant background colour (no map) is such a uniform sky too, sampled the same way. */
 #ifndef RS_SHADING_ENVMAP_H
 #define RS_SHADING_ENVMAP_H
 
 #include "core/sampling.h"
 #include "scenes/scene.h"
 
-RS_HD int rs_env_present(const rs_scene *s) { return s->env_image != RS_NO_TEXTURE; }
+/* Whether rays that leave the scene see a light: a map, or a constant background colour, which
+ * finalize makes a uniform sky (env_uniform without an image). */
+RS_HD int rs_env_present(const rs_scene *s)
+{
+    return s->env_image != RS_NO_TEXTURE || s->env_uniform;
+}
 
 /* Whether light sampling has anything to pick: an emitter or a map that is not black. */
 RS_HD int rs_scene_has_lights(const rs_scene *s) { return s->n_lights > 0 || s->env_pick > 0.0f; }
@@ -48,13 +54,14 @@ RS_HD void rs_env_texel_of(const rs_image *im, rs_vec3 m, uint32_t *i, uint32_t 
 /* Radiance arriving along -d from the map, d unit (not necessarily: it is normalised). */
 RS_HD_COLD rs_vec3 rs_env_radiance(const rs_scene *s, rs_vec3 d)
 {
-    const rs_image *im = &s->images[s->env_image];
+    const rs_image *im;
     rs_vec3 m;
     uint32_t i, j;
     float st;
     const float *t;
-    if (s->env_uniform)
+    if (s->env_uniform) /* first: a constant background has no image */
         return s->env_uniform_le;
+    im = &s->images[s->env_image];
     m = rs_env_rot(s->env_rot, rs_v3_normalize(d));
     rs_env_texel_of(im, m, &i, &j, &st);
     t = &im->rgb[3 * ((size_t)j * im->width + i)];
@@ -89,14 +96,13 @@ RS_HD float rs_env_texel_pdf(const rs_scene *s, uint32_t i, uint32_t j)
  * included. */
 RS_HD_COLD float rs_env_pdf(const rs_scene *s, rs_vec3 d)
 {
-    const rs_image *im = &s->images[s->env_image];
     uint32_t i, j;
     float st;
-    if (!s->env_marg_cdf)
-        return 0.0f;
     if (s->env_uniform)
         return 0.25f * RS_INV_PI;
-    rs_env_texel_of(im, rs_env_rot(s->env_rot, rs_v3_normalize(d)), &i, &j, &st);
+    if (!s->env_marg_cdf)
+        return 0.0f;
+    rs_env_texel_of(&s->images[s->env_image], rs_env_rot(s->env_rot, rs_v3_normalize(d)), &i, &j, &st);
     if (!(st > 0.0f))
         return 0.0f;
     return rs_env_texel_pdf(s, i, j) / (2.0f * RS_PI * RS_PI * st);
@@ -112,15 +118,16 @@ RS_HD_COLD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi,
     uint32_t i, j;
     float du, dv, u, v, theta, phi, st, span;
     rs_vec3 m;
-    if (!s->env_marg_cdf)
-        return 0;
     if (s->env_uniform) {
-        /* a uniform map: uniform over the sphere (the rotation changes nothing) */
+        /* a uniform map or a constant background: uniform over the sphere (the rotation
+         * changes nothing) */
         *wi = rs_sample_uniform_sphere(u1, u2);
         *pdf = 0.25f * RS_INV_PI;
         *le = s->env_uniform_le;
         return 1;
     }
+    if (!s->env_marg_cdf)
+        return 0;
     im = &s->images[s->env_image];
     j = rs_env_cdf_find(s->env_marg_cdf, im->height, u1);
     span = s->env_marg_cdf[j + 1] - s->env_marg_cdf[j];
@@ -149,6 +156,33 @@ RS_HD_COLD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi,
         *le = rs_v3_mul(rs_v3(t[0], t[1], t[2]), s->env_scale);
     }
     return *pdf > 0.0f;
+}
+
+/* A uniform sky seen from a surface point with unit normal n: sampled in proportion to cos
+ * about n (the hemisphere light can arrive from through a reflecting surface), pdf max(0, n.w) /
+ * pi, the very distribution a Lambertian BSDF samples, so that the MIS weights of the two are
+ * 1/2 each and no light sample is spent below the surface (uniform over the sphere wasted half
+ * of them).  A map, or n zero (no surface: the light tests), is sampled as rs_env_sample does,
+ * and rs_env_pdf_at is rs_env_pdf there. */
+RS_HD float rs_env_pdf_at(const rs_scene *s, rs_vec3 n, rs_vec3 d)
+{
+    if (s->env_uniform && !rs_v3_is_zero(n))
+        return rs_fmaxf(0.0f, rs_v3_dot(n, d) / rs_v3_length(d)) * RS_INV_PI;
+    return rs_env_pdf(s, d);
+}
+
+RS_HD int rs_env_sample_at(const rs_scene *s, rs_vec3 n, float u1, float u2, rs_vec3 *wi,
+                           float *pdf, rs_vec3 *le)
+{
+    if (s->env_uniform && !rs_v3_is_zero(n)) {
+        rs_onb f = rs_onb_from_normal(n);
+        rs_vec3 l = rs_sample_cosine_hemisphere(u1, u2);
+        *wi = rs_onb_to_world(&f, l);
+        *pdf = rs_env_pdf_at(s, n, *wi); /* as a BSDF ray that escapes is weighed */
+        *le = s->env_uniform_le;
+        return *pdf > 0.0f;
+    }
+    return rs_env_sample(s, u1, u2, wi, pdf, le);
 }
 
 #endif

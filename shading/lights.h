@@ -152,12 +152,13 @@ RS_HD_COLD int rs_light_sample_delta(const rs_scene *s, rs_vec3 x, float u_pick,
                               s->lights[l].pick_pdf / ((1.0f - s->env_pick) * (1.0f - a)), out);
 }
 
-/* Samples a light of `subset` (RS_LIGHTS_*) as seen from x at `time`; the pdf is relative to the
- * subset (the pick probability divided by the subset's).  Returns 0 (and no sample) if the
- * subset is empty or the sample is degenerate (x on the light's plane, or inside a one-point
+/* Samples a light of `subset` (RS_LIGHTS_*) as seen from x at `time` on a surface with unit
+ * normal n_x (zero: none; a uniform sky is sampled about it, shading/envmap.h); the pdf is relative
+ * to the subset (the pick probability divided by the subset's).  Returns 0 (and no sample) if
+ * the subset is empty or the sample is degenerate (x on the light's plane, or inside a one-point
  * light). */
-RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float time, float u_pick,
-                             float u1, float u2, rs_light_sample *out)
+RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3 n_x,
+                               float time, float u_pick, float u1, float u2, rs_light_sample *out)
 {
     uint32_t l, prim, n = s->n_lights;
     const rs_light *lt;
@@ -180,7 +181,7 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
     }
     if (env_pick > 0.0f) {
         if (u_pick < env_pick) {
-            if (!rs_env_sample(s, u1, u2, &out->wi, &out->pdf, &out->le))
+            if (!rs_env_sample_at(s, n_x, u1, u2, &out->wi, &out->pdf, &out->le))
                 return 0;
             out->pdf *= env_pick;
             out->point = x;
@@ -257,6 +258,13 @@ RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float tim
     return 1;
 }
 
+/* The same seen from no surface. */
+RS_HD int rs_light_sample_in(const rs_scene *s, int subset, rs_vec3 x, float time, float u_pick,
+                             float u1, float u2, rs_light_sample *out)
+{
+    return rs_light_sample_from(s, subset, x, rs_v3_splat(0.0f), time, u_pick, u1, u2, out);
+}
+
 /* A sample of any light (RS_LIGHTS_ALL). */
 RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_pick, float u1,
                              float u2, rs_light_sample *out)
@@ -287,7 +295,7 @@ RS_HD float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float
 /* The pdf of direction w (unit) from x summed over every light that the line x + t w meets,
  * ignoring occlusion, the environment map's included: the pdf of RS_LIGHTS_AREA sampling (the
  * mixture PDF's light term). */
-RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 w)
+RS_HD float rs_lights_pdf_dir_at(const rs_scene *s, rs_vec3 x, rs_vec3 n, float time, rs_vec3 w)
 {
     rs_geom g = rs_scene_geom(s);
     rs_ray r;
@@ -306,10 +314,16 @@ RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 
                                     rs_prim_normal(s, prim, rs_ray_at(&r, t), time));
     }
     if (s->env_pick > 0.0f)
-        pdf += s->env_pick * rs_env_pdf(s, w);
+        pdf += s->env_pick * rs_env_pdf_at(s, n, w);
     if (s->n_lights > s->n_area_lights && s->area_mass > 0.0f)
         pdf /= s->area_mass; /* relative to what RS_LIGHTS_AREA picks from */
     return pdf;
+}
+
+/* The same seen from no surface. */
+RS_HD float rs_lights_pdf_dir(const rs_scene *s, rs_vec3 x, float time, rs_vec3 w)
+{
+    return rs_lights_pdf_dir_at(s, x, rs_v3_splat(0.0f), time, w);
 }
 
 #endif

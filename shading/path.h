@@ -150,6 +150,7 @@ RS_HD rs_ray rs_path_begin_at(const rs_integrator *it, uint32_t pixel, uint32_t 
     ps->radiance = rs_v3_splat(0.0f);
     ps->pending = rs_v3_splat(0.0f);
     ps->bsdf_pdf = 0.0f;
+    ps->env_pdf = 0.0f;
     ps->time = time;
     ps->flags = (uint8_t)RS_PATH_SPECULAR;
     return ray;
@@ -388,7 +389,7 @@ RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, c
     int through;
     /* the light seen from the surface point itself (its distance, direction and pdf); only the
      * shadow ray starts at the offset origin */
-    if (!rs_light_sample_in(sc, subset, v->x, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+    if (!rs_light_sample_from(sc, subset, v->x, v->n, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
         return 0;
     c = rs_v3_dot(v->n, ls.wi);
     through = !(rs_v3_dot(v->n_geo, ls.wi) > 0.0f); /* beyond a transmitting surface */
@@ -449,8 +450,8 @@ RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, co
          * map and the emitters; punctual lights have a shadow ray of their own) */
         if (rl.v[3] < 0.5f) {
             rs_light_sample ls;
-            if (!rs_light_sample_in(sc, RS_LIGHTS_AREA, v->x, r->time, rl.v[0], rl.v[1],
-                                    rl.v[2], &ls))
+            if (!rs_light_sample_from(sc, RS_LIGHTS_AREA, v->x, v->n, r->time, rl.v[0],
+                                      rl.v[1], rl.v[2], &ls))
                 return 0;
             *wi = ls.wi;
         } else {
@@ -463,7 +464,7 @@ RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, co
         ci = rs_v3_dot(v->n, *wi);
         if (!rs_vertex_side_ok(v, *wi, ci, !(rs_v3_dot(v->n_geo, *wi) > 0.0f)))
             return 0; /* f = 0 below the surface: the path carries nothing further */
-        *pdf = 0.5f * rs_lights_pdf_dir(sc, v->x, r->time, *wi) +
+        *pdf = 0.5f * rs_lights_pdf_dir_at(sc, v->x, v->n, r->time, *wi) +
                0.5f * rs_bsdf_pdf_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
         f = rs_bsdf_eval_side(v->m, v->albedo, v->n, v->wo, *wi, v->front);
         if (!(*pdf > 0.0f))
@@ -508,8 +509,12 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
             bg = rs_env_radiance(sc, r.d);
             if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) &&
                 sc->env_pick > 0.0f)
-                bg = rs_v3_scale(bg, rs_power_heuristic(ps->bsdf_pdf,
-                                                        sc->env_pick * rs_env_pdf(sc, r.d)));
+                /* a uniform sky's pdf depends on the vertex the ray left (its normal): kept
+                 * from there; a map's on the direction alone */
+                bg = rs_v3_scale(bg, rs_power_heuristic(
+                                         ps->bsdf_pdf, sc->env_uniform ? ps->env_pdf
+                                                                       : sc->env_pick *
+                                                                             rs_env_pdf(sc, r.d)));
         } else {
             bg = rs_scene_background(sc, r.d);
         }
@@ -599,6 +604,7 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
     next->time = r.time;
     ps->throughput = beta;
     ps->bsdf_pdf = pdf;
+    ps->env_pdf = sc->env_uniform && !specular ? sc->env_pick * rs_env_pdf_at(sc, v.n, wi) : 0.0f;
     ps->flags = (uint8_t)(specular ? RS_PATH_SPECULAR : 0);
     return out | RS_SHADE_NEXT;
 }

@@ -4,8 +4,8 @@
  * RS_HD path code works on (rs_path_state, shading/path.h), the structure of arrays a wave keeps
  * (rs_paths, one array per field, indexed by the path's slot in its wave), their allocation, and
  * the loads and stores between the two.  Adding a field is one line here (Cycles'
- * kernel/integrator/state_template.h is the model).  Byte budget per path: 45 B
- *   throughput, radiance, pending (3 x 12 B), bsdf_pdf, time (2 x 4 B), flags (1 B).  (flags
+ * kernel/integrator/state_template.h is the model).  Byte budget per path: 49 B
+ *   throughput, radiance, pending (3 x 12 B), bsdf_pdf, env_pdf, time (3 x 4 B), flags (1 B).  (flags
  *   as 4 bytes cost 1.3% of a 1-thread Cornell render in memory traffic.) */
 #ifndef RS_STREAMS_PATHS_H
 #define RS_STREAMS_PATHS_H
@@ -19,6 +19,8 @@
     X(rs_vec3, radiance)   /* light gathered so far */                                            \
     X(rs_vec3, pending)    /* next-event contribution waiting for its shadow ray */               \
     X(float, bsdf_pdf)     /* solid-angle pdf of the BSDF sample that made the current ray */     \
+    X(float, env_pdf)      /* with a uniform sky: light sampling's pdf of that ray's direction */ \
+                           /* at the vertex that made it (shading/envmap.h, env_pick included) */ \
     X(float, time)         /* the path's time in the shutter interval (its rays share it) */      \
     X(uint8_t, flags)      /* RS_PATH_* (shading/path.h) */
 /* clang-format on */

@@ -355,6 +355,125 @@ static void test_uniform_map(void **state)
     }
 }
 
+/* A constant background colour (no map) is a uniform sky to light sampling: finalize marks it,
+ * picks it (the only light), and it samples, weighs and returns radiance as a uniform map does;
+ * the RTIOW gradient and a black background are not lights.  Under a background of 1 the
+ * furnace's sphere renders its albedo with every strategy, on the CPU and the GPU fallback. */
+static void test_constant_background(void **state)
+{
+    rs_scene *s;
+    uint32_t m;
+    int mode, dev, i, kind;
+    rs_material mat = rs_mat_lambertian(rs_v3_splat(0.5f));
+    (void)state;
+    for (kind = 0; kind < 3; ++kind) { /* a colour, the gradient, black */
+        uint64_t seed = 5;
+        assert_int_equal(rs_scene_create("bg", &s), RS_OK);
+        assert_int_equal(rs_scene_add_material(s, &mat, &m), RS_OK);
+        assert_int_equal(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, m), RS_OK);
+        s->background = kind == 2 ? rs_v3_splat(0.0f) : rs_v3(0.25f, 0.5f, 1.0f);
+        s->background_top = rs_v3(1, 1, 1);
+        s->background_sky = kind == 1;
+        assert_int_equal(rs_scene_finalize(s), RS_OK);
+        assert_int_equal(s->env_uniform, kind == 0);
+        assert_int_equal(rs_env_present(s), kind == 0);
+        assert_true(s->env_pick == (kind == 0 ? 1.0f : 0.0f));
+        assert_int_equal(rs_scene_has_lights(s), kind == 0);
+        for (i = 0; kind == 0 && i < 1000; ++i) {
+            rs_vec3 wi, le;
+            float pdf;
+            assert_true(rs_env_sample(s, rnd_f(&seed), rnd_f(&seed), &wi, &pdf, &le));
+            assert_true(pdf == 0.25f * (float)RS_INV_PI && rs_env_pdf(s, wi) == pdf);
+            assert_true(le.x == 0.25f && le.y == 0.5f && le.z == 1.0f);
+            le = rs_env_radiance(s, rnd_unit(&seed));
+            assert_true(le.x == 0.25f && le.y == 0.5f && le.z == 1.0f);
+        }
+        rs_scene_destroy(s);
+    }
+    assert_int_equal(rs_scene_create("bg", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &mat, &m), RS_OK);
+    assert_int_equal(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, m), RS_OK);
+    s->background = rs_v3_splat(1.0f);
+    s->camera.from = rs_v3(0, 0, 3.2f);
+    s->camera.at = rs_v3(0, 0, 0);
+    s->camera.vfov_deg = 30;
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    for (dev = 0; dev < 2; ++dev)
+        for (mode = 0; mode < 4; ++mode) {
+            rt_args a = rt_defaults("", 24, 64);
+            float *img;
+            double sum = 0, sum2 = 0;
+            int n = 0;
+            a.sampling = (rs_sampling)mode;
+            a.megakernel = dev;
+            a.fallback_only = dev;
+            img = rt_render_scene(s, &a, NULL);
+            assert_non_null(img);
+            for (i = 0; i < 24 * 24; ++i) {
+                float v = img[3 * i], x = (float)(i % 24) - 11.5f, y = (float)(i / 24) - 11.5f;
+                if (x * x + y * y > 64.0f)
+                    continue;
+                sum += v;
+                sum2 += v * v;
+                ++n;
+            }
+            {
+                double mean = sum / n, sd = sqrt(fmax(0, sum2 / n - mean * mean));
+                print_message("constant background, %-8s %s: sphere mean %.5f (pixel sd %.4f)\n",
+                              rs_sampling_name((rs_sampling)mode), dev ? "gpu fallback" : "cpu",
+                              mean, sd);
+                assert_true(img[0] == 1.0f);
+                assert_true(fabs(mean - 0.5) < 5 * sd / sqrt(n) + 1e-6 || fabs(mean - 0.5) < 1e-4);
+                assert_true(fabs(mean - 0.5) < 0.005);
+            }
+            free(img);
+        }
+    rs_scene_destroy(s);
+}
+
+/* A uniform sky seen from a surface (rs_env_sample_at) is sampled in proportion to cos about
+ * the normal, a tilted one here: chi-square over 8 x 16 cells of equal probability under that
+ * density (1 - cos^2 and the azimuth, each uniform), every pdf the one rs_env_pdf_at gives, no
+ * direction below the surface; the map's sampling is the sphere's where the normal is zero. */
+static void test_uniform_sky_cosine(void **state)
+{
+    float rgb[4 * 2 * 3];
+    rs_scene *s;
+    rs_vec3 n = rs_v3_normalize(rs_v3(0.3f, 0.8f, -0.5f)), wi, le;
+    rs_onb f = rs_onb_from_normal(n);
+    double bins[128] = {0}, chi;
+    uint64_t seed = 91;
+    float pdf;
+    const int count = 128000;
+    int i;
+    (void)state;
+    for (i = 0; i < 4 * 2 * 3; ++i)
+        rgb[i] = 2.0f;
+    s = env_scene(rgb, 4, 2, NULL, -1, 0);
+    for (i = 0; i < count; ++i) {
+        float z, phi;
+        int a, b;
+        assert_true(rs_env_sample_at(s, n, rnd_f(&seed), rnd_f(&seed), &wi, &pdf, &le));
+        z = rs_v3_dot(n, wi);
+        assert_true(z > 0.0f && fabsf(rs_v3_length(wi) - 1.0f) < 1e-5f);
+        assert_true(pdf == rs_env_pdf_at(s, n, wi));
+        assert_true(fabsf(pdf - z * (float)RS_INV_PI) < 1e-6f);
+        assert_true(le.x == 2.0f && le.y == 2.0f && le.z == 2.0f);
+        phi = atan2f(rs_v3_dot(f.b, wi), rs_v3_dot(f.t, wi));
+        a = (int)((1.0f - z * z) * 8.0f);
+        b = (int)((phi + (float)PI_D) / (2.0f * (float)PI_D) * 16.0f);
+        bins[(a > 7 ? 7 : a < 0 ? 0 : a) * 16 + (b > 15 ? 15 : b < 0 ? 0 : b)] += 1.0;
+    }
+    chi = chi_square(bins, 128, count / 128.0);
+    print_message("uniform sky about a tilted normal: chi-square %.1f (127 dof, critical 181.99)\n",
+                  chi);
+    assert_true(chi < 181.99);
+    /* below the surface: never sampled, pdf 0; no normal: the sphere */
+    assert_true(rs_env_pdf_at(s, n, rs_v3_neg(n)) == 0.0f);
+    assert_true(rs_env_pdf_at(s, rs_v3_splat(0.0f), rs_v3_neg(n)) == 0.25f * (float)RS_INV_PI);
+    rs_scene_destroy(s);
+}
+
 /* The furnace under a uniform map: the sphere renders its albedo, 0.5, with every strategy. */
 static void test_furnace(void **state)
 {
@@ -698,6 +817,7 @@ int main(void)
         cmocka_unit_test(test_strategies_agree),   cmocka_unit_test(test_furnace_ggx),
         cmocka_unit_test(test_mixed_lights_agree), cmocka_unit_test(test_pbr_emitter),
         cmocka_unit_test(test_bad_maps),          cmocka_unit_test(test_uniform_map),
+        cmocka_unit_test(test_constant_background), cmocka_unit_test(test_uniform_sky_cosine),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
