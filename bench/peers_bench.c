@@ -52,6 +52,21 @@
 #include "machine.h"
 #include "render_util.h"
 
+#define USAGE                                                                                  \
+    "usage: peers_bench [options]   time to RMSE 0.02 and 0.01, raystream against its peers\n"   \
+    "  --quick             raystream only, small, one thread (the test suite's smoke run)\n"    \
+    "  --scenes LIST       cornell,interior (default both; interior needs ../shared/models)\n"  \
+    "  --threads LIST      thread counts, each pinned to the first cores (default 1,2)\n"      \
+    "  --size N            image width and height (default 256)\n"                             \
+    "  --levels A,B,...    sample counts measured (default 4,16,64,256; interior 4,16,64)\n"   \
+    "  --ref-spp N         samples of each converged reference (default 1024)\n"               \
+    "  --runs N            interleaved rounds, the median is kept (default 3)\n"              \
+    "  --depth N           max depth of both scenes (default 50 box, 16 interior)\n"          \
+    "  --venv DIR          Mitsuba and LuxCore venv (default $RS_PEERS_VENV or build/peers-venv)\n" \
+    "  --cycles-venv DIR   Cycles (bpy) venv (default $RS_CYCLES_VENV or the venv + -cycles)\n" \
+    "  --no-peers          raystream's rows only\n"                                             \
+    "  --keep DIR          keep the exported scenes and images in DIR\n"                        \
+    "Install the peers with: sh scripts/install-peers.sh\n"
 #define MAX_LEVELS 12
 #define MAX_RUNS   9
 #define MAX_ROWS   12
@@ -932,11 +947,11 @@ int main(int argc, char **argv)
             o.peers = 0;
         } else if (strcmp(argv[i], "--keep") == 0 && i + 1 < argc) {
             keep = argv[++i];
+        } else if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
+            fputs(USAGE, stdout);
+            return 0;
         } else {
-            fprintf(stderr,
-                    "usage: peers_bench [--quick] [--scenes cornell,interior] [--threads 1,2] "
-                    "[--size N] [--levels A,B,...] [--ref-spp N] [--runs N] [--depth N] [--venv DIR] "
-                    "[--cycles-venv DIR] [--no-peers] [--keep DIR]\n");
+            fprintf(stderr, "%s: unknown option or missing value '%s'\n%s", prog, argv[i], USAGE);
             return 2;
         }
     }
