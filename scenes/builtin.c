@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 
+#include "core/try.h"
 #include "scenes/mesh.h"
 
 #include <math.h>
@@ -17,13 +18,6 @@ static rs_material lambertian(float r, float g, float b)
 
 static rs_material light(float r, float g, float b) { return rs_mat_light(rs_v3(r, g, b), 0); }
 
-#define TRY(expr)                                                                                  \
-  do {                                                                                             \
-    rs_status st_ = (expr);                                                                        \
-    if (st_ != RS_OK)                                                                              \
-      return st_;                                                                                  \
-  } while (0)
-
 /* The room of Shirley's Cornell box ("Ray Tracing: The Rest of Your Life" v4), exactly: quads
  * as corner Q and edges u, v; the light emits only downward (its u x v is -y).  Returns the
  * white material in *white_out. */
@@ -32,20 +26,20 @@ static rs_status build_cornell_room(rs_scene *s, uint32_t *white_out)
     rs_material m;
     uint32_t red, white, green, lit;
     m = lambertian(.65f, .05f, .05f);
-    TRY(rs_scene_add_material(s, &m, &red));
+    RS_TRY(rs_scene_add_material(s, &m, &red));
     m = lambertian(.73f, .73f, .73f);
-    TRY(rs_scene_add_material(s, &m, &white));
+    RS_TRY(rs_scene_add_material(s, &m, &white));
     m = lambertian(.12f, .45f, .15f);
-    TRY(rs_scene_add_material(s, &m, &green));
+    RS_TRY(rs_scene_add_material(s, &m, &green));
     m = light(15, 15, 15);
-    TRY(rs_scene_add_material(s, &m, &lit));
+    RS_TRY(rs_scene_add_material(s, &m, &lit));
 
-    TRY(rs_scene_add_quad(s, rs_v3(555, 0, 0), rs_v3(0, 0, 555), rs_v3(0, 555, 0), green));
-    TRY(rs_scene_add_quad(s, rs_v3(0, 0, 555), rs_v3(0, 0, -555), rs_v3(0, 555, 0), red));
-    TRY(rs_scene_add_quad(s, rs_v3(213, 554, 227), rs_v3(130, 0, 0), rs_v3(0, 0, 105), lit));
-    TRY(rs_scene_add_quad(s, rs_v3(0, 555, 0), rs_v3(555, 0, 0), rs_v3(0, 0, 555), white));
-    TRY(rs_scene_add_quad(s, rs_v3(0, 0, 555), rs_v3(555, 0, 0), rs_v3(0, 0, -555), white));
-    TRY(rs_scene_add_quad(s, rs_v3(555, 0, 555), rs_v3(-555, 0, 0), rs_v3(0, 555, 0), white));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(555, 0, 0), rs_v3(0, 0, 555), rs_v3(0, 555, 0), green));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(0, 0, 555), rs_v3(0, 0, -555), rs_v3(0, 555, 0), red));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(213, 554, 227), rs_v3(130, 0, 0), rs_v3(0, 0, 105), lit));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(0, 555, 0), rs_v3(555, 0, 0), rs_v3(0, 0, 555), white));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(0, 0, 555), rs_v3(555, 0, 0), rs_v3(0, 0, -555), white));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(555, 0, 555), rs_v3(-555, 0, 0), rs_v3(0, 555, 0), white));
     *white_out = white;
 
     s->camera.from = rs_v3(278, 278, -800);
@@ -60,11 +54,11 @@ static rs_status build_cornell_room(rs_scene *s, uint32_t *white_out)
 static rs_status build_cornell(rs_scene *s)
 {
     uint32_t white;
-    TRY(build_cornell_room(s, &white));
-    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
-                         white));
-    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 165, 165), -18.0f, rs_v3(130, 0, 65),
-                         white));
+    RS_TRY(build_cornell_room(s, &white));
+    RS_TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
+                            white));
+    RS_TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 165, 165), -18.0f, rs_v3(130, 0, 65),
+                            white));
     return RS_OK;
 }
 
@@ -73,11 +67,11 @@ static rs_status build_cornell_glass(rs_scene *s)
 {
     uint32_t white, glass;
     rs_material m = rs_mat_dielectric(1.5f);
-    TRY(build_cornell_room(s, &white));
-    TRY(rs_scene_add_material(s, &m, &glass));
-    TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
-                         white));
-    TRY(rs_scene_add_sphere(s, rs_v3(190, 90, 190), 90.0f, glass));
+    RS_TRY(build_cornell_room(s, &white));
+    RS_TRY(rs_scene_add_material(s, &m, &glass));
+    RS_TRY(rs_scene_add_box(s, rs_v3(0, 0, 0), rs_v3(165, 330, 165), 15.0f, rs_v3(265, 0, 295),
+                            white));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(190, 90, 190), 90.0f, glass));
     return RS_OK;
 }
 
@@ -113,14 +107,14 @@ static rs_status build_random_spheres(rs_scene *s, int bouncing)
         checker.a = rs_v3(.2f, .3f, .1f);
         checker.b = rs_v3(.9f, .9f, .9f);
         checker.scale = 0.32f;
-        TRY(rs_scene_add_texture(s, &checker, &tex));
+        RS_TRY(rs_scene_add_texture(s, &checker, &tex));
         m = rs_mat_lambertian(rs_v3_splat(1.0f));
         m.albedo_tex = tex;
     } else {
         m = rs_mat_lambertian(rs_v3(.5f, .5f, .5f));
     }
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(0, -1000, 0), 1000.0f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(0, -1000, 0), 1000.0f, id));
     for (a = -11; a < 11; ++a)
         for (b = -11; b < 11; ++b) {
             float choose = (float)scene_rand(&st);
@@ -134,34 +128,34 @@ static rs_status build_random_spheres(rs_scene *s, int bouncing)
                 rs_vec3 c2 =
                     rs_v3((float)scene_rand(&st), (float)scene_rand(&st), (float)scene_rand(&st));
                 m = rs_mat_lambertian(rs_v3_mul(c1, c2));
-                TRY(rs_scene_add_material(s, &m, &id));
+                RS_TRY(rs_scene_add_material(s, &m, &id));
                 if (bouncing)
-                    TRY(rs_scene_add_moving_sphere(
+                    RS_TRY(rs_scene_add_moving_sphere(
                         s, c, 0.0f, rs_v3_add(c, rs_v3(0, rand_range(&st, 0, 0.5f), 0)), 1.0f, 0.2f,
                         id));
                 else
-                    TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+                    RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
             } else if (choose < 0.95f) {
                 m = rs_mat_metal(rs_v3(rand_range(&st, .5f, 1), rand_range(&st, .5f, 1),
                                        rand_range(&st, .5f, 1)),
                                  rand_range(&st, 0, .5f));
-                TRY(rs_scene_add_material(s, &m, &id));
-                TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+                RS_TRY(rs_scene_add_material(s, &m, &id));
+                RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
             } else {
                 m = rs_mat_dielectric(1.5f);
-                TRY(rs_scene_add_material(s, &m, &id));
-                TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+                RS_TRY(rs_scene_add_material(s, &m, &id));
+                RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
             }
         }
     m = rs_mat_dielectric(1.5f);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(0, 1, 0), 1.0f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(0, 1, 0), 1.0f, id));
     m = rs_mat_lambertian(rs_v3(.4f, .2f, .1f));
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(-4, 1, 0), 1.0f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(-4, 1, 0), 1.0f, id));
     m = rs_mat_metal(rs_v3(.7f, .6f, .5f), 0.0f);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(4, 1, 0), 1.0f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(4, 1, 0), 1.0f, id));
 
     s->camera.from = rs_v3(13, 2, 3);
     s->camera.at = rs_v3(0, 0, 0);
@@ -223,70 +217,70 @@ static rs_status build_materials(rs_scene *s)
     tex.a = rs_v3(.75f, .75f, .75f);
     tex.b = rs_v3(.25f, .25f, .28f);
     tex.scale = 1.0f;
-    TRY(rs_scene_add_texture(s, &tex, &t_floor));
+    RS_TRY(rs_scene_add_texture(s, &tex, &t_floor));
     tex.a = rs_v3(.9f, .8f, .1f);
     tex.b = rs_v3(.1f, .2f, .6f);
     tex.scale = 0.3f;
-    TRY(rs_scene_add_texture(s, &tex, &t_checker));
+    RS_TRY(rs_scene_add_texture(s, &tex, &t_checker));
     tex.type = RS_TEX_STRIPES;
     tex.a = rs_v3(.85f, .85f, .85f);
     tex.b = rs_v3(.7f, .1f, .1f);
     tex.scale = 12.0f;
-    TRY(rs_scene_add_texture(s, &tex, &t_stripes));
-    TRY(add_uv_grid_image(s, &image));
+    RS_TRY(rs_scene_add_texture(s, &tex, &t_stripes));
+    RS_TRY(add_uv_grid_image(s, &image));
     tex.type = RS_TEX_IMAGE;
     tex.image = image;
-    TRY(rs_scene_add_texture(s, &tex, &t_image));
+    RS_TRY(rs_scene_add_texture(s, &tex, &t_image));
 
     m = rs_mat_lambertian(rs_v3_splat(1.0f));
     m.albedo_tex = t_floor;
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_quad(s, rs_v3(-20, 0, 20), rs_v3(40, 0, 0), rs_v3(0, 0, -40), id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(-20, 0, 20), rs_v3(40, 0, 0), rs_v3(0, 0, -40), id));
 
     for (i = 0; i < 3; ++i) { /* back row */
         m = rs_mat_disney_diffuse(warm, 0.5f * (float)i);
-        TRY(rs_scene_add_material(s, &m, &id));
-        TRY(rs_scene_add_sphere(s, rs_v3(-4.0f + 2.0f * (float)i, 0.8f, -2.2f), 0.8f, id));
+        RS_TRY(rs_scene_add_material(s, &m, &id));
+        RS_TRY(rs_scene_add_sphere(s, rs_v3(-4.0f + 2.0f * (float)i, 0.8f, -2.2f), 0.8f, id));
     }
     m = rs_mat_lambertian(warm);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, -2.2f), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, -2.2f), 0.8f, id));
     m = rs_mat_diffuse_uniform(warm);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, -2.2f), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, -2.2f), 0.8f, id));
 
     for (i = 0; i < 3; ++i) { /* middle row */
         m = rs_mat_phong(rs_v3(.1f, .25f, .6f), rs_v3(.35f, .35f, .35f), phong_n[i]);
-        TRY(rs_scene_add_material(s, &m, &id));
-        TRY(rs_scene_add_sphere(s, rs_v3(-4.0f + 2.0f * (float)i, 0.8f, 0), 0.8f, id));
+        RS_TRY(rs_scene_add_material(s, &m, &id));
+        RS_TRY(rs_scene_add_sphere(s, rs_v3(-4.0f + 2.0f * (float)i, 0.8f, 0), 0.8f, id));
     }
     m = rs_mat_metal(rs_v3(.8f, .8f, .85f), 0.3f);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, 0), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, 0), 0.8f, id));
     m = rs_mat_metal(rs_v3(.9f, .9f, .9f), 0.0f);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, 0), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, 0), 0.8f, id));
 
     m = rs_mat_dielectric(1.5f); /* front row */
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(-4, 0.8f, 2.2f), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(-4, 0.8f, 2.2f), 0.8f, id));
     m = rs_mat_lambertian(rs_v3_splat(1.0f));
     m.albedo_tex = t_checker;
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(-2, 0.8f, 2.2f), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(-2, 0.8f, 2.2f), 0.8f, id));
     m.albedo_tex = t_stripes;
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(0, 0.8f, 2.2f), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(0, 0.8f, 2.2f), 0.8f, id));
     m.albedo_tex = t_image;
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, 2.2f), 0.8f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(2, 0.8f, 2.2f), 0.8f, id));
     m = rs_mat_light(rs_v3(4, 3.2f, 2), 0);
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, 2.2f), 0.5f, id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(4, 0.8f, 2.2f), 0.5f, id));
 
     m = rs_mat_light(rs_v3(6, 6, 6), 0); /* the key light, facing down */
-    TRY(rs_scene_add_material(s, &m, &id));
-    TRY(rs_scene_add_quad(s, rs_v3(-3, 7, -3), rs_v3(6, 0, 0), rs_v3(0, 0, 6), id));
+    RS_TRY(rs_scene_add_material(s, &m, &id));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(-3, 7, -3), rs_v3(6, 0, 0), rs_v3(0, 0, 6), id));
 
     s->camera.from = rs_v3(0, 6.5f, 11);
     s->camera.at = rs_v3(0, 0.5f, 0);
@@ -341,8 +335,8 @@ static rs_status build_cornell_teapot(rs_scene *s, const rs_builtin_opts *o)
 {
     uint32_t white, teapot;
     rs_material m = rs_mat_phong(rs_v3(.15f, .3f, .55f), rs_v3(.35f, .35f, .35f), 60.0f);
-    TRY(build_cornell_room(s, &white));
-    TRY(rs_scene_add_material(s, &m, &teapot));
+    RS_TRY(build_cornell_room(s, &white));
+    RS_TRY(rs_scene_add_material(s, &m, &teapot));
     return add_model(s, o, "teapot/teapot.obj", 330.0f, rs_v3(278, 0, 260), 25.0f, teapot);
 }
 
@@ -351,11 +345,11 @@ static rs_status build_cornell_bunny_teapot(rs_scene *s, const rs_builtin_opts *
 {
     uint32_t white, teapot, bunny;
     rs_material m = rs_mat_metal(rs_v3(.85f, .75f, .55f), 0.15f);
-    TRY(build_cornell_room(s, &white));
-    TRY(rs_scene_add_material(s, &m, &teapot));
+    RS_TRY(build_cornell_room(s, &white));
+    RS_TRY(rs_scene_add_material(s, &m, &teapot));
     m = rs_mat_lambertian(rs_v3(.75f, .72f, .68f));
-    TRY(rs_scene_add_material(s, &m, &bunny));
-    TRY(add_model(s, o, "bunny/bun_zipper.ply", 290.0f, rs_v3(375, 0, 345), -20.0f, bunny));
+    RS_TRY(rs_scene_add_material(s, &m, &bunny));
+    RS_TRY(add_model(s, o, "bunny/bun_zipper.ply", 290.0f, rs_v3(375, 0, 345), -20.0f, bunny));
     return add_model(s, o, "teapot/teapot.obj", 270.0f, rs_v3(185, 0, 185), 30.0f, teapot);
 }
 
@@ -368,11 +362,11 @@ static rs_status build_cornell_mesh(rs_scene *s, const rs_builtin_opts *o)
     rs_mesh_info info;
     if (!o || !o->mesh_file)
         return rs_error_set(RS_ERR_ARG, "builtin:cornell-mesh needs a mesh file (--mesh FILE)");
-    TRY(build_cornell_room(s, &white));
+    RS_TRY(build_cornell_room(s, &white));
     mo.fit = 1;
     mo.fit_size = 330.0f;
     mo.fit_base = rs_v3(278, 0, 278);
-    TRY(rs_scene_add_mesh(s, o->mesh_file, &mo, &info));
+    RS_TRY(rs_scene_add_mesh(s, o->mesh_file, &mo, &info));
     if (o->log) {
         char why[160], strips[64] = "";
         if (info.strips)
@@ -396,8 +390,8 @@ static rs_status build_furnace(rs_scene *s)
 {
     rs_material m = lambertian(0.5f, 0.5f, 0.5f);
     uint32_t grey;
-    TRY(rs_scene_add_material(s, &m, &grey));
-    TRY(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, grey));
+    RS_TRY(rs_scene_add_material(s, &m, &grey));
+    RS_TRY(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, grey));
     s->camera.from = rs_v3(0, 0, 5);
     s->camera.at = rs_v3(0, 0, 0);
     s->camera.up = rs_v3(0, 1, 0);

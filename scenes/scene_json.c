@@ -13,6 +13,7 @@
 
 #include "core/alloc.h"
 #include "core/file.h"
+#include "core/try.h"
 #include "scenes/mesh.h"
 #include "scenes/transform.h"
 
@@ -296,13 +297,6 @@ static int lookup(const named *list, uint32_t n, const char *name, uint32_t *id)
     return 0;
 }
 
-#define TRY(expr)                                                                                  \
-  do {                                                                                             \
-    rs_status st_ = (expr);                                                                        \
-    if (st_ != RS_OK)                                                                              \
-      return st_;                                                                                  \
-  } while (0)
-
 static rs_status read_camera(ctx *c, const cJSON *cam)
 {
     static const char *const keys[] = {"from",           "at",      "up", "vfov", "aperture",
@@ -311,13 +305,13 @@ static rs_status read_camera(ctx *c, const cJSON *cam)
     const cJSON *sh;
     if (!cJSON_IsObject(cam))
         return FAIL(c, "camera", "expected an object");
-    TRY(check_keys(c, cam, "camera", keys));
-    TRY(get_vec3(c, cam, "camera", "from", 1, rs_v3(0, 0, 0), &d->from));
-    TRY(get_vec3(c, cam, "camera", "at", 1, rs_v3(0, 0, 0), &d->at));
-    TRY(get_vec3(c, cam, "camera", "up", 0, rs_v3(0, 1, 0), &d->up));
-    TRY(get_num(c, cam, "camera", "vfov", 0, 40.0, 1e-3, 179.0, &d->vfov_deg));
-    TRY(get_num(c, cam, "camera", "aperture", 0, 0.0, 0.0, 1e30, &d->aperture));
-    TRY(get_num(c, cam, "camera", "focus_distance", 0, 0.0, 0.0, 1e30, &d->focus_dist));
+    RS_TRY(check_keys(c, cam, "camera", keys));
+    RS_TRY(get_vec3(c, cam, "camera", "from", 1, rs_v3(0, 0, 0), &d->from));
+    RS_TRY(get_vec3(c, cam, "camera", "at", 1, rs_v3(0, 0, 0), &d->at));
+    RS_TRY(get_vec3(c, cam, "camera", "up", 0, rs_v3(0, 1, 0), &d->up));
+    RS_TRY(get_num(c, cam, "camera", "vfov", 0, 40.0, 1e-3, 179.0, &d->vfov_deg));
+    RS_TRY(get_num(c, cam, "camera", "aperture", 0, 0.0, 0.0, 1e30, &d->aperture));
+    RS_TRY(get_num(c, cam, "camera", "focus_distance", 0, 0.0, 0.0, 1e30, &d->focus_dist));
     if (rs_v3_length(rs_v3_sub(d->from, d->at)) == 0.0f)
         return FAIL(c, "camera", "'from' and 'at' must differ");
     if (rs_v3_length(rs_v3_cross(d->up, rs_v3_sub(d->from, d->at))) == 0.0f)
@@ -344,9 +338,9 @@ static rs_status read_image_size(ctx *c, const cJSON *img)
     float w, h;
     if (!cJSON_IsObject(img))
         return FAIL(c, "image", "expected an object");
-    TRY(check_keys(c, img, "image", keys));
-    TRY(get_num(c, img, "image", "width", 0, 512, 1, 32768, &w));
-    TRY(get_num(c, img, "image", "height", 0, 512, 1, 32768, &h));
+    RS_TRY(check_keys(c, img, "image", keys));
+    RS_TRY(get_num(c, img, "image", "width", 0, 512, 1, 32768, &w));
+    RS_TRY(get_num(c, img, "image", "height", 0, 512, 1, 32768, &h));
     if (w != floorf(w) || h != floorf(h))
         return FAIL(c, "image", "width and height must be whole numbers");
     c->scene->width = (uint32_t)w;
@@ -370,21 +364,21 @@ static rs_status read_envmap(ctx *c, const cJSON *bg)
     float r[9];
     uint32_t image;
     int i, k;
-    TRY(check_keys(c, bg, "background", keys));
-    TRY(get_string(c, bg, "background", "map", &file));
+    RS_TRY(check_keys(c, bg, "background", keys));
+    RS_TRY(get_string(c, bg, "background", "map", &file));
     if (sc && cJSON_IsNumber(sc)) {
         if (!(sc->valuedouble >= 0) || sc->valuedouble > 1e30)
             return FAIL(c, "background.scale", "must be >= 0");
         scale = rs_v3_splat((float)sc->valuedouble);
     } else if (sc) {
-        TRY(get_color(c, bg, "background", "scale", 1, scale, &scale));
+        RS_TRY(get_color(c, bg, "background", "scale", 1, scale, &scale));
     }
     for (i = 0; i < 9; ++i)
         r[i] = (i % 4 == 0) ? 1.0f : 0.0f;
     if (rot) {
         /* the map turns by `rotate` in the world: directions go back by its inverse */
         rs_xform x;
-        TRY(read_rotation(c, rot, "background.rotate", &x));
+        RS_TRY(read_rotation(c, rot, "background.rotate", &x));
         for (i = 0; i < 3; ++i)
             for (k = 0; k < 3; ++k)
                 r[3 * i + k] = (float)x.m[k][i];
@@ -406,7 +400,7 @@ static rs_status read_envmap(ctx *c, const cJSON *bg)
                             (unsigned)(i / 3) / im->width,
                             isfinite(im->rgb[i]) ? "negative" : "not finite");
     }
-    TRY(rs_scene_set_environment(s, image, scale, r));
+    RS_TRY(rs_scene_set_environment(s, image, scale, r));
     return RS_OK;
 }
 
@@ -417,16 +411,16 @@ static rs_status read_background(ctx *c, const cJSON *bg)
     if (cJSON_IsObject(bg) && cJSON_GetObjectItemCaseSensitive(bg, "map"))
         return read_envmap(c, bg);
     if (cJSON_IsArray(bg)) {
-        TRY(vec3_of(c, bg, "background", &s->background));
+        RS_TRY(vec3_of(c, bg, "background", &s->background));
         if (s->background.x < 0 || s->background.y < 0 || s->background.z < 0)
             return FAIL(c, "background", "colour components must be >= 0");
         return RS_OK;
     }
     if (!cJSON_IsObject(bg))
         return FAIL(c, "background", "expected [r, g, b] or {\"horizon\": .., \"zenith\": ..}");
-    TRY(check_keys(c, bg, "background", keys));
-    TRY(get_color(c, bg, "background", "horizon", 1, rs_v3(0, 0, 0), &s->background));
-    TRY(get_color(c, bg, "background", "zenith", 1, rs_v3(0, 0, 0), &s->background_top));
+    RS_TRY(check_keys(c, bg, "background", keys));
+    RS_TRY(get_color(c, bg, "background", "horizon", 1, rs_v3(0, 0, 0), &s->background));
+    RS_TRY(get_color(c, bg, "background", "zenith", 1, rs_v3(0, 0, 0), &s->background_top));
     s->background_sky = 1;
     return RS_OK;
 }
@@ -451,23 +445,23 @@ static rs_status read_texture(ctx *c, const cJSON *t, const char *path, const ch
     memset(&tex, 0, sizeof tex);
     if (!cJSON_IsObject(t))
         return FAIL(c, path, "expected an object");
-    TRY(get_string(c, t, path, "type", &type));
+    RS_TRY(get_string(c, t, path, "type", &type));
     if (strcmp(type, "solid") == 0) {
-        TRY(check_keys(c, t, path, k_solid));
+        RS_TRY(check_keys(c, t, path, k_solid));
         tex.type = RS_TEX_SOLID;
-        TRY(get_reflectance(c, t, path, "color", 1, rs_v3(0, 0, 0), &tex.a));
+        RS_TRY(get_reflectance(c, t, path, "color", 1, rs_v3(0, 0, 0), &tex.a));
     } else if (strcmp(type, "checker") == 0 || strcmp(type, "stripes") == 0) {
-        TRY(check_keys(c, t, path, k_two));
+        RS_TRY(check_keys(c, t, path, k_two));
         tex.type = type[0] == 'c' ? RS_TEX_CHECKER : RS_TEX_STRIPES;
-        TRY(get_reflectance(c, t, path, "a", 1, rs_v3(0, 0, 0), &tex.a));
-        TRY(get_reflectance(c, t, path, "b", 1, rs_v3(0, 0, 0), &tex.b));
-        TRY(get_num(c, t, path, "scale", 0, type[0] == 'c' ? 1.0 : 10.0, 1e-6, 1e6, &tex.scale));
+        RS_TRY(get_reflectance(c, t, path, "a", 1, rs_v3(0, 0, 0), &tex.a));
+        RS_TRY(get_reflectance(c, t, path, "b", 1, rs_v3(0, 0, 0), &tex.b));
+        RS_TRY(get_num(c, t, path, "scale", 0, type[0] == 'c' ? 1.0 : 10.0, 1e-6, 1e6, &tex.scale));
     } else if (strcmp(type, "image") == 0) {
         const char *file = "";
         char full[1024];
         rs_status st;
-        TRY(check_keys(c, t, path, k_image));
-        TRY(get_string(c, t, path, "file", &file));
+        RS_TRY(check_keys(c, t, path, k_image));
+        RS_TRY(get_string(c, t, path, "file", &file));
         resolve_path(c, file, full, sizeof full);
         tex.type = RS_TEX_IMAGE;
         rs_error_clear();
@@ -481,7 +475,7 @@ static rs_status read_texture(ctx *c, const cJSON *t, const char *path, const ch
     } else {
         return FAIL(c, path, "unknown texture type '%s' (solid, checker, stripes, image)", type);
     }
-    TRY(rs_scene_add_texture(c->scene, &tex, &id));
+    RS_TRY(rs_scene_add_texture(c->scene, &tex, &id));
     c->textures[c->n_textures].name = name;
     c->textures[c->n_textures++].id = id;
     return RS_OK;
@@ -547,8 +541,8 @@ static rs_status read_conductor(ctx *c, const cJSON *m, const char *path, float 
     }
     if (by_index) {
         rs_vec3 eta, k;
-        TRY(get_color(c, m, path, "eta", 1, rs_v3(0, 0, 0), &eta));
-        TRY(get_color(c, m, path, "k", 1, rs_v3(0, 0, 0), &k));
+        RS_TRY(get_color(c, m, path, "eta", 1, rs_v3(0, 0, 0), &eta));
+        RS_TRY(get_color(c, m, path, "k", 1, rs_v3(0, 0, 0), &k));
         subpath(p, sizeof p, path, "eta");
         if (!(eta.x > 0 && eta.y > 0 && eta.z > 0))
             return FAIL(c, p, "must be > 0");
@@ -581,33 +575,33 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
     uint32_t id;
     if (!cJSON_IsObject(m))
         return FAIL(c, path, "expected an object");
-    TRY(get_string(c, m, path, "type", &type));
+    RS_TRY(get_string(c, m, path, "type", &type));
     if (strcmp(type, "lambertian") == 0 || strcmp(type, "diffuse_uniform") == 0) {
         mat = type[0] == 'l' ? rs_mat_lambertian(rs_v3_splat(.5f))
                              : rs_mat_diffuse_uniform(rs_v3_splat(.5f));
-        TRY(check_keys(c, m, path, k_diffuse));
-        TRY(read_albedo(c, m, path, "albedo", &mat));
+        RS_TRY(check_keys(c, m, path, k_diffuse));
+        RS_TRY(read_albedo(c, m, path, "albedo", &mat));
     } else if (strcmp(type, "disney_diffuse") == 0) {
         mat = rs_mat_disney_diffuse(rs_v3_splat(.5f), 0.5f);
-        TRY(check_keys(c, m, path, k_disney));
-        TRY(read_albedo(c, m, path, "albedo", &mat));
-        TRY(get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &mat.roughness));
+        RS_TRY(check_keys(c, m, path, k_disney));
+        RS_TRY(read_albedo(c, m, path, "albedo", &mat));
+        RS_TRY(get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &mat.roughness));
     } else if (strcmp(type, "phong") == 0) {
         mat = rs_mat_phong(rs_v3_splat(.5f), rs_v3_splat(.5f), 50.0f);
-        TRY(check_keys(c, m, path, k_phong));
-        TRY(read_albedo(c, m, path, "kd", &mat));
-        TRY(get_reflectance(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat.specular));
-        TRY(get_num(c, m, path, "exponent", 0, 50.0, 0.0, 1e6, &mat.exponent));
+        RS_TRY(check_keys(c, m, path, k_phong));
+        RS_TRY(read_albedo(c, m, path, "kd", &mat));
+        RS_TRY(get_reflectance(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat.specular));
+        RS_TRY(get_num(c, m, path, "exponent", 0, 50.0, 0.0, 1e6, &mat.exponent));
     } else if (strcmp(type, "metal") == 0) {
         mat = rs_mat_metal(rs_v3_splat(.8f), 0.0f);
-        TRY(check_keys(c, m, path, k_metal));
-        TRY(get_reflectance(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat.albedo));
-        TRY(get_num(c, m, path, "fuzz", 0, 0.0, 0.0, 1.0, &mat.fuzz));
+        RS_TRY(check_keys(c, m, path, k_metal));
+        RS_TRY(get_reflectance(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat.albedo));
+        RS_TRY(get_num(c, m, path, "fuzz", 0, 0.0, 0.0, 1.0, &mat.fuzz));
     } else if (strcmp(type, "dielectric") == 0) {
         mat = rs_mat_dielectric(1.5f);
-        TRY(check_keys(c, m, path, k_glass));
-        TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat.ior));
-        TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+        RS_TRY(check_keys(c, m, path, k_glass));
+        RS_TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat.ior));
+        RS_TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
         {
             const cJSON *fr = cJSON_GetObjectItemCaseSensitive(m, "fresnel");
             char p[256];
@@ -620,28 +614,28 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
         }
     } else if (strcmp(type, "conductor") == 0) {
         float r;
-        TRY(check_keys(c, m, path, k_cond));
-        TRY(get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
-        TRY(read_conductor(c, m, path, r * r, &mat));
+        RS_TRY(check_keys(c, m, path, k_cond));
+        RS_TRY(get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
+        RS_TRY(read_conductor(c, m, path, r * r, &mat));
     } else if (strcmp(type, "rough_dielectric") == 0) {
         float r, ior;
-        TRY(check_keys(c, m, path, k_rglass));
-        TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &ior));
-        TRY(get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
+        RS_TRY(check_keys(c, m, path, k_rglass));
+        RS_TRY(get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &ior));
+        RS_TRY(get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
         mat = rs_mat_rough_dielectric(ior, r * r);
-        TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+        RS_TRY(get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
     } else if (strcmp(type, "pbr") == 0) {
         float r, metal;
-        TRY(check_keys(c, m, path, k_pbr));
-        TRY(get_num(c, m, path, "metallic", 0, 0.0, 0.0, 1.0, &metal));
-        TRY(get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &r));
+        RS_TRY(check_keys(c, m, path, k_pbr));
+        RS_TRY(get_num(c, m, path, "metallic", 0, 0.0, 0.0, 1.0, &metal));
+        RS_TRY(get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &r));
         mat = rs_mat_pbr(rs_v3_splat(.8f), metal, r);
-        TRY(read_albedo(c, m, path, "base_color", &mat));
+        RS_TRY(read_albedo(c, m, path, "base_color", &mat));
     } else if (strcmp(type, "light") == 0) {
         mat = rs_mat_light(rs_v3_splat(1.0f), 0);
-        TRY(check_keys(c, m, path, k_light));
-        TRY(get_color(c, m, path, "emission", 1, rs_v3(0, 0, 0), &mat.emission));
-        TRY(get_bool(c, m, path, "two_sided", 0, &two));
+        RS_TRY(check_keys(c, m, path, k_light));
+        RS_TRY(get_color(c, m, path, "emission", 1, rs_v3(0, 0, 0), &mat.emission));
+        RS_TRY(get_bool(c, m, path, "two_sided", 0, &two));
         mat.flags = two ? RS_MAT_TWO_SIDED : 0u;
     } else {
         return FAIL(c, path,
@@ -649,10 +643,10 @@ static rs_status read_material(ctx *c, const cJSON *m, const char *path, const c
                     "phong, metal, dielectric, conductor, rough_dielectric, pbr, light)",
                     type);
     }
-    TRY(get_bool(c, m, path, "importance_sampling", 1, &is_ok));
+    RS_TRY(get_bool(c, m, path, "importance_sampling", 1, &is_ok));
     if (!is_ok)
         mat.flags |= RS_MAT_UNIFORM_SAMPLING;
-    TRY(rs_scene_add_material(c->scene, &mat, &id));
+    RS_TRY(rs_scene_add_material(c->scene, &mat, &id));
     c->materials[c->n_materials].name = name;
     c->materials[c->n_materials++].id = id;
     return RS_OK;
@@ -662,7 +656,7 @@ static rs_status object_material(ctx *c, const cJSON *o, const char *path, uint3
 {
     const char *name = "";
     char p[256];
-    TRY(get_string(c, o, path, "material", &name));
+    RS_TRY(get_string(c, o, path, "material", &name));
     subpath(p, sizeof p, path, "material");
     if (!lookup(c->materials, c->n_materials, name, id))
         return FAIL(c, p, "no material named '%s'", name);
@@ -681,7 +675,7 @@ static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xfor
     if (!cJSON_IsObject(st) || !st->child || st->child->next)
         return FAIL(c, p, "a transform step is an object of one key: matrix, translate, rotate "
                           "or scale");
-    TRY(check_keys(c, st, p, keys));
+    RS_TRY(check_keys(c, st, p, keys));
     it = st->child;
     subpath(q, sizeof q, p, it->string);
     if (strcmp(it->string, "matrix") == 0) {
@@ -706,7 +700,7 @@ static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xfor
         return RS_OK;
     }
     if (strcmp(it->string, "translate") == 0) {
-        TRY(vec3_of(c, it, q, &v));
+        RS_TRY(vec3_of(c, it, q, &v));
         *out = rs_xform_translate(v.x, v.y, v.z);
         return RS_OK;
     }
@@ -714,7 +708,7 @@ static rs_status read_xform_step(ctx *c, const cJSON *st, const char *p, rs_xfor
         if (cJSON_IsNumber(it))
             v = rs_v3_splat((float)it->valuedouble);
         else
-            TRY(vec3_of(c, it, q, &v));
+            RS_TRY(vec3_of(c, it, q, &v));
         if (v.x == 0 || v.y == 0 || v.z == 0)
             return FAIL(c, q, "a scale must not be 0 (it would flatten the object)");
         *out = rs_xform_scale(v.x, v.y, v.z);
@@ -735,7 +729,7 @@ static rs_status read_rotation(ctx *c, const cJSON *it, const char *q, rs_xform 
         char mp[300];
         double scale;
         int i;
-        TRY(check_keys(c, it, q, k_mat));
+        RS_TRY(check_keys(c, it, q, k_mat));
         subpath(mp, sizeof mp, q, "matrix");
         if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 9)
             return FAIL(c, mp, "expected 9 numbers (a 3x3 rotation, row by row)");
@@ -755,9 +749,9 @@ static rs_status read_rotation(ctx *c, const cJSON *it, const char *q, rs_xform 
         double axis[3];
         float deg;
         char ap[300];
-        TRY(check_keys(c, it, q, k_axis));
-        TRY(get_vec3(c, it, q, "axis", 1, rs_v3(0, 0, 0), &v));
-        TRY(get_num(c, it, q, "degrees", 1, 0, -1e6, 1e6, &deg));
+        RS_TRY(check_keys(c, it, q, k_axis));
+        RS_TRY(get_vec3(c, it, q, "axis", 1, rs_v3(0, 0, 0), &v));
+        RS_TRY(get_num(c, it, q, "degrees", 1, 0, -1e6, 1e6, &deg));
         subpath(ap, sizeof ap, q, "axis");
         if (rs_v3_is_zero(v))
             return FAIL(c, ap, "the axis must not be zero");
@@ -768,7 +762,7 @@ static rs_status read_rotation(ctx *c, const cJSON *it, const char *q, rs_xform 
     if (!cJSON_IsArray(it))
         return FAIL(c, q, "expected [x, y, z] (Euler angles in degrees) or {\"axis\": [x, y, z], "
                           "\"degrees\": a}");
-    TRY(vec3_of(c, it, q, &v));
+    RS_TRY(vec3_of(c, it, q, &v));
     if (fabsf(v.x) > 1e6f || fabsf(v.y) > 1e6f || fabsf(v.z) > 1e6f)
         return FAIL(c, q, "angles must lie within +-1e6 degrees");
     *out = rs_xform_rotate_euler(v.x, v.y, v.z);
@@ -788,13 +782,13 @@ static rs_status read_transform(ctx *c, const cJSON *o, const char *path, rs_xfo
         return RS_OK;
     subpath(p, sizeof p, path, "transform");
     if (cJSON_IsObject(tr)) {
-        TRY(read_xform_step(c, tr, p, out));
+        RS_TRY(read_xform_step(c, tr, p, out));
     } else if (cJSON_IsArray(tr)) {
         for (it = tr->child; it; it = it->next, ++i) {
             rs_xform step, all;
             char sp[280];
             snprintf(sp, sizeof sp, "%s[%d]", p, i);
-            TRY(read_xform_step(c, it, sp, &step));
+            RS_TRY(read_xform_step(c, it, sp, &step));
             all = rs_xform_compose(&step, out);
             *out = all;
         }
@@ -852,8 +846,8 @@ static rs_status copy_mesh(ctx *c, const mesh_copy *m)
     for (i = 0; i < m->n; ++i) {
         rs_vec3 v[3];
         v[0] = m->tris[i].v0, v[1] = m->tris[i].v1, v[2] = m->tris[i].v2;
-        TRY(rs_scene_add_triangle_full(c->scene, v, m->uv ? m->uv + 6 * (size_t)i : NULL,
-                                       m->normal ? m->normal + 9 * (size_t)i : NULL, m->mat[i]));
+        RS_TRY(rs_scene_add_triangle_full(c->scene, v, m->uv ? m->uv + 6 * (size_t)i : NULL,
+                                          m->normal ? m->normal + 9 * (size_t)i : NULL, m->mat[i]));
     }
     return RS_OK;
 }
@@ -886,19 +880,19 @@ static rs_status add_punctual(ctx *c, const cJSON *o, const char *path, const ch
     memset(&p, 0, sizeof p);
     if (type[0] == 'p') {
         p.type = RS_PUNCTUAL_POINT;
-        TRY(check_keys(c, o, path, k_point));
-        TRY(get_vec3(c, o, path, "position", 1, rs_v3(0, 0, 0), &p.pos));
-        TRY(get_color(c, o, path, "intensity", 1, rs_v3(0, 0, 0), &p.intensity));
+        RS_TRY(check_keys(c, o, path, k_point));
+        RS_TRY(get_vec3(c, o, path, "position", 1, rs_v3(0, 0, 0), &p.pos));
+        RS_TRY(get_color(c, o, path, "intensity", 1, rs_v3(0, 0, 0), &p.intensity));
     } else if (type[0] == 's') {
         float inner, outer;
         char q[256];
         p.type = RS_PUNCTUAL_SPOT;
-        TRY(check_keys(c, o, path, k_spot));
-        TRY(get_vec3(c, o, path, "position", 1, rs_v3(0, 0, 0), &p.pos));
-        TRY(get_vec3(c, o, path, "direction", 1, rs_v3(0, 0, 0), &p.dir));
-        TRY(get_color(c, o, path, "intensity", 1, rs_v3(0, 0, 0), &p.intensity));
-        TRY(get_num(c, o, path, "inner", 0, 0.0, 0.0, 90.0, &inner));
-        TRY(get_num(c, o, path, "outer", 0, 45.0, 0.0, 90.0, &outer));
+        RS_TRY(check_keys(c, o, path, k_spot));
+        RS_TRY(get_vec3(c, o, path, "position", 1, rs_v3(0, 0, 0), &p.pos));
+        RS_TRY(get_vec3(c, o, path, "direction", 1, rs_v3(0, 0, 0), &p.dir));
+        RS_TRY(get_color(c, o, path, "intensity", 1, rs_v3(0, 0, 0), &p.intensity));
+        RS_TRY(get_num(c, o, path, "inner", 0, 0.0, 0.0, 90.0, &inner));
+        RS_TRY(get_num(c, o, path, "outer", 0, 45.0, 0.0, 90.0, &outer));
         subpath(q, sizeof q, path, "outer");
         if (outer < inner)
             return FAIL(c, q, "the outer cone must not be narrower than the inner");
@@ -906,9 +900,9 @@ static rs_status add_punctual(ctx *c, const cJSON *o, const char *path, const ch
         p.cos_outer = cosf(outer * 0.017453292519943295f);
     } else {
         p.type = RS_PUNCTUAL_DIRECTIONAL;
-        TRY(check_keys(c, o, path, k_dir));
-        TRY(get_vec3(c, o, path, "direction", 1, rs_v3(0, 0, 0), &p.dir));
-        TRY(get_color(c, o, path, "irradiance", 1, rs_v3(0, 0, 0), &p.intensity));
+        RS_TRY(check_keys(c, o, path, k_dir));
+        RS_TRY(get_vec3(c, o, path, "direction", 1, rs_v3(0, 0, 0), &p.dir));
+        RS_TRY(get_color(c, o, path, "irradiance", 1, rs_v3(0, 0, 0), &p.intensity));
     }
     if (p.type != RS_PUNCTUAL_POINT && rs_v3_is_zero(p.dir)) {
         char q[256];
@@ -934,12 +928,12 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
     rs_mesh_info info;
     rs_status st;
     mo.strict_textures = 1; /* a scene file's textures must be there */
-    TRY(check_keys(c, o, path, keys));
-    TRY(get_string(c, o, path, "file", &file));
+    RS_TRY(check_keys(c, o, path, keys));
+    RS_TRY(get_string(c, o, path, "file", &file));
     if (cJSON_GetObjectItemCaseSensitive(o, "material")) {
         if (ov)
             return FAIL(c, path, "give either 'material' or 'materials', not both");
-        TRY(object_material(c, o, path, &mo.material));
+        RS_TRY(object_material(c, o, path, &mo.material));
     }
     if (ov) {
         const cJSON *it;
@@ -963,19 +957,19 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
     }
     /* the thesis's placement, applied to the file's coordinates before the fit: a scale per
      * axis, then rotations about x, y and z (degrees) */
-    TRY(get_vec3(c, o, path, "scale", 0, rs_v3(1, 1, 1), &mo.scale));
+    RS_TRY(get_vec3(c, o, path, "scale", 0, rs_v3(1, 1, 1), &mo.scale));
     subpath(p, sizeof p, path, "scale");
     if (mo.scale.x == 0 || mo.scale.y == 0 || mo.scale.z == 0)
         return FAIL(c, p, "a scale must not be 0 (it would flatten the mesh)");
-    TRY(get_vec3(c, o, path, "rotate", 0, rs_v3(0, 0, 0), &mo.rotate_deg));
+    RS_TRY(get_vec3(c, o, path, "rotate", 0, rs_v3(0, 0, 0), &mo.rotate_deg));
     if (fit) {
         subpath(p, sizeof p, path, "fit");
         if (!cJSON_IsObject(fit))
             return FAIL(c, p, "expected {\"size\": s, \"base\": [x, y, z]}");
-        TRY(check_keys(c, fit, p, k_fit));
+        RS_TRY(check_keys(c, fit, p, k_fit));
         mo.fit = 1;
-        TRY(get_num(c, fit, p, "size", 1, 1, 1e-30, 1e30, &mo.fit_size));
-        TRY(get_vec3(c, fit, p, "base", 0, rs_v3(0, 0, 0), &mo.fit_base));
+        RS_TRY(get_num(c, fit, p, "size", 1, 1, 1e-30, 1e30, &mo.fit_size));
+        RS_TRY(get_vec3(c, fit, p, "base", 0, rs_v3(0, 0, 0), &mo.fit_base));
     }
     for (k = 0; k < c->n_meshes; ++k)
         if (c->meshes[k].node == o)
@@ -1021,25 +1015,25 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
     if (strcmp(type, "sphere") == 0) {
         rs_vec3 center, to;
         float r;
-        TRY(check_keys(c, o, path, k_sphere));
-        TRY(get_vec3(c, o, path, "center", 1, rs_v3(0, 0, 0), &center));
-        TRY(get_num(c, o, path, "radius", 1, 0, 1e-30, 1e30, &r));
-        TRY(object_material(c, o, path, &mat));
+        RS_TRY(check_keys(c, o, path, k_sphere));
+        RS_TRY(get_vec3(c, o, path, "center", 1, rs_v3(0, 0, 0), &center));
+        RS_TRY(get_num(c, o, path, "radius", 1, 0, 1e-30, 1e30, &r));
+        RS_TRY(object_material(c, o, path, &mat));
         if (cJSON_GetObjectItemCaseSensitive(o, "moving_to") &&
             cJSON_GetObjectItemCaseSensitive(o, "velocity"))
             return FAIL(c, path, "give either 'moving_to' or 'velocity', not both");
         if (cJSON_GetObjectItemCaseSensitive(o, "moving_to")) {
             /* the centre moves linearly from `center` at time 0 to `moving_to` at time 1 */
-            TRY(get_vec3(c, o, path, "moving_to", 1, center, &to));
+            RS_TRY(get_vec3(c, o, path, "moving_to", 1, center, &to));
             return rs_scene_add_moving_sphere(s, center, 0.0f, to, 1.0f, r, mat);
         }
         if (cJSON_GetObjectItemCaseSensitive(o, "velocity")) {
             /* the centre at time t is center + t velocity (what `raystream export` writes: the
              * stored motion exactly) */
             rs_vec3 vel;
-            TRY(get_vec3(c, o, path, "velocity", 1, center, &vel));
-            TRY(rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, vel), 1.0f, r,
-                                           mat));
+            RS_TRY(get_vec3(c, o, path, "velocity", 1, center, &vel));
+            RS_TRY(
+                rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, vel), 1.0f, r, mat));
             s->sphere_motion[s->n_spheres - 1] = vel;
             return RS_OK;
         }
@@ -1047,13 +1041,13 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
     }
     if (strcmp(type, "quad") == 0) {
         rs_vec3 q, u, v;
-        TRY(check_keys(c, o, path, k_quad));
-        TRY(get_vec3(c, o, path, "q", 1, rs_v3(0, 0, 0), &q));
-        TRY(get_vec3(c, o, path, "u", 1, rs_v3(0, 0, 0), &u));
-        TRY(get_vec3(c, o, path, "v", 1, rs_v3(0, 0, 0), &v));
+        RS_TRY(check_keys(c, o, path, k_quad));
+        RS_TRY(get_vec3(c, o, path, "q", 1, rs_v3(0, 0, 0), &q));
+        RS_TRY(get_vec3(c, o, path, "u", 1, rs_v3(0, 0, 0), &u));
+        RS_TRY(get_vec3(c, o, path, "v", 1, rs_v3(0, 0, 0), &v));
         if (rs_v3_is_zero(rs_v3_cross(u, v)))
             return FAIL(c, path, "u and v must span a parallelogram (u x v = 0)");
-        TRY(object_material(c, o, path, &mat));
+        RS_TRY(object_material(c, o, path, &mat));
         return rs_scene_add_quad(s, q, u, v, mat);
     }
     if (strcmp(type, "triangle") == 0) {
@@ -1064,23 +1058,23 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
         float uvs[6], ns[9];
         char sp[256];
         int i;
-        TRY(check_keys(c, o, path, k_tri));
+        RS_TRY(check_keys(c, o, path, k_tri));
         subpath(sp, sizeof sp, path, "vertices");
         if (!cJSON_IsArray(vs) || cJSON_GetArraySize(vs) != 3)
             return FAIL(c, vs ? sp : path, vs ? "expected 3 vertices" : "missing 'vertices'");
         for (i = 0; i < 3; ++i)
-            TRY(vec3_of(c, cJSON_GetArrayItem(vs, i), sp, &p[i]));
-        TRY(object_material(c, o, path, &mat));
+            RS_TRY(vec3_of(c, cJSON_GetArrayItem(vs, i), sp, &p[i]));
+        RS_TRY(object_material(c, o, path, &mat));
         if (!uv && !nrm)
             return rs_scene_add_triangle(s, p[0], p[1], p[2], mat);
         if (uv) {
             subpath(sp, sizeof sp, path, "uv");
-            TRY(read_floats(c, uv, sp, 6, "(u0, v0, u1, v1, u2, v2)", uvs));
+            RS_TRY(read_floats(c, uv, sp, 6, "(u0, v0, u1, v1, u2, v2)", uvs));
         }
         if (nrm) {
             /* unit vertex normals (zeros: the face's), as `raystream export` writes a mesh's */
             subpath(sp, sizeof sp, path, "normals");
-            TRY(read_floats(c, nrm, sp, 9, "(three normals)", ns));
+            RS_TRY(read_floats(c, nrm, sp, 9, "(three normals)", ns));
         }
         if (!nrm)
             return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
@@ -1089,14 +1083,14 @@ static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const c
     if (strcmp(type, "box") == 0) {
         rs_vec3 lo, hi, t;
         float rot;
-        TRY(check_keys(c, o, path, k_box));
-        TRY(get_vec3(c, o, path, "min", 1, rs_v3(0, 0, 0), &lo));
-        TRY(get_vec3(c, o, path, "max", 1, rs_v3(0, 0, 0), &hi));
+        RS_TRY(check_keys(c, o, path, k_box));
+        RS_TRY(get_vec3(c, o, path, "min", 1, rs_v3(0, 0, 0), &lo));
+        RS_TRY(get_vec3(c, o, path, "max", 1, rs_v3(0, 0, 0), &hi));
         if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
             return FAIL(c, path, "'max' must exceed 'min' on every axis");
-        TRY(get_num(c, o, path, "rotate_y", 0, 0.0, -1e6, 1e6, &rot));
-        TRY(get_vec3(c, o, path, "translate", 0, rs_v3(0, 0, 0), &t));
-        TRY(object_material(c, o, path, &mat));
+        RS_TRY(get_num(c, o, path, "rotate_y", 0, 0.0, -1e6, 1e6, &rot));
+        RS_TRY(get_vec3(c, o, path, "translate", 0, rs_v3(0, 0, 0), &t));
+        RS_TRY(object_material(c, o, path, &mat));
         return rs_scene_add_box(s, lo, hi, rot, t, mat);
     }
     if (strcmp(type, "mesh") == 0)
@@ -1168,7 +1162,7 @@ static rs_status place_instance(ctx *c, group *g, const char *path, const rs_xfo
         for (it = g->objects->child, i = 0; it; it = it->next, ++i) {
             char q[300];
             snprintf(q, sizeof q, "groups.%s[%d]", g->name, i);
-            TRY(read_object(c, it, q, &id));
+            RS_TRY(read_object(c, it, q, &id));
             if (rs_scene_prim_count(c->scene) > MAX_PRIMS)
                 return FAIL(c, path, "the scene would pass %u primitives", MAX_PRIMS);
         }
@@ -1225,8 +1219,8 @@ static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const r
     uint32_t k, before = rs_scene_prim_count(c->scene);
     char p[256];
     int i = 0;
-    TRY(check_keys(c, o, path, keys));
-    TRY(get_string(c, o, path, "group", &name));
+    RS_TRY(check_keys(c, o, path, keys));
+    RS_TRY(get_string(c, o, path, "group", &name));
     subpath(p, sizeof p, path, "group");
     g = (group *)find_group(c, name);
     if (!g)
@@ -1248,7 +1242,7 @@ static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const r
         snprintf(c->instance_path, sizeof c->instance_path, "%s", path);
     if (c->depth == 0 && group_of_triangles(c, g, 0)) {
         int copied;
-        TRY(place_instance(c, g, path, xf, &copied));
+        RS_TRY(place_instance(c, g, path, xf, &copied));
         if (!copied)
             return RS_OK;
         g->prims = rs_scene_prim_count(c->scene) - before;
@@ -1259,7 +1253,7 @@ static rs_status read_instance(ctx *c, const cJSON *o, const char *path, const r
     for (it = g->objects->child; it; it = it->next, ++i) {
         char q[300];
         snprintf(q, sizeof q, "groups.%s[%d]", g->name, i);
-        TRY(read_object(c, it, q, xf));
+        RS_TRY(read_object(c, it, q, xf));
         if (rs_scene_prim_count(c->scene) > MAX_PRIMS)
             return FAIL(c, path, "the scene would pass %u primitives (this group is copied, not instanced)",
                         MAX_PRIMS);
@@ -1277,12 +1271,12 @@ static rs_status read_object(ctx *c, const cJSON *o, const char *path, const rs_
     rs_xform own, xf;
     if (!cJSON_IsObject(o))
         return FAIL(c, path, "expected an object");
-    TRY(get_string(c, o, path, "type", &type));
-    TRY(read_transform(c, o, path, &own));
+    RS_TRY(get_string(c, o, path, "type", &type));
+    RS_TRY(read_transform(c, o, path, &own));
     xf = rs_xform_compose(parent, &own);
     if (strcmp(type, "instance") == 0)
         return read_instance(c, o, path, &xf);
-    TRY(add_primitive(c, o, path, type));
+    RS_TRY(add_primitive(c, o, path, type));
     if (!rs_xform_is_identity(&xf) && rs_scene_transform_since(c->scene, &mark, &xf) != RS_OK) {
         char msg[400], p[256];
         snprintf(msg, sizeof msg, "%s", rs_error_message());
@@ -1316,7 +1310,7 @@ static rs_status read_map(ctx *c, const cJSON *root, const char *key,
         if ((read == read_material && lookup(c->materials, c->n_materials, it->string, &dummy)) ||
             (read == read_texture && lookup(c->textures, c->n_textures, it->string, &dummy)))
             return FAIL(c, p, "defined twice");
-        TRY(read(c, it, p, it->string));
+        RS_TRY(read(c, it, p, it->string));
     }
     return RS_OK;
 }
@@ -1346,7 +1340,7 @@ static rs_status check_tree(const ctx *c, const cJSON *it, const char *path)
         } else {
             snprintf(p, sizeof p, "%s[%d]", path, i);
         }
-        TRY(check_tree(c, a, p));
+        RS_TRY(check_tree(c, a, p));
     }
     return RS_OK;
 }
@@ -1360,17 +1354,17 @@ static rs_status build(ctx *c, const cJSON *root)
     int i = 0;
     if (!cJSON_IsObject(root))
         return rs_error_set(RS_ERR_ARG, "%s: the scene must be a JSON object", c->label);
-    TRY(check_tree(c, root, ""));
-    TRY(check_keys(c, root, "(top level)", keys));
+    RS_TRY(check_tree(c, root, ""));
+    RS_TRY(check_keys(c, root, "(top level)", keys));
     if (!cJSON_GetObjectItemCaseSensitive(root, "camera"))
         return FAIL(c, "(top level)", "missing 'camera'");
-    TRY(read_camera(c, cJSON_GetObjectItemCaseSensitive(root, "camera")));
+    RS_TRY(read_camera(c, cJSON_GetObjectItemCaseSensitive(root, "camera")));
     if (cJSON_GetObjectItemCaseSensitive(root, "image"))
-        TRY(read_image_size(c, cJSON_GetObjectItemCaseSensitive(root, "image")));
+        RS_TRY(read_image_size(c, cJSON_GetObjectItemCaseSensitive(root, "image")));
     if (cJSON_GetObjectItemCaseSensitive(root, "background"))
-        TRY(read_background(c, cJSON_GetObjectItemCaseSensitive(root, "background")));
-    TRY(read_map(c, root, "textures", read_texture, &c->n_textures));
-    TRY(read_map(c, root, "materials", read_material, &c->n_materials));
+        RS_TRY(read_background(c, cJSON_GetObjectItemCaseSensitive(root, "background")));
+    RS_TRY(read_map(c, root, "textures", read_texture, &c->n_textures));
+    RS_TRY(read_map(c, root, "materials", read_material, &c->n_materials));
     groups = cJSON_GetObjectItemCaseSensitive(root, "groups");
     if (groups) {
         if (!cJSON_IsObject(groups))
@@ -1396,7 +1390,7 @@ static rs_status build(ctx *c, const cJSON *root)
     for (it = objs->child; it; it = it->next, ++i) {
         char p[64];
         snprintf(p, sizeof p, "objects[%d]", i);
-        TRY(read_object(c, it, p, &id));
+        RS_TRY(read_object(c, it, p, &id));
     }
     if (c->log) {
         uint32_t g;
