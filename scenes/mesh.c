@@ -2,6 +2,7 @@
 #define _DEFAULT_SOURCE /* mkstemps, for a glTF binary's embedded textures */
 #include "scenes/mesh.h"
 #include "scenes/gltf.h"
+#include "scenes/ply_header.h"
 #include "scenes/ply_strips.h"
 #include "scenes/transform.h"
 
@@ -120,11 +121,10 @@ static void mio_close(struct aiFileIO *io, struct aiFile *f)
 /* Assimp's PLY reader spins for ever on a header that stops before end_header, and aborts the
  * whole process (an ai_assert in its triangulation, found by tests/fuzz/fuzz_mesh) on an ascii
  * file whose data stops before the elements its header declares.  A file that says it is PLY
- * (by its first line or its extension) must reach end_header within this many bytes and hold the
- * data its header declares: in ascii, a line for every instance of an element that has a
- * property (one instance a line, as the format writes them); in binary, the bytes of every
- * instance's fixed-size properties (a list counts its length field only). */
-#define PLY_MAX_HEADER (64u << 10)
+ * (by its first line or its extension) must have a header that scenes/ply_header.h accepts
+ * (end_header within its first 64 KiB; counts and, in binary, bytes that the data can hold) and,
+ * in ascii, a line for every instance of an element that has a property (one instance a line,
+ * as the format writes them). */
 
 static int ext_is(const char *path, const char *ext)
 {
@@ -138,68 +138,29 @@ static int ext_is(const char *path, const char *ext)
     return 1;
 }
 
-static uint64_t add_sat(uint64_t a, uint64_t b) { return a + b < a ? UINT64_MAX : a + b; }
-
-static uint64_t mul_sat(uint64_t a, uint64_t b)
-{
-    return a && b > UINT64_MAX / a ? UINT64_MAX : a * b;
-}
-
-/* Bytes of a PLY scalar type in binary (char/int8 ... double/float64); 1 for an unknown name
- * (Assimp refuses those itself). */
-static uint64_t ply_type_bytes(const char *t, size_t n)
-{
-    static const struct {
-        const char *name;
-        uint64_t bytes;
-    } types[] = {{"char", 1},   {"uchar", 1},   {"int8", 1},   {"uint8", 1},   {"short", 2},
-                 {"ushort", 2}, {"int16", 2},   {"uint16", 2}, {"int", 4},     {"uint", 4},
-                 {"int32", 4},  {"uint32", 4},  {"float", 4},  {"float32", 4}, {"double", 8},
-                 {"float64", 8}};
-    size_t k;
-    for (k = 0; k < sizeof types / sizeof types[0]; ++k)
-        if (strlen(types[k].name) == n && strncmp(t, types[k].name, n) == 0)
-            return types[k].bytes;
-    return 1;
-}
-
-/* The next blank-separated word of [*p, eol): its start, and its length in *n (0 at the end). */
-static const char *next_word(const char **p, const char *eol, size_t *n)
-{
-    const char *w = *p;
-    while (w < eol && (*w == ' ' || *w == '\t' || *w == '\r'))
-        ++w;
-    *p = w;
-    while (*p < eol && **p != ' ' && **p != '\t' && **p != '\r')
-        ++*p;
-    *n = (size_t)(*p - w);
-    return w;
-}
-
-/* Checks a file that says it is PLY (*is_ply set); any other file passes. */
+/* Checks a file that says it is PLY (*is_ply set: 1, or 2 for one of triangle strips, which
+ * Assimp does not read: a stripped model came out as one triangle; scenes/ply_strips.h does);
+ * any other file passes. */
 static rs_status check_ply_header(const char *path, int *is_ply_out)
 {
     FILE *f;
-    uint64_t size, lines = 0, bytes = 0, count = 0, inst_bytes = 0, need_lines = 0,
-                   need_bytes = 0, total = 0;
-    unsigned line = 0;
+    uint64_t size, lines = 0;
     char *buf;
-    size_t n, hdr = 0, i;
-    const char *p, *end;
-    int is_ply, has_prop = 0, found = 0, ascii = 1, last_nl = 1;
+    size_t n, i;
+    int last_nl;
+    rs_ply_header h;
     rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
+    *is_ply_out = 0;
     if (st != RS_OK)
         return st;
-    buf = (char *)rs_alloc(PLY_MAX_HEADER + 1, 1);
+    buf = (char *)rs_alloc(RS_PLY_MAX_HEADER + 1, 1);
     if (!buf) {
         fclose(f);
         return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
     }
-    n = fread(buf, 1, PLY_MAX_HEADER, f);
+    n = fread(buf, 1, RS_PLY_MAX_HEADER, f);
     buf[n] = '\0';
-    is_ply = n >= 4 && memcmp(buf, "ply", 3) == 0 && (buf[3] == '\n' || buf[3] == '\r');
-    *is_ply_out = is_ply;
-    if (!is_ply) {
+    if (!rs_ply_is_ply(buf, n)) {
         fclose(f);
         rs_free(buf);
         if (ext_is(path, "ply"))
@@ -207,106 +168,31 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
                                 path);
         return RS_OK;
     }
-    for (p = buf, end = buf + n; p < end;) {
-        const char *eol = (const char *)memchr(p, '\n', (size_t)(end - p)), *q, *w;
-        int is_elem, is_end;
-        size_t wn;
-        if (!eol)
-            break; /* the header's last line is cut */
-        ++line;
-        is_elem = strncmp(p, "element", 7) == 0 && (p[7] == ' ' || p[7] == '\t');
-        is_end = strncmp(p, "end_header", 10) == 0 && (p + 10 == eol || isspace((unsigned char)p[10]));
-        if (is_elem || is_end) {
-            /* every instance counts against the data's size (Assimp allocates each one, with
-             * or without properties); only those with properties take a line or bytes */
-            total = add_sat(total, count);
-            if (has_prop) {
-                need_lines = add_sat(need_lines, count);
-                need_bytes = add_sat(need_bytes, mul_sat(count, inst_bytes));
-            }
-            has_prop = 0;
-            count = inst_bytes = 0;
-        }
-        if (is_elem) {
-            /* exactly "element NAME COUNT", COUNT a whole number below 2^32 (Assimp read a
-             * mangled line's count as 2^32 - 1 and asked for 64 GiB: tests/fuzz/fuzz_mesh) */
-            char *num_end = NULL;
-            size_t nn;
-            const char *name;
-            q = p + 7;
-            name = next_word(&q, eol, &nn);
-            if (nn == 9 && strncmp(name, "tristrips", 9) == 0)
-                /* Assimp reads no strips (a stripped model came out as one triangle): our own
-                 * reader does (scenes/ply_strips.h) */
-                *is_ply_out = 2;
-            w = next_word(&q, eol, &wn);
-            if (wn)
-                count = strtoull(w, &num_end, 10);
-            if (!wn || num_end != w + wn || !isdigit((unsigned char)*w) || count > UINT32_MAX ||
-                (next_word(&q, eol, &wn), wn != 0)) {
-                fclose(f);
-                rs_free(buf);
-                return rs_error_set(RS_ERR_ARG,
-                                    "%s: PLY header line %u is not 'element NAME COUNT'", path,
-                                    line);
-            }
-        } else if (strncmp(p, "property", 8) == 0) {
-            has_prop = 1;
-            q = p + 8;
-            w = next_word(&q, eol, &wn);
-            if (wn == 4 && strncmp(w, "list", 4) == 0)
-                w = next_word(&q, eol, &wn); /* the list's length type: its items may be 0 */
-            inst_bytes = add_sat(inst_bytes, ply_type_bytes(w, wn));
-        } else if (strncmp(p, "format", 6) == 0) {
-            q = p + 6;
-            w = next_word(&q, eol, &wn);
-            ascii = wn == 5 && strncmp(w, "ascii", 5) == 0;
-        } else if (is_end) {
-            found = 1;
-            hdr = (size_t)(eol + 1 - buf);
-            break;
-        }
-        p = eol + 1;
-    }
-    if (!found) {
+    memset(&h, 0, sizeof h);
+    st = rs_ply_parse_header(path, buf, n, size, 0, &h);
+    *is_ply_out = h.tristrips ? 2 : 1;
+    if (st != RS_OK || !h.ascii) {
         fclose(f);
         rs_free(buf);
-        return rs_error_set(RS_ERR_ARG, "%s: PLY header has no end_header (within its first %u KiB)",
-                            path, PLY_MAX_HEADER >> 10);
+        return st;
     }
-    if (total > size - hdr) {
-        fclose(f);
-        rs_free(buf);
-        return rs_error_set(RS_ERR_ARG,
-                            "%s: PLY header declares %llu elements, more than its %llu bytes of "
-                            "data could hold",
-                            path, (unsigned long long)total, (unsigned long long)(size - hdr));
-    }
-    if (ascii) {
-        /* the data's lines: every newline, and a last line without one */
-        for (i = hdr; i < n; ++i)
+    /* the ascii data's lines: every newline, and a last line without one */
+    for (i = h.data_at; i < n; ++i)
+        lines += buf[i] == '\n';
+    last_nl = n == h.data_at || buf[n - 1] == '\n';
+    while (lines < h.need_lines && (n = fread(buf, 1, RS_PLY_MAX_HEADER, f)) > 0) {
+        for (i = 0; i < n; ++i)
             lines += buf[i] == '\n';
-        last_nl = n == hdr || buf[n - 1] == '\n';
-        while (lines < need_lines && (n = fread(buf, 1, PLY_MAX_HEADER, f)) > 0) {
-            for (i = 0; i < n; ++i)
-                lines += buf[i] == '\n';
-            last_nl = buf[n - 1] == '\n';
-        }
-        lines += !last_nl;
+        last_nl = buf[n - 1] == '\n';
     }
+    lines += !last_nl;
     fclose(f);
     rs_free(buf);
-    bytes = size - hdr;
-    if (ascii && lines < need_lines)
+    if (lines < h.need_lines)
         return rs_error_set(RS_ERR_ARG,
                             "%s: PLY header declares %llu elements, but its ascii data has only "
                             "%llu lines (a cut file?)",
-                            path, (unsigned long long)need_lines, (unsigned long long)lines);
-    if (!ascii && need_bytes > bytes)
-        return rs_error_set(RS_ERR_ARG,
-                            "%s: PLY header declares elements of at least %llu bytes, but its "
-                            "binary data has only %llu (a cut file?)",
-                            path, (unsigned long long)need_bytes, (unsigned long long)bytes);
+                            path, (unsigned long long)h.need_lines, (unsigned long long)lines);
     return RS_OK;
 }
 

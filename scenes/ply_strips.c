@@ -9,23 +9,7 @@
 
 #include "core/alloc.h"
 #include "core/file.h"
-
-#define MAX_PROPS 64
-
-typedef enum { T_NONE, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64 } ply_type;
-
-typedef struct ply_prop {
-    char name[64];
-    ply_type type;     /* the value's type (a list's items) */
-    ply_type len_type; /* a list's length type, T_NONE for a scalar */
-} ply_prop;
-
-typedef struct ply_elem {
-    char name[64];
-    uint64_t count;
-    ply_prop props[MAX_PROPS];
-    int n_props;
-} ply_elem;
+#include "scenes/ply_header.h"
 
 typedef struct reader {
     const char *path;
@@ -34,30 +18,8 @@ typedef struct reader {
     unsigned line; /* ascii: the current line, for messages */
 } reader;
 
-static ply_type type_of(const char *w)
-{
-    static const struct {
-        const char *name;
-        ply_type t;
-    } k[] = {{"char", T_I8},    {"int8", T_I8},     {"uchar", T_U8},  {"uint8", T_U8},
-             {"short", T_I16},  {"int16", T_I16},   {"ushort", T_U16}, {"uint16", T_U16},
-             {"int", T_I32},    {"int32", T_I32},   {"uint", T_U32},  {"uint32", T_U32},
-             {"float", T_F32},  {"float32", T_F32}, {"double", T_F64}, {"float64", T_F64}};
-    size_t i;
-    for (i = 0; i < sizeof k / sizeof k[0]; ++i)
-        if (strcmp(w, k[i].name) == 0)
-            return k[i].t;
-    return T_NONE;
-}
-
-static size_t type_size(ply_type t)
-{
-    static const size_t sz[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
-    return sz[t];
-}
-
 /* The next value of type t as a double; 0 at the end of the data or on a bad number. */
-static int read_value(reader *r, ply_type t, double *out)
+static int read_value(reader *r, rs_ply_type t, double *out)
 {
     if (r->ascii) {
         char *e;
@@ -83,7 +45,7 @@ static int read_value(reader *r, ply_type t, double *out)
         return 1;
     }
     {
-        size_t n = type_size(t), i;
+        size_t n = rs_ply_type_size(t), i;
         unsigned char b[8];
         if ((size_t)(r->end - r->p) < n)
             return 0;
@@ -91,39 +53,39 @@ static int read_value(reader *r, ply_type t, double *out)
             b[i] = r->p[r->big ? n - 1 - i : i];
         r->p += n;
         switch (t) {
-        case T_I8: *out = (int8_t)b[0]; break;
-        case T_U8: *out = b[0]; break;
-        case T_I16: {
+        case RS_PLY_I8: *out = (int8_t)b[0]; break;
+        case RS_PLY_U8: *out = b[0]; break;
+        case RS_PLY_I16: {
             int16_t v;
             memcpy(&v, b, 2);
             *out = v;
             break;
         }
-        case T_U16: {
+        case RS_PLY_U16: {
             uint16_t v;
             memcpy(&v, b, 2);
             *out = v;
             break;
         }
-        case T_I32: {
+        case RS_PLY_I32: {
             int32_t v;
             memcpy(&v, b, 4);
             *out = v;
             break;
         }
-        case T_U32: {
+        case RS_PLY_U32: {
             uint32_t v;
             memcpy(&v, b, 4);
             *out = v;
             break;
         }
-        case T_F32: {
+        case RS_PLY_F32: {
             float v;
             memcpy(&v, b, 4);
             *out = v;
             break;
         }
-        case T_F64: {
+        case RS_PLY_F64: {
             double v;
             memcpy(&v, b, 8);
             *out = v;
@@ -140,91 +102,6 @@ static rs_status cut(const reader *r, const char *what)
     if (r->ascii)
         return rs_error_set(RS_ERR_ARG, "%s: PLY data line %u: %s", r->path, r->line, what);
     return rs_error_set(RS_ERR_ARG, "%s: PLY data: %s", r->path, what);
-}
-
-/* Parses the header in text[0, n): elements, format; *data_at = the offset after end_header. */
-static rs_status parse_header(const char *path, const char *text, size_t n, ply_elem *elems,
-                              int *n_elems, int max_elems, int *ascii, int *big, size_t *data_at)
-{
-    const char *p = text, *end = text + n;
-    unsigned line = 0;
-    *n_elems = 0;
-    *ascii = 1;
-    *big = 0;
-    while (p < end) {
-        const char *eol = (const char *)memchr(p, '\n', (size_t)(end - p));
-        char ln[256], a[64], b[64], c[64], d[64];
-        int k;
-        size_t len;
-        if (!eol)
-            break;
-        ++line;
-        len = (size_t)(eol - p) < sizeof ln - 1 ? (size_t)(eol - p) : sizeof ln - 1;
-        memcpy(ln, p, len);
-        ln[len] = '\0';
-        if (len && ln[len - 1] == '\r')
-            ln[len - 1] = '\0';
-        k = sscanf(ln, "%63s %63s %63s %63s", a, b, c, d);
-        p = eol + 1;
-        if (k <= 0 || strcmp(a, "ply") == 0 || strcmp(a, "comment") == 0 ||
-            strcmp(a, "obj_info") == 0)
-            continue;
-        if (strcmp(a, "format") == 0 && k >= 2) {
-            *ascii = strcmp(b, "ascii") == 0;
-            *big = strcmp(b, "binary_big_endian") == 0;
-            if (!*ascii && !*big && strcmp(b, "binary_little_endian") != 0)
-                return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown format '%s'",
-                                    path, line, b);
-        } else if (strcmp(a, "element") == 0 && k == 3) {
-            ply_elem *e;
-            char *ce;
-            if (*n_elems >= max_elems)
-                return rs_error_set(RS_ERR_ARG, "%s: PLY header: more than %d elements", path,
-                                    max_elems);
-            e = &elems[(*n_elems)++];
-            memset(e, 0, sizeof *e);
-            snprintf(e->name, sizeof e->name, "%s", b);
-            e->count = strtoull(c, &ce, 10);
-            if (*ce || !isdigit((unsigned char)c[0]) || e->count > UINT32_MAX)
-                return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u is not 'element NAME "
-                                                "COUNT'", path, line);
-        } else if (strcmp(a, "property") == 0 && *n_elems > 0) {
-            ply_elem *e = &elems[*n_elems - 1];
-            ply_prop *pr;
-            if (e->n_props >= MAX_PROPS)
-                return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: too many properties",
-                                    path, line);
-            pr = &e->props[e->n_props++];
-            memset(pr, 0, sizeof *pr);
-            if (strcmp(b, "list") == 0 && k == 4) {
-                /* "property list LEN_TYPE TYPE NAME": the name is the fifth word */
-                char name[64] = "";
-                sscanf(ln, "%*s %*s %*s %*s %63s", name);
-                pr->len_type = type_of(c);
-                pr->type = type_of(d);
-                snprintf(pr->name, sizeof pr->name, "%s", name);
-                if (pr->len_type == T_NONE || pr->type == T_NONE || pr->len_type >= T_F32)
-                    return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad list property",
-                                        path, line);
-            } else if (k == 3) {
-                pr->type = type_of(b);
-                snprintf(pr->name, sizeof pr->name, "%s", c);
-                if (pr->type == T_NONE)
-                    return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown type '%s'",
-                                        path, line, b);
-            } else {
-                return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad property", path,
-                                    line);
-            }
-        } else if (strcmp(a, "end_header") == 0) {
-            *data_at = (size_t)(p - text);
-            return RS_OK;
-        } else {
-            return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unexpected '%s'", path, line,
-                                a);
-        }
-    }
-    return rs_error_set(RS_ERR_ARG, "%s: PLY header has no end_header", path);
 }
 
 void rs_ply_strips_free(rs_ply_strips *s)
@@ -270,9 +147,10 @@ static rs_status strip_triangles(rs_ply_strips *out, const uint32_t *idx, size_t
 rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
 {
     enum { MAX_ELEMS = 16 };
-    ply_elem elems[MAX_ELEMS];
-    int n_elems, ascii, big, e, have_xyz = 0;
-    size_t len, data_at = 0, cap = 0;
+    rs_ply_elem elems[MAX_ELEMS];
+    rs_ply_header h;
+    int e, have_xyz = 0;
+    size_t len, cap = 0;
     char *text;
     reader r;
     uint32_t *strip = NULL;
@@ -282,26 +160,29 @@ rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
     st = rs_file_read(path, RS_FILE_MAX_MESH_BYTES, &text, &len);
     if (st != RS_OK)
         return st;
-    st = parse_header(path, text, len, elems, &n_elems, MAX_ELEMS, &ascii, &big, &data_at);
+    memset(&h, 0, sizeof h);
+    h.elems = elems;
+    h.max_elems = MAX_ELEMS;
+    st = rs_ply_parse_header(path, text, len, len, 1, &h);
     if (st != RS_OK) {
         rs_free(text);
         return st;
     }
     r.path = path;
-    r.p = (const unsigned char *)text + data_at;
+    r.p = (const unsigned char *)text + h.data_at;
     r.end = (const unsigned char *)text + len;
-    r.ascii = ascii;
-    r.big = big;
+    r.ascii = h.ascii;
+    r.big = h.big;
     r.line = 1;
-    for (e = 0; e < n_elems && st == RS_OK; ++e) {
-        ply_elem *el = &elems[e];
+    for (e = 0; e < h.n_elems && st == RS_OK; ++e) {
+        rs_ply_elem *el = &elems[e];
         int is_vertex = strcmp(el->name, "vertex") == 0;
         int is_strips = strcmp(el->name, "tristrips") == 0;
         int px = -1, py = -1, pz = -1, pl = -1, k;
         uint64_t i;
         for (k = 0; k < el->n_props; ++k) {
-            const ply_prop *pr = &el->props[k];
-            if (is_vertex && pr->len_type == T_NONE) {
+            const rs_ply_prop *pr = &el->props[k];
+            if (is_vertex && pr->len_type == RS_PLY_NONE) {
                 if (strcmp(pr->name, "x") == 0)
                     px = k;
                 else if (strcmp(pr->name, "y") == 0)
@@ -309,7 +190,7 @@ rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
                 else if (strcmp(pr->name, "z") == 0)
                     pz = k;
             }
-            if (is_strips && pr->len_type != T_NONE && pl < 0)
+            if (is_strips && pr->len_type != RS_PLY_NONE && pl < 0)
                 pl = k;
         }
         if (is_vertex) {
@@ -317,7 +198,7 @@ rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
                 st = rs_error_set(RS_ERR_ARG, "%s: PLY vertices have no x, y and z", path);
                 break;
             }
-            /* the header's count is bounded by check_ply_header against the file's size */
+            /* the header's count is bounded by the file's size (rs_ply_parse_header) */
             out->vertices = (float *)rs_alloc(3 * (size_t)el->count + 3, sizeof *out->vertices);
             if (!out->vertices) {
                 st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
@@ -333,9 +214,9 @@ rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
         }
         for (i = 0; i < el->count && st == RS_OK; ++i) {
             for (k = 0; k < el->n_props; ++k) {
-                const ply_prop *pr = &el->props[k];
+                const rs_ply_prop *pr = &el->props[k];
                 double v;
-                if (pr->len_type != T_NONE) {
+                if (pr->len_type != RS_PLY_NONE) {
                     double cnt;
                     uint64_t j, n;
                     if (!read_value(&r, pr->len_type, &cnt) || !(cnt >= 0) || cnt > 1e9) {

@@ -6,7 +6,9 @@
  * (s[i], s[i+1], s[i+2]) for even i and (s[i+1], s[i], s[i+2]) for odd i, so that all keep the
  * first one's orientation; triangles with a repeated vertex join strips and are skipped (counted
  * as joins, not as dropped faces).  ascii, binary_little_endian and binary_big_endian; vertices
- * need x, y and z of any numeric type; other elements and properties are read past. */
+ * need x, y and z of any numeric type; other elements and properties are read past.  The header
+ * is parsed by scenes/ply_header.h in its strict mode (every line understood, counts bounded by
+ * the file's size). */
 #ifndef RS_SCENES_PLY_STRIPS_H
 #define RS_SCENES_PLY_STRIPS_H
 

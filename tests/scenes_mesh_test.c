@@ -21,6 +21,7 @@
 #include "accel/bvh.h"
 #include "scenes/builtin.h"
 #include "scenes/mesh.h"
+#include "scenes/ply_strips.h"
 #include "test_files.h"
 #include "test_rand.h"
 
@@ -313,6 +314,20 @@ static void test_ply_headers(void **state)
          "property float y\nproperty float z\nelement face 1\n"
          "property list uchar int vertex_indices\nend_header\n0123456789abcdefghij",
          "at least 37 bytes, but its binary data has only 20"},
+        /* a file of triangle strips: the same header parser (scenes/ply_header.h), strict for
+         * our own reader, which refuses any line it would not understand */
+        {"ply\nformat binary_middle_endian 1.0\nelement vertex 0\nproperty float x\n"
+         "element tristrips 0\nproperty list int int vertex_indices\nend_header\n",
+         "line 2: unknown format 'binary_middle_endian'"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nelement tristrips 0\n"
+         "property list int int vertex_indices\nend_header\n0\n",
+         "line 4: unknown type 'half'"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement tristrips 0\n"
+         "property list float int vertex_indices\nend_header\n0\n",
+         "line 6: bad list property"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement tristrips 0\n"
+         "property list int int vertex_indices\nvertex_order ccw\nend_header\n0\n",
+         "line 7: unexpected 'vertex_order'"},
     };
     char dir[] = "/tmp/rs_ply_XXXXXX", path[256];
     size_t k;
@@ -323,6 +338,19 @@ static void test_ply_headers(void **state)
     for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         write_file(path, cases[k].text);
         expect_mesh_error(path, path, cases[k].words);
+    }
+    {
+        /* the strip reader on its own bounds the header's counts by the file's size too (it
+         * used to rely on the import's check, and would have asked for 48 GB here) */
+        rs_ply_strips strips;
+        write_file(path, "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+                         "property float y\nproperty float z\nelement tristrips 1\n"
+                         "property list int int vertex_indices\nend_header\n0 0 0\n");
+        rs_error_clear();
+        assert_int_equal(rs_ply_read_strips(path, &strips), RS_ERR_ARG);
+        assert_non_null(strstr(rs_error_message(), "declares 4000000001 elements, more than"));
+        assert_null(strips.vertices);
+        rs_error_clear();
     }
     alarm(0);
     remove(path);
