@@ -794,6 +794,8 @@ static rs_status import_file(const char *path, unsigned int flags, const struct 
     st = check_ply_header(path, &is_ply);
     if (st != RS_OK)
         return st;
+    if (is_ply == 2)
+        return strips_scene(path, out);
     memset(&mio, 0, sizeof mio);
     mio.io.OpenProc = mio_open;
     mio.io.CloseProc = mio_close;
@@ -803,8 +805,6 @@ static rs_status import_file(const char *path, unsigned int flags, const struct 
      * below checks every index and coordinate and drops just the bad faces. */
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE,
                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    if (is_ply == 2)
-        return strips_scene(path, out);
     if (is_ply) {
         /* a PLY is read once without post-processing first: faces without indices are refused
          * before the steps that crash on them see them (has_empty_face) */
