@@ -71,6 +71,50 @@ static void test_obj_placement_uv_normals(void **state)
     rs_scene_destroy(s);
 }
 
+/* The placement's normals go by the inverse transpose, with a normal that is not along an axis:
+ * scale (2, 1, 1), then a quarter turn about z, (x, y, z) -> (-y, x, z), is M = R S, and
+ * M^-T = R S^-1 takes n = (0.48, 0.64, 0.6) to R (0.24, 0.64, 0.6) = (-0.64, 0.24, 0.6), over
+ * its length sqrt(0.8272).  The plain matrix would give R (0.96, 0.64, 0.6) = (-0.64, 0.96, 0.6)
+ * and M^-1 = S^-1 R^T gives (0.32, -0.48, 0.6), while a normal along an axis (as above) cannot
+ * tell them apart.  The triangle lies across n: its placed face normal agrees. */
+static void test_obj_normals_inverse_transpose(void **state)
+{
+    char dir[] = "/tmp/rs_nrm_XXXXXX", path[256];
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    const float k = 1.0f / sqrtf(0.8272f);
+    const rs_tri *t;
+    rs_vec3 face;
+    int i;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/tilted.obj", dir);
+    /* v1 - v0 = a across n, v2 - v0 = n x a */
+    write_file(path, "v 0 0 0\nv 0.64 -0.48 0\nv 0.288 0.384 -0.64\nvn 0.48 0.64 0.6\n"
+                     "f 1//1 2//1 3//1\n");
+    o.scale = rs_v3(2, 1, 1);
+    o.rotate_deg = rs_v3(0, 0, 90);
+    assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    assert_non_null(s->tri_normal);
+    t = &s->tris[0];
+    /* v1: (0.64, -0.48, 0) -> (1.28, -0.48, 0) -> (0.48, 1.28, 0) */
+    assert_true(near(t->v1.x, 0.48f) && near(t->v1.y, 1.28f) && near(t->v1.z, 0));
+    face = rs_v3_normalize(rs_v3_cross(rs_v3_sub(t->v1, t->v0), rs_v3_sub(t->v2, t->v0)));
+    for (i = 0; i < 3; ++i) {
+        const float *nv = &s->tri_normal[3 * i];
+        if (!(near(nv[0], -0.64f * k) && near(nv[1], 0.24f * k) && near(nv[2], 0.6f * k)))
+            fail_msg("vertex %d's normal (%g, %g, %g), want (%g, %g, %g)", i, nv[0], nv[1], nv[2],
+                     -0.64f * k, 0.24f * k, 0.6f * k);
+        assert_true(rs_v3_dot(face, rs_v3(nv[0], nv[1], nv[2])) > 1.0f - 1e-5f);
+    }
+    rs_scene_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
 static void test_ply_and_gltf(void **state)
 {
     uint32_t mat;
@@ -623,6 +667,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_obj_placement_uv_normals),
+        cmocka_unit_test(test_obj_normals_inverse_transpose),
         cmocka_unit_test(test_ply_and_gltf),
         cmocka_unit_test(test_fit),
         cmocka_unit_test(test_malformed),

@@ -3,7 +3,8 @@
  *   - the transform steps compose in the stated order and match matrices worked by hand;
  *   - a transformed sphere, quad, triangle and box land where the transform puts them, and a
  *     mirroring transform keeps every surface's outward normal (quads, triangles and their vertex
- *     normals);
+ *     normals); vertex normals go by the inverse transpose (a rotation then a non-uniform scale,
+ *     against values worked by hand);
  *   - a scene of instances (nested, with transforms) renders the same image, bit for bit, as the
  *     same objects written out one by one with the instances' transforms;
  *   - a mesh object reads its file relative to the scene, keeps or replaces its materials by name,
@@ -163,6 +164,54 @@ static void test_mirror_keeps_orientation(void **state)
         expect_v3(rs_v3(t->tri_normal[0], t->tri_normal[1], t->tri_normal[2]), 0, 0, 1);
         rs_scene_destroy(t);
     }
+}
+
+/* Vertex normals go by the inverse transpose of the linear part.  M = S R: a quarter turn about
+ * z, (x, y, z) -> (-y, x, z), then a scale by 2 along x.  Then M^-T = S^-1 R, so the normal
+ * n = (0.48, 0.64, 0.6) goes to R n = (-0.64, 0.48, 0.6), then to (-0.32, 0.48, 0.6), over its
+ * length sqrt(0.6928).  Wrong matrices give other directions: M itself (-1.28, 0.48, 0.6), M^-1
+ * (the cofactor read transposed) (0.64, -0.24, 0.6), M^T (0.64, -0.96, 0.6); a diagonal scale
+ * alone would not tell M^-T from M^-1.  The triangle lies across n, so its transformed face
+ * normal must agree with the transformed vertex normals. */
+static void test_normals_inverse_transpose(void **state)
+{
+    static const double z[3] = {0, 0, 1};
+    const float n[3] = {0.48f, 0.64f, 0.6f};
+    /* v1 = a across n, v2 = n x a: (v1 - v0) x (v2 - v0) = |a|^2 n */
+    rs_vec3 v[3] = {{0, 0, 0}, {0.64f, -0.48f, 0}, {0.288f, 0.384f, -0.64f}};
+    float nrm[9];
+    rs_xform r = rs_xform_rotate_axis(z, 90), sc = rs_xform_scale(2, 1, 1);
+    rs_xform x = rs_xform_compose(&sc, &r);
+    rs_scene_mark mark;
+    rs_scene *t;
+    rs_vec3 face;
+    const float k = 1.0f / sqrtf(0.6928f);
+    int i;
+    (void)state;
+    for (i = 0; i < 9; ++i)
+        nrm[i] = n[i % 3];
+    assert_int_equal(rs_scene_create("t", &t), RS_OK);
+    {
+        rs_material m = rs_mat_lambertian(rs_v3_splat(0.5f));
+        uint32_t id;
+        assert_int_equal(rs_scene_add_material(t, &m, &id), RS_OK);
+        mark = rs_scene_mark_now(t);
+        assert_int_equal(rs_scene_add_triangle_full(t, v, NULL, nrm, id), RS_OK);
+    }
+    /* the face normal before: along n */
+    face = rs_v3_normalize(rs_v3_cross(rs_v3_sub(t->tris[0].v1, t->tris[0].v0),
+                                       rs_v3_sub(t->tris[0].v2, t->tris[0].v0)));
+    expect_v3(face, n[0], n[1], n[2]);
+    assert_int_equal(rs_scene_transform_since(t, &mark, &x), RS_OK);
+    /* the vertices by M: (0.64, -0.48, 0) -> (0.48, 0.64, 0) -> (0.96, 0.64, 0) */
+    expect_v3(t->tris[0].v1, 0.96f, 0.64f, 0);
+    face = rs_v3_normalize(rs_v3_cross(rs_v3_sub(t->tris[0].v1, t->tris[0].v0),
+                                       rs_v3_sub(t->tris[0].v2, t->tris[0].v0)));
+    expect_v3(face, -0.32f * k, 0.48f * k, 0.6f * k);
+    for (i = 0; i < 3; ++i)
+        expect_v3(rs_v3(t->tri_normal[3 * i], t->tri_normal[3 * i + 1], t->tri_normal[3 * i + 2]),
+                  -0.32f * k, 0.48f * k, 0.6f * k);
+    rs_scene_destroy(t);
 }
 
 /* The instanced scene and the same objects written out give the same image bit for bit.  The
@@ -453,6 +502,7 @@ int main(void)
         cmocka_unit_test(test_steps_compose_in_order),
         cmocka_unit_test(test_objects_move),
         cmocka_unit_test(test_mirror_keeps_orientation),
+        cmocka_unit_test(test_normals_inverse_transpose),
         cmocka_unit_test(test_instances_equal_flattened),
         cmocka_unit_test(test_mesh_objects),
         cmocka_unit_test(test_lights_and_export),
