@@ -18,8 +18,9 @@
  *   sum is positive when the vertices wind counter-clockwise about n (right-handed about n);
  *   test_contour_reference checks this, and the formula itself, against known limits.
  *
- * Also: several lights picked in proportion to power still sum to the total irradiance, and
- * rs_light_pdf_hit gives the same pdf as rs_light_sample_at for the sampled point. */
+ * Also: several lights picked in proportion to power still sum to the total irradiance,
+ * rs_light_pdf_hit gives the same pdf as rs_light_sample_at for the sampled point, and a moving
+ * sphere light is sampled where it is at the time asked for. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -112,9 +113,10 @@ typedef struct estimate {
     double mean, se;
 } estimate;
 
-/* Light-sampling estimate of the irradiance at x with normal n (first channel of Le, which the
- * scenes here keep grey), from `count` samples. */
-static estimate irradiance_mc(const rs_scene *s, rs_vec3 x, rs_vec3 n, uint64_t seed, int count)
+/* Light-sampling estimate of the irradiance at x with normal n at `time` (first channel of Le,
+ * which the scenes here keep grey), from `count` samples. */
+static estimate irradiance_mc_at(const rs_scene *s, rs_vec3 x, rs_vec3 n, float time,
+                                 uint64_t seed, int count)
 {
     uint64_t st = seed;
     double sum = 0.0, sum2 = 0.0, var;
@@ -124,7 +126,7 @@ static estimate irradiance_mc(const rs_scene *s, rs_vec3 x, rs_vec3 n, uint64_t 
         rs_light_sample ls;
         double c, val = 0.0;
         float up = rnd_f(&st), u1 = rnd_f(&st), u2 = rnd_f(&st);
-        if (rs_light_sample_at(s, x, 0.0f, up, u1, u2, &ls)) {
+        if (rs_light_sample_at(s, x, time, up, u1, u2, &ls)) {
             assert_true(ls.pdf > 0.0f);
             c = d3_dot(d3_of(n), d3_of(ls.wi));
             if (c > 0.0)
@@ -137,6 +139,11 @@ static estimate irradiance_mc(const rs_scene *s, rs_vec3 x, rs_vec3 n, uint64_t 
     var = fmax(0.0, sum2 / count - e.mean * e.mean);
     e.se = sqrt(var / (count - 1));
     return e;
+}
+
+static estimate irradiance_mc(const rs_scene *s, rs_vec3 x, rs_vec3 n, uint64_t seed, int count)
+{
+    return irradiance_mc_at(s, x, n, 0.0f, seed, count);
 }
 
 /* Asserts the estimate's standard error < 0.2% of the exact value and agreement within 1%. */
@@ -244,6 +251,67 @@ static void test_sphere_light(void **state)
     sphere_case(1.5, 30.0, 4);
     sphere_case(3.0, 60.0, 5);
     sphere_case(20.0, 85.0, 6);
+}
+
+/* A sphere light that moves (rs_scene_add_moving_sphere: radius 0.75 from c0 = (-2, 0, 0) at
+ * t = 0 to c1 = (2, 0, 0) at t = 1) is sampled where it is at the time asked for, c(t) = c0 + 4t x:
+ * from x = (0.5, 2.5, 0.3), at t = 0, 0.25, ..., 1, every sample lies on the sphere around c(t)
+ * (along wi at distance dist, with the outward normal there), its pdf is what rs_light_pdf_hit
+ * gives at t, and the irradiance at x toward c(t) is pi L (r / d(t))^2.  At t = 0.75 a point
+ * 0.22 from c(0.75), inside the sphere then (outside it at any t < 0.69), gets points on the
+ * sphere around c(0.75) (sampled by area).  Sampling the sphere where it stands at t = 0
+ * fails every check for t > 0. */
+static void test_moving_sphere_light(void **state)
+{
+    const float r = 0.75f, L = 3.0f;
+    rs_scene *s = new_scene();
+    rs_vec3 x = rs_v3(0.5f, 2.5f, 0.3f);
+    uint64_t st = 77;
+    int k, i;
+    (void)state;
+    assert_int_equal(rs_scene_add_moving_sphere(s, rs_v3(-2, 0, 0), 0.0f, rs_v3(2, 0, 0), 1.0f, r,
+                                                add_light(s, L, 0)),
+                     RS_OK);
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    assert_int_equal(s->n_lights, 1);
+    for (k = 0; k <= 5; ++k) {
+        /* k = 5: from inside, at t = 0.75 */
+        float t = k < 5 ? 0.25f * (float)k : 0.75f;
+        d3 c = d3_make(-2.0 + 4.0 * t, 0, 0);
+        rs_vec3 from = k < 5 ? x : rs_v3((float)c.x + 0.1f, 0.2f, 0.0f);
+        char name[96];
+        for (i = 0; i < 2000; ++i) {
+            rs_light_sample ls;
+            d3 p, off;
+            double rad, pdf_hit;
+            memset(&ls, 0, sizeof ls);
+            assert_int_equal(
+                rs_light_sample_at(s, from, t, rnd_f(&st), rnd_f(&st), rnd_f(&st), &ls), 1);
+            p = d3_of(ls.point);
+            off = d3_sub(p, c);
+            rad = sqrt(d3_dot(off, off));
+            if (!(fabs(rad - r) <= 1e-4))
+                fail_msg("t = %.2f: a sample at (%g, %g, %g), %g from the centre (%g, 0, 0) the "
+                         "sphere has then (radius %g)",
+                         t, p.x, p.y, p.z, rad, c.x, r);
+            /* along wi, at dist; the normal is the outward one there */
+            assert_true(rs_v3_length(rs_v3_sub(rs_v3_madd(from, ls.wi, ls.dist), ls.point)) <=
+                        1e-4f);
+            assert_true(fabs(d3_dot(d3_of(ls.n), off) / rad - 1.0) <= 1e-4);
+            pdf_hit = rs_light_pdf_hit(s, 0, from, t, ls.wi, ls.dist, ls.n);
+            assert_true(fabs(pdf_hit - ls.pdf) <= 1e-3 * ls.pdf);
+        }
+        if (k < 5) {
+            d3 to_c = d3_sub(c, d3_of(x));
+            double d = sqrt(d3_dot(to_c, to_c));
+            rs_vec3 n = v3_of(d3_make(to_c.x / d, to_c.y / d, to_c.z / d));
+            double ct = d3_dot(d3_of(n), to_c) / d;
+            snprintf(name, sizeof name, "moving sphere at t = %.2f", t);
+            check_irradiance(name, irradiance_mc_at(s, x, n, t, 80 + (uint64_t)k, N_SAMPLES / 2),
+                             PI_D * L * (r / d) * (r / d) * ct);
+        }
+    }
+    rs_scene_destroy(s);
 }
 
 /* ---- quad and triangle lights -------------------------------------------------------------- */
@@ -584,6 +652,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_contour_reference), cmocka_unit_test(test_sphere_light),
+        cmocka_unit_test(test_moving_sphere_light),
         cmocka_unit_test(test_quad_light),        cmocka_unit_test(test_triangle_light),
         cmocka_unit_test(test_several_lights),    cmocka_unit_test(test_pdf_consistency),
         cmocka_unit_test(test_punctual),
