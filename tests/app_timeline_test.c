@@ -3,8 +3,10 @@
  *     with <svg and ends with </svg>, has exactly one rectangle per span in its stage's colour
  *     and on its lane, names the lanes XML-escaped, and a legend of exactly the stages used;
  *   - very many spans are merged so the file stays small;
- *   - the log keeps its first `capacity` spans and counts the rest in `dropped`, also when 4
- *     threads add at once; adding to no timeline is a no-op;
+ *   - the log keeps its first `capacity` spans and counts the rest in `dropped` (however many,
+ *     without overwriting a kept span), also when 4 threads add at once; adding to, reading or
+ *     asking the time of no timeline is a no-op; create refuses a missing out pointer and
+ *     reports either allocation failing (RS_ERR_NOMEM, *out NULL);
  *   - a path in a folder that does not exist is RS_ERR_IO and leaves no file (nor its .tmp).
  * Every test writes into its own mkdtemp folder, removed afterwards. */
 #include <setjmp.h>
@@ -299,6 +301,77 @@ static void test_capacity_overflow(void **state)
     rs_timeline_destroy(t);
 }
 
+/* Past capacity the log stays as it was, however many more spans come: each is counted in
+ * `dropped` and none overwrites a kept one; exactly `capacity` spans drop none; the counts may be
+ * asked for without their pointers. */
+static void test_overflow_keeps_counting(void **state)
+{
+    rs_timeline *t;
+    const rs_span *sp, *again;
+    uint32_t n, i;
+    uint64_t dropped;
+    (void)state;
+    assert_int_equal(rs_timeline_create(3, &t), RS_OK);
+    for (i = 0; i < 3; ++i)
+        rs_timeline_add(t, (uint16_t)i, RS_STAGE_RAYGEN, 10 + i, 0.25 * i, 0.25 * i + 0.125);
+    sp = rs_timeline_spans(t, &n, &dropped);
+    assert_int_equal(n, 3);
+    assert_int_equal(dropped, 0); /* full, nothing lost yet */
+    for (i = 0; i < 1000; ++i)
+        rs_timeline_add(t, 7, RS_STAGE_FILM, 99, 5.0, 6.0);
+    again = rs_timeline_spans(t, &n, &dropped);
+    assert_ptr_equal(again, sp);
+    assert_int_equal(n, 3);
+    assert_int_equal(dropped, 1000);
+    for (i = 0; i < 3; ++i) {
+        assert_int_equal(sp[i].lane, i);
+        assert_int_equal(sp[i].wave, 10 + i);
+        assert_int_equal(sp[i].stage, RS_STAGE_RAYGEN);
+        assert_true(sp[i].t0 == 0.25 * i && sp[i].t1 == 0.25 * i + 0.125);
+    }
+    /* one more, and the counts alone (no pointers for them) */
+    rs_timeline_add(t, 0, RS_STAGE_SHADE, 0, 0.0, 1.0);
+    assert_ptr_equal(rs_timeline_spans(t, NULL, NULL), sp);
+    assert_ptr_equal(rs_timeline_spans(t, NULL, &dropped), sp);
+    assert_int_equal(dropped, 1001);
+    assert_ptr_equal(rs_timeline_spans(t, &n, NULL), sp);
+    assert_int_equal(n, 3);
+    rs_timeline_destroy(t);
+}
+
+/* rs_timeline_create refuses a missing out pointer (RS_ERR_ARG), and reports either allocation
+ * failing as RS_ERR_NOMEM with *out NULL (whatever it held before) and its own message. */
+static void test_create_bad_arguments(void **state)
+{
+    rs_timeline *t;
+    (void)state;
+    rs_error_clear();
+    assert_int_equal(rs_timeline_create(4, NULL), RS_ERR_ARG);
+    assert_non_null(strstr(rs_error_message(), "no out pointer"));
+    rs_error_clear();
+
+    t = (rs_timeline *)&t; /* not NULL: create must clear it */
+    rs_alloc_fail_after(0); /* the log itself */
+    assert_int_equal(rs_timeline_create(4, &t), RS_ERR_NOMEM);
+    rs_alloc_fail_after(-1);
+    assert_null(t);
+    assert_non_null(strstr(rs_error_message(), "out of memory for the timeline"));
+    rs_error_clear();
+
+    t = (rs_timeline *)&t;
+    rs_alloc_fail_after(1); /* its spans */
+    assert_int_equal(rs_timeline_create(4, &t), RS_ERR_NOMEM);
+    rs_alloc_fail_after(-1);
+    assert_null(t);
+    assert_non_null(strstr(rs_error_message(), "a timeline of 4 spans"));
+    rs_error_clear();
+
+    /* and after the failures, a create works */
+    assert_int_equal(rs_timeline_create(4, &t), RS_OK);
+    assert_non_null(t);
+    rs_timeline_destroy(t);
+}
+
 typedef struct adder {
     rs_timeline *t;
     uint16_t lane;
@@ -361,9 +434,12 @@ static void test_null_timeline(void **state)
     double a, b;
     (void)state;
     rs_timeline_add(NULL, 0, RS_STAGE_SHADE, 0, 0.0, 1.0);
+    rs_timeline_add(NULL, 65535, RS_STAGE_PASS, UINT32_MAX, 1.0, 0.0);
     assert_null(rs_timeline_spans(NULL, &n, &dropped));
     assert_int_equal(n, 0);
     assert_int_equal(dropped, 0);
+    assert_null(rs_timeline_spans(NULL, NULL, NULL));
+    assert_true(rs_timeline_now(NULL) == 0.0);
     rs_timeline_destroy(NULL);
     assert_int_equal(rs_timeline_write_svg("/tmp/x.svg", NULL, NULL, 1, NULL), RS_ERR_ARG);
     rs_error_clear();
@@ -412,6 +488,7 @@ int main(void)
         cmocka_unit_test(test_stage_names_and_colors), cmocka_unit_test(test_svg_known_spans),
         cmocka_unit_test(test_svg_many_spans_merged),  cmocka_unit_test(test_capacity_overflow),
         cmocka_unit_test(test_concurrent_adds),        cmocka_unit_test(test_null_timeline),
-        cmocka_unit_test(test_missing_folder)};
+        cmocka_unit_test(test_missing_folder),         cmocka_unit_test(test_create_bad_arguments),
+        cmocka_unit_test(test_overflow_keeps_counting)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
