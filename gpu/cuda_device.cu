@@ -10,7 +10,10 @@
  * Every CUDA call that can fail is checked against its own return value (CUDA_TRY, kernel
  * launches through cudaLaunchKernel) and reported with the call's text, file and line; release
  * paths (cudaFree, cudaFreeHost, cudaStreamDestroy) have nobody to report to and ignore theirs.
- * Launch sizes come from the occupancy API, not hand-tuned constants. */
+ * Launch sizes come from the occupancy API under each kernel's __launch_bounds__ (internal.h), not
+ * hand-tuned constants; at create the device's stack limit is raised to what the kernels' own
+ * attributes say they need (cudaFuncGetAttributes localSizeBytes), so that no launch has to grow
+ * it (a launch that must grow it synchronises the device and can fail mid-render). */
 #include "gpu/internal.h"
 
 #include <stdio.h>
@@ -20,7 +23,8 @@
 #include "core/alloc.h"
 #include "scheduler/sched.h"
 
-__global__ void rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
+__global__ void __launch_bounds__(RS_CUDA_TRACE_BLOCK_MAX, 1)
+    rs_trace_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
 {
     uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i < batch.count)
@@ -104,7 +108,7 @@ static void free_staging(rs_cuda_impl *c)
 /* Both staging sets for the largest piece of the largest chunk, once per device. */
 static rs_status make_staging(rs_cuda_impl *c)
 {
-    uint32_t cap = rs_cuda_piece_size(RS_SCHED_MAX_CHUNK);
+    uint32_t cap = rs_gpu_piece_size(RS_SCHED_MAX_CHUNK);
     rs_ray_soa r;
     rs_hit_soa h;
     uint8_t *o;
@@ -223,7 +227,7 @@ static rs_status launch_piece(rs_device *d, rs_cuda_impl *c, rs_cuda_stage *s,
 }
 
 /* A chunk is cut into pieces (up to 4 of a chunk of at most RS_SCHED_MAX_CHUNK rays, none under
- * RS_CUDA_MIN_PIECE, none over the staging) that alternate between the two stages: piece k + 1
+ * RS_GPU_MIN_PIECE, none over the staging) that alternate between the two stages: piece k + 1
  * is packed and queued while piece k runs.  Every piece queued is waited for, also on failure. */
 static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
 {
@@ -235,7 +239,7 @@ static rs_status cuda_trace(rs_device *d, const rs_trace_batch *batch, uint32_t 
     if (n == 0)
         return RS_OK;
     CUDA_TRY(cudaSetDevice(c->ordinal));
-    piece = rs_cuda_piece_size(n);
+    piece = rs_gpu_piece_size(n);
     if (piece > c->cap)
         piece = c->cap; /* a fixed chunk size above RS_SCHED_MAX_CHUNK: more pieces */
     for (off = begin, k = 0; off < end && st == RS_OK; off += piece, ++k) {
@@ -304,20 +308,152 @@ static const rs_device_ops cuda_ops = {cuda_upload,        cuda_trace,     cuda_
 
 extern "C" int rs_gpu_compiled(void) { return 1; }
 
+/* "12.4" from CUDA's version number 12040 (1000 major + 10 minor). */
+static void cuda_version_text(int v, char *buf, size_t n)
+{
+    snprintf(buf, n, "%d.%d", v / 1000, v % 1000 / 10);
+}
+
+/* What cudaGetDeviceCount said, once per process (the runtime reads the devices once). */
+typedef struct gpu_probe {
+    int n;
+    char why[320];
+} gpu_probe;
+
+static gpu_probe probe_devices(void)
+{
+    gpu_probe p;
+    int n = 0, drv = 0, rt = 0;
+    char dv[16], rv[16];
+    cudaError_t e = cudaGetDeviceCount(&n);
+    memset(&p, 0, sizeof p);
+    if (e == cudaSuccess && n > 0) {
+        p.n = n;
+        return p;
+    }
+    /* the driver's and the runtime's CUDA versions: the driver's is 0 where none is installed */
+    if (cudaDriverGetVersion(&drv) != cudaSuccess)
+        drv = 0;
+    if (cudaRuntimeGetVersion(&rt) != cudaSuccess)
+        rt = CUDART_VERSION;
+    cuda_version_text(drv, dv, sizeof dv);
+    cuda_version_text(rt, rv, sizeof rv);
+    if (e == cudaErrorInsufficientDriver && drv == 0)
+        snprintf(p.why, sizeof p.why,
+                 "no NVIDIA driver is loaded (cudaDriverGetVersion reports none; this build's CUDA "
+                 "runtime is %s)",
+                 rv);
+    else if (e == cudaErrorInsufficientDriver && drv < rt)
+        snprintf(p.why, sizeof p.why,
+                 "the NVIDIA driver is older than this build's CUDA runtime: the driver supports "
+                 "CUDA %s, the runtime is CUDA %s (cudaErrorInsufficientDriver; CUDA 13.x needs "
+                 "driver 580 or newer, 12.x 525 or newer): update the driver or build with an "
+                 "older toolkit",
+                 dv, rv);
+    else if (e == cudaSuccess || e == cudaErrorNoDevice)
+        snprintf(p.why, sizeof p.why,
+                 "no CUDA device is present (driver for CUDA %s, runtime CUDA %s; "
+                 "CUDA_VISIBLE_DEVICES may hide them)",
+                 dv, rv);
+    else
+        snprintf(p.why, sizeof p.why,
+                 "the CUDA runtime could not start: %s, %s (driver for CUDA %s, runtime CUDA %s)",
+                 cudaGetErrorName(e), cudaGetErrorString(e), dv, rv);
+    return p;
+}
+
 extern "C" int rs_gpu_count(const char **why)
 {
-    int n = 0;
-    cudaError_t e = cudaGetDeviceCount(&n);
-    if (e != cudaSuccess) {
-        if (why)
-            *why = e == cudaErrorInsufficientDriver ? "no NVIDIA driver is loaded"
-                   : e == cudaErrorNoDevice         ? "no CUDA device is present"
-                                                    : "the CUDA runtime could not start";
-        return 0;
+    static const gpu_probe p = probe_devices(); /* C++ static: made once, thread-safely */
+    if (p.n == 0 && why)
+        *why = p.why;
+    return p.n;
+}
+
+/* Raises device `index`'s stack limit (per thread; the device current) to the most local memory
+ * a kernel of ours uses, as cudaFuncGetAttributes reports it (also what fails first when the
+ * build has no code for this GPU's architecture).  The limit is never lowered. */
+static rs_status size_stack(int index)
+{
+    static const char *const names[2] = {"rs_trace_kernel", "rs_megakernel_kernel"};
+    const void *fn[2];
+    cudaFuncAttributes a;
+    size_t need = 0, have = 0, local[2];
+    cudaError_t e;
+    int k;
+    fn[0] = (const void *)rs_trace_kernel;
+    fn[1] = rs_cuda_megakernel_entry();
+    for (k = 0; k < 2; ++k) {
+        if ((e = cudaFuncGetAttributes(&a, fn[k])) != cudaSuccess) {
+            cudaDeviceProp prop;
+            int major = 0, minor = 0;
+            if (cudaGetDeviceProperties(&prop, index) == cudaSuccess)
+                major = prop.major, minor = prop.minor;
+            return rs_error_set(RS_ERR_CUDA,
+                                "gpu:%d: cudaFuncGetAttributes(%s) failed: %s (the build's "
+                                "CMAKE_CUDA_ARCHITECTURES must include this GPU's sm_%d%d)",
+                                index, names[k], cudaGetErrorString(e), major, minor);
+        }
+        local[k] = a.localSizeBytes;
+        need = local[k] > need ? local[k] : need;
     }
-    if (n == 0 && why)
-        *why = "no CUDA device is present";
-    return n;
+    CUDA_TRY(cudaDeviceGetLimit(&have, cudaLimitStackSize));
+    if (have >= need)
+        return RS_OK;
+    if ((e = cudaDeviceSetLimit(cudaLimitStackSize, need)) != cudaSuccess)
+        return rs_error_set(RS_ERR_CUDA,
+                            "gpu:%d: cannot raise the CUDA stack from %zu to %zu bytes per thread, "
+                            "the kernels' local memory (cudaFuncGetAttributes localSizeBytes: "
+                            "%s %zu, %s %zu): cudaDeviceSetLimit(cudaLimitStackSize) failed: %s",
+                            index, have, need, names[0], local[0], names[1], local[1],
+                            cudaGetErrorString(e));
+    CUDA_TRY(cudaDeviceGetLimit(&have, cudaLimitStackSize));
+    if (have < need)
+        return rs_error_set(RS_ERR_CUDA,
+                            "gpu:%d: the CUDA stack limit reads %zu bytes per thread after "
+                            "cudaDeviceSetLimit(cudaLimitStackSize, %zu), under the kernels' %zu",
+                            index, have, need, need);
+    return RS_OK;
+}
+
+extern "C" int rs_gpu_describe(int index, char *buf, size_t n)
+{
+    static const char *const names[2] = {"trace", "megakernel"};
+    const char *why = "";
+    int count = rs_gpu_count(&why), drv = 0, rt = 0, k;
+    char dv[16], rv[16];
+    cudaDeviceProp prop;
+    size_t used, stack = 0;
+    if (index < 0 || index >= count) {
+        snprintf(buf, n, "gpu:%d: not available (%s)", index, count ? "index out of range" : why);
+        return -1;
+    }
+    if (cudaGetDeviceProperties(&prop, index) != cudaSuccess ||
+        cudaSetDevice(index) != cudaSuccess) {
+        snprintf(buf, n, "gpu:%d: its properties cannot be read", index);
+        return -1;
+    }
+    (void)cudaDriverGetVersion(&drv);
+    (void)cudaRuntimeGetVersion(&rt);
+    cuda_version_text(drv, dv, sizeof dv);
+    cuda_version_text(rt, rv, sizeof rv);
+    (void)cudaDeviceGetLimit(&stack, cudaLimitStackSize);
+    used = (size_t)snprintf(buf, n, "gpu:%d %s (sm_%d%d, %d SMs), driver for CUDA %s, runtime %s;",
+                            index, prop.name, prop.major, prop.minor, prop.multiProcessorCount, dv,
+                            rv);
+    for (k = 0; k < 2 && used < n; ++k) {
+        cudaFuncAttributes a;
+        const void *fn = k ? rs_cuda_megakernel_entry() : (const void *)rs_trace_kernel;
+        if (cudaFuncGetAttributes(&a, fn) != cudaSuccess)
+            used += (size_t)snprintf(buf + used, n - used, " %s: no attributes;", names[k]);
+        else
+            used += (size_t)snprintf(buf + used, n - used,
+                                     " %s: %d registers, %zu B local, blocks <= %d;", names[k],
+                                     a.numRegs, a.localSizeBytes, a.maxThreadsPerBlock);
+    }
+    if (used < n)
+        snprintf(buf + used, n - used, " stack limit %zu B per thread", stack);
+    return 0;
 }
 
 static rs_status make_streams(rs_cuda_impl *c)
@@ -343,6 +479,8 @@ extern "C" rs_status rs_gpu_device_create(int index, rs_device **out)
                             n == 0 ? why : "index out of range");
     CUDA_TRY(cudaGetDeviceProperties(&prop, index));
     CUDA_TRY(cudaSetDevice(index));
+    if ((st = size_stack(index)) != RS_OK)
+        return st;
     CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_trace_kernel, 0, 0));
     d = (rs_device *)rs_calloc(1, sizeof *d);
     c = (rs_cuda_impl *)rs_calloc(1, sizeof *c);

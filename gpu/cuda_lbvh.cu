@@ -18,8 +18,11 @@ typedef struct morton_frame {
     float lo[3], scale[3];
 } morton_frame;
 
-__global__ void rs_morton_kernel(const rs_vec3 *centroid, uint32_t n, morton_frame f,
-                                 uint32_t *codes, uint32_t *ids)
+#define RS_MORTON_BLOCK_MAX 256 /* its __launch_bounds__; the occupancy API chooses under it */
+
+__global__ void __launch_bounds__(RS_MORTON_BLOCK_MAX, 1)
+    rs_morton_kernel(const rs_vec3 *centroid, uint32_t n, morton_frame f, uint32_t *codes,
+                     uint32_t *ids)
 {
     uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i < n) {

@@ -25,8 +25,9 @@
 
 #define RS_WARP 32
 
-__global__ void rs_megakernel_kernel(rs_integrator it, rs_path_tracer tr, uint32_t sample,
-                                     rs_vec3 *radiance, rs_cuda_mk_counts *counts)
+__global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
+    rs_megakernel_kernel(rs_integrator it, rs_path_tracer tr, uint32_t sample, rs_vec3 *radiance,
+                         rs_cuda_mk_counts *counts)
 {
     uint32_t pixel = blockIdx.x * blockDim.x + threadIdx.x;
     rs_path_counts n;
@@ -52,6 +53,8 @@ __global__ void rs_megakernel_kernel(rs_integrator it, rs_path_tracer tr, uint32
         atomicMax(&counts->max_bounce, max_bounce);
     }
 }
+
+const void *rs_cuda_megakernel_entry(void) { return (const void *)rs_megakernel_kernel; }
 
 void rs_cuda_pass_release(rs_cuda_impl *c)
 {
@@ -81,6 +84,7 @@ static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_inte
     size_t image = (size_t)it->npix * sizeof(rs_vec3);
     int min_grid = 0, block = 0, k;
     rs_status st;
+    /* at most RS_CUDA_MK_BLOCK_MAX (the kernel's __launch_bounds__, which the API reads) */
     CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_megakernel_kernel, 0, 0));
     /* whole warps only: the counters' shuffles need every lane */
     block -= block % RS_WARP;

@@ -24,8 +24,15 @@ extern "C" {
 
 /* 1 if this build contains the CUDA device. */
 int rs_gpu_compiled(void);
-/* Usable CUDA devices; 0 with a reason in *why (static text) when there are none. */
+/* Usable CUDA devices; 0 with a reason in *why (text that lives as long as the process) when
+ * there are none: no driver, a driver older than this build's CUDA runtime (with both versions,
+ * cudaDriverGetVersion / cudaRuntimeGetVersion), no device, or the runtime's own error. */
 int rs_gpu_count(const char **why);
+/* One line about CUDA device `index` into buf (n bytes): its name and compute capability, the
+ * driver's and the runtime's CUDA versions, each kernel's registers, local memory per thread and
+ * largest block (cudaFuncGetAttributes) and the device's stack limit.  0, or -1 with the reason
+ * in buf (no such device, a build without CUDA). */
+int rs_gpu_describe(int index, char *buf, size_t n);
 /* Creates CUDA device `index` (0-based), named "cuda:INDEX (NAME)": flags RS_DEVICE_OWN_MEMORY,
  * threads 0, pass_samples RS_GPU_PASS_SAMPLES; host_alloc gives page-locked memory that trace
  * copies from and to by DMA.  RS_ERR_DEVICE_LOST when it cannot be used. */
@@ -33,6 +40,19 @@ rs_status rs_gpu_device_create(int index, rs_device **out);
 /* Samples per render_pass call the CUDA device asks for: few, so that cancel and progress are
  * seen often, enough that the film add of one sample overlaps the kernel of the next. */
 #define RS_GPU_PASS_SAMPLES 4u
+/* Pieces smaller than this are not worth a CUDA stream switch. */
+#define RS_GPU_MIN_PIECE 32768u
+/* The piece size the CUDA device (and its fallback) cut a trace chunk of n rays into: a quarter
+ * of it (up to four pieces, over the CUDA device's two streams), but at least RS_GPU_MIN_PIECE
+ * rays (all of a smaller chunk).  Both stage at most rs_gpu_piece_size(RS_SCHED_MAX_CHUNK) rays
+ * at a time; a larger chunk (a fixed --chunk-size) is cut into more pieces of that size. */
+static inline uint32_t rs_gpu_piece_size(uint32_t n)
+{
+    uint32_t piece = n / 4 + (n % 4 != 0);
+    if (piece < RS_GPU_MIN_PIECE)
+        piece = n < RS_GPU_MIN_PIECE ? n : RS_GPU_MIN_PIECE;
+    return piece;
+}
 /* The stand-in for CUDA device `gpu_index` where it cannot be used (gpu/gpu_fallback.c, in every
  * build): named "gpu-fallback:INDEX", flags 0 (it runs on host threads), pass_samples 1.  It
  * keeps its own copy of the geometry and BVH (made at upload as the GPU makes its own), stages

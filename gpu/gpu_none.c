@@ -2,6 +2,7 @@
 #include "gpu/gpu_device.h"
 
 #include <stddef.h>
+#include <stdio.h>
 
 int rs_gpu_compiled(void) { return 0; }
 
@@ -10,6 +11,12 @@ int rs_gpu_count(const char **why)
     if (why)
         *why = "this build has no CUDA support (configured with RS_CUDA=OFF or without nvcc)";
     return 0;
+}
+
+int rs_gpu_describe(int index, char *buf, size_t n)
+{
+    snprintf(buf, n, "gpu:%d: this build has no CUDA support", index);
+    return -1;
 }
 
 rs_status rs_gpu_device_create(int index, rs_device **out)

@@ -6,7 +6,7 @@
  *   at create      two streams (stage 0's is "the device's stream": the megakernel runs on it);
  *   at upload      the geometry + BVH copy (scheduler/device_copy.h, rs_cuda_mirror_ops) and the
  *                  staging of both stages, sized for the largest piece a chunk is cut into
- *                  (rs_cuda_piece_size(RS_SCHED_MAX_CHUNK)): one pinned and one device block
+ *                  (rs_gpu_piece_size(RS_SCHED_MAX_CHUNK)): one pinned and one device block
  *                  per stage, carved into the ray, hit and occlusion arrays;
  *   at pass_begin  the scene copy and, per slot of the megakernel's double buffer, a device and
  *                  a pinned radiance image, device and pinned ray counters and an event.
@@ -20,18 +20,17 @@
 #include "gpu/gpu_device.h"
 #include "scheduler/device_copy.h"
 
-#define RS_CUDA_STAGES    2
-#define RS_CUDA_MIN_PIECE 32768u /* pieces smaller than this are not worth a stream switch */
+#define RS_CUDA_STAGES 2
 
-/* The piece size for a chunk of n rays: a quarter of it (up to four pieces over the two
- * stages), but at least RS_CUDA_MIN_PIECE rays (all of a smaller chunk). */
-static inline uint32_t rs_cuda_piece_size(uint32_t n)
-{
-    uint32_t piece = n / 4 + (n % 4 != 0);
-    if (piece < RS_CUDA_MIN_PIECE)
-        piece = n < RS_CUDA_MIN_PIECE ? n : RS_CUDA_MIN_PIECE;
-    return piece;
-}
+/* The kernels' __launch_bounds__(MAX, 1): the most threads per block each may be launched with;
+ * the occupancy API (cudaOccupancyMaxPotentialBlockSize, which reads the kernel's
+ * maxThreadsPerBlock) picks the block size under it.  The second argument, 1 block per SM, is
+ * deliberate: with the first alone, ptxas (CUDA 13.0, sm_90) aims at a higher occupancy by itself
+ * and cut the megakernel from 160 to 128 registers with 380 bytes of spills per thread; with
+ * (256, 1) it allows 255 and keeps what it chose unbounded (-Xptxas -v: the megakernel 162
+ * registers, the trace kernel 118, no spills, stack frames of 976 and 736 bytes unchanged). */
+#define RS_CUDA_TRACE_BLOCK_MAX 256
+#define RS_CUDA_MK_BLOCK_MAX    256
 
 /* One of the two staging sets a chunk's pieces alternate between.  While one piece's rays are
  * copied in, traced and copied out on one stream, the host packs the next piece into the other
@@ -93,5 +92,8 @@ rs_status rs_cuda_pass_begin(rs_device *d, const rs_scene *scene, const rs_integ
 rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                               rs_path_counts *counts);
 void rs_cuda_pass_release(rs_cuda_impl *c);
+/* The megakernel's entry point, for cudaFuncGetAttributes (gpu/cuda_device.cu sizes the stack
+ * from it and the trace kernel). */
+const void *rs_cuda_megakernel_entry(void);
 
 #endif
