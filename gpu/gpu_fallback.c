@@ -1,23 +1,33 @@
 /* gpu/gpu_fallback.c — the stand-in for a CUDA device that is not there.
  *
- * It does what the CUDA device does, step for step, with host memory and host threads:
- *   upload       copies the geometry and BVH into memory of its own (scheduler/device_copy.h
- *                with host ops), as the GPU copies them into device memory: nothing of the
- *                caller's is borrowed;
- *   trace        copies each chunk's rays into its own staging buffers ("copy in"), runs the
- *                kernel body — rs_trace_one, the RS_HD binary BVH traversal the CUDA kernel
- *                runs — over them on host threads, and copies the answers back ("copy out");
- *                the chunk's transfer bytes are counted as the CUDA device counts them;
- *   pass_begin   copies the scene (the same device_copy call as the GPU's);
+ * It follows the CUDA device's data flow with host memory and host threads, and runs the same
+ * kernel bodies, so that its answers and images are the CUDA device's wherever the CUDA device's
+ * own are the CPU's (tests/gpu_trace_test.c says where; render_gpucheck_test checks the fallback
+ * against the CPU device bit for bit):
+ *   upload       copies the geometry and BVH into memory of its own (scheduler/device_copy.h with
+ *                host ops; the GPU: the same call with CUDA ops): nothing of the caller's is
+ *                borrowed;
+ *   trace        cuts each chunk into the CUDA device's pieces (rs_gpu_piece_size: the same
+ *                boundaries, none over the CUDA staging's size) and, piece by piece, copies the
+ *                rays into its own staging buffers ("copy in", rs_trace_stage_in), runs the
+ *                kernel body — rs_trace_one, the RS_HD binary BVH traversal the CUDA kernel runs —
+ *                over them on host threads, and copies the answers back ("copy out",
+ *                rs_trace_stage_out); the bytes are counted as the CUDA device counts a chunk's;
+ *   pass_begin   copies the scene (the same rs_device_copy_scene call as the GPU's; a pass of no
+ *                pixels is refused, as there);
  *   render_pass  the CUDA render_pass's passes: per sample, rs_path_radiance for every pixel
- *                into a radiance buffer (the pixels split among host threads by the job's
- *                strategy), then rs_film_add_image.  Its image is the CPU megakernel's, bit for
- *                bit: the same path code, the binary BVH's closest hits (the 4-wide BVH's, by
- *                rs_hit_better), each pixel's samples added in sample order.
- * So a render with --devices cpu,gpu (or the megakernel on gpu) on a machine without a GPU
- * exercises the same data flow, chunk boundaries and answers as one with a GPU.
- *
- * The copies' own upload is not counted in stats.bytes_*: those count chunk traffic only.
+ *                (path index sample * npix + pixel, as the CUDA kernel's thread computes it) into
+ *                a radiance buffer (the pixels split among host threads by the job's strategy),
+ *                then rs_film_add_image: each pixel's samples added in sample order.  Its image is
+ *                the CPU megakernel's, bit for bit.
+ * What it does not imitate: the two CUDA streams (its pieces run one after another, so nothing
+ * overlaps), the page-locked memory (it has no host_alloc, so a batch is never "pinned" and every
+ * piece goes through its staging, where the CUDA device copies a pinned batch by DMA in place),
+ * the double-buffered overlap of one sample's film add with the next sample's kernel, and the
+ * sizes: it asks the pass loop for 1 sample per render_pass call (the GPU 4) and looks at cancel
+ * between pixels as well as between samples, since a host pass is slow; its flags are 0 (no own
+ * memory), so the scheduler gives it a CPU's chunk sizes and one wave in flight.  Its stats count
+ * chunk traffic only (the GPU also counts the upload, the scene copy and each pass's image).
  * Thread safety: as scheduler/device.h; the ray counters of a pass are atomics. */
 #include "gpu/gpu_device.h"
 
@@ -29,6 +39,7 @@
 #include "core/alloc.h"
 #include "core/cores.h"
 #include "scheduler/device_copy.h"
+#include "scheduler/sched.h"
 #include "shading/path_counts.h"
 
 typedef struct fallback_impl {
@@ -55,15 +66,19 @@ static void free_staging(fallback_impl *f)
     f->cap = 0;
 }
 
-/* Room for n staged rays; grows (at least doubling) only when a chunk is larger than any
- * before, so chunks of a steady size allocate nothing. */
+/* Room for n staged rays (a piece: at most the CUDA staging's rs_gpu_piece_size(
+ * RS_SCHED_MAX_CHUNK)); grows (at least doubling, up to that size) only when a piece is larger
+ * than any before, so pieces of a steady size allocate nothing. */
 static rs_status ensure_staging(fallback_impl *f, uint32_t n)
 {
+    const uint32_t most = rs_gpu_piece_size(RS_SCHED_MAX_CHUNK);
     rs_status st;
     uint32_t cap;
     if (n <= f->cap)
         return RS_OK;
-    cap = f->cap > n / 2 ? (f->cap > UINT32_MAX / 2 ? n : 2 * f->cap) : n;
+    cap = f->cap > n / 2 ? 2 * f->cap : n; /* f->cap < n <= most: no overflow */
+    if (cap > most)
+        cap = n > most ? n : most;
     free_staging(f);
     if ((st = rs_ray_soa_init(&f->rays, cap)) != RS_OK ||
         (st = rs_hit_soa_init(&f->hits, cap)) != RS_OK) {
@@ -101,26 +116,19 @@ static rs_status fallback_upload(rs_device *d, const rs_geom *g, const rs_bvh *b
     return RS_OK;
 }
 
-static rs_status fallback_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin,
-                                uint32_t end)
+/* One piece, rays [begin, begin + n) of the batch: copy in, the kernel body on host threads,
+ * copy out. */
+static void trace_piece(rs_device *d, fallback_impl *f, const rs_trace_batch *batch, uint32_t begin,
+                        uint32_t n)
 {
-    fallback_impl *f = (fallback_impl *)d->impl;
-    uint32_t n = end - begin;
     rs_trace_batch db;
-    rs_status st;
     long i;
     int threads;
-    if (!f->uploaded)
-        return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
-    if (n == 0)
-        return RS_OK;
-    if ((st = ensure_staging(f, n)) != RS_OK)
-        return st;
     d->stats.bytes_to_device += rs_trace_stage_in(&f->rays, batch, begin, n);
-
     memset(&db, 0, sizeof db);
     db.kind = batch->kind;
     db.count = n;
+    db.wave = batch->wave;
     db.rays = f->rays;
     db.hits = f->hits;
     db.occluded = f->occluded;
@@ -130,8 +138,27 @@ static rs_status fallback_trace(rs_device *d, const rs_trace_batch *batch, uint3
     for (i = 0; i < (long)n; ++i)
         rs_trace_one(&f->geom.bvh, &f->geom.geom, &db, (uint32_t)i);
     rs_cores_release(f->cores, threads);
-
     d->stats.bytes_from_device += rs_trace_stage_out(batch, begin, n, &f->hits, f->occluded);
+}
+
+/* The chunk in the CUDA device's pieces (gpu/cuda_device.cu:cuda_trace), one after another. */
+static rs_status fallback_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin,
+                                uint32_t end)
+{
+    fallback_impl *f = (fallback_impl *)d->impl;
+    uint32_t n = end - begin, piece, off, cap = rs_gpu_piece_size(RS_SCHED_MAX_CHUNK);
+    rs_status st;
+    if (!f->uploaded)
+        return rs_error_set(RS_ERR_ARG, "device %s: trace before upload", d->name);
+    if (n == 0)
+        return RS_OK;
+    piece = rs_gpu_piece_size(n);
+    if (piece > cap)
+        piece = cap; /* a fixed chunk size above RS_SCHED_MAX_CHUNK: more pieces */
+    if ((st = ensure_staging(f, piece)) != RS_OK)
+        return st;
+    for (off = begin; off < end; off += piece)
+        trace_piece(d, f, batch, off, end - off < piece ? end - off : piece);
     return RS_OK;
 }
 
@@ -142,11 +169,13 @@ static rs_status fallback_pass_begin(rs_device *d, const rs_scene *scene, const 
     release_pass(f);
     if (!f->uploaded)
         return rs_error_set(RS_ERR_ARG, "device %s: pass_begin before upload", d->name);
+    if (it->npix == 0)
+        return rs_error_set(RS_ERR_ARG, "device %s: a pass of no pixels", d->name);
     if ((st = rs_device_copy_scene(scene, &f->geom, &rs_device_copy_host_ops, &f->scene)) != RS_OK)
         return st;
     f->it = *it;
     f->it.scene = f->scene.scene;
-    f->radiance = (rs_vec3 *)rs_alloc(it->npix ? it->npix : 1, sizeof *f->radiance);
+    f->radiance = (rs_vec3 *)rs_alloc(it->npix, sizeof *f->radiance);
     if (!f->radiance) {
         release_pass(f);
         return rs_error_set(RS_ERR_NOMEM, "device %s: out of memory for a %u-pixel pass", d->name,
