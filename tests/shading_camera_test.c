@@ -9,6 +9,10 @@
  * image-right is world -x and the top-left pixel looks toward +x, +y.
  *
  * What is checked, over the Cornell camera and random cameras (fixed seed):
+ *   - rs_camera_make's own fields: for the Cornell camera against the values this frame gives
+ *     (worked by hand), for random ones against what each field means (the viewport's size,
+ *     perpendicular axes, handedness, the image centre f ahead, the lens axes), not against a
+ *     second derivation of the frame (frame_of below only measures the rays' angles);
  *   - the image centre looks exactly at `at` (odd square images, and even / non-square ones);
  *   - the top-left corner ray makes vfov/2 with the view direction vertically and
  *     atan(aspect * tan(vfov/2)) horizontally, with or without an explicit focus distance;
@@ -79,6 +83,14 @@ static void to3(rs_vec3 a, double *out)
     out[0] = a.x;
     out[1] = a.y;
     out[2] = a.z;
+}
+
+/* a equals (x, y, z) to `rel` of the largest of |x|, |y|, |z| (exactly for rel 0). */
+static void expect_v3_near(rs_vec3 a, double x, double y, double z, double rel, const char *what)
+{
+    double tol = rel * fmax(fabs(x), fmax(fabs(y), fabs(z)));
+    if (!(fabs(a.x - x) <= tol && fabs(a.y - y) <= tol && fabs(a.z - z) <= tol))
+        fail_msg("%s: (%.9g, %.9g, %.9g), want (%.9g, %.9g, %.9g)", what, a.x, a.y, a.z, x, y, z);
 }
 
 /* A random camera: position in [-100, 100]^3, looking 1 .. 1000 units away, an up vector at
@@ -215,13 +227,26 @@ static void test_cornell_orientation(void **state)
     rs_ray tr = rs_camera_ray(&c, w - 1, 0, 0.5f, 0.5f, 0.0f, 0.0f);
     rs_ray bl = rs_camera_ray(&c, 0, h - 1, 0.5f, 0.5f, 0.0f, 0.0f);
     rs_ray br = rs_camera_ray(&c, w - 1, h - 1, 0.5f, 0.5f, 0.0f, 0.0f);
-    frame f = frame_of(cornell_from(), cornell_at(), rs_v3(0, 1, 0));
+    rs_camera lens = rs_camera_make(cornell_from(), cornell_at(), rs_v3(0, 1, 0), 40.0f, 10.0f,
+                                    0.0f, w, h);
+    /* the viewport on the focus plane, 800 ahead: 2 tan(20 deg) 800 high, 4/3 of that wide */
+    const double vh = 2.0 * tan(20.0 * PI_D / 180.0) * 800.0, vw = vh * 4.0 / 3.0;
     uint32_t x;
     (void)state;
-    /* the frame derived in the header comment: u = -x, v = +y, w = -z */
-    assert_true(f.u[0] == -1.0 && f.u[1] == 0.0 && f.u[2] == 0.0);
-    assert_true(f.v[0] == 0.0 && f.v[1] == 1.0 && f.v[2] == 0.0);
-    assert_true(f.w[0] == 0.0 && f.w[1] == 0.0 && f.w[2] == -1.0);
+    /* rs_camera_make's own output, against the frame derived in the header comment (u = -x,
+     * v = +y, w = -z): one pixel right is vw / 400 along -x, one pixel down vh / 300 along -y;
+     * the top-left corner, relative to the origin, is 800 ahead (+z), half the viewport to
+     * image-left (+x) and up (+y); the lens axes are u and v times the radius 5 */
+    expect_v3_near(c.origin, 278.0, 278.0, -800.0, 0.0, "origin");
+    expect_v3_near(c.du, -vw / w, 0.0, 0.0, 1e-6, "du");
+    expect_v3_near(c.dv, 0.0, -vh / h, 0.0, 1e-6, "dv");
+    expect_v3_near(c.corner, vw / 2.0, vh / 2.0, 800.0, 1e-6, "corner");
+    assert_true(c.lens_radius == 0.0f);
+    expect_v3_near(lens.du, -vw / w, 0.0, 0.0, 1e-6, "du (with a lens)");
+    expect_v3_near(lens.corner, vw / 2.0, vh / 2.0, 800.0, 1e-6, "corner (with a lens)");
+    assert_true(lens.lens_radius == 5.0f);
+    expect_v3_near(lens.lens_u, -5.0, 0.0, 0.0, 1e-6, "lens_u");
+    expect_v3_near(lens.lens_v, 0.0, 5.0, 0.0, 1e-6, "lens_v");
     /* all look into the box (+z) */
     assert_true(tl.d.z > 0.8f && br.d.z > 0.8f);
     /* top-left: up and to camera-left, which is world +x */
@@ -282,6 +307,69 @@ static void test_pixel_axes_random(void **state)
             rs_ray e1 = rs_camera_ray(&c, px, py, 1.0f, jy, 0.0f, 0.0f);
             rs_ray e2 = rs_camera_ray(&c, px + 1, py, 0.0f, jy, 0.0f, 0.0f);
             assert_true(rs_v3_length(rs_v3_sub(e1.d, e2.d)) <= 1e-5f);
+        }
+    }
+}
+
+/* rs_camera_make's fields for random cameras, against what they mean rather than against a
+ * second derivation of the frame: the origin is `from`; du and dv are perpendicular to each other,
+ * to the view direction and (du) to `up`; |du| width and |dv| height are the viewport,
+ * 2 tan(vfov / 2) f high and width / height of that wide, f the focus distance; du x dv points
+ * ahead, toward `at` (image-right, image-down), and dv against `up`; the image centre,
+ * corner + du width / 2 + dv height / 2, is the point f ahead; the lens axes lie along du and
+ * -dv, each as long as the lens radius. */
+static void test_make_fields(void **state)
+{
+    uint64_t s = 0xf1e1d;
+    int i;
+    (void)state;
+    for (i = 0; i < 20000; ++i) {
+        cam_case k = random_case(&s);
+        float ap = (i & 1) ? rnd_range(&s, 0.01, 4.0) : 0.0f;
+        float fd = (i & 2) ? rnd_range(&s, 0.5, 50.0) : 0.0f;
+        rs_camera c = rs_camera_make(k.from, k.at, k.up, k.vfov, ap, fd, k.w, k.h);
+        double view[3] = {(double)k.at.x - k.from.x, (double)k.at.y - k.from.y,
+                          (double)k.at.z - k.from.z};
+        double up[3], du[3], dv[3], lu[3], lv[3], n[3], corner[3], centre[3], f, vh, vw, ldu, ldv;
+        int a;
+        to3(k.up, up);
+        to3(c.du, du);
+        to3(c.dv, dv);
+        to3(c.lens_u, lu);
+        to3(c.lens_v, lv);
+        f = fd > 0.0f ? fd : sqrt(dot3(view, view));
+        normalize3(view);
+        normalize3(up);
+        vh = 2.0 * tan(0.5 * k.vfov * PI_D / 180.0) * f;
+        vw = vh * k.w / k.h;
+        ldu = sqrt(dot3(du, du));
+        ldv = sqrt(dot3(dv, dv));
+        assert_true(c.origin.x == k.from.x && c.origin.y == k.from.y && c.origin.z == k.from.z);
+        if (!(fabs(ldu * k.w - vw) <= 1e-5 * vw && fabs(ldv * k.h - vh) <= 1e-5 * vh))
+            fail_msg("camera %d: viewport %g x %g, want %g x %g", i, ldu * k.w, ldv * k.h, vw, vh);
+        assert_true(fabs(dot3(du, dv)) <= 1e-5 * ldu * ldv);
+        assert_true(fabs(dot3(du, view)) <= 1e-5 * ldu);
+        assert_true(fabs(dot3(dv, view)) <= 1e-5 * ldv);
+        assert_true(fabs(dot3(du, up)) <= 1e-5 * ldu);
+        cross3(du, dv, n);
+        assert_true(dot3(n, view) >= (1.0 - 1e-5) * ldu * ldv);
+        assert_true(dot3(dv, up) < 0.0);
+        to3(c.corner, corner);
+        for (a = 0; a < 3; ++a)
+            centre[a] = corner[a] + du[a] * (0.5 * k.w) + dv[a] * (0.5 * k.h) - view[a] * f;
+        /* float rounding: terms as large as the viewport */
+        if (!(sqrt(dot3(centre, centre)) <= 1e-5 * (f + vw + vh)))
+            fail_msg("camera %d: the image centre is %g off the point %g ahead", i,
+                     sqrt(dot3(centre, centre)), f);
+        assert_true(c.lens_radius == 0.5f * ap);
+        if (ap > 0.0f) {
+            double r = 0.5 * ap;
+            assert_true(fabs(sqrt(dot3(lu, lu)) - r) <= 1e-5 * r);
+            assert_true(fabs(sqrt(dot3(lv, lv)) - r) <= 1e-5 * r);
+            assert_true(dot3(lu, du) >= (1.0 - 1e-5) * r * ldu);
+            assert_true(-dot3(lv, dv) >= (1.0 - 1e-5) * r * ldv);
+        } else {
+            assert_true(dot3(lu, lu) == 0.0 && dot3(lv, lv) == 0.0);
         }
     }
 }
@@ -397,6 +485,7 @@ int main(void)
         cmocka_unit_test(test_centre_looks_at_target),
         cmocka_unit_test(test_corner_angles),
         cmocka_unit_test(test_cornell_orientation),
+        cmocka_unit_test(test_make_fields),
         cmocka_unit_test(test_pixel_axes_random),
         cmocka_unit_test(test_unit_directions_and_pinhole),
         cmocka_unit_test(test_lens),
