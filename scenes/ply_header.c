@@ -55,11 +55,11 @@ static rs_ply_type type_of(const words *ws, int i)
     static const struct {
         const char *name;
         rs_ply_type t;
-    } k[] = {{"char", RS_PLY_I8},     {"int8", RS_PLY_I8},     {"uchar", RS_PLY_U8},
-             {"uint8", RS_PLY_U8},    {"short", RS_PLY_I16},   {"int16", RS_PLY_I16},
-             {"ushort", RS_PLY_U16},  {"uint16", RS_PLY_U16},  {"int", RS_PLY_I32},
-             {"int32", RS_PLY_I32},   {"uint", RS_PLY_U32},    {"uint32", RS_PLY_U32},
-             {"float", RS_PLY_F32},   {"float32", RS_PLY_F32}, {"double", RS_PLY_F64},
+    } k[] = {{"char", RS_PLY_I8},    {"int8", RS_PLY_I8},     {"uchar", RS_PLY_U8},
+             {"uint8", RS_PLY_U8},   {"short", RS_PLY_I16},   {"int16", RS_PLY_I16},
+             {"ushort", RS_PLY_U16}, {"uint16", RS_PLY_U16},  {"int", RS_PLY_I32},
+             {"int32", RS_PLY_I32},  {"uint", RS_PLY_U32},    {"uint32", RS_PLY_U32},
+             {"float", RS_PLY_F32},  {"float32", RS_PLY_F32}, {"double", RS_PLY_F64},
              {"float64", RS_PLY_F64}};
     size_t j;
     for (j = 0; j < sizeof k / sizeof k[0]; ++j)
@@ -143,9 +143,8 @@ rs_status rs_ply_parse_header(const char *path, const char *text, size_t n, uint
                 count = count > UINT32_MAX ? count : 10 * count + (uint64_t)(ws.w[2][i] - '0');
             }
             if (!ok || count > UINT32_MAX)
-                return rs_error_set(RS_ERR_ARG,
-                                    "%s: PLY header line %u is not 'element NAME COUNT'", path,
-                                    line);
+                return rs_error_set(
+                    RS_ERR_ARG, "%s: PLY header line %u is not 'element NAME COUNT'", path, line);
             if (strict) {
                 rs_ply_elem *e;
                 if (h->n_elems >= h->max_elems)
@@ -179,16 +178,14 @@ rs_status rs_ply_parse_header(const char *path, const char *text, size_t n, uint
                     word(&ws, 4, pr->name);
                     if (pr->len_type == RS_PLY_NONE || pr->type == RS_PLY_NONE ||
                         pr->len_type >= RS_PLY_F32)
-                        return rs_error_set(RS_ERR_ARG,
-                                            "%s: PLY header line %u: bad list property", path,
-                                            line);
+                        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad list property",
+                                            path, line);
                 } else if (ws.count == 3) {
                     pr->type = type_of(&ws, 1);
                     word(&ws, 2, pr->name);
                     if (pr->type == RS_PLY_NONE)
-                        return rs_error_set(RS_ERR_ARG,
-                                            "%s: PLY header line %u: unknown type '%s'", path,
-                                            line, word(&ws, 1, b));
+                        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown type '%s'",
+                                            path, line, word(&ws, 1, b));
                 } else {
                     return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad property", path,
                                         line);
@@ -198,8 +195,8 @@ rs_status rs_ply_parse_header(const char *path, const char *text, size_t n, uint
             h->ascii = word_is(&ws, 1, "ascii");
             h->big = word_is(&ws, 1, "binary_big_endian");
             if (strict && !h->ascii && !h->big && !word_is(&ws, 1, "binary_little_endian"))
-                return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown format '%s'",
-                                    path, line, word(&ws, 1, b));
+                return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown format '%s'", path,
+                                    line, word(&ws, 1, b));
         } else if (is_end) {
             found = 1;
             h->data_at = (size_t)(p - text);
