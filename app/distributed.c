@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 
 /* which sanitizer this is built with (gcc's macros, clang's __has_feature) */
 #if defined(__SANITIZE_ADDRESS__)
@@ -79,13 +80,6 @@ struct rs_dist {
     int any_dead;
     char (*desc)[RS_DIST_DESC]; /* rank 0: every rank's */
 };
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static void sleep_s(double s)
 {
@@ -335,9 +329,9 @@ static void *local_main(void *arg)
 
         rs_film_clear(l->scratch);
         memset(&rs, 0, sizeof rs);
-        t0 = now_s();
+        t0 = rs_now_s();
         st = job->render(job->user, s0, n, l->scratch, &l->cancel, &rs);
-        t1 = now_s();
+        t1 = rs_now_s();
         if (st == RS_OK && job->fault.slow_factor > 1 && job->fault.slow_rank == l->rank)
             sleep_s((job->fault.slow_factor - 1) * (t1 - t0));
         /* the merge and its report under one lock: a flush sees a film and the list of the
@@ -351,7 +345,7 @@ static void *local_main(void *arg)
                 pthread_mutex_unlock(l->acc_mu);
         }
         l->busy = 0;
-        l->busy_s += now_s() - t0;
+        l->busy_s += rs_now_s() - t0;
         if (st == RS_OK) {
             l->passes++;
             l->paths += rs.paths_done;
@@ -493,14 +487,14 @@ static void idle_nap(double *nap, int active)
 /* Waits for `req` without spinning a core; gives up (cancelling it) after timeout_s. */
 static int wait_req(MPI_Request *req, double timeout_s)
 {
-    double t0 = now_s(), nap = 1e-4;
+    double t0 = rs_now_s(), nap = 1e-4;
     for (;;) {
         int flag = 0;
         if (MPI_Test(req, &flag, MPI_STATUS_IGNORE) != MPI_SUCCESS)
             return 0;
         if (flag)
             return 1;
-        if (now_s() - t0 > timeout_s) {
+        if (rs_now_s() - t0 > timeout_s) {
             MPI_Cancel(req);
             MPI_Request_free(req);
             return 0;
@@ -633,7 +627,7 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
 {
     local l;
     rs_film *spare = NULL, *acc;
-    double last_sent = now_s(), last_heard = now_s(), nap = 1e-4;
+    double last_sent = rs_now_s(), last_heard = rs_now_s(), nap = 1e-4;
     int asked = 0, stopping = 0, aborting = 0, failed = 0;
     rs_status st;
     rs_film_clear(film);
@@ -653,7 +647,7 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
         for (i = 0; i < k; ++i) {
             uint64_t v[2] = {s0[i], n[i]};
             send_small(v, 2, 0, T_DONE);
-            last_sent = now_s();
+            last_sent = rs_now_s();
             active = 1;
         }
         if (local_exited(&l)) {
@@ -668,13 +662,13 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
         if (!stopping && !aborting && !asked && local_held(&l) < QUEUE) {
             send_small(NULL, 0, 0, T_REQ);
             asked = 1;
-            last_sent = now_s();
+            last_sent = rs_now_s();
             active = 1;
         }
         if ((flag = poll_rank0(&tag, v)) < 0)
             break;
         if (flag) {
-            last_heard = now_s();
+            last_heard = rs_now_s();
             if (tag == T_PASS) {
                 local_push(&l, (uint32_t)v[0], (uint32_t)v[1]);
                 asked = 0;
@@ -689,14 +683,14 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
                 fprintf(stderr, "raystream: rank %d: could not send its film to rank 0\n",
                         d->rank);
             }
-            last_sent = now_s();
+            last_sent = rs_now_s();
             active = 1;
         }
-        if (now_s() - last_sent > 1.0) {
+        if (rs_now_s() - last_sent > 1.0) {
             send_small(NULL, 0, 0, T_HB);
-            last_sent = now_s();
+            last_sent = rs_now_s();
         }
-        if (now_s() - last_heard > timeout_s) {
+        if (rs_now_s() - last_heard > timeout_s) {
             fprintf(stderr, "raystream: rank %d: rank 0 has been silent for %.0f s; stopping\n",
                     d->rank, timeout_s);
             d->any_dead = 1;
@@ -728,9 +722,9 @@ static rs_status run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film, d
         fprintf(stderr, "raystream: rank %d: could not send its film to rank 0\n", d->rank);
     } else {
         /* rank 0's word on how to end: MPI_Finalize waits for every rank, the dead too */
-        double t_bye = now_s(), nap = 1e-4;
+        double t_bye = rs_now_s(), nap = 1e-4;
         int got = 0;
-        while (!got && now_s() - t_bye < timeout_s) {
+        while (!got && rs_now_s() - t_bye < timeout_s) {
             uint64_t v[2];
             int tag = 0, flag = poll_rank0(&tag, v);
             if (flag < 0)
@@ -983,7 +977,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
     local l;
     pthread_mutex_t film_mu = PTHREAD_MUTEX_INITIALIZER;
     rs_film *tmp = NULL;
-    double t0 = now_s(), nap = 1e-4, t_signal = 0, last_hb = t0, grace_s, next_flush;
+    double t0 = rs_now_s(), nap = 1e-4, t_signal = 0, last_hb = t0, grace_s, next_flush;
     int r, n = d->size, signalled = 0, flush_round = 0;
     const char *kill_after = getenv("OMPI_MCA_odls_base_sigkill_timeout");
     uint32_t p;
@@ -1052,7 +1046,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
         int flag = 0, active = 0, k, i, all_finished;
         uint32_t s0[DONE_MAX], nn[DONE_MAX];
         MPI_Status ms;
-        double now = now_s();
+        double now = rs_now_s();
 
         /* stop conditions */
         if (!signalled && job->cancel && atomic_load(job->cancel)) {
@@ -1138,7 +1132,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                 MPI_Recv(v, cnt > H_COUNT ? H_COUNT : cnt, MPI_UINT64_T, r, ms.MPI_TAG,
                          MPI_COMM_WORLD, MPI_STATUS_IGNORE);
             }
-            c.last_seen[r] = now_s();
+            c.last_seen[r] = rs_now_s();
             active = 1;
             if (!res->rank[r].alive) {
                 /* a rank given up on, heard from again: its passes are out already */
@@ -1151,13 +1145,13 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                     progress(&c);
                 }
             } else if (ms.MPI_TAG == T_FILM) {
-                double t_recv = now_s();
+                double t_recv = rs_now_s();
                 int got = recv_film(&c, r, v, tmp, film, &film_mu, timeout_s);
                 int q;
                 /* the others' silence while this film came does not count */
                 for (q = 1; q < n; ++q)
                     if (q != r)
-                        c.last_seen[q] += now_s() - t_recv;
+                        c.last_seen[q] += rs_now_s() - t_recv;
                 if (got) {
                     rs_dist_rank_stats *rk = &res->rank[r];
                     for (p = 0; p < c.n_passes; ++p)
@@ -1215,7 +1209,7 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
 
         /* periodic flushes: every worker sends what it finished; once all are in, the frame
          * holds every finished pass, and job->saved writes it */
-        now = now_s();
+        now = rs_now_s();
         if (next_flush > 0 && !signalled && !flush_round && now >= next_flush) {
             for (r = 1; r < n; ++r)
                 if (!c.finished[r]) {
@@ -1234,13 +1228,13 @@ static rs_status run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *fi
                     call_saved(&c, &l, film, &film_mu);
                 res->flushes++;
                 flush_round = 0;
-                next_flush = now_s() + job->flush_every_s;
+                next_flush = rs_now_s() + job->flush_every_s;
                 active = 1;
             }
         }
 
         /* a heartbeat to the workers, so that one waiting for an answer knows rank 0 lives */
-        now = now_s();
+        now = rs_now_s();
         if (now - last_hb > 1.0) {
             for (r = 1; r < n; ++r)
                 if (!c.finished[r])
@@ -1286,7 +1280,7 @@ finish:
     res->rank[0].passes = l.passes;
     res->rank[0].paths = l.paths;
     res->rank[0].busy_s = l.busy_s;
-    res->rank[0].wall_s = now_s() - t0;
+    res->rank[0].wall_s = rs_now_s() - t0;
     res->rank[0].comm_cpu_s = thread_cpu_s() - g_cpu0;
     res->local = l.sum;
     res->rays_closest += l.sum.rays_closest;
@@ -1301,7 +1295,7 @@ finish:
     res->n_done = merged_ranges(&c, &res->done, &res->samples_done);
     res->complete = count_state(&c, P_MERGED, c.n_passes) == c.n_passes;
 out:
-    res->seconds = now_s() - t0;
+    res->seconds = rs_now_s() - t0;
     res->messages = g_msgs;
     res->message_bytes = g_msg_bytes;
     rs_film_destroy(tmp);

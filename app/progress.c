@@ -5,13 +5,6 @@
 #include <time.h>
 #include <unistd.h>
 
-double rs_now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 void rs_progress_begin(rs_progress *p, int enabled)
 {
     p->enabled = enabled;

@@ -5,6 +5,8 @@
 
 #include <stdint.h>
 
+#include "core/clock.h"
+
 typedef struct rs_progress {
     int enabled;
     int tty;
@@ -17,6 +19,5 @@ void rs_progress_begin(rs_progress *p, int enabled);
 void rs_progress_update(void *progress, uint64_t done, uint64_t total);
 /* Ends the bar's line (if any). */
 void rs_progress_end(rs_progress *p);
-double rs_now_s(void);
 
 #endif

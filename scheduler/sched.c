@@ -16,9 +16,9 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 #include "scheduler/timeline.h"
 
 typedef struct chunk {
@@ -54,13 +54,6 @@ struct rs_sched {
     rs_timeline *timeline; /* chunk spans, one lane per device; NULL: none */
     char last_error[512];
 };
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static rs_sched_job *queue_at(const rs_sched *s, uint32_t k)
 {
@@ -146,18 +139,18 @@ static void *dispatch_main(void *arg)
         double t0, t1;
         rs_status st;
         if (s->q_len == 0 && s->n_retry == 0 && !s->stop) {
-            t0 = now_s();
+            t0 = rs_now_s();
             while (s->q_len == 0 && s->n_retry == 0 && !s->stop)
                 pthread_cond_wait(&s->work_cv, &s->lock);
-            w->dev->stats.idle_s += now_s() - t0;
+            w->dev->stats.idle_s += rs_now_s() - t0;
         }
         if (!take_chunk(s, w, &c))
             break; /* stop, and nothing left */
         pthread_mutex_unlock(&s->lock);
 
-        t0 = now_s();
+        t0 = rs_now_s();
         st = w->dev->ops->trace(w->dev, c.job->batch, c.begin, c.end);
-        t1 = now_s();
+        t1 = rs_now_s();
         if (s->timeline && st == RS_OK) {
             /* the timeline's clock: the span ends now and lasted t1 - t0 */
             double e = rs_timeline_now(s->timeline);

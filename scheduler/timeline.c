@@ -7,16 +7,16 @@
 #include "scheduler/timeline.h"
 
 #include <pthread.h>
-#include <time.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 
 struct rs_timeline {
     rs_span *spans;
     uint32_t capacity;
     uint32_t n;
     uint64_t dropped;
-    struct timespec start;
+    double start;         /* rs_now_s at creation */
     pthread_mutex_t lock; /* held only for the few stores of one add (never across a call out) */
 };
 
@@ -58,7 +58,7 @@ rs_status rs_timeline_create(uint32_t capacity, rs_timeline **out)
         return rs_error_set(RS_ERR_NOMEM, "cannot create the timeline's lock");
     }
     t->capacity = capacity;
-    clock_gettime(CLOCK_MONOTONIC, &t->start);
+    t->start = rs_now_s();
     *out = t;
     return RS_OK;
 }
@@ -72,14 +72,7 @@ void rs_timeline_destroy(rs_timeline *t)
     rs_free(t);
 }
 
-double rs_timeline_now(const rs_timeline *t)
-{
-    struct timespec ts;
-    if (!t)
-        return 0.0;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)(ts.tv_sec - t->start.tv_sec) + 1e-9 * (double)(ts.tv_nsec - t->start.tv_nsec);
-}
+double rs_timeline_now(const rs_timeline *t) { return t ? rs_now_s() - t->start : 0.0; }
 
 void rs_timeline_add(rs_timeline *t, uint16_t lane, rs_stage stage, uint32_t wave, double t0,
                      double t1)
