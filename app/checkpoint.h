@@ -38,27 +38,13 @@
 #include <stdint.h>
 
 #include "scenes/scene.h"
+#include "scheduler/plan.h"
 #include "shading/film.h"
 
 #define RS_CHECKPOINT_VERSION 2u
 
-/* The paths a film holds: sorted, disjoint, non-touching ranges [lo, hi) of the sample-major
- * numbering. */
-#define RS_CHECKPOINT_MAX_RANGES 65536u
-typedef struct rs_path_ranges {
-    uint64_t (*r)[2];
-    uint32_t n, cap;
-} rs_path_ranges;
-
-/* Adds [lo, hi) to the set (joined with what it overlaps or touches).  0 when out of memory or
- * past RS_CHECKPOINT_MAX_RANGES. */
-int rs_path_ranges_add(rs_path_ranges *s, uint64_t lo, uint64_t hi);
-/* Adds every range of `b` to `a`; 0 as above. */
-int rs_path_ranges_union(rs_path_ranges *a, const rs_path_ranges *b);
-uint64_t rs_path_ranges_total(const rs_path_ranges *s);
-/* Whether the set is one range from 0 (or empty): a prefix [0, total). */
-int rs_path_ranges_is_prefix(const rs_path_ranges *s);
-void rs_path_ranges_free(rs_path_ranges *s);
+/* The paths a film holds (scheduler/plan.h): at most this many ranges in a file. */
+#define RS_CHECKPOINT_MAX_RANGES RS_PATH_RANGES_MAX
 
 /* What decides the image, as the checkpoint records it. */
 typedef struct rs_checkpoint_key {

@@ -33,7 +33,6 @@
 #include "scenes/scene_export.h"
 #include "scenes/scene_json.h"
 #include "scheduler/fault.h"
-#include "scheduler/passes.h"
 #include "scheduler/render.h"
 
 #ifndef RS_VERSION
@@ -272,6 +271,7 @@ typedef struct render_run {
     int n_devs;
     rs_device *mk; /* the megakernel's one device */
     rs_sched *sched;
+    rs_engine *engine; /* set up once; every plan of the render runs on it */
     rs_film *film;
     rs_timeline *timeline;
     float *rgb;
@@ -293,9 +293,7 @@ typedef struct render_run {
     rs_checkpoint_key key;               /* what decides the image, for --checkpoint/--resume */
     uint64_t resumed;                    /* paths the --resume file held */
     rs_path_ranges held;                 /* paths the film held before the render under way */
-    uint64_t piece_lo;                   /* the render under way adds paths from here */
-    uint64_t on_film;                    /* ... and has added [piece_lo, on_film) */
-    uint64_t progress_base;              /* paths done by earlier renders of this run */
+    const rs_path_ranges *done;          /* ... and what the render has added (the engine's) */
     double last_ckpt;                    /* when the last checkpoint was written (rs_now_s) */
     double ckpt_every_s;                 /* --checkpoint-interval */
     rs_progress progress;
@@ -309,6 +307,7 @@ typedef struct render_run {
 static void run_release(render_run *r)
 {
     int i;
+    rs_engine_destroy(r->engine);
     rs_sched_destroy(r->sched);
     for (i = 0; i < r->n_devs; ++i)
         rs_device_destroy(r->devs[i]);
@@ -326,7 +325,7 @@ static void run_release(render_run *r)
 static int film_ranges(const render_run *r, rs_path_ranges *out)
 {
     memset(out, 0, sizeof *out);
-    if (rs_path_ranges_union(out, &r->held) && rs_path_ranges_add(out, r->piece_lo, r->on_film))
+    if (rs_path_ranges_union(out, &r->held) && (!r->done || rs_path_ranges_union(out, r->done)))
         return 1;
     fprintf(stderr, "raystream: out of memory for the checkpoint's list of paths\n");
     rs_path_ranges_free(out);
@@ -628,9 +627,6 @@ static int make_film(const rs_cli_options *o, render_run *r)
         return rc;
     r->st.spp = k->spp;
     r->resumed = rs_path_ranges_total(&r->held);
-    /* a prefix continues from its end; other sets fill their gaps (render_gaps) */
-    if (rs_path_ranges_is_prefix(&r->held))
-        r->st.path_begin = r->piece_lo = r->on_film = r->resumed;
     if (o->megakernel)
         return resume_whole_samples(o, r, "the megakernel continues whole passes only (use "
                                           "--integrator stream)");
@@ -723,6 +719,10 @@ static int start_devices(const rs_cli_options *o, render_run *r)
         fprintf(stderr, "raystream: out of memory for a %ux%u image\n", r->st.width, r->st.height);
         return RS_EXIT_RUNTIME;
     }
+    /* under mpirun the job's coordinator keeps the time (app/distributed.h) */
+    r->st.time_limit_s = r->dist ? 0.0 : o->time_limit_s;
+    if (rs_engine_create(r->scene, &r->st, r->sched, r->mk, &r->engine) != RS_OK)
+        return fail(RS_EXIT_RUNTIME, "starting the render");
     return RS_EXIT_OK;
 }
 
@@ -731,86 +731,25 @@ static int start_devices(const rs_cli_options *o, render_run *r)
  * Returns an exit code: 128 + the signal for an interrupted render. */
 static void on_progress(void *user, uint64_t done, uint64_t total)
 {
-    render_run *r = (render_run *)user;
-    uint64_t all = (uint64_t)r->st.width * r->st.height * r->st.spp - r->resumed;
-    if (r->progress_base || total < all) /* one of several renders (render_gaps) */
-        rs_progress_update(&r->progress, r->progress_base + done, all);
-    else
-        rs_progress_update(&r->progress, done, total);
+    rs_progress_update(&((render_run *)user)->progress, done, total);
 }
 
-/* The render thread, whenever the film holds a prefix of the paths: a periodic checkpoint.  A
- * failed one is reported and the render goes on (the last good file stays). */
-static void on_film_ready(void *user, const rs_film *film, uint64_t paths)
+/* The render thread, whenever the film holds what it held plus `done`: a periodic checkpoint.
+ * A failed one is reported and the render goes on (the last good file stays). */
+static void on_film_ready(void *user, const rs_film *film, const rs_path_ranges *done)
 {
     render_run *r = (render_run *)user;
     double now;
     (void)film;
-    r->on_film = paths;
+    r->done = done;
     if (!r->ckpt_out || (now = rs_now_s()) - r->last_ckpt < r->ckpt_every_s ||
-        (r->held.n == 0 && paths == (uint64_t)r->st.width * r->st.height * r->st.spp))
+        rs_path_ranges_total(&r->held) + rs_path_ranges_total(done) ==
+            (uint64_t)r->st.width * r->st.height * r->st.spp)
         return; /* the last is written at the end */
     r->last_ckpt = now;
     (void)write_checkpoint(r, 1);
 }
 
-
-/* A resumed film that holds several ranges of paths (an MPI job stopped with passes missing):
- * each gap between them is rendered in turn, [q0, q1) as the render of q1 / npix samples from
- * path q0 on (every range starts at a whole sample, app/checkpoint.h).  The film's sums are
- * exact, so the order does not matter: the result is the uninterrupted render's. */
-static rs_status render_gaps(const rs_cli_options *o, render_run *r, rs_render_hooks *hooks)
-{
-    uint64_t npix = (uint64_t)r->st.width * r->st.height, end = npix * r->st.spp, cur = 0;
-    rs_path_ranges gaps;
-    rs_status rst = RS_OK;
-    double t0 = rs_now_s();
-    uint32_t i;
-    memset(&gaps, 0, sizeof gaps);
-    for (i = 0; i <= r->held.n; ++i) {
-        uint64_t lo = i < r->held.n ? r->held.r[i][0] : end;
-        if (lo > cur && !rs_path_ranges_add(&gaps, cur, lo < end ? lo : end))
-            return rs_error_set(RS_ERR_NOMEM, "out of memory");
-        if (i < r->held.n)
-            cur = r->held.r[i][1];
-    }
-    memset(&r->stats, 0, sizeof r->stats);
-    for (i = 0; i < gaps.n && rst == RS_OK; ++i) {
-        rs_render_settings st = r->st;
-        rs_render_stats one;
-        st.spp = (uint32_t)(gaps.r[i][1] / npix);
-        st.spp_total = r->st.spp;
-        st.path_begin = gaps.r[i][0];
-        r->piece_lo = r->on_film = gaps.r[i][0];
-        if (o->time_limit_s > 0) {
-            double left = o->time_limit_s - (rs_now_s() - t0);
-            if (left <= 0 && i > 0) {
-                r->stats.time_limited = 1;
-                break;
-            }
-            hooks->time_limit_s = left > 1e-6 ? left : 1e-6;
-        }
-        if (o->megakernel)
-            rst = rs_render_passes(r->scene, r->mk, &st, hooks, r->film, &one);
-        else
-            rst = rs_render(r->scene, r->sched, &st, hooks, r->film, &one);
-        rs_render_stats_add(&r->stats, &one);
-        r->progress_base += one.paths_done;
-        r->on_film = r->piece_lo + one.paths_done;
-        if (i + 1 < gaps.n && !rs_path_ranges_add(&r->held, r->piece_lo, r->on_film))
-            rst = rs_error_set(RS_ERR_NOMEM, "out of memory");
-        else if (i + 1 < gaps.n)
-            r->piece_lo = r->on_film = 0; /* now in held */
-        if (one.time_limited)
-            break;
-    }
-    /* the paths_total of the gaps not begun */
-    for (; i + 1 < gaps.n; ++i)
-        r->stats.paths_total += gaps.r[i + 1][1] - gaps.r[i + 1][0];
-    rs_path_ranges_free(&gaps);
-    r->stats.seconds = rs_now_s() - t0;
-    return rst;
-}
 
 static int run_render(const rs_cli_options *o, render_run *r)
 {
@@ -822,26 +761,29 @@ static int run_render(const rs_cli_options *o, render_run *r)
     hooks.progress = on_progress;
     hooks.user = r;
     hooks.cancel = &g_cancel;
-    hooks.time_limit_s = o->time_limit_s;
     r->ckpt_every_s = o->ckpt_every_s;
     r->last_ckpt = rs_now_s();
     if (r->ckpt_out) {
         hooks.film_ready = on_film_ready;
         rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
     }
-    if (!rs_path_ranges_is_prefix(&r->held)) {
-        rst = render_gaps(o, r, &hooks);
-    } else if (o->megakernel) {
-        rst = rs_render_passes(r->scene, r->mk, &r->st, &hooks, r->film, &r->stats);
-    } else if (o->adaptive > 0) {
+    if (o->adaptive > 0) {
         rs_adaptive a;
         a.threshold = r->adaptive_t = o->adaptive;
         a.min_spp = o->adaptive_min_spp;
-        rst = rs_render_adaptive(r->scene, r->sched, &r->st, &a, &hooks, r->film, &r->stats,
-                                 &r->adaptive);
+        rst = rs_render_adaptive(r->engine, &a, &hooks, r->film, &r->stats, &r->adaptive);
     } else {
-        rst = rs_render(r->scene, r->sched, &r->st, &hooks, r->film, &r->stats);
+        /* what the film lacks: everything, or the gaps of a --resume */
+        rs_work_plan plan;
+        memset(&plan, 0, sizeof plan);
+        if (!rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,
+                                       &plan.todo))
+            rst = rs_error_set(RS_ERR_NOMEM, "out of memory");
+        else
+            rst = rs_engine_run(r->engine, &plan, &hooks, r->film, &r->stats);
+        rs_work_plan_free(&plan);
     }
+    r->done = rs_engine_done(r->engine);
     rs_progress_end(&r->progress);
     if (rst == RS_ERR_CANCELLED) {
         rs_error_clear();
@@ -1128,7 +1070,8 @@ static void print_summary(const rs_cli_options *o, const render_run *r)
                 (unsigned long long)r->resumed);
     if (r->ckpt_out)
         fprintf(stderr, "Checkpoint %s holds %llu samples. ", r->ckpt_out->path,
-                (unsigned long long)(rs_path_ranges_total(&r->held) + r->on_film - r->piece_lo));
+                (unsigned long long)(rs_path_ranges_total(&r->held) +
+                                     (r->done ? rs_path_ranges_total(r->done) : 0)));
     if (r->interrupted)
         fprintf(stderr, "Wrote %s with %llu of %llu samples (at least %u per pixel).\n", r->out,
                 (unsigned long long)(r->stats.paths_done + r->resumed),
@@ -1223,7 +1166,7 @@ static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_laye
     }
     if (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH)) {
         rs_bvh_view v = rs_bvh_view_of(r->bvh);
-        if (rs_render_constants(r->scene, &r->st, r->film, &it) != RS_OK)
+        if (rs_render_constants(r->scene, &r->st, &it) != RS_OK)
             return -1;
         rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, bufs[0], bufs[1], bufs[2]);
     }
@@ -1311,17 +1254,17 @@ static rs_status dist_render_pass(void *user, uint32_t s0, uint32_t n, rs_film *
                                   const atomic_int *cancel, rs_render_stats *stats)
 {
     render_run *r = (render_run *)user;
-    rs_render_settings st = r->st;
     rs_render_hooks h;
-    st.sample_base = s0;
-    st.spp = n;
-    st.spp_total = r->st.spp; /* the zsobol sampler's point set is the whole render's */
-    st.path_begin = 0;
+    rs_work_plan plan;
+    rs_status st;
     memset(&h, 0, sizeof h);
     h.cancel = cancel;
-    if (r->mk)
-        return rs_render_passes(r->scene, r->mk, &st, &h, film, stats);
-    return rs_render(r->scene, r->sched, &st, &h, film, stats);
+    if (!rs_work_plan_samples(&plan, (uint64_t)r->st.width * r->st.height, s0, s0 + n))
+        st = rs_error_set(RS_ERR_NOMEM, "out of memory");
+    else
+        st = rs_engine_run(r->engine, &plan, &h, film, stats);
+    rs_work_plan_free(&plan);
+    return st;
 }
 
 /* "host: cpu (2 threads), gpu0" */
@@ -1458,7 +1401,7 @@ static int dist_run(const rs_cli_options *o, render_run *r)
 {
     rs_dist_job job;
     rs_status st;
-    uint64_t npix = (uint64_t)r->st.width * r->st.height, cur = 0;
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
     uint32_t(*todo)[2] = NULL, n_todo = 0, i;
     install_stop_signals();
     memset(&job, 0, sizeof job);
@@ -1468,18 +1411,20 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     job.spp = r->st.spp;
     /* the samples the film lacks (all of them, or the gaps of a --resume) */
     if (r->rank == 0) {
+        rs_path_ranges lack;
+        memset(&lack, 0, sizeof lack);
         todo = rs_calloc((size_t)r->held.n + 1, sizeof *todo);
-        if (!todo)
+        if (!todo || !rs_path_ranges_complement(&r->held, npix * r->st.spp, &lack)) {
+            rs_free(todo);
+            rs_path_ranges_free(&lack);
             return fail(RS_EXIT_RUNTIME, "out of memory");
-        for (i = 0; i <= r->held.n; ++i) {
-            uint64_t lo = i < r->held.n ? r->held.r[i][0] / npix : r->st.spp;
-            if (lo > cur) {
-                todo[n_todo][0] = (uint32_t)cur;
-                todo[n_todo++][1] = (uint32_t)(lo - cur);
-            }
-            if (i < r->held.n)
-                cur = r->held.r[i][1] / npix;
         }
+        /* every range starts and ends on whole samples (checked at --resume) */
+        for (i = 0; i < lack.n; ++i) {
+            todo[n_todo][0] = (uint32_t)(lack.r[i][0] / npix);
+            todo[n_todo++][1] = (uint32_t)((lack.r[i][1] - lack.r[i][0]) / npix);
+        }
+        rs_path_ranges_free(&lack);
     }
     job.todo = (const uint32_t(*)[2])todo;
     job.n_todo = n_todo;
@@ -1523,7 +1468,7 @@ static int dist_run(const rs_cli_options *o, render_run *r)
         }
         rs_path_ranges_free(&r->held);
         r->held = now;
-        r->piece_lo = r->on_film = 0;
+        r->done = NULL;
     }
     if (r->dres.stopped) {
         r->interrupted = atomic_load(&g_signal) ? atomic_load(&g_signal) : SIGTERM;

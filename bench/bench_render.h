@@ -10,7 +10,6 @@
 #include "accel/bvh8.h"
 #include "core/cores.h"
 #include "cpu/cpu_device.h"
-#include "scheduler/passes.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/render.h"

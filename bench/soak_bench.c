@@ -42,7 +42,6 @@
 #include "machine.h"
 #include "scenes/scene_json.h"
 #include "scheduler/fault.h"
-#include "scheduler/passes.h"
 #include "scheduler/render.h"
 
 #define PROG     "soak_bench"

@@ -2,16 +2,9 @@
 #include "scheduler/adaptive.h"
 
 #include <string.h>
-#include <time.h>
 
 #include "core/alloc.h"
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "core/clock.h"
 
 /* A round's progress as the whole render's: the samples of earlier rounds and of stopped
  * pixels (as if they had run to spp) are done. */
@@ -27,28 +20,64 @@ static void round_progress(void *user, uint64_t done, uint64_t total)
     p->outer->progress(p->outer->user, p->done_before + done, p->total);
 }
 
-
-rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
-                             const rs_render_settings *settings, const rs_adaptive *a,
-                             const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats,
-                             rs_adaptive_stats *as)
+/* Which pixels go on after n samples: the noisy pixels still running, and their running
+ * neighbours, listed in `list` (returns how many); the other running pixels stop, each counted
+ * in *stopped and its samples up to spp in *skipped. */
+static uint32_t next_round(const rs_film *film, double threshold, uint32_t spp, uint32_t n,
+                           uint8_t *running, uint8_t *need, uint32_t *list, uint32_t *stopped,
+                           uint64_t *skipped)
 {
-    const uint32_t w = settings->width, h = settings->height, spp = settings->spp;
+    const uint32_t w = film->width, h = film->height;
     const size_t npix = (size_t)w * h;
-    rs_render_settings r = *settings;
+    uint32_t count = 0;
+    size_t p;
+    int x, y;
+    for (p = 0; p < npix; ++p)
+        need[p] = running[p] && rs_film_rel_error(film, (uint32_t)p) > threshold;
+    for (y = 0; y < (int)h; ++y)
+        for (x = 0; x < (int)w; ++x) {
+            int dx, dy, go = 0;
+            p = (size_t)y * w + (size_t)x;
+            if (!running[p])
+                continue;
+            for (dy = -1; dy <= 1 && !go; ++dy)
+                for (dx = -1; dx <= 1 && !go; ++dx) {
+                    int xx = x + dx, yy = y + dy;
+                    go = xx >= 0 && yy >= 0 && xx < (int)w && yy < (int)h &&
+                         need[(size_t)yy * w + (size_t)xx];
+                }
+            if (go) {
+                list[count++] = (uint32_t)p;
+            } else {
+                running[p] = 0;
+                (*stopped)++;
+                *skipped += spp - n;
+            }
+        }
+    return count;
+}
+
+rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,
+                             rs_film *film, rs_render_stats *stats, rs_adaptive_stats *as)
+{
+    const rs_render_settings *set = rs_engine_settings(e);
+    const uint32_t spp = set->spp;
+    const size_t npix = (size_t)set->width * set->height;
     rs_render_hooks rh;
     progress_ctx pc;
     rs_render_stats one;
+    rs_work_plan plan;
     uint8_t *running = NULL, *need = NULL;
     uint32_t *list = NULL, n;
-    double t0 = now_s();
+    double t0 = rs_now_s();
     rs_status st = RS_OK;
     memset(stats, 0, sizeof *stats);
     memset(as, 0, sizeof *as);
+    memset(&plan, 0, sizeof plan);
     if (!(a->threshold > 0) || a->min_spp < 2)
         return rs_error_set(RS_ERR_ARG, "adaptive sampling needs a threshold > 0 and at least 2 "
                                         "samples before any pixel stops");
-    if (settings->path_begin || settings->pixels || settings->sample_base)
+    if (set->path_begin)
         return rs_error_set(RS_ERR_ARG, "adaptive sampling starts from an empty film");
     if (hooks && hooks->film_ready)
         return rs_error_set(RS_ERR_ARG, "adaptive sampling cannot be checkpointed yet");
@@ -73,57 +102,29 @@ rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
         rh.progress = round_progress;
         rh.user = &pc;
     }
-    r.spp_total = spp;
     for (n = 0; n < spp;) {
-        uint32_t step, count = 0;
-        size_t p;
-        if (n == 0) {
-            step = a->min_spp < spp ? a->min_spp : spp; /* every pixel */
-            r.pixels = NULL;
-            r.n_pixels = 0;
+        uint32_t step, count;
+        if (n == 0) { /* every pixel */
+            step = a->min_spp < spp ? a->min_spp : spp;
+            plan.pixels = NULL;
+            count = (uint32_t)npix;
         } else {
-            int x, y;
-            /* who goes on: the noisy pixels still running, and their running neighbours */
-            for (p = 0; p < npix; ++p)
-                need[p] = running[p] && rs_film_rel_error(film, (uint32_t)p) > a->threshold;
-            for (y = 0; y < (int)h; ++y)
-                for (x = 0; x < (int)w; ++x) {
-                    int dx, dy, go = 0;
-                    p = (size_t)y * w + (size_t)x;
-                    if (!running[p])
-                        continue;
-                    for (dy = -1; dy <= 1 && !go; ++dy)
-                        for (dx = -1; dx <= 1 && !go; ++dx) {
-                            int xx = x + dx, yy = y + dy;
-                            go = xx >= 0 && yy >= 0 && xx < (int)w && yy < (int)h &&
-                                 need[(size_t)yy * w + (size_t)xx];
-                        }
-                    if (go)
-                        list[count++] = (uint32_t)p;
-                    else {
-                        running[p] = 0;
-                        as->stopped++;
-                        pc.done_before += spp - n; /* counted as done */
-                    }
-                }
+            count = next_round(film, a->threshold, spp, n, running, need, list, &as->stopped,
+                               &pc.done_before);
             if (count == 0)
                 break;
             step = n / 4 > 4 ? n / 4 : 4;
             step = step < spp - n ? step : spp - n;
-            r.pixels = list;
-            r.n_pixels = count;
+            plan.pixels = list;
         }
-        r.sample_base = n;
-        r.spp = step;
-        if (hooks && hooks->time_limit_s > 0) {
-            double left = hooks->time_limit_s - (now_s() - t0);
-            if (n > 0 && left <= 0) {
-                stats->time_limited = 1;
-                break;
-            }
-            rh.time_limit_s = left > 1e-6 ? left : 1e-6;
+        /* samples [n, n + step) of the round's pixels */
+        plan.n_pixels = count;
+        plan.todo.n = 0;
+        if (!rs_path_ranges_add(&plan.todo, (uint64_t)count * n, (uint64_t)count * (n + step))) {
+            st = rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
+            break;
         }
-        st = rs_render(scene, sched, &r, &rh, film, &one);
+        st = rs_engine_run(e, &plan, &rh, film, &one);
         rs_render_stats_add(stats, &one);
         as->rounds++;
         as->samples += one.paths_done;
@@ -133,9 +134,10 @@ rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
         n += step;
     }
 out:
+    rs_path_ranges_free(&plan.todo);
     rs_free(running);
     rs_free(need);
     rs_free(list);
-    stats->seconds = now_s() - t0;
+    stats->seconds = rs_now_s() - t0;
     return st;
 }

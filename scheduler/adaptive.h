@@ -6,8 +6,8 @@
  * relative error (rs_film_rel_error: the standard error of the mean luminance over the mean)
  * is above the threshold, and their eight neighbours (so that a converged patch's edge keeps up
  * with the noise beside it), get a quarter more samples each (at least 4, up to spp), by a
- * stream render over just those pixels (rs_render_settings.pixels, from the round's first
- * sample on); the others stop for good.  Which pixels go on is decided from the film alone,
+ * plan over just those pixels (scheduler/plan.h), run by the render's one engine; the others
+ * stop for good.  Which pixels go on is decided from the film alone,
  * between rounds, and each path keeps its (pixel, sample) and with them its random numbers: so
  * the image does not depend on the devices, threads, chunks or waves (the stream engine's rule),
  * a pixel that stops after n samples is exactly that pixel of an n-sample render, and one that
@@ -23,19 +23,17 @@ typedef struct rs_adaptive {
 } rs_adaptive;
 
 typedef struct rs_adaptive_stats {
-    uint32_t rounds;    /* renders, the first (every pixel) included */
-    uint64_t samples;   /* samples taken, all pixels together */
-    uint32_t stopped;   /* pixels that stopped before spp */
+    uint32_t rounds;  /* renders, the first (every pixel) included */
+    uint64_t samples; /* samples taken, all pixels together */
+    uint32_t stopped; /* pixels that stopped before spp */
 } rs_adaptive_stats;
 
-/* rs_render with adaptive sampling up to settings->spp samples a pixel (the stream integrator,
- * a fresh film: path_begin, pixels and sample_base must be 0).  hooks as rs_render's but
- * film_ready, which must be NULL; a time limit ends the rounds (the last one on a whole pass of
- * its pixels); progress counts a stopped pixel's remaining samples as done.  *stats sums the
- * rounds' (seconds: the whole). */
-rs_status rs_render_adaptive(const rs_scene *scene, rs_sched *sched,
-                             const rs_render_settings *settings, const rs_adaptive *a,
-                             const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats,
-                             rs_adaptive_stats *astats);
+/* Adaptive sampling up to the engine's spp samples a pixel (a stream engine, a fresh film), as
+ * plans on engine `e`.  hooks as rs_engine_run's but film_ready, which must be NULL; the
+ * engine's time limit ends the rounds (the last one on a whole pass of its pixels); progress
+ * counts a stopped pixel's remaining samples as done.  *stats sums the rounds' (seconds: the
+ * whole). */
+rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,
+                             rs_film *film, rs_render_stats *stats, rs_adaptive_stats *astats);
 
 #endif

@@ -1,27 +1,25 @@
-/* scheduler/passes.c — see passes.h. */
-#include "scheduler/passes.h"
-
+/* scheduler/passes.c — the megakernel's run of a plan (render.h): the plan's samples handed to
+ * one device's render_pass in calls of d->pass_samples samples (all of a range for the CPU
+ * device, whose pixel loop adds each pixel's samples one after the other; a few per call for a
+ * GPU, which runs one pass over every pixel per sample), with Ctrl-C, the time limit and
+ * progress checked between calls.  Each pixel gets its samples in sample order, so the image is
+ * the stream engine's bit for bit.
+ *
+ * With a time limit or a film_ready hook the film must end every call on whole samples: the CPU
+ * device then gets one sample per call and is not told of a cancel (it would stop within a
+ * sample), which the loop checks between calls instead. */
 #include <string.h>
-#include <time.h>
+
+#include "core/clock.h"
+#include "scheduler/engine_impl.h"
 
 typedef struct pass_ctx {
-    const rs_render_hooks *hooks;
-    rs_render_stats *stats;
-    int whole_calls; /* the device is not told of a cancel: each call ends on whole samples */
+    rs_run *c;
+    uint64_t call_paths; /* the paths the call under way has put on the film */
+    int whole_calls;     /* the device is not told of a cancel: each call ends on whole samples */
 } pass_ctx;
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int pass_cancelled(void *user)
-{
-    const pass_ctx *p = (const pass_ctx *)user;
-    return p->hooks && p->hooks->cancel && atomic_load(p->hooks->cancel);
-}
+static int pass_cancelled(void *user) { return rs_run_cancelled(((const pass_ctx *)user)->c); }
 
 static int device_cancelled(void *user)
 {
@@ -33,89 +31,80 @@ static int device_cancelled(void *user)
 static void pass_progress(void *user, uint64_t paths)
 {
     pass_ctx *p = (pass_ctx *)user;
-    p->stats->paths_done += paths;
-    if (p->hooks && p->hooks->progress)
-        p->hooks->progress(p->hooks->user, p->stats->paths_done, p->stats->paths_total);
+    rs_run *c = p->c;
+    p->call_paths += paths;
+    c->stats->paths_done += paths;
+    if (c->hooks && c->hooks->progress)
+        c->hooks->progress(c->hooks->user, c->stats->paths_done, c->stats->paths_total);
 }
 
-rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_settings *st,
-                           const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats)
+rs_status rs_passes_setup(rs_engine *e)
 {
-    rs_integrator it;
+    rs_device *d = e->mk;
+    return d->ops->pass_begin ? d->ops->pass_begin(d, e->scene, &e->it) : RS_OK;
+}
+
+rs_status rs_passes_run(rs_run *c)
+{
+    rs_engine *e = c->e;
+    rs_device *d = e->mk;
+    const rs_render_hooks *hooks = c->hooks;
+    const uint64_t npix = c->it.npix;
     rs_pass_job job;
     rs_path_counts counts = {0, 0, 0};
     pass_ctx p;
-    rs_status status;
-    double t_start = now_s();
-    uint32_t s0, s_begin, s_end, per;
+    rs_status status = RS_OK;
+    uint32_t per, calls = 0;
     /* a time limit or a reader of the film needs the film on whole samples between calls */
-    int consistent = hooks && (hooks->time_limit_s > 0 || hooks->film_ready);
+    int consistent = e->st.time_limit_s > 0 || (hooks && hooks->film_ready);
 
-    memset(stats, 0, sizeof *stats);
-    if ((status = rs_render_constants(scene, st, film, &it)) != RS_OK)
-        return status;
-    if (!d->ops->render_pass)
-        return rs_error_set(RS_ERR_ARG, "device %s cannot run the megakernel", d->name);
-    if (st->pixels)
-        return rs_error_set(RS_ERR_ARG, "the megakernel renders whole images only: adaptive "
-                                        "sampling needs --integrator stream");
-    if (st->path_begin % it.npix != 0)
-        return rs_error_set(RS_ERR_ARG,
-                            "the megakernel continues from whole passes only, and the film holds "
-                            "%llu samples of %u pixels (use --integrator stream)",
-                            (unsigned long long)st->path_begin, it.npix);
-    /* samples [sample_base + path_begin / npix, sample_base + spp) (a pass of an MPI job starts
-     * at a later sample) */
-    s_begin = st->sample_base + (uint32_t)(st->path_begin / it.npix);
-    s_end = st->sample_base + st->spp;
-    it.sample_base = 0; /* the devices number paths by their absolute sample, s * npix + pixel */
-    stats->paths_total = (uint64_t)it.npix * st->spp - st->path_begin;
-    if (d->ops->pass_begin && (status = d->ops->pass_begin(d, scene, &it)) != RS_OK)
-        return status;
-    p.hooks = hooks;
-    p.stats = stats;
+    p.c = c;
     /* the CPU's per-pixel loop (pass_samples 0) stops within a sample on a cancel: with
      * `consistent` it gets one sample per call and runs each call to its end instead (the same
      * image: each pixel still sums its samples in sample order); the GPU devices stop between
      * samples anyway */
     p.whole_calls = consistent && d->pass_samples == 0;
     memset(&job, 0, sizeof job);
-    job.it = &it;
-    job.film = film;
-    job.strategy = st->strategy;
+    job.it = &e->it;
+    job.film = c->film;
+    job.strategy = e->st.strategy;
     job.cancelled = device_cancelled;
     job.progress = pass_progress;
     job.user = &p;
-    per = d->pass_samples ? d->pass_samples : (consistent ? 1 : st->spp);
-    for (s0 = s_begin; s0 < s_end && status == RS_OK; s0 += per) {
-        uint32_t n = s_end - s0 < per ? s_end - s0 : per;
+    per = d->pass_samples ? d->pass_samples : (consistent ? 1 : e->st.spp);
+    while (status == RS_OK && rs_run_more(c)) {
+        /* samples [s0, s0 + n) of every pixel: paths s0 * npix + pixel */
+        uint32_t s0 = (uint32_t)(c->next_path / npix), left;
+        uint32_t n;
         double t0, t1;
         if (pass_cancelled(&p))
             break;
-        if (hooks && hooks->time_limit_s > 0 && s0 > s_begin &&
-            now_s() - t_start >= hooks->time_limit_s) {
-            stats->time_limited = 1;
+        (void)rs_run_time_cut(c, c->next_path);
+        if (!rs_run_more(c))
             break;
-        }
-        t0 = now_s();
+        left = (uint32_t)((c->end_path - c->next_path) / npix);
+        n = left < per ? left : per;
+        p.call_paths = 0;
+        t0 = rs_now_s();
         status = d->ops->render_pass(d, &job, s0, n, &counts);
-        t1 = now_s();
-        stats->stage_s[RS_STAGE_PASS] += t1 - t0;
-        if (st->timeline) {
+        t1 = rs_now_s();
+        c->stats->stage_s[RS_STAGE_PASS] += t1 - t0;
+        if (e->st.timeline) {
             /* the device's lane: one span per call, labelled with its first sample */
-            double e = rs_timeline_now(st->timeline);
-            rs_timeline_add(st->timeline, 0, RS_STAGE_PASS, s0, e - (t1 - t0), e);
+            double end = rs_timeline_now(e->st.timeline);
+            rs_timeline_add(e->st.timeline, 0, RS_STAGE_PASS, s0, end - (t1 - t0), end);
         }
+        calls++;
+        c->next_path += (uint64_t)n * npix;
         /* the devices count whole samples only (a cancelled pass is left out of the film) */
-        if (status == RS_OK && hooks && hooks->film_ready)
-            hooks->film_ready(hooks->user, film, st->path_begin + stats->paths_done);
+        if (status == RS_OK && p.call_paths)
+            status = rs_run_on_film(c, (uint64_t)s0 * npix, (uint64_t)s0 * npix + p.call_paths);
     }
-    stats->rays_closest = counts.closest;
-    stats->rays_shadow = counts.shadow;
-    stats->max_bounce = counts.max_bounce;
-    stats->waves = (s0 - s_begin) / (per ? per : 1);
+    c->stats->rays_closest = counts.closest;
+    c->stats->rays_shadow = counts.shadow;
+    c->stats->max_bounce = counts.max_bounce;
+    c->stats->waves = calls;
     if (status == RS_OK && pass_cancelled(&p))
         status = rs_error_set(RS_ERR_CANCELLED, "render interrupted");
-    stats->seconds = now_s() - t_start;
     return status;
 }

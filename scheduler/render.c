@@ -1,59 +1,14 @@
-/* scheduler/render.c — see render.h.  The loop is a table of named stages; each slot (a wave in
- * flight) holds the index of the stage it runs next. */
-#include "scheduler/render.h"
-
+/* scheduler/render.c — the stream engine's run of a plan (render.h): waves of paths through a
+ * table of named stages; each slot (a wave in flight) holds the index of the stage it runs
+ * next. */
 #include <string.h>
-#include <time.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 #include "core/cores.h"
-#include "streams/wave.h"
+#include "scheduler/engine_impl.h"
 
-/* SLOT_IDLE: the slot holds no wave.  Otherwise its `stage` is an rs_stage. */
-#define SLOT_IDLE 0xffu
-
-/* One wave in flight and its buffers. */
-typedef struct slot {
-    rs_wave_buffers b;
-    uint8_t stage;  /* next stage to run, or SLOT_IDLE */
-    uint64_t wave;  /* index of the wave it holds */
-    uint64_t start; /* its first path */
-    uint32_t count, alive, bounce, cur;
-    uint32_t n_shadow;
-    rs_trace_batch batch; /* what `job` traces: must live as long as the job */
-    rs_sched_job job;
-} slot;
-
-typedef struct render_ctx {
-    rs_integrator it;
-    rs_stage_exec ex; /* threads granted to the stage running now */
-    rs_render_settings st;
-    rs_sched *sched;
-    const rs_render_hooks *hooks;
-    rs_render_stats *stats;
-    rs_film *film;
-    slot slots[RS_RENDER_MAX_WAVES];
-    uint32_t n_slots;
-    uint64_t next_path;       /* the first path no wave has started yet */
-    uint64_t end_path;        /* paths [next_path, end_path) are still to start: the render's
-                                 end, or the end of the pass under way once the time is up */
-    uint64_t on_film;         /* the film holds paths [0, on_film) */
-    double t_start;           /* when rs_render began (now_s) */
-    uint64_t ended;           /* paths ended in waves not yet on the film */
-    rs_host_allocator pinned; /* a device's host_alloc for the wave buffers, if one has it */
-    int have_pinned;
-} render_ctx;
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cancelled(const rs_render_hooks *h) { return h && h->cancel && atomic_load(h->cancel); }
-
-static void report(const render_ctx *c)
+static void report(const rs_run *c)
 {
     const rs_render_hooks *h = c->hooks;
     if (h && h->progress)
@@ -61,7 +16,7 @@ static void report(const render_ctx *c)
 }
 
 /* Hands the slot's rays to the scheduler: extension rays (closest hit) or shadow rays. */
-static void submit(render_ctx *c, slot *sl, rs_trace_kind kind)
+static void submit(rs_run *c, rs_slot *sl, rs_trace_kind kind)
 {
     rs_wave_buffers *b = &sl->b;
     memset(&sl->batch, 0, sizeof sl->batch);
@@ -81,32 +36,30 @@ static void submit(render_ctx *c, slot *sl, rs_trace_kind kind)
         sl->batch.occluded = b->occluded;
         c->stats->rays_shadow += sl->n_shadow;
     }
-    rs_sched_submit(c->sched, &sl->batch, &sl->job);
+    rs_sched_submit(c->e->sched, &sl->batch, &sl->job);
 }
 
-/* ---- the stages: each runs one step of a slot's wave and returns the slot's next stage ---- */
+/* ---- the stages: each runs one step of a slot's wave and says whether what it made is empty
+ * (the table below then picks the stage's `next_if_empty`) ---------------------------------- */
 
-static uint8_t stage_raygen(render_ctx *c, slot *sl, rs_status *status)
+static int stage_raygen(rs_run *c, rs_slot *sl, rs_status *status)
 {
     (void)status;
     rs_integrator_raygen(&c->it, &c->ex, sl->start, sl->count, &sl->b.paths, &sl->b.ext[0]);
     submit(c, sl, RS_TRACE_CLOSEST);
-    return RS_STAGE_TRACE_CLOSEST;
+    return 0;
 }
 
 /* Both trace stages wait for the slot's submission; the devices did the work meanwhile. */
-static uint8_t stage_trace(render_ctx *c, slot *sl, rs_status *status)
+static int stage_wait(rs_run *c, rs_slot *sl, rs_status *status)
 {
-    int closest = sl->stage == RS_STAGE_TRACE_CLOSEST;
-    *status = rs_sched_wait(c->sched, &sl->job);
-    if (*status != RS_OK)
-        return SLOT_IDLE;
-    return closest ? RS_STAGE_SHADE : RS_STAGE_RESOLVE_SHADOWS;
+    *status = rs_sched_wait(c->e->sched, &sl->job);
+    return 0;
 }
 
 /* Emission, next-event shadow rays and the next extension rays; the shadow rays are packed for
- * the devices here. */
-static uint8_t stage_shade(render_ctx *c, slot *sl, rs_status *status)
+ * the devices here.  Empty: no shadow ray. */
+static int stage_shade(rs_run *c, rs_slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;
     (void)status;
@@ -114,22 +67,22 @@ static uint8_t stage_shade(render_ctx *c, slot *sl, rs_status *status)
                         sl->alive, &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
     sl->n_shadow = rs_stream_pack_runs(&b->shadow, &b->runs, 1, sl->alive);
     if (sl->n_shadow == 0)
-        return RS_STAGE_COMPACT;
+        return 1;
     submit(c, sl, RS_TRACE_OCCLUDED);
-    return RS_STAGE_TRACE_SHADOW;
+    return 0;
 }
 
-static uint8_t stage_resolve_shadows(render_ctx *c, slot *sl, rs_status *status)
+static int stage_resolve_shadows(rs_run *c, rs_slot *sl, rs_status *status)
 {
     (void)status;
     rs_integrator_resolve_shadows(&c->ex, &sl->b.shadow, sl->b.occluded, sl->n_shadow,
                                   &sl->b.paths);
-    return RS_STAGE_COMPACT;
+    return 0;
 }
 
 /* The surviving paths' next rays, in slot order, become the current stream: the shade stage
- * wrote them in runs into the other buffer, packed here in place. */
-static uint8_t stage_compact(render_ctx *c, slot *sl, rs_status *status)
+ * wrote them in runs into the other buffer, packed here in place.  Empty: no path alive. */
+static int stage_compact(rs_run *c, rs_slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;
     uint32_t before = sl->alive;
@@ -140,13 +93,13 @@ static uint8_t stage_compact(render_ctx *c, slot *sl, rs_status *status)
     sl->bounce++;
     report(c);
     if (sl->alive == 0)
-        return RS_STAGE_FILM;
+        return 1;
     submit(c, sl, RS_TRACE_CLOSEST);
-    return RS_STAGE_TRACE_CLOSEST;
+    return 0;
 }
 
 typedef struct flush_ctx {
-    const slot *sl;
+    const rs_slot *sl;
     rs_film *film;
     const rs_integrator *it;
     uint32_t npix; /* paths per pass */
@@ -166,10 +119,9 @@ static void flush_range(void *ctx, uint32_t begin, uint32_t end)
 }
 
 /* The wave onto the film in path order (run only for the next wave in wave order). */
-static uint8_t stage_film(render_ctx *c, slot *sl, rs_status *status)
+static int stage_film(rs_run *c, rs_slot *sl, rs_status *status)
 {
     flush_ctx f;
-    (void)status;
     f.sl = sl;
     f.film = c->film;
     f.it = &c->it;
@@ -179,55 +131,63 @@ static uint8_t stage_film(render_ctx *c, slot *sl, rs_status *status)
     c->stats->paths_done += sl->count;
     c->ended -= sl->count;
     c->stats->waves++;
-    c->on_film = sl->start + sl->count;
     report(c);
-    if (c->hooks && c->hooks->film_ready)
-        c->hooks->film_ready(c->hooks->user, c->film, c->on_film);
-    return SLOT_IDLE;
+    *status = rs_run_on_film(c, sl->start, sl->start + sl->count);
+    return 0;
 }
 
-typedef uint8_t (*stage_fn)(render_ctx *c, slot *sl, rs_status *status);
-
-/* The stage table, in rs_stage order; `host` stages take threads from the core budget. */
-static const struct {
-    stage_fn run;
-    int host;
+/* The stage table, in rs_stage order: what runs, whether it takes threads from the core budget
+ * (`host`; the others wait for the devices), whether the slot yields to the round robin before
+ * it (a wait, or the film, which takes the waves in wave order), and the stage after it. */
+static const struct stage_def {
+    int (*run)(rs_run *c, rs_slot *sl, rs_status *status);
+    uint8_t host, yields, next, next_if_empty;
 } stages[RS_STAGE_PASS] = {
-    {stage_raygen, 1},          {stage_trace, 0},   {stage_shade, 1}, {stage_trace, 0},
-    {stage_resolve_shadows, 1}, {stage_compact, 1}, {stage_film, 1},
+    /* RS_STAGE_RAYGEN */ {stage_raygen, 1, 0, RS_STAGE_TRACE_CLOSEST, RS_STAGE_TRACE_CLOSEST},
+    /* RS_STAGE_TRACE_CLOSEST */ {stage_wait, 0, 1, RS_STAGE_SHADE, RS_STAGE_SHADE},
+    /* RS_STAGE_SHADE */ {stage_shade, 1, 0, RS_STAGE_TRACE_SHADOW, RS_STAGE_COMPACT},
+    /* RS_STAGE_TRACE_SHADOW */
+    {stage_wait, 0, 1, RS_STAGE_RESOLVE_SHADOWS, RS_STAGE_RESOLVE_SHADOWS},
+    /* RS_STAGE_RESOLVE_SHADOWS */
+    {stage_resolve_shadows, 1, 0, RS_STAGE_COMPACT, RS_STAGE_COMPACT},
+    /* RS_STAGE_COMPACT */ {stage_compact, 1, 0, RS_STAGE_TRACE_CLOSEST, RS_STAGE_FILM},
+    /* RS_STAGE_FILM */ {stage_film, 1, 1, SLOT_IDLE, SLOT_IDLE},
 };
 
-/* Runs the slot's current stage, timed under its name. */
-static rs_status run_stage(render_ctx *c, slot *sl)
+/* Runs the slot's current stage, timed under its name; a failed stage leaves the slot idle. */
+static rs_status run_stage(rs_run *c, rs_slot *sl)
 {
-    uint8_t s = sl->stage;
+    const struct stage_def *d = &stages[sl->stage];
+    const rs_render_settings *st = &c->e->st;
     rs_status status = RS_OK;
     double t0, t1;
-    if (stages[s].host)
-        c->ex.threads = rs_cores_acquire(c->st.cores, c->st.threads);
-    t0 = now_s();
-    sl->stage = stages[s].run(c, sl, &status);
-    t1 = now_s();
-    if (stages[s].host) {
-        rs_cores_release(c->st.cores, c->ex.threads);
+    int empty;
+    if (d->host)
+        c->ex.threads = rs_cores_acquire(st->cores, st->threads);
+    t0 = rs_now_s();
+    empty = d->run(c, sl, &status);
+    t1 = rs_now_s();
+    if (d->host) {
+        rs_cores_release(st->cores, c->ex.threads);
         c->stats->shade_s += t1 - t0;
         /* waits are gaps on the render thread's lane: the devices' lanes show the work */
-        if (c->st.timeline) {
-            double e = rs_timeline_now(c->st.timeline);
-            rs_timeline_add(c->st.timeline, c->st.timeline_lane, (rs_stage)s, (uint32_t)sl->wave,
-                            e - (t1 - t0), e);
+        if (st->timeline) {
+            double e = rs_timeline_now(st->timeline);
+            rs_timeline_add(st->timeline, st->timeline_lane, (rs_stage)sl->stage,
+                            (uint32_t)sl->wave, e - (t1 - t0), e);
         }
     } else {
         c->stats->trace_s += t1 - t0;
     }
-    c->stats->stage_s[s] += t1 - t0;
+    c->stats->stage_s[sl->stage] += t1 - t0;
+    sl->stage = status != RS_OK ? SLOT_IDLE : empty ? d->next_if_empty : d->next;
     return status;
 }
 
 /* Starts the next wave: paths [next_path, next_path + wave_paths), cut at end_path. */
-static rs_status slot_start(render_ctx *c, slot *sl, uint64_t wave)
+static rs_status slot_start(rs_run *c, rs_slot *sl, uint64_t wave)
 {
-    uint64_t left = c->end_path - c->next_path, per = c->st.wave_paths;
+    uint64_t left = c->end_path - c->next_path, per = c->e->st.wave_paths;
     sl->wave = wave;
     sl->start = c->next_path;
     sl->count = (uint32_t)(left < per ? left : per);
@@ -239,96 +199,77 @@ static rs_status slot_start(render_ctx *c, slot *sl, uint64_t wave)
     return run_stage(c, sl);
 }
 
-/* Runs the slot's stages up to its next submission (a trace stage, waited for on its next
- * visit) or the end of its paths. */
-static rs_status slot_step(render_ctx *c, slot *sl)
+/* Runs the slot's stages up to the next one it yields before, or its end. */
+static rs_status slot_step(rs_run *c, rs_slot *sl)
 {
     rs_status status;
     do {
         status = run_stage(c, sl);
-    } while (status == RS_OK && sl->stage != RS_STAGE_TRACE_CLOSEST &&
-             sl->stage != RS_STAGE_TRACE_SHADOW && sl->stage != RS_STAGE_FILM &&
-             sl->stage != SLOT_IDLE);
+    } while (status == RS_OK && sl->stage != SLOT_IDLE && !stages[sl->stage].yields);
     return status;
 }
 
 /* Runs the film stage of every finished wave that is next in wave order. */
-static rs_status flush_in_order(render_ctx *c, uint64_t *next_flush)
+static rs_status flush_in_order(rs_run *c, uint64_t *next_flush)
 {
+    rs_engine *e = c->e;
     rs_status status = RS_OK;
     for (;;) {
         uint32_t j;
-        for (j = 0; j < c->n_slots; ++j)
-            if (c->slots[j].stage == RS_STAGE_FILM && c->slots[j].wave == *next_flush)
+        for (j = 0; j < e->n_slots; ++j)
+            if (e->slots[j].stage == RS_STAGE_FILM && e->slots[j].wave == *next_flush)
                 break;
-        if (j == c->n_slots)
+        if (j == e->n_slots)
             return status;
-        if ((status = run_stage(c, &c->slots[j])) != RS_OK)
+        if ((status = run_stage(c, &e->slots[j])) != RS_OK)
             return status;
         (*next_flush)++;
     }
 }
 
-void rs_render_stats_add(rs_render_stats *sum, const rs_render_stats *r)
+/* Round robin over the slots: each visit runs a slot up to its next wait, so the devices trace
+ * the other slots' rays meanwhile; finished waves go to the film in wave order. */
+rs_status rs_stream_run(rs_run *c)
 {
-    int k;
-    for (k = 0; k < RS_STAGE_COUNT; ++k)
-        sum->stage_s[k] += r->stage_s[k];
-    sum->trace_s += r->trace_s;
-    sum->shade_s += r->shade_s;
-    sum->paths_total += r->paths_total;
-    sum->paths_done += r->paths_done;
-    sum->rays_closest += r->rays_closest;
-    sum->rays_shadow += r->rays_shadow;
-    sum->waves += r->waves;
-    if (r->max_bounce > sum->max_bounce)
-        sum->max_bounce = r->max_bounce;
-    sum->time_limited |= r->time_limited;
-}
-
-rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *st,
-                              const rs_film *film, rs_integrator *it)
-{
-    uint64_t npix;
-    if (st->width == 0 || st->height == 0 || st->spp == 0 || st->max_depth == 0)
-        return rs_error_set(RS_ERR_ARG, "width, height, spp and max depth must be >= 1");
-    if (film->width != st->width || film->height != st->height)
-        return rs_error_set(RS_ERR_ARG, "film is %ux%u but the render is %ux%u", film->width,
-                            film->height, st->width, st->height);
-    npix = (uint64_t)st->width * st->height;
-    /* npix and spp are both < 2^32, so npix * spp cannot overflow 64 bits */
-    if (npix > UINT32_MAX)
-        return rs_error_set(RS_ERR_ARG, "image too large: %ux%u at %u spp", st->width, st->height,
-                            st->spp);
-    if (st->path_begin > npix * st->spp)
-        return rs_error_set(RS_ERR_ARG,
-                            "the film already holds %llu samples, more than %ux%u at %u spp",
-                            (unsigned long long)st->path_begin, st->width, st->height, st->spp);
-    if (st->pixels && (st->n_pixels == 0 || st->n_pixels > npix))
-        return rs_error_set(RS_ERR_ARG, "a pass over %u of %llu pixels", st->n_pixels,
-                            (unsigned long long)npix);
-    if ((uint64_t)st->sample_base + st->spp > (st->spp_total ? st->spp_total : st->spp) ||
-        (st->spp_total && st->spp_total < st->spp))
-        return rs_error_set(RS_ERR_ARG, "samples %u..%u of a %u spp render", st->sample_base,
-                            st->sample_base + st->spp, st->spp_total);
-    memset(it, 0, sizeof *it);
-    it->scene = scene;
-    it->camera = rs_camera_make(scene->camera.from, scene->camera.at, scene->camera.up,
-                                scene->camera.vfov_deg, scene->camera.aperture,
-                                scene->camera.focus_dist, st->width, st->height);
-    it->seed = st->seed;
-    it->width = st->width;
-    it->height = st->height;
-    it->npix = (uint32_t)npix;
-    it->spp = st->spp_total ? st->spp_total : st->spp;
-    it->pixel_of = st->pixels;
-    it->n_active = st->pixels ? st->n_pixels : (uint32_t)npix;
-    it->sample_base = st->sample_base;
-    it->max_depth = st->max_depth;
-    it->rr_depth = st->rr_depth ? st->rr_depth : 3;
-    it->sampling = (uint32_t)st->sampling;
-    it->sampler = (uint32_t)st->sampler;
-    return RS_OK;
+    rs_engine *e = c->e;
+    uint64_t next_wave = 0, next_flush = 0;
+    rs_status status = RS_OK;
+    uint32_t k, busy;
+    c->ex.threads = e->st.threads;
+    c->ex.strategy = e->st.strategy;
+    c->stats->wave_paths = e->st.wave_paths;
+    for (busy = 1; status == RS_OK && busy;) {
+        busy = 0;
+        for (k = 0; k < e->n_slots && status == RS_OK; ++k) {
+            rs_slot *sl = &e->slots[k];
+            if (sl->stage == SLOT_IDLE && rs_run_more(c)) {
+                if (rs_run_cancelled(c))
+                    break;
+                (void)rs_run_time_cut(c, c->next_path);
+                if (rs_run_more(c))
+                    status = slot_start(c, sl, next_wave++);
+            } else if (sl->stage != SLOT_IDLE && stages[sl->stage].yields &&
+                       sl->stage != RS_STAGE_FILM) {
+                if (rs_run_cancelled(c))
+                    break;
+                status = slot_step(c, sl);
+            }
+            if (status == RS_OK)
+                status = flush_in_order(c, &next_flush);
+            busy |= sl->stage != SLOT_IDLE || rs_run_more(c);
+        }
+        if (status == RS_OK && rs_run_cancelled(c))
+            status = rs_error_set(RS_ERR_CANCELLED, "render interrupted");
+    }
+    /* on a failure or an interruption, take back what is still with the scheduler: the engine
+     * keeps the buffers for its next run */
+    for (k = 0; k < e->n_slots; ++k) {
+        rs_slot *sl = &e->slots[k];
+        if (sl->stage == RS_STAGE_TRACE_CLOSEST || sl->stage == RS_STAGE_TRACE_SHADOW)
+            (void)rs_sched_wait(e->sched, &sl->job);
+        sl->stage = SLOT_IDLE;
+    }
+    return status;
 }
 
 /* Host memory for the wave buffers from a device's host_alloc (the first device that has one:
@@ -345,23 +286,24 @@ static void pinned_release(void *user, void *p)
     d->ops->host_free(d, p);
 }
 
-static void choose_host_memory(render_ctx *c)
+/* The allocator of the first device with host_alloc; 0 when none has one. */
+static int device_host_memory(rs_sched *sched, rs_host_allocator *a)
 {
     int i;
-    for (i = 0; i < rs_sched_device_count(c->sched); ++i) {
-        rs_device *d = rs_sched_device(c->sched, i);
+    for (i = 0; i < rs_sched_device_count(sched); ++i) {
+        rs_device *d = rs_sched_device(sched, i);
         if (d->ops->host_alloc && d->ops->host_free) {
-            c->pinned.alloc = pinned_alloc;
-            c->pinned.release = pinned_release;
-            c->pinned.user = d;
-            c->have_pinned = 1;
-            return;
+            a->alloc = pinned_alloc;
+            a->release = pinned_release;
+            a->user = d;
+            return 1;
         }
     }
+    return 0;
 }
 
 /* The settings with the automatic choices made: the wave size, waves in flight, the wave size
- * per slot. */
+ * per slot, for a render of `total` paths. */
 static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint64_t total)
 {
     int i, gpu = 0, n_dev = rs_sched_device_count(sched);
@@ -373,15 +315,12 @@ static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint
         /* One CPU device: waves the caches hold when the render thread and the device's
          * dispatch thread share one core (RS_RENDER_HOST_WAVE per thread), bigger ones when the
          * dispatch thread has a core of its own to trace on while the stages run
-         * (RS_RENDER_HOST_WAVE_FREE: 16384 was 16-27% slower there, docs/performance.md).
-         * Several devices need the big wave to share out (with 16384-path waves cpu:1 + the
-         * fallback lost 10-30% of its load balance). */
-        uint64_t host = (uint64_t)(rs_cores_allowed() > 1 ? RS_RENDER_HOST_WAVE_FREE
-                                                          : RS_RENDER_HOST_WAVE) *
-                        (uint32_t)st->threads;
-        st->wave_paths = gpu || n_dev > 1 || host > RS_RENDER_DEFAULT_WAVE
-                             ? RS_RENDER_DEFAULT_WAVE
-                             : (uint32_t)host;
+         * (RS_RENDER_HOST_WAVE_FREE).  Several devices need the big wave to share out. */
+        uint64_t host =
+            (uint64_t)(rs_cores_allowed() > 1 ? RS_RENDER_HOST_WAVE_FREE : RS_RENDER_HOST_WAVE) *
+            (uint32_t)st->threads;
+        st->wave_paths = gpu || n_dev > 1 || host > RS_RENDER_DEFAULT_WAVE ? RS_RENDER_DEFAULT_WAVE
+                                                                           : (uint32_t)host;
     }
     if (st->waves_in_flight == 0)
         st->waves_in_flight = gpu ? 2 : 1;
@@ -391,115 +330,33 @@ static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint
         st->wave_paths = (uint32_t)total;
 }
 
-/* Once the time limit is reached: no path past the end of the pass that holds the last path
- * started (at least the first pass this call adds to), so the film ends on a whole pass. */
-static void apply_time_limit(render_ctx *c)
+rs_status rs_stream_setup(rs_engine *e)
 {
-    uint64_t npix = c->it.n_active, end, first_pass_end; /* paths per pass */
-    const rs_render_hooks *h = c->hooks;
-    if (!h || h->time_limit_s <= 0 || c->stats->time_limited ||
-        now_s() - c->t_start < h->time_limit_s)
-        return;
-    end = (c->next_path + npix - 1) / npix * npix;
-    first_pass_end = (c->st.path_begin / npix + 1) * npix;
-    if (end < first_pass_end)
-        end = first_pass_end;
-    if (end < c->end_path) {
-        c->end_path = end;
-        c->stats->time_limited = 1;
-    }
-}
-
-/* Round robin over the slots: each visit runs a slot up to its next submission, so the devices
- * trace the other slots' rays meanwhile; finished waves go to the film in wave order. */
-static rs_status run_waves(render_ctx *c)
-{
-    uint64_t next_wave = 0, next_flush = 0;
+    uint64_t total = (uint64_t)e->it.npix * e->st.spp, n_waves;
+    rs_host_allocator pinned;
+    int have_pinned = device_host_memory(e->sched, &pinned);
     rs_status status = RS_OK;
-    uint32_t k, busy;
-    for (busy = 1; status == RS_OK && busy;) {
-        busy = 0;
-        for (k = 0; k < c->n_slots && status == RS_OK; ++k) {
-            slot *sl = &c->slots[k];
-            if (sl->stage == SLOT_IDLE && c->next_path < c->end_path) {
-                if (cancelled(c->hooks))
-                    break;
-                apply_time_limit(c);
-                if (c->next_path < c->end_path)
-                    status = slot_start(c, sl, next_wave++);
-            } else if (sl->stage == RS_STAGE_TRACE_CLOSEST || sl->stage == RS_STAGE_TRACE_SHADOW) {
-                if (cancelled(c->hooks))
-                    break;
-                status = slot_step(c, sl);
-            }
-            if (status == RS_OK)
-                status = flush_in_order(c, &next_flush);
-            busy |= sl->stage != SLOT_IDLE || c->next_path < c->end_path;
-        }
-        if (status == RS_OK && cancelled(c->hooks))
-            status = rs_error_set(RS_ERR_CANCELLED, "render interrupted");
-    }
-    return status;
-}
-
-rs_status rs_render(const rs_scene *scene, rs_sched *sched, const rs_render_settings *st_in,
-                    const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats)
-{
-    render_ctx *c;
-    rs_integrator it;
-    uint64_t total, n_waves;
     uint32_t k;
-    double t_start = now_s();
-    rs_status status;
-
-    memset(stats, 0, sizeof *stats);
-    if ((status = rs_render_constants(scene, st_in, film, &it)) != RS_OK)
-        return status;
-    if (st_in->waves_in_flight > RS_RENDER_MAX_WAVES)
-        return rs_error_set(RS_ERR_ARG, "%u waves in flight: at most %u", st_in->waves_in_flight,
-                            RS_RENDER_MAX_WAVES);
-    c = (render_ctx *)rs_calloc(1, sizeof *c);
-    if (!c)
-        return rs_error_set(RS_ERR_NOMEM, "out of memory for the render loop");
-    total = (uint64_t)it.n_active * st_in->spp - st_in->path_begin; /* this call's paths */
-    c->it = it;
-    c->st = *st_in;
-    c->sched = sched;
-    c->hooks = hooks;
-    c->stats = stats;
-    c->film = film;
-    c->next_path = c->on_film = st_in->path_begin;
-    c->end_path = st_in->path_begin + total;
-    c->t_start = t_start;
-    resolve_settings(&c->st, sched, total);
-    c->ex.threads = c->st.threads;
-    c->ex.strategy = c->st.strategy;
-    n_waves = total ? (total + c->st.wave_paths - 1) / c->st.wave_paths : 0;
-    c->n_slots = n_waves < c->st.waves_in_flight ? (uint32_t)n_waves : c->st.waves_in_flight;
-    stats->paths_total = total;
-    choose_host_memory(c);
-    for (k = 0; k < c->n_slots; ++k)
-        c->slots[k].stage = SLOT_IDLE;
-    for (k = 0; k < c->n_slots && status == RS_OK; ++k) {
-        status = rs_wave_buffers_create(c->st.wave_paths, c->have_pinned ? &c->pinned : NULL,
-                                        &c->slots[k].b);
-        if (status == RS_ERR_NOMEM && c->have_pinned) {
+    resolve_settings(&e->st, e->sched, total);
+    n_waves = (total + e->st.wave_paths - 1) / e->st.wave_paths;
+    e->n_slots = n_waves < e->st.waves_in_flight ? (uint32_t)n_waves : e->st.waves_in_flight;
+    for (k = 0; k < RS_RENDER_MAX_WAVES; ++k)
+        e->slots[k].stage = SLOT_IDLE;
+    for (k = 0; k < e->n_slots && status == RS_OK; ++k) {
+        status =
+            rs_wave_buffers_create(e->st.wave_paths, have_pinned ? &pinned : NULL, &e->slots[k].b);
+        if (status == RS_ERR_NOMEM && have_pinned) {
             /* page-locked memory is scarcer than memory: the device then stages its chunks */
             rs_error_clear();
-            status = rs_wave_buffers_create(c->st.wave_paths, NULL, &c->slots[k].b);
+            status = rs_wave_buffers_create(e->st.wave_paths, NULL, &e->slots[k].b);
         }
     }
-    if (status == RS_OK && total > 0)
-        status = run_waves(c);
-    /* on a failure or an interruption, take back what is still with the scheduler before the
-     * buffers go: the render thread owns them */
-    for (k = 0; k < c->n_slots; ++k) {
-        slot *sl = &c->slots[k];
-        if (sl->stage == RS_STAGE_TRACE_CLOSEST || sl->stage == RS_STAGE_TRACE_SHADOW)
-            (void)rs_sched_wait(sched, &sl->job);
-        rs_wave_buffers_destroy(&sl->b);
-    }
-    rs_free(c);
-    stats->seconds = now_s() - t_start;
     return status;
+}
+
+void rs_stream_release(rs_engine *e)
+{
+    uint32_t k;
+    for (k = 0; k < e->n_slots; ++k)
+        rs_wave_buffers_destroy(&e->slots[k].b);
 }

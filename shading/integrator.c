@@ -56,8 +56,8 @@ int rs_sampler_parse(const char *text, rs_sampler *out)
 /* Pixel and sample of paths wave_start + p, for p = path[i] (or p0 + i where path is NULL),
  * i < n.  A stream keeps its paths in increasing order, so after one division each entry is a
  * step from the one before (a step back or past a whole image divides again); the numbers are
- * those of g mod n_active and g div n_active (mapped through it->pixel_of, and sample_base
- * added, for a pass over some pixels). */
+ * those of g mod n_active and g div n_active (mapped through it->pixel_of for a plan over some
+ * pixels). */
 static void locate(const rs_integrator *it, uint64_t wave_start, const uint32_t *path,
                    uint32_t p0, uint32_t n, uint32_t *pixel, uint32_t *sample)
 {
@@ -78,12 +78,10 @@ static void locate(const rs_integrator *it, uint64_t wave_start, const uint32_t 
         pixel[i] = px;
         sample[i] = sm;
     }
-    /* a pass over some pixels only (adaptive sampling): their indices, from the pass's sample */
-    if (it->pixel_of || it->sample_base)
-        for (i = 0; i < n; ++i) {
-            pixel[i] = it->pixel_of ? it->pixel_of[pixel[i]] : pixel[i];
-            sample[i] += it->sample_base;
-        }
+    /* a plan over some pixels only (adaptive sampling): their indices */
+    if (it->pixel_of)
+        for (i = 0; i < n; ++i)
+            pixel[i] = it->pixel_of[pixel[i]];
 }
 
 /* out[i] = rs_path_rand(it, pixel[i], sample[i], bounce, group), i < n. */

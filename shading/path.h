@@ -78,11 +78,11 @@ typedef struct rs_integrator {
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     uint32_t sampling;  /* rs_sampling */
     uint32_t sampler;   /* rs_sampler */
-    /* The pixels a pass covers (adaptive sampling, scheduler/adaptive.h): path g is pixel
-     * pixel_of[g mod n_active] (NULL: g mod n_active itself, n_active = npix), sample
-     * sample_base + g div n_active.  Host memory: only the stream engine's host stages read it. */
+    /* The pixels of the plan being run (scheduler/plan.h): path g is pixel pixel_of[g mod
+     * n_active] (NULL: g mod n_active itself, n_active = npix), sample g div n_active.  Host
+     * memory: only the stream engine's host stages read it. */
     const uint32_t *pixel_of;
-    uint32_t n_active, sample_base;
+    uint32_t n_active;
 } rs_integrator;
 
 /* Pixel and sample of path g. */
@@ -93,7 +93,7 @@ RS_HD uint32_t rs_path_pixel(const rs_integrator *it, uint64_t g)
 }
 RS_HD uint32_t rs_path_sample(const rs_integrator *it, uint64_t g)
 {
-    return it->sample_base + (uint32_t)(g / it->n_active);
+    return (uint32_t)(g / it->n_active);
 }
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the

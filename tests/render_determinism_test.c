@@ -237,7 +237,7 @@ static void test_zsobol_settings(void **state)
  * whose batch says it came from that memory. */
 static rs_device_ops g_host_ops;
 static const rs_device_ops *g_inner_ops;
-static int g_host_fail, g_host_blocks, g_pinned_chunks;
+static int g_host_fail, g_host_blocks, g_host_allocs, g_pinned_chunks;
 
 static void *host_alloc_counted(rs_device *d, size_t bytes)
 {
@@ -245,6 +245,7 @@ static void *host_alloc_counted(rs_device *d, size_t bytes)
     if (g_host_fail)
         return NULL;
     g_host_blocks++;
+    g_host_allocs++;
     return rs_alloc_aligned(bytes, 1);
 }
 
@@ -262,7 +263,9 @@ static rs_status trace_counting_pinned(rs_device *d, const rs_trace_batch *b, ui
     return g_inner_ops->trace(d, b, lo, hi);
 }
 
-static float *render_with_host_memory(void)
+/* The render on one engine as plans of samples [0, cut[0]), [cut[0], cut[1]), ...,
+ * [cut[n_cuts - 1], SPP); n_cuts 0: one plan. */
+static float *render_with_host_memory_in(const uint32_t *cut, int n_cuts)
 {
     rt_args a = rt_defaults("cornell", SIZE, SPP);
     rs_scene *scene = NULL;
@@ -294,8 +297,20 @@ static float *render_with_host_memory(void)
     st.seed = a.seed;
     st.sampling = a.sampling;
     st.threads = 1;
-    st.wave_paths = 3000; /* several waves, each buffer set allocated and freed */
-    assert_int_equal(rs_render(scene, sched, &st, NULL, film, &stats), RS_OK);
+    st.wave_paths = 3000; /* several waves through the buffers of each slot */
+    {
+        rs_engine *e = NULL;
+        int k;
+        assert_int_equal(rs_engine_create(scene, &st, sched, NULL, &e), RS_OK);
+        for (k = 0; k <= n_cuts; ++k) {
+            rs_work_plan plan;
+            assert_true(rs_work_plan_samples(&plan, (uint64_t)SIZE * SIZE, k ? cut[k - 1] : 0,
+                                             k < n_cuts ? cut[k] : SPP));
+            assert_int_equal(rs_engine_run(e, &plan, NULL, film, &stats), RS_OK);
+            rs_work_plan_free(&plan);
+        }
+        rs_engine_destroy(e);
+    }
     rs_film_resolve(film, rgb);
     rs_sched_destroy(sched);
     rs_device_destroy(dev);
@@ -304,6 +319,8 @@ static float *render_with_host_memory(void)
     rs_scene_destroy(scene);
     return rgb;
 }
+
+static float *render_with_host_memory(void) { return render_with_host_memory_in(NULL, 0); }
 
 /* Wave buffers from a device's host_alloc: every chunk says so (a GPU then copies it by DMA
  * without staging), every block is given back, and the image is unchanged; where host_alloc
@@ -325,6 +342,102 @@ static void test_wave_buffers_in_device_memory(void **state)
     assert_memory_equal(img, g_ref, NF * sizeof(float));
     assert_int_equal(g_pinned_chunks, 0);
     free(img);
+}
+
+/* One engine, many plans: the wave buffers are allocated once per render (with a GPU each is
+ * page-locked memory, costly to get), however many plans run on it, and the image is the one
+ * plan's bit for bit. */
+static void test_plans_share_the_buffers(void **state)
+{
+    static const uint32_t cuts[] = {1, 2, 5, 6};
+    float *img;
+    int one;
+    (void)state;
+    g_host_fail = 0;
+    g_host_blocks = g_host_allocs = 0;
+    img = render_with_host_memory_in(NULL, 0);
+    one = g_host_allocs;
+    assert_true(one > 0);
+    free(img);
+    g_host_allocs = 0;
+    img = render_with_host_memory_in(cuts, 4); /* five plans */
+    assert_memory_equal(img, g_ref, NF * sizeof(float));
+    assert_int_equal(g_host_allocs, one);
+    assert_int_equal(g_host_blocks, 0);
+    free(img);
+}
+
+/* A megakernel device that counts its scene copies (pass_begin) and uploads. */
+static rs_device_ops g_count_ops;
+static const rs_device_ops *g_count_inner;
+static int g_pass_begins, g_uploads;
+
+static rs_status pass_begin_counted(rs_device *d, const rs_scene *s, const rs_integrator *it)
+{
+    g_pass_begins++;
+    return g_count_inner->pass_begin(d, s, it);
+}
+
+static rs_status upload_counted(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
+{
+    g_uploads++;
+    return g_count_inner->upload(d, g, bvh);
+}
+
+/* The megakernel on the GPU fallback (which copies the scene at pass_begin as the CUDA device
+ * copies it to the GPU): one upload and one scene copy per render, whatever the plans, and the
+ * image of the stream engine's one plan. */
+static void test_megakernel_copies_the_scene_once(void **state)
+{
+    rs_scene *scene = NULL;
+    rs_bvh *bvh = NULL;
+    rs_device *dev = NULL;
+    rs_film *film = NULL;
+    rs_engine *e = NULL;
+    rs_render_settings st;
+    rs_render_stats stats;
+    rt_args a = rt_defaults("cornell", SIZE, SPP);
+    rs_geom g;
+    float *rgb = (float *)malloc(NF * sizeof *rgb);
+    uint32_t s;
+    (void)state;
+    assert_int_equal(rs_builtin_create("cornell", &scene), RS_OK);
+    g = rs_scene_geom(scene);
+    assert_int_equal(rs_bvh_build(&g, NULL, &bvh), RS_OK);
+    assert_int_equal(rs_gpu_fallback_create(1, 0, NULL, &dev), RS_OK);
+    g_count_inner = dev->ops;
+    g_count_ops = *dev->ops;
+    g_count_ops.pass_begin = pass_begin_counted;
+    g_count_ops.upload = upload_counted;
+    dev->ops = &g_count_ops;
+    g_pass_begins = g_uploads = 0;
+    assert_int_equal(rs_device_upload(dev, &g, bvh), RS_OK);
+    assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
+    memset(&st, 0, sizeof st);
+    st.width = st.height = SIZE;
+    st.spp = SPP;
+    st.max_depth = a.max_depth;
+    st.seed = a.seed;
+    st.sampling = a.sampling;
+    st.threads = 1;
+    assert_int_equal(rs_engine_create(scene, &st, NULL, dev, &e), RS_OK);
+    for (s = 0; s < SPP; s += 3) { /* plans of 3, 3 and 2 samples, as an MPI rank's passes */
+        rs_work_plan plan;
+        assert_true(
+            rs_work_plan_samples(&plan, (uint64_t)SIZE * SIZE, s, s + 3 < SPP ? s + 3 : SPP));
+        assert_int_equal(rs_engine_run(e, &plan, NULL, film, &stats), RS_OK);
+        rs_work_plan_free(&plan);
+    }
+    assert_int_equal(g_uploads, 1);
+    assert_int_equal(g_pass_begins, 1);
+    rs_film_resolve(film, rgb);
+    assert_memory_equal(rgb, g_ref, NF * sizeof(float));
+    rs_engine_destroy(e);
+    rs_device_destroy(dev);
+    rs_film_destroy(film);
+    rs_bvh_destroy(bvh);
+    rs_scene_destroy(scene);
+    free(rgb);
 }
 
 /* ---- film pieces: a film rendered in pieces and merged in any order is the one film ------ */
@@ -364,21 +477,24 @@ static rs_film *render_piece(piece_rig *g, uint32_t s0, uint32_t n, uint32_t spp
     rs_film *film = NULL;
     rs_render_settings st;
     rs_render_stats stats;
+    rs_engine *e = NULL;
+    rs_work_plan plan;
     assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
     memset(&st, 0, sizeof st);
     st.width = st.height = SIZE;
-    st.spp = n;
-    st.sample_base = s0;
-    st.spp_total = spp;
+    st.spp = spp;
     st.max_depth = 8;
     st.seed = 7;
     st.sampler = sampler;
     st.threads = 1;
     st.wave_paths = wave;
-    if (megakernel)
-        assert_int_equal(rs_render_passes(g->scene, g->dev, &st, NULL, film, &stats), RS_OK);
-    else
-        assert_int_equal(rs_render(g->scene, g->sched, &st, NULL, film, &stats), RS_OK);
+    assert_int_equal(rs_engine_create(g->scene, &st, megakernel ? NULL : g->sched,
+                                      megakernel ? g->dev : NULL, &e),
+                     RS_OK);
+    assert_true(rs_work_plan_samples(&plan, (uint64_t)SIZE * SIZE, s0, s0 + n));
+    assert_int_equal(rs_engine_run(e, &plan, NULL, film, &stats), RS_OK);
+    rs_work_plan_free(&plan);
+    rs_engine_destroy(e);
     return film;
 }
 
@@ -539,6 +655,8 @@ int main(void)
         cmocka_unit_test(test_integrators_and_device_sets),
         cmocka_unit_test(test_zsobol_settings),
         cmocka_unit_test(test_wave_buffers_in_device_memory),
+        cmocka_unit_test(test_plans_share_the_buffers),
+        cmocka_unit_test(test_megakernel_copies_the_scene_once),
         cmocka_unit_test(test_failure_with_waves_in_flight),
         cmocka_unit_test(test_film_pieces_merge_exactly),
         cmocka_unit_test(test_film_fixed_point_is_order_free),

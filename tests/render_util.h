@@ -9,7 +9,6 @@
 
 #include "core/alloc.h"
 #include "cpu/cpu_device.h"
-#include "scheduler/passes.h"
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 #include "scheduler/fault.h"
@@ -126,7 +125,12 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
             goto out;
     } else if (a->adaptive.threshold > 0) {
         rs_adaptive_stats as;
-        if (rs_render_adaptive(scene, sched, &st, &a->adaptive, NULL, film, &stats, &as) != RS_OK)
+        rs_engine *e = NULL;
+        rs_status rst = rs_engine_create(scene, &st, sched, NULL, &e);
+        if (rst == RS_OK)
+            rst = rs_render_adaptive(e, &a->adaptive, NULL, film, &stats, &as);
+        rs_engine_destroy(e);
+        if (rst != RS_OK)
             goto out;
         if (a->adaptive_out)
             *a->adaptive_out = as;
