@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include "core/try.h"
+#include "scenes/builtin_gpucheck.h"
 #include "scenes/mesh.h"
 
 #include <math.h>
@@ -427,6 +428,8 @@ static const builtin g_builtins[] = {
      build_cornell_bunny_teapot},
     {"furnace", "white furnace: an albedo-0.5 diffuse sphere under a white sky (renders 0.5)",
      build_furnace, NULL},
+    {"gpucheck", "every material, texture, light and primitive the GPU shades (the GPU check's)",
+     rs_builtin_build_gpucheck, NULL},
 };
 
 #define N_BUILTINS ((int)(sizeof g_builtins / sizeof g_builtins[0]))
