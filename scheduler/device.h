@@ -1,13 +1,14 @@
 /* scheduler/device.h — what the render loops know of a device: a table of functions.
  *
  * One device model serves both integrators.  The CPU device (cpu/), the CUDA device and its CPU
- * fallback (gpu/) each fill this table; the wavefront loop (scheduler/render.c) and the pass
- * loop of the megakernel (scheduler/passes.c) see nothing else, and cpu/ and gpu/ never include
+ * fallback (gpu/) each fill this table; the engine's stream runs (scheduler/render.c) and
+ * megakernel runs (scheduler/passes.c) see nothing else, and cpu/ and gpu/ never include
  * each other.
  *
  * Life cycle: create (device-specific constructor) -> upload once -> trace many chunks (from
- * exactly one dispatch thread at a time) and/or pass_begin once, render_pass many times (from the
- * render thread) -> destroy.
+ * exactly one dispatch thread at a time) and/or pass_begin once per render (the engine's
+ * creation, scheduler/render.h), render_pass many times (from the render thread, for every plan
+ * the engine runs) -> destroy.
  *
  * Memory.  A device with RS_DEVICE_OWN_MEMORY traces in memory of its own (a CUDA device): the
  * geometry is copied at upload and every chunk is copied in and out.  Where it offers host_alloc,
@@ -17,7 +18,8 @@
  *
  * Thread safety: `trace` is only called from the device's dispatch thread, `pass_begin` and
  * `render_pass` only from the render thread, never both in one render.  `stats` is written by
- * the scheduler under its lock; read it after rs_sched_destroy or through rs_sched_stats. */
+ * the scheduler under its lock; read it after rs_sched_destroy or through rs_sched_device_stats
+ * (scheduler/sched.h). */
 #ifndef RS_SCHEDULER_DEVICE_H
 #define RS_SCHEDULER_DEVICE_H
 
