@@ -11,6 +11,7 @@
 typedef struct progress_ctx {
     const rs_render_hooks *outer;
     uint64_t done_before, total;
+    void *run; /* the adaptive_run it belongs to */
 } progress_ctx;
 
 static void round_progress(void *user, uint64_t done, uint64_t total)
@@ -57,87 +58,200 @@ static uint32_t next_round(const rs_film *film, double threshold, uint32_t spp, 
     return count;
 }
 
-rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,
-                             rs_film *film, rs_render_stats *stats, rs_adaptive_stats *as)
+rs_status rs_adaptive_state_init(rs_adaptive_state *s, uint32_t npix)
 {
-    const rs_render_settings *set = rs_engine_settings(e);
-    const uint32_t spp = set->spp;
-    const size_t npix = (size_t)set->width * set->height;
-    rs_render_hooks rh;
+    memset(s, 0, sizeof *s);
+    s->running = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
+    if (!s->running)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
+    memset(s->running, 1, npix);
+    return RS_OK;
+}
+
+void rs_adaptive_state_free(rs_adaptive_state *s)
+{
+    rs_free(s->running);
+    memset(s, 0, sizeof *s);
+}
+
+int rs_adaptive_state_fits(const rs_adaptive_state *s, const uint32_t *count, uint32_t npix,
+                           uint32_t spp)
+{
+    uint64_t in_round = 0, running = 0;
+    uint32_t p;
+    if ((uint64_t)s->n + s->step > spp)
+        return 0;
+    for (p = 0; p < npix; ++p) {
+        if (s->running[p] > 1)
+            return 0;
+        if (!s->running[p] && count[p] > s->n)
+            return 0;
+        if (s->running[p] && (count[p] < s->n || count[p] > s->n + s->step))
+            return 0;
+        in_round += s->running[p] ? count[p] - s->n : 0;
+        running += s->running[p];
+    }
+    return in_round == s->round_done && s->round_done <= running * s->step;
+}
+
+/* One adaptive render: the engine, the state and what the rounds share. */
+typedef struct adaptive_run {
+    rs_engine *e;
+    const rs_adaptive *a;
+    rs_adaptive_state *s;
+    const rs_render_hooks *outer;
+    rs_render_hooks hooks; /* the outer ones, progress and film_ready seen through the run's */
     progress_ctx pc;
+    rs_film *film;
+    rs_render_stats *stats;
+    uint64_t round_base; /* the round's paths on the film before the run under way */
+    uint8_t *need;
+    uint32_t *list;
+} adaptive_run;
+
+/* The film holds the run's `done` paths of the round: the state says so before the outer hook
+ * (a checkpoint) sees the film. */
+static void round_film_ready(void *user, const rs_film *film, const rs_path_ranges *done)
+{
+    adaptive_run *r = (adaptive_run *)((const progress_ctx *)user)->run;
+    r->s->round_done = r->round_base + rs_path_ranges_total(done);
+    r->outer->film_ready(r->outer->user, film, done);
+}
+
+/* Runs the round under way (r->s->step > 0) from where the film stands: its pixels are the
+ * running ones, listed; returns the engine's status, *limited when the time limit cut it. */
+static rs_status run_round(adaptive_run *r, int *limited)
+{
+    rs_adaptive_state *s = r->s;
+    const uint32_t npix = r->film->width * r->film->height;
     rs_render_stats one;
     rs_work_plan plan;
-    uint8_t *running = NULL, *need = NULL;
-    uint32_t *list = NULL, n;
-    double t0 = rs_now_s();
-    rs_status st = RS_OK;
-    memset(stats, 0, sizeof *stats);
-    memset(as, 0, sizeof *as);
+    rs_status st;
+    uint32_t count = 0, p;
+    for (p = 0; p < npix; ++p)
+        if (s->running[p])
+            r->list[count++] = p;
     memset(&plan, 0, sizeof plan);
-    if (!(a->threshold > 0) || a->min_spp < 2)
+    if (count < npix) { /* every pixel is the image's own numbering */
+        plan.pixels = r->list;
+        plan.n_pixels = count;
+    }
+    if (!rs_path_ranges_add(&plan.todo, (uint64_t)count * s->n + s->round_done,
+                            (uint64_t)count * (s->n + s->step)))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
+    r->round_base = s->round_done;
+    st = rs_engine_run(r->e, &plan, &r->hooks, r->film, &one);
+    rs_work_plan_free(&plan);
+    s->round_done = r->round_base + one.paths_done;
+    rs_render_stats_add(r->stats, &one);
+    s->stats.samples += one.paths_done;
+    r->pc.done_before += one.paths_done;
+    *limited = one.time_limited;
+    if (st == RS_OK && !one.time_limited) { /* the round is done */
+        s->n += s->step;
+        s->step = 0;
+        s->round_done = 0;
+    }
+    return st;
+}
+
+/* Decides the next round from the film (s->step == 0): its samples, or 0 when every pixel has
+ * stopped or has spp samples. */
+static uint32_t decide_round(adaptive_run *r)
+{
+    rs_adaptive_state *s = r->s;
+    const uint32_t spp = rs_engine_settings(r->e)->spp;
+    uint32_t step;
+    if (s->n >= spp)
+        return 0;
+    if (s->n == 0) /* every pixel, min_spp samples */
+        return r->a->min_spp < spp ? r->a->min_spp : spp;
+    if (next_round(r->film, r->a->threshold, spp, s->n, s->running, r->need, r->list,
+                   &s->stats.stopped, &r->pc.done_before) == 0)
+        return 0;
+    step = s->n / 4 > 4 ? s->n / 4 : 4;
+    return step < spp - s->n ? step : spp - s->n;
+}
+
+/* What adaptive sampling needs before it begins or continues; the progress context. */
+static rs_status adaptive_begin(adaptive_run *r, const rs_render_hooks *hooks)
+{
+    const rs_render_settings *set = rs_engine_settings(r->e);
+    const uint32_t npix = set->width * set->height;
+    rs_adaptive_state *s = r->s;
+    uint32_t p;
+    rs_status st;
+    if (!(r->a->threshold > 0) || r->a->min_spp < 2)
         return rs_error_set(RS_ERR_ARG, "adaptive sampling needs a threshold > 0 and at least 2 "
                                         "samples before any pixel stops");
-    if (set->path_begin)
-        return rs_error_set(RS_ERR_ARG, "adaptive sampling starts from an empty film");
-    if (hooks && hooks->film_ready)
-        return rs_error_set(RS_ERR_ARG, "adaptive sampling cannot be checkpointed yet");
-    if ((st = rs_film_track_variance(film)) != RS_OK)
-        return st;
-    running = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
-    need = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
-    list = (uint32_t *)rs_alloc(npix ? npix : 1, sizeof *list);
-    if (!running || !need || !list) {
-        st = rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
-        goto out;
+    if (!s->running) {
+        if (set->path_begin)
+            return rs_error_set(RS_ERR_ARG, "adaptive sampling starts from an empty film");
+        if ((st = rs_film_track_variance(r->film)) != RS_OK ||
+            (st = rs_adaptive_state_init(s, npix)) != RS_OK)
+            return st;
+    } else if (!r->film->sum_l2 || !rs_adaptive_state_fits(s, r->film->count, npix, set->spp)) {
+        return rs_error_set(RS_ERR_ARG, "adaptive sampling continues a film of its own only");
     }
-    memset(running, 1, npix);
+    r->need = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
+    r->list = (uint32_t *)rs_alloc(npix ? npix : 1, sizeof *r->list);
+    if (!r->need || !r->list)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
+    /* done so far: the film's samples, and the samples stopped pixels will never take */
+    r->pc.outer = hooks;
+    r->pc.total = (uint64_t)npix * set->spp;
+    r->pc.done_before = 0;
+    r->pc.run = r;
+    for (p = 0; p < npix; ++p)
+        r->pc.done_before += s->running[p] ? r->film->count[p] : set->spp;
     if (hooks)
-        rh = *hooks;
+        r->hooks = *hooks;
     else
-        memset(&rh, 0, sizeof rh);
-    pc.outer = hooks;
-    pc.total = (uint64_t)npix * spp;
-    pc.done_before = 0;
-    if (hooks && hooks->progress) {
-        rh.progress = round_progress;
-        rh.user = &pc;
-    }
-    for (n = 0; n < spp;) {
-        uint32_t step, count;
-        if (n == 0) { /* every pixel */
-            step = a->min_spp < spp ? a->min_spp : spp;
-            plan.pixels = NULL;
-            count = (uint32_t)npix;
-        } else {
-            count = next_round(film, a->threshold, spp, n, running, need, list, &as->stopped,
-                               &pc.done_before);
-            if (count == 0)
+        memset(&r->hooks, 0, sizeof r->hooks);
+    r->hooks.user = &r->pc;
+    r->hooks.progress = hooks && hooks->progress ? round_progress : NULL;
+    r->hooks.film_ready = hooks && hooks->film_ready ? round_film_ready : NULL;
+    r->outer = hooks;
+    return RS_OK;
+}
+
+rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state *state,
+                          const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats)
+{
+    adaptive_run r;
+    double t0 = rs_now_s();
+    rs_status st;
+    int limited = 0;
+    memset(stats, 0, sizeof *stats);
+    memset(&r, 0, sizeof r);
+    r.e = e;
+    r.a = a;
+    r.s = state;
+    r.film = film;
+    r.stats = stats;
+    st = adaptive_begin(&r, hooks);
+    while (st == RS_OK && !limited) {
+        if (state->step == 0) {
+            if ((state->step = decide_round(&r)) == 0)
                 break;
-            step = n / 4 > 4 ? n / 4 : 4;
-            step = step < spp - n ? step : spp - n;
-            plan.pixels = list;
+            state->stats.rounds++;
         }
-        /* samples [n, n + step) of the round's pixels */
-        plan.n_pixels = count;
-        plan.todo.n = 0;
-        if (!rs_path_ranges_add(&plan.todo, (uint64_t)count * n, (uint64_t)count * (n + step))) {
-            st = rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
-            break;
-        }
-        st = rs_engine_run(e, &plan, &rh, film, &one);
-        rs_render_stats_add(stats, &one);
-        as->rounds++;
-        as->samples += one.paths_done;
-        pc.done_before += one.paths_done;
-        if (st != RS_OK || one.time_limited)
-            break;
-        n += step;
+        st = run_round(&r, &limited);
     }
-out:
-    rs_path_ranges_free(&plan.todo);
-    rs_free(running);
-    rs_free(need);
-    rs_free(list);
+    rs_free(r.need);
+    rs_free(r.list);
     stats->seconds = rs_now_s() - t0;
+    return st;
+}
+
+rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,
+                             rs_film *film, rs_render_stats *stats, rs_adaptive_stats *astats)
+{
+    rs_adaptive_state s;
+    rs_status st;
+    memset(&s, 0, sizeof s);
+    st = rs_adaptive_run(e, a, &s, hooks, film, stats);
+    *astats = s.stats;
+    rs_adaptive_state_free(&s);
     return st;
 }

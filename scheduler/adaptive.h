@@ -23,16 +23,40 @@ typedef struct rs_adaptive {
 } rs_adaptive;
 
 typedef struct rs_adaptive_stats {
-    uint32_t rounds;  /* renders, the first (every pixel) included */
+    uint32_t rounds;  /* plans run, the first (every pixel) included */
     uint64_t samples; /* samples taken, all pixels together */
     uint32_t stopped; /* pixels that stopped before spp */
 } rs_adaptive_stats;
 
-/* Adaptive sampling up to the engine's spp samples a pixel (a stream engine, a fresh film), as
- * plans on engine `e`.  hooks as rs_engine_run's but film_ready, which must be NULL; the
- * engine's time limit ends the rounds (the last one on a whole pass of its pixels); progress
- * counts a stopped pixel's remaining samples as done.  *stats sums the rounds' (seconds: the
- * whole). */
+/* Where an adaptive render stands whenever the film holds whole waves: with the film (and its
+ * squared-luminance sums) this is all a checkpoint needs to continue it bit for bit. */
+typedef struct rs_adaptive_state {
+    uint8_t *running;    /* per pixel: still sampled (in the round under way); NULL: not begun */
+    uint32_t n;          /* samples every running pixel had when the round under way began */
+    uint32_t step;       /* that round's samples per pixel; 0: no round under way, the next one
+                            is decided from the film */
+    uint64_t round_done; /* that round's paths on the film: the first round_done of its plan */
+    rs_adaptive_stats stats;
+} rs_adaptive_state;
+
+/* A state for a film of `npix` pixels before any sample: every pixel running.  RS_ERR_NOMEM. */
+rs_status rs_adaptive_state_init(rs_adaptive_state *s, uint32_t npix);
+void rs_adaptive_state_free(rs_adaptive_state *s);
+/* Whether `s` can be the state of a film with these counts (a checkpoint's): running pixels
+ * have between n and n + step samples and the round's done paths, the others at most n. */
+int rs_adaptive_state_fits(const rs_adaptive_state *s, const uint32_t *count, uint32_t npix,
+                           uint32_t spp);
+
+/* Adaptive sampling up to the engine's spp samples a pixel (a stream engine), as plans on
+ * engine `e`, from *state: a fresh one (running NULL: the film must be empty, and then tracks
+ * its variance) or one saved with the film (a checkpoint: the film holds its squared-luminance
+ * sums).  *state follows the render: whenever hooks->film_ready is called it describes the
+ * film, so a checkpoint written there continues to the same image.  The engine's time limit
+ * ends the rounds (the last one on a whole pass of its pixels); progress counts a stopped
+ * pixel's remaining samples as done.  *stats sums the rounds' (seconds: the whole). */
+rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state *state,
+                          const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats);
+/* rs_adaptive_run from a fresh state, its statistics in *astats. */
 rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,
                              rs_film *film, rs_render_stats *stats, rs_adaptive_stats *astats);
 

@@ -190,6 +190,117 @@ static void test_bad_settings(void **state)
     rs_film_destroy(film);
 }
 
+/* Stops the render (cancel) at the film_ready call number `stop_at`, and counts the calls. */
+typedef struct stopper {
+    atomic_int cancel;
+    int calls, stop_at;
+} stopper;
+
+static void stop_at_call(void *user, const rs_film *film, const rs_path_ranges *done)
+{
+    stopper *k = (stopper *)user;
+    (void)film;
+    (void)done;
+    if (++k->calls == k->stop_at)
+        atomic_store(&k->cancel, 1);
+}
+
+static rs_render_settings split_settings(void)
+{
+    rs_render_settings st;
+    memset(&st, 0, sizeof st);
+    st.width = st.height = SIZE;
+    st.spp = SPP;
+    st.max_depth = 8;
+    st.seed = 5;
+    st.sampler = RS_SAMPLER_SOBOL;
+    st.threads = 1;
+    st.wave_paths = 500; /* many waves: many places to stop */
+    return st;
+}
+
+/* An adaptive render stopped at film_ready call `stop_at` (0: never), its film and state
+ * copied (as a checkpoint keeps them), then continued on a new engine to the end. */
+static rs_film *render_split(int stop_at, rs_adaptive_stats *out, int *calls)
+{
+    rs_render_settings st = split_settings();
+    rs_adaptive a = {0.08, 8};
+    rs_adaptive_state s;
+    rs_render_hooks h;
+    rs_render_stats stats;
+    rs_film *film = NULL, *copy = NULL;
+    engine_rig g;
+    stopper k;
+    rs_status rst;
+    memset(&s, 0, sizeof s);
+    memset(&h, 0, sizeof h);
+    k.calls = 0;
+    k.stop_at = stop_at;
+    atomic_init(&k.cancel, 0);
+    h.cancel = &k.cancel;
+    h.film_ready = stop_at_call;
+    h.user = &k;
+    assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
+    assert_int_equal(rig_make(&g, &st), RS_OK);
+    rst = rs_adaptive_run(g.e, &a, &s, &h, film, &stats);
+    rig_free(&g);
+    *calls = k.calls;
+    if (rst == RS_OK) {
+        *out = s.stats;
+        rs_adaptive_state_free(&s);
+        return film;
+    }
+    assert_int_equal(rst, RS_ERR_CANCELLED);
+    rs_error_clear();
+    /* what a checkpoint keeps: the film's sums, counts and squared luminance, and the state */
+    assert_int_equal(rs_film_create(SIZE, SIZE, &copy), RS_OK);
+    assert_int_equal(rs_film_track_variance(copy), RS_OK);
+    assert_int_equal(rs_film_merge(copy, film), RS_OK);
+    rs_film_destroy(film);
+    assert_true(rs_adaptive_state_fits(&s, copy->count, SIZE * SIZE, SPP));
+    assert_int_equal(rig_make(&g, &st), RS_OK);
+    assert_int_equal(rs_adaptive_run(g.e, &a, &s, NULL, copy, &stats), RS_OK);
+    rig_free(&g);
+    *out = s.stats;
+    rs_adaptive_state_free(&s);
+    return copy;
+}
+
+static void assert_same_film(const rs_film *x, const rs_film *y)
+{
+    size_t n = (size_t)SIZE * SIZE;
+    assert_memory_equal(x->sum, y->sum, 3 * n * sizeof *x->sum);
+    assert_memory_equal(x->count, y->count, n * sizeof *x->count);
+    assert_memory_equal(x->sum_l2, y->sum_l2, n * sizeof *x->sum_l2);
+}
+
+/* An adaptive render is a sequence of plans that can stop after any wave: stopped in the first
+ * round, within a later one, and at every tenth wave, and continued from its film and state, it
+ * is the uninterrupted render bit for bit (the same pixels stop, with the same samples). */
+static void test_stopped_and_continued_is_the_same(void **state)
+{
+    rs_adaptive_stats whole, part;
+    rs_film *ref, *film;
+    int calls, c, stops[8], n = 0;
+    (void)state;
+    ref = render_split(0, &whole, &calls);
+    print_message("%d waves in %u rounds, %u pixels stopped\n", calls, whole.rounds, whole.stopped);
+    assert_true(whole.rounds >= 3 && whole.stopped > 0 && calls > 20);
+    stops[n++] = 1;
+    stops[n++] = calls - 1;
+    for (c = calls / 7; c < calls - 1 && n < 8; c += calls / 7)
+        stops[n++] = c;
+    for (c = 0; c < n; ++c) {
+        int calls2;
+        film = render_split(stops[c], &part, &calls2);
+        assert_same_film(film, ref);
+        assert_int_equal(part.stopped, whole.stopped);
+        assert_int_equal(part.samples, whole.samples);
+        rs_film_destroy(film);
+    }
+    rs_film_destroy(ref);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -197,6 +308,7 @@ int main(void)
         cmocka_unit_test(test_unmet_threshold_is_the_full_render),
         cmocka_unit_test(test_devices_and_chunks_change_nothing),
         cmocka_unit_test(test_bad_settings),
+        cmocka_unit_test(test_stopped_and_continued_is_the_same),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
