@@ -108,7 +108,8 @@ static size_t make_header(unsigned char *h, const rs_checkpoint_key *key,
     if (name_len >= NAME_MAX_BYTES)
         name_len = NAME_MAX_BYTES - 1;
     memcpy(h, k_magic, 8);
-    put32(h + 8, RS_CHECKPOINT_VERSION);
+    put32(h + 8,
+          key->adaptive_threshold > 0 ? RS_CHECKPOINT_VERSION_ADAPTIVE : RS_CHECKPOINT_VERSION);
     put32(h + 12, (uint32_t)(FIXED_HEADER + name_len + 8 + 16 * (size_t)held->n));
     put64(h + 16, key->scene_hash);
     put64(h + 24, key->seed);
@@ -145,9 +146,36 @@ static int put(FILE *f, const void *p, size_t n, uint64_t *sum)
     return fwrite(p, 1, n, f) == n;
 }
 
-int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
-                        const rs_checkpoint_key *key, const rs_film *film,
-                        const rs_path_ranges *held)
+#define ADAPTIVE_FIXED 48u /* the adaptive section before its per-pixel arrays */
+
+/* The adaptive section's fixed part for *ad. */
+static void make_adaptive(unsigned char *q, const rs_checkpoint_key *key,
+                          const rs_adaptive_state *ad)
+{
+    memset(q, 0, ADAPTIVE_FIXED);
+    memcpy(q, &key->adaptive_threshold, 8);
+    put32(q + 8, key->adaptive_min_spp);
+    put32(q + 12, ad->n);
+    put32(q + 16, ad->step);
+    put32(q + 20, ad->stats.rounds);
+    put64(q + 24, ad->round_done);
+    put64(q + 32, ad->stats.samples);
+    put32(q + 40, ad->stats.stopped);
+}
+
+/* The film's samples (the paths an adaptive film holds). */
+static uint64_t film_samples(const rs_film *film)
+{
+    size_t i, npix = (size_t)film->width * film->height;
+    uint64_t t = 0;
+    for (i = 0; i < npix; ++i)
+        t += film->count[i];
+    return t;
+}
+
+static int write_file(const char *path, const char *staged, int rename_now,
+                      const rs_checkpoint_key *key, const rs_film *film, const rs_path_ranges *held,
+                      const rs_adaptive_state *ad)
 {
     unsigned char *header;
     size_t npix = (size_t)film->width * film->height, n;
@@ -170,8 +198,16 @@ int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
         return 0;
     }
     n = make_header(header, key, held, film->nonfinite);
+    if (ad) /* no ranges: the paths held are the film's samples */
+        put64(header + 32, film_samples(film));
     ok = put(f, header, n, &sum) && put(f, film->sum, npix * 3 * sizeof *film->sum, &sum) &&
          put(f, film->count, npix * sizeof *film->count, &sum);
+    if (ad && ok) {
+        unsigned char q[ADAPTIVE_FIXED];
+        make_adaptive(q, key, ad);
+        ok = put(f, q, sizeof q, &sum) && put(f, film->sum_l2, npix * sizeof *film->sum_l2, &sum) &&
+             put(f, ad->running, npix, &sum);
+    }
     ok = ok && fwrite(&sum, 1, sizeof sum, f) == sizeof sum;
     ok = fflush(f) == 0 && ok;
     ok = fsync(fileno(f)) == 0 && ok; /* on disk before it replaces the last good one */
@@ -184,6 +220,25 @@ int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
             strerror(errno));
     unlink(staged);
     return 0;
+}
+
+int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
+                        const rs_checkpoint_key *key, const rs_film *film,
+                        const rs_path_ranges *held)
+{
+    return write_file(path, staged, rename_now, key, film, held, NULL);
+}
+
+int rs_checkpoint_write_adaptive(const char *path, const char *staged, int rename_now,
+                                 const rs_checkpoint_key *key, const rs_film *film,
+                                 const rs_adaptive_state *ad)
+{
+    static const rs_path_ranges none = {NULL, 0, 0};
+    if (!film->sum_l2) {
+        fprintf(stderr, "raystream: --checkpoint %s: the film keeps no variance\n", path);
+        return 0;
+    }
+    return write_file(path, staged, rename_now, key, film, &none, ad);
 }
 
 /* One line "raystream: --resume PATH: ..." and `code`. */
@@ -217,8 +272,8 @@ static int mismatch_s(const char *path, const char *field, const char *in_file, 
 }
 
 /* The header against `want`.  Returns RS_EXIT_OK or the exit code after one line. */
-static int check_header(const char *path, const unsigned char *h, const char *name,
-                        uint64_t end, rs_checkpoint_key *want)
+static int check_header(const char *path, const unsigned char *h, const char *name, uint64_t end,
+                        rs_checkpoint_key *want)
 {
     uint32_t u[10];
     int i;
@@ -264,8 +319,8 @@ static int check_header(const char *path, const unsigned char *h, const char *na
         char a[48], b[48];
         snprintf(a, sizeof a, "%llu", (unsigned long long)end);
         snprintf(b, sizeof b, "%u", want->spp);
-        return refuse(RS_EXIT_USAGE, path, "holds paths up to %s, more than --spp %s asks for",
-                      a, b);
+        return refuse(RS_EXIT_USAGE, path, "holds paths up to %s, more than --spp %s asks for", a,
+                      b);
     }
     return RS_EXIT_OK;
 }
@@ -296,132 +351,245 @@ static int counts_agree(const rs_film *film, const rs_path_ranges *held)
     return ok;
 }
 
-int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
-                       rs_path_ranges *held)
-{
-    unsigned char *h = (unsigned char *)malloc(FIXED_HEADER + NAME_MAX_BYTES + 8 +
-                                               16 * (size_t)RS_CHECKPOINT_MAX_RANGES);
-    char name[NAME_MAX_BYTES];
-    size_t npix = (size_t)film->width * film->height, hdr, name_len;
-    uint64_t size, expect, sum = FNV_OFFSET, stored, end = 0, prev = 0;
-    uint32_t fw, fh, n_ranges, k;
+/* A checkpoint being read: its header and what the header says. */
+typedef struct reader {
+    const char *path;
     FILE *f;
-    int rc;
-    if (!h) {
-        fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
-        return RS_EXIT_RUNTIME;
-    }
-    if (rs_file_open(path, (uint64_t)1 << 46, &f, &size) != RS_OK) {
-        fprintf(stderr, "raystream: --resume %s\n", rs_error_message());
-        rs_error_clear();
-        free(h);
-        return RS_EXIT_USAGE;
-    }
-    rc = RS_EXIT_RUNTIME;
-    if (size < FIXED_HEADER + 8 || fread(h, 1, FIXED_HEADER, f) != FIXED_HEADER) {
-        refuse(rc, path, "truncated: not a raystream checkpoint (%s%s)",
-               size < FIXED_HEADER + 8 ? "too short" : "cannot read", "");
-        goto out;
-    }
-    if (memcmp(h, k_magic, 8) != 0) {
-        refuse(rc, path, "not a raystream checkpoint (no RSCKPT magic)%s%s", "", "");
-        goto out;
-    }
-    if (get32(h + 8) != RS_CHECKPOINT_VERSION) {
+    uint64_t size, sum; /* the file's size; the checksum of what was read */
+    unsigned char *h;   /* the header */
+    char name[NAME_MAX_BYTES];
+    size_t hdr, name_len;
+    uint32_t version, n_ranges;
+    uint64_t end; /* the last range's end */
+} reader;
+
+/* The fixed header, the scene name and the ranges.  RS_EXIT_OK or RS_EXIT_RUNTIME after one
+ * line. */
+static int read_header(reader *r)
+{
+    const int rc = RS_EXIT_RUNTIME;
+    uint64_t prev = 0;
+    uint32_t k;
+    if (r->size < FIXED_HEADER + 8 || fread(r->h, 1, FIXED_HEADER, r->f) != FIXED_HEADER)
+        return refuse(rc, r->path, "truncated: not a raystream checkpoint (%s%s)",
+                      r->size < FIXED_HEADER + 8 ? "too short" : "cannot read", "");
+    if (memcmp(r->h, k_magic, 8) != 0)
+        return refuse(rc, r->path, "not a raystream checkpoint (no RSCKPT magic)%s%s", "", "");
+    r->version = get32(r->h + 8);
+    if (r->version != RS_CHECKPOINT_VERSION && r->version != RS_CHECKPOINT_VERSION_ADAPTIVE) {
         char v[16], want_v[16];
-        snprintf(v, sizeof v, "%u", get32(h + 8));
+        snprintf(v, sizeof v, "%u", r->version);
         snprintf(want_v, sizeof want_v, "%u", RS_CHECKPOINT_VERSION);
-        refuse(rc, path, "checkpoint version %s; this raystream reads version %s", v, want_v);
-        goto out;
+        return refuse(rc, r->path, "checkpoint version %s; this raystream reads version %s", v,
+                      want_v);
     }
-    name_len = get32(h + 88);
-    hdr = get32(h + 12);
-    if (name_len >= NAME_MAX_BYTES || fread(h + FIXED_HEADER, 1, name_len + 8, f) != name_len + 8) {
-        refuse(rc, path, "corrupt header (scene name of %s bytes)%s",
-               name_len >= NAME_MAX_BYTES ? "too many" : "a wrong number of", "");
-        goto out;
-    }
-    memcpy(name, h + FIXED_HEADER, name_len);
-    name[name_len] = '\0';
-    n_ranges = get32(h + FIXED_HEADER + name_len);
-    if (n_ranges > RS_CHECKPOINT_MAX_RANGES ||
-        hdr != FIXED_HEADER + name_len + 8 + 16 * (size_t)n_ranges ||
-        fread(h + FIXED_HEADER + name_len + 8, 16, n_ranges, f) != n_ranges) {
-        refuse(rc, path, "corrupt header (the list of paths held)%s%s", "", "");
-        goto out;
-    }
-    for (k = 0; k < n_ranges; ++k) {
-        const unsigned char *q = h + FIXED_HEADER + name_len + 8 + 16 * (size_t)k;
+    r->name_len = get32(r->h + 88);
+    r->hdr = get32(r->h + 12);
+    if (r->name_len >= NAME_MAX_BYTES ||
+        fread(r->h + FIXED_HEADER, 1, r->name_len + 8, r->f) != r->name_len + 8)
+        return refuse(rc, r->path, "corrupt header (scene name of %s bytes)%s",
+                      r->name_len >= NAME_MAX_BYTES ? "too many" : "a wrong number of", "");
+    memcpy(r->name, r->h + FIXED_HEADER, r->name_len);
+    r->name[r->name_len] = '\0';
+    r->n_ranges = get32(r->h + FIXED_HEADER + r->name_len);
+    if (r->n_ranges > RS_CHECKPOINT_MAX_RANGES ||
+        (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE && r->n_ranges != 0) ||
+        r->hdr != FIXED_HEADER + r->name_len + 8 + 16 * (size_t)r->n_ranges ||
+        fread(r->h + FIXED_HEADER + r->name_len + 8, 16, r->n_ranges, r->f) != r->n_ranges)
+        return refuse(rc, r->path, "corrupt header (the list of paths held)%s%s", "", "");
+    for (k = 0; k < r->n_ranges; ++k) {
+        const unsigned char *q = r->h + FIXED_HEADER + r->name_len + 8 + 16 * (size_t)k;
         uint64_t lo = get64(q), hi = get64(q + 8);
-        if (lo >= hi || (k > 0 && lo <= prev) || hi > ((uint64_t)1 << 62)) {
-            refuse(rc, path, "corrupt header (the paths held are not sorted ranges)%s%s", "",
-                   "");
-            goto out;
-        }
-        prev = end = hi;
+        if (lo >= hi || (k > 0 && lo <= prev) || hi > ((uint64_t)1 << 62))
+            return refuse(rc, r->path, "corrupt header (the paths held are not sorted ranges)%s%s",
+                          "", "");
+        prev = r->end = hi;
     }
-    /* the file's own size first: a mismatch is reported only for a file that is whole */
-    fw = get32(h + 48);
-    fh = get32(h + 52);
-    if (fw == 0 || fh == 0 || fw > 65536 || fh > 65536) {
-        refuse(rc, path, "corrupt header (image size %s)%s", "out of range", "");
-        goto out;
-    }
-    expect = (uint64_t)hdr + (uint64_t)fw * fh * (3 * sizeof *film->sum + sizeof *film->count) + 8;
-    if (size != expect) {
+    return RS_EXIT_OK;
+}
+
+/* The file's size against its header (a mismatch is reported only for a file that is whole),
+ * then the image size against the render's. */
+static int check_size(const reader *r, const rs_checkpoint_key *want, size_t npix)
+{
+    uint32_t fw = get32(r->h + 48), fh = get32(r->h + 52);
+    uint64_t per_pixel = 3 * sizeof(rs_film_sum) + sizeof(uint32_t), expect;
+    if (fw == 0 || fh == 0 || fw > 65536 || fh > 65536)
+        return refuse(RS_EXIT_RUNTIME, r->path, "corrupt header (image size %s)%s", "out of range",
+                      "");
+    if (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE)
+        per_pixel += sizeof(double) + 1;
+    expect = (uint64_t)r->hdr + (uint64_t)fw * fh * per_pixel + 8 +
+             (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE ? ADAPTIVE_FIXED : 0);
+    if (r->size != expect) {
         char a[32], b[32];
-        snprintf(a, sizeof a, "%llu", (unsigned long long)size);
+        snprintf(a, sizeof a, "%llu", (unsigned long long)r->size);
         snprintf(b, sizeof b, "%llu", (unsigned long long)expect);
-        refuse(rc, path, "%s bytes where its header makes %s: truncated or corrupt", a, b);
-        goto out;
+        return refuse(RS_EXIT_RUNTIME, r->path,
+                      "%s bytes where its header makes %s: truncated or corrupt", a, b);
     }
     if ((uint64_t)fw * fh != npix || fw != want->width) {
         char a[32], b[32];
         snprintf(a, sizeof a, "%ux%u", fw, fh);
         snprintf(b, sizeof b, "%ux%u", want->width, want->height);
-        rc = mismatch_s(path, "size", a, b);
-        goto out;
+        return mismatch_s(r->path, "size", a, b);
     }
-    sum = fnv(sum, h, hdr);
-    if (fread(film->sum, sizeof *film->sum, npix * 3, f) != npix * 3 ||
-        fread(film->count, sizeof *film->count, npix, f) != npix ||
-        fread(&stored, 1, sizeof stored, f) != sizeof stored) {
-        refuse(rc, path, "truncated while reading the film%s%s", "", "");
-        goto out;
+    return RS_EXIT_OK;
+}
+
+/* n bytes into p, folded into the checksum; 0 when the file ends first. */
+static int take(reader *r, void *p, size_t n)
+{
+    if (fread(p, 1, n, r->f) != n)
+        return 0;
+    r->sum = fnv(r->sum, p, n);
+    return 1;
+}
+
+/* The film (and an adaptive section into q, ad and the film's squared luminance), then the
+ * checksum. */
+static int read_film(reader *r, rs_film *film, unsigned char *q, rs_adaptive_state *ad)
+{
+    size_t npix = (size_t)film->width * film->height;
+    uint64_t stored;
+    int ok;
+    r->sum = fnv(FNV_OFFSET, r->h, r->hdr);
+    ok = take(r, film->sum, npix * 3 * sizeof *film->sum) &&
+         take(r, film->count, npix * sizeof *film->count);
+    if (ok && r->version == RS_CHECKPOINT_VERSION_ADAPTIVE)
+        ok = take(r, q, ADAPTIVE_FIXED) && take(r, film->sum_l2, npix * sizeof *film->sum_l2) &&
+             take(r, ad->running, npix);
+    if (!ok || fread(&stored, 1, sizeof stored, r->f) != sizeof stored)
+        return refuse(RS_EXIT_RUNTIME, r->path, "truncated while reading the film%s%s", "", "");
+    if (r->sum != stored)
+        return refuse(RS_EXIT_RUNTIME, r->path,
+                      "corrupt: the checksum does not match its content%s%s", "", "");
+    return RS_EXIT_OK;
+}
+
+/* The ranges into *held, checked against the counts. */
+static int take_ranges(const reader *r, const rs_film *film, rs_path_ranges *held)
+{
+    const int rc = RS_EXIT_RUNTIME;
+    size_t npix = (size_t)film->width * film->height;
+    uint32_t k;
+    for (k = 0; k < r->n_ranges; ++k) {
+        const unsigned char *q = r->h + FIXED_HEADER + r->name_len + 8 + 16 * (size_t)k;
+        if (get64(q) % npix != 0) /* every range starts at a whole sample */
+            return refuse(rc, r->path,
+                          "corrupt header (a range of paths starts within a sample)%s%s", "", "");
+        if (!rs_path_ranges_add(held, get64(q), get64(q + 8)))
+            return refuse(rc, r->path, "out of memory for its list of paths%s%s", "", "");
     }
-    sum = fnv(sum, film->sum, npix * 3 * sizeof *film->sum);
-    sum = fnv(sum, film->count, npix * sizeof *film->count);
-    if (sum != stored) {
-        refuse(rc, path, "corrupt: the checksum does not match its content%s%s", "", "");
-        goto out;
+    if (rs_path_ranges_total(held) != get64(r->h + 32) || !counts_agree(film, held))
+        return refuse(rc, r->path, "corrupt: the sample counts do not match its header%s%s", "",
+                      "");
+    return RS_EXIT_OK;
+}
+
+/* The adaptive section against the render's --adaptive and the film. */
+static int take_adaptive(const reader *r, const unsigned char *q, const rs_checkpoint_key *want,
+                         const rs_film *film, rs_adaptive_state *ad)
+{
+    size_t i, npix = (size_t)film->width * film->height;
+    double t;
+    memcpy(&t, q, 8);
+    if (t != want->adaptive_threshold || get32(q + 8) != want->adaptive_min_spp) {
+        char a[48], b[48];
+        snprintf(a, sizeof a, "%g and --adaptive-min-spp %u", t, get32(q + 8));
+        snprintf(b, sizeof b, "%g and --adaptive-min-spp %u", want->adaptive_threshold,
+                 want->adaptive_min_spp);
+        return mismatch_s(r->path, "--adaptive", a, b);
     }
-    if ((rc = check_header(path, h, name, end, want)) != RS_EXIT_OK)
-        goto out;
-    rc = RS_EXIT_RUNTIME;
-    for (k = 0; k < n_ranges; ++k) {
-        const unsigned char *q = h + FIXED_HEADER + name_len + 8 + 16 * (size_t)k;
-        if (get64(q) % npix != 0) { /* every range starts at a whole sample */
-            refuse(rc, path, "corrupt header (a range of paths starts within a sample)%s%s", "",
-                   "");
-            goto out;
-        }
-        if (!rs_path_ranges_add(held, get64(q), get64(q + 8))) {
-            refuse(rc, path, "out of memory for its list of paths%s%s", "", "");
-            goto out;
-        }
+    ad->n = get32(q + 12);
+    ad->step = get32(q + 16);
+    ad->stats.rounds = get32(q + 20);
+    ad->round_done = get64(q + 24);
+    ad->stats.samples = get64(q + 32);
+    ad->stats.stopped = get32(q + 40);
+    for (i = 0; i < npix; ++i)
+        if (!(film->sum_l2[i] >= 0 && film->sum_l2[i] < 1e300))
+            break;
+    if (i < npix || film_samples(film) != get64(r->h + 32) ||
+        !rs_adaptive_state_fits(ad, film->count, (uint32_t)npix, want->spp))
+        return refuse(RS_EXIT_RUNTIME, r->path,
+                      "corrupt: the sample counts do not match its adaptive state%s%s", "", "");
+    return RS_EXIT_OK;
+}
+
+/* Whether the file's kind (adaptive or not) is the render's; one line when not. */
+static int same_kind(const reader *r, const rs_checkpoint_key *want)
+{
+    int file_adaptive = r->version == RS_CHECKPOINT_VERSION_ADAPTIVE;
+    if (file_adaptive == (want->adaptive_threshold > 0))
+        return RS_EXIT_OK;
+    return refuse(RS_EXIT_USAGE, r->path,
+                  "made %s --adaptive, but this render is %s (the same "
+                  "settings are needed to continue it)",
+                  file_adaptive ? "with" : "without", file_adaptive ? "not adaptive" : "adaptive");
+}
+
+static int read_any(const char *path, rs_checkpoint_key *want, rs_film *film, rs_path_ranges *held,
+                    rs_adaptive_state *ad)
+{
+    reader r;
+    unsigned char q[ADAPTIVE_FIXED];
+    size_t npix = (size_t)film->width * film->height;
+    int rc;
+    memset(&r, 0, sizeof r);
+    r.path = path;
+    r.h = (unsigned char *)malloc(FIXED_HEADER + NAME_MAX_BYTES + 8 +
+                                  16 * (size_t)RS_CHECKPOINT_MAX_RANGES);
+    if (!r.h) {
+        fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
+        return RS_EXIT_RUNTIME;
     }
-    if (rs_path_ranges_total(held) != get64(h + 32) || !counts_agree(film, held)) {
-        refuse(rc, path, "corrupt: the sample counts do not match its header%s%s", "", "");
-        goto out;
+    if (rs_file_open(path, (uint64_t)1 << 46, &r.f, &r.size) != RS_OK) {
+        fprintf(stderr, "raystream: --resume %s\n", rs_error_message());
+        rs_error_clear();
+        free(r.h);
+        return RS_EXIT_USAGE;
     }
-    film->nonfinite = get64(h + 40);
-    rc = RS_EXIT_OK;
-out:
-    fclose(f);
-    free(h);
+    if ((rc = read_header(&r)) == RS_EXIT_OK && (rc = check_size(&r, want, npix)) == RS_EXIT_OK &&
+        (rc = same_kind(&r, want)) == RS_EXIT_OK &&
+        (rc = read_film(&r, film, q, ad)) == RS_EXIT_OK &&
+        (rc = check_header(path, r.h, r.name, r.end, want)) == RS_EXIT_OK) {
+        if (ad && want->spp != get32(r.h + 56)) /* the last round's size depends on it */
+            rc = mismatch_u(path, "--spp (adaptive sampling's rounds depend on it)",
+                            get32(r.h + 56), want->spp);
+        else
+            rc = ad ? take_adaptive(&r, q, want, film, ad) : take_ranges(&r, film, held);
+    }
+    if (rc == RS_EXIT_OK)
+        film->nonfinite = get64(r.h + 40);
+    fclose(r.f);
+    free(r.h);
     if (rc != RS_EXIT_OK) {
         memset(film->count, 0, npix * sizeof *film->count);
-        rs_path_ranges_free(held);
+        if (held)
+            rs_path_ranges_free(held);
     }
+    return rc;
+}
+
+int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
+                       rs_path_ranges *held)
+{
+    return read_any(path, want, film, held, NULL);
+}
+
+int rs_checkpoint_read_adaptive(const char *path, rs_checkpoint_key *want, rs_film *film,
+                                rs_adaptive_state *ad)
+{
+    int rc;
+    memset(ad, 0, sizeof *ad);
+    if (rs_film_track_variance(film) != RS_OK ||
+        rs_adaptive_state_init(ad, film->width * film->height) != RS_OK) {
+        fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
+        rs_error_clear();
+        return RS_EXIT_RUNTIME;
+    }
+    if ((rc = read_any(path, want, film, NULL, ad)) != RS_EXIT_OK)
+        rs_adaptive_state_free(ad);
     return rc;
 }

@@ -28,20 +28,30 @@
  *              height)
  *         4*P  the counts, u32 a pixel (must be the ranges' paths of that pixel)
  *           8  FNV-1a 64 of every byte before it
+ * Version 3, an adaptive render (--adaptive), is version 2 with no ranges (R = 0; the counts
+ * say what each pixel holds: its first samples, scheduler/adaptive.h) and, between the counts
+ * and the checksum, the adaptive section:
+ *           8  the threshold (f64)
+ *          40  min spp, n, step, rounds (u32 each), the round's paths on the film (u64), samples
+ *              taken (u64), pixels stopped (u32), 4 zero bytes (rs_adaptive_state)
+ *         8*P  each pixel's sum of squared luminance (f64; summed in sample order)
+ *           P  each pixel's running flag (0 or 1)
  * Everything that decides the image is in the header; the devices, threads, chunk and wave
  * sizes, the BVH builder and the integrator are not (they do not change the image).  spp matters
- * only to the zsobol sampler (its point set depends on it); with the others a checkpoint may be
- * continued to more samples. */
+ * only to the zsobol sampler (its point set depends on it) and to adaptive sampling (its last
+ * round's size); with the others a checkpoint may be continued to more samples. */
 #ifndef RS_APP_CHECKPOINT_H
 #define RS_APP_CHECKPOINT_H
 
 #include <stdint.h>
 
 #include "scenes/scene.h"
+#include "scheduler/adaptive.h"
 #include "scheduler/plan.h"
 #include "shading/film.h"
 
-#define RS_CHECKPOINT_VERSION 2u
+#define RS_CHECKPOINT_VERSION          2u /* a render over every pixel */
+#define RS_CHECKPOINT_VERSION_ADAPTIVE 3u /* --adaptive: version 2 and an adaptive section */
 
 /* The paths a film holds (scheduler/plan.h): at most this many ranges in a file. */
 #define RS_CHECKPOINT_MAX_RANGES RS_PATH_RANGES_MAX
@@ -53,6 +63,8 @@ typedef struct rs_checkpoint_key {
     uint32_t width, height, spp, max_depth, rr_depth;
     uint32_t sampling, sampler;
     uint32_t isect_sphere, isect_tri, isect_aabb;
+    double adaptive_threshold; /* --adaptive: > 0 (its min spp below); 0: not adaptive */
+    uint32_t adaptive_min_spp;
     const char *scene; /* the scene's name on the command line (messages only) */
 } rs_checkpoint_key;
 
@@ -66,6 +78,11 @@ uint64_t rs_checkpoint_scene_hash(const rs_scene *s);
 int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
                         const rs_checkpoint_key *key, const rs_film *film,
                         const rs_path_ranges *held);
+/* The same for an adaptive render (key->adaptive_threshold > 0): `held` is not used (the film's
+ * counts say what it holds), *ad and the film's squared-luminance sums are saved with it. */
+int rs_checkpoint_write_adaptive(const char *path, const char *staged, int rename_now,
+                                 const rs_checkpoint_key *key, const rs_film *film,
+                                 const rs_adaptive_state *ad);
 
 /* Reads checkpoint `path` for a render with settings `want` into `film` (want's size, fresh):
  * *held (empty) gets the paths it holds.  want->spp == 0 takes the file's spp into want->spp.
@@ -74,5 +91,10 @@ int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
  * file and the one asked for); RS_EXIT_RUNTIME after one line when it is truncated or corrupt. */
 int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
                        rs_path_ranges *held);
+/* The same for an adaptive render (want->adaptive_threshold > 0): the file must be an adaptive
+ * checkpoint with the same threshold and min spp; *ad (zeroed) gets its state, the film its
+ * squared-luminance sums.  A file of the other kind is refused with one line. */
+int rs_checkpoint_read_adaptive(const char *path, rs_checkpoint_key *want, rs_film *film,
+                                rs_adaptive_state *ad);
 
 #endif
