@@ -2,12 +2,12 @@
  * (every function RS_HD): its camera ray, the shading of each of its vertices, and the whole
  * path traced to its end for the megakernel integrators.
  *
- * The wavefront stages (shading/integrator.c) call rs_path_begin and rs_path_shade on each entry
- * of a stream; the megakernels (the devices' render_pass: cpu/cpu_megakernel.c,
+ * The wavefront stages (shading/integrator.c) call rs_path_begin_at and rs_path_shade_at on each
+ * entry of a stream; the megakernels (the devices' render_pass: cpu/cpu_megakernel.c,
  * gpu/cuda_megakernel.cu, gpu/gpu_fallback.c) call rs_path_radiance, which calls the same two
  * with a traversal between.
- * A path is named by its global index g: pixel g mod npix, sample g div npix; with the bounce
- * that picks its random numbers, so every integrator makes the same paths.
+ * A path is named by its pixel and sample (from its index in a plan, scheduler/plan.h); with the
+ * bounce they pick its random numbers, so every integrator makes the same paths.
  *
  * Estimators, per sampling mode, at a non-delta vertex with BSDF f and its sampling pdf p_b:
  *   mis      next-event: light sample with pdf p_l, weight w_l = p_l^2 / (p_l^2 + p_b^2),
@@ -60,7 +60,7 @@ typedef enum rs_sampler {
 /* Path flags. */
 #define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
 
-/* What rs_path_shade made. */
+/* What rs_path_shade_at made. */
 #define RS_SHADE_NEXT   1u /* the path goes on with *next */
 #define RS_SHADE_SHADOW 2u /* a shadow ray *shadow carries ps->pending */
 
@@ -154,12 +154,6 @@ RS_HD rs_ray rs_path_begin_at(const rs_integrator *it, uint32_t pixel, uint32_t 
     ps->time = time;
     ps->flags = (uint8_t)RS_PATH_SPECULAR;
     return ray;
-}
-
-/* The camera ray of path g, and its state reset. */
-RS_HD rs_ray rs_path_begin(const rs_integrator *it, uint64_t g, rs_path_state *ps)
-{
-    return rs_path_begin_at(it, rs_path_pixel(it, g), rs_path_sample(it, g), NULL, ps);
 }
 
 RS_HD float rs_power_heuristic(float a, float b)
@@ -609,15 +603,6 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uin
     return out | RS_SHADE_NEXT;
 }
 
-/* rs_path_shade_at for path g, its numbers made where needed. */
-RS_HD uint32_t rs_path_shade(const rs_integrator *it, uint64_t g, uint32_t bounce,
-                             const rs_ray *ray, const rs_hit *h, rs_path_state *ps, rs_ray *next,
-                             rs_ray *shadow)
-{
-    return rs_path_shade_at(it, rs_path_pixel(it, g), rs_path_sample(it, g), bounce, NULL,
-                            ray, h, ps, next, shadow);
-}
-
 /* What a megakernel traces with: the binary BVH over `geom` (device pointers on the GPU), or on
  * the host the 8-wide one where `bvh8` is set, the 4-wide one where `bvh4` is. */
 typedef struct rs_path_tracer {
@@ -665,9 +650,11 @@ RS_HD int rs_path_occluded(const rs_path_tracer *tr, rs_ray r)
 RS_HD rs_vec3 rs_path_radiance(const rs_integrator *it, const rs_path_tracer *tr, uint64_t g,
                                rs_path_counts *n)
 {
+    /* pixel and sample once per path: a 64-bit division and remainder, not one per vertex */
+    const uint32_t pixel = rs_path_pixel(it, g), sample = rs_path_sample(it, g);
     rs_path_state ps;
-    rs_ray r = rs_path_begin(it, g, &ps), next, shadow;
-    next = shadow = r; /* set by rs_path_shade where its flags say: this quiets gcc */
+    rs_ray r = rs_path_begin_at(it, pixel, sample, NULL, &ps), next, shadow;
+    next = shadow = r; /* set by rs_path_shade_at where its flags say: this quiets gcc */
     uint32_t bounce;
     for (bounce = 0;; ++bounce) {
         rs_hit h;
@@ -676,7 +663,7 @@ RS_HD rs_vec3 rs_path_radiance(const rs_integrator *it, const rs_path_tracer *tr
         ++n->closest;
         if (bounce > n->max_bounce)
             n->max_bounce = bounce;
-        made = rs_path_shade(it, g, bounce, &r, &h, &ps, &next, &shadow);
+        made = rs_path_shade_at(it, pixel, sample, bounce, NULL, &r, &h, &ps, &next, &shadow);
         if (made & RS_SHADE_SHADOW) {
             ++n->shadow;
             if (!rs_path_occluded(tr, shadow))
