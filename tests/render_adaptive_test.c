@@ -130,35 +130,23 @@ static void test_devices_and_chunks_change_nothing(void **state)
     free(ref);
 }
 
-/* An engine over one CPU device for `st`, or NULL with RS_ERR_ARG from its creation. */
+/* The Cornell box on one CPU device and an engine for `st` over it (or the engine's status). */
 typedef struct engine_rig {
-    rs_scene *s;
-    rs_bvh *bvh;
-    rs_device *dev;
-    rs_sched *sched;
+    rt_rig g;
     rs_engine *e;
 } engine_rig;
 
 static rs_status rig_make(engine_rig *g, const rs_render_settings *st)
 {
-    rs_geom geom;
-    memset(g, 0, sizeof *g);
-    assert_int_equal(rs_builtin_create("cornell", &g->s), RS_OK);
-    geom = rs_scene_geom(g->s);
-    assert_int_equal(rs_bvh_build(&geom, NULL, &g->bvh), RS_OK);
-    assert_int_equal(rs_cpu_device_create(1, "cpu", &g->dev), RS_OK);
-    assert_int_equal(rs_device_upload(g->dev, &geom, g->bvh), RS_OK);
-    assert_int_equal(rs_sched_create(&g->dev, 1, NULL, &g->sched), RS_OK);
-    return rs_engine_create(g->s, st, g->sched, NULL, &g->e);
+    g->e = NULL;
+    assert_true(rt_rig_up(&g->g, "cornell"));
+    return rs_engine_create(g->g.scene, st, g->g.sched, NULL, &g->e);
 }
 
 static void rig_free(engine_rig *g)
 {
     rs_engine_destroy(g->e);
-    rs_sched_destroy(g->sched);
-    rs_device_destroy(g->dev);
-    rs_bvh_destroy(g->bvh);
-    rs_scene_destroy(g->s);
+    rt_rig_down(&g->g);
 }
 
 static void test_bad_settings(void **state)

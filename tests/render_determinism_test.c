@@ -290,14 +290,8 @@ static float *render_with_host_memory_in(const uint32_t *cut, int n_cuts)
     assert_int_equal(rs_device_upload(dev, &g, bvh), RS_OK);
     assert_int_equal(rs_sched_create(&dev, 1, NULL, &sched), RS_OK);
     assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
-    memset(&st, 0, sizeof st);
-    st.width = st.height = SIZE;
-    st.spp = SPP;
-    st.max_depth = a.max_depth;
-    st.seed = a.seed;
-    st.sampling = a.sampling;
-    st.threads = 1;
-    st.wave_paths = 3000; /* several waves through the buffers of each slot */
+    a.wave_paths = 3000; /* several waves through the buffers of each slot */
+    st = rt_settings(&a);
     {
         rs_engine *e = NULL;
         int k;
@@ -413,13 +407,7 @@ static void test_megakernel_copies_the_scene_once(void **state)
     g_pass_begins = g_uploads = 0;
     assert_int_equal(rs_device_upload(dev, &g, bvh), RS_OK);
     assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
-    memset(&st, 0, sizeof st);
-    st.width = st.height = SIZE;
-    st.spp = SPP;
-    st.max_depth = a.max_depth;
-    st.seed = a.seed;
-    st.sampling = a.sampling;
-    st.threads = 1;
+    st = rt_settings(&a);
     assert_int_equal(rs_engine_create(scene, &st, NULL, dev, &e), RS_OK);
     for (s = 0; s < SPP; s += 3) { /* plans of 3, 3 and 2 samples, as an MPI rank's passes */
         rs_work_plan plan;
@@ -442,36 +430,9 @@ static void test_megakernel_copies_the_scene_once(void **state)
 
 /* ---- film pieces: a film rendered in pieces and merged in any order is the one film ------ */
 
-typedef struct piece_rig {
-    rs_scene *scene;
-    rs_bvh *bvh;
-    rs_device *dev;
-    rs_sched *sched;
-} piece_rig;
-
-static void rig_up(piece_rig *g, const char *scene)
-{
-    rs_geom geom;
-    memset(g, 0, sizeof *g);
-    assert_int_equal(rs_builtin_create(scene, &g->scene), RS_OK);
-    geom = rs_scene_geom(g->scene);
-    assert_int_equal(rs_bvh_build(&geom, NULL, &g->bvh), RS_OK);
-    assert_int_equal(rs_cpu_device_create(1, "cpu", &g->dev), RS_OK);
-    assert_int_equal(rs_device_upload(g->dev, &geom, g->bvh), RS_OK);
-    assert_int_equal(rs_sched_create(&g->dev, 1, NULL, &g->sched), RS_OK);
-}
-
-static void rig_down(piece_rig *g)
-{
-    rs_sched_destroy(g->sched);
-    rs_device_destroy(g->dev);
-    rs_bvh_destroy(g->bvh);
-    rs_scene_destroy(g->scene);
-}
-
 /* samples [s0, s0 + n) of every pixel of a `spp`-sample render, onto a fresh film, by the stream
  * engine (waves of `wave` paths) or the megakernel */
-static rs_film *render_piece(piece_rig *g, uint32_t s0, uint32_t n, uint32_t spp, uint32_t wave,
+static rs_film *render_piece(rt_rig *g, uint32_t s0, uint32_t n, uint32_t spp, uint32_t wave,
                              int megakernel, rs_sampler sampler)
 {
     rs_film *film = NULL;
@@ -515,9 +476,9 @@ static void test_film_pieces_merge_exactly(void **state)
 {
     static const rs_sampler samplers[] = {RS_SAMPLER_SOBOL, RS_SAMPLER_ZSOBOL};
     size_t k;
-    piece_rig g;
+    rt_rig g;
     (void)state;
-    rig_up(&g, "cornell");
+    assert_true(rt_rig_up(&g, "cornell"));
     for (k = 0; k < sizeof samplers / sizeof samplers[0]; ++k) {
         rs_film *one = render_piece(&g, 0, 11, 11, 0, 0, samplers[k]);
         rs_film *p[3], *fwd = NULL, *rev = NULL;
@@ -545,7 +506,7 @@ static void test_film_pieces_merge_exactly(void **state)
         rs_film_destroy(fwd);
         rs_film_destroy(rev);
     }
-    rig_down(&g);
+    rt_rig_down(&g);
 }
 
 /* Why the sums are integers: the same samples summed as doubles in two groupings differ, where

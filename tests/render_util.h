@@ -29,16 +29,16 @@ typedef struct rt_args {
     uint32_t waves;           /* waves in flight; 0: auto */
     int real_gpu;             /* CUDA device 0 instead of the fallback in the two options above */
     rs_par_strategy strategy; /* the CPU device's, the shading's and the megakernel's */
-    int megakernel;    /* the per-pixel integrator (scheduler/passes.h, on devs[0]) instead of the
-                          stream */
-    int no_bvh;        /* one leaf holding every primitive: brute force */
-    rs_bvh_method bvh; /* the builder (zeroed: median) */
-    int fail_after;    /* > 0: the second device fails after this many chunks (RS_FAULT) */
-    int shared_cores;  /* devices and shading share a budget of `threads` cores */
+    int megakernel;     /* the per-pixel integrator (scheduler/passes.c, on devs[0]) instead of the
+                           stream */
+    int no_bvh;         /* one leaf holding every primitive: brute force */
+    rs_bvh_method bvh;  /* the builder (zeroed: median) */
+    int fail_after;     /* > 0: the second device fails after this many chunks (RS_FAULT) */
+    int shared_cores;   /* devices and shading share a budget of `threads` cores */
     uint32_t bvh_width; /* the CPU device's traversal: 2, 4 or 8 (0: 4) */
-    int cli_bvh; /* the CLI's tree instead: the widest traversal this CPU runs (bvh_width is
-                    ignored) over leaves the size of its blocks (rs_bvh_wide_leaf_size) */
-    rs_adaptive adaptive; /* threshold > 0: rs_render_adaptive (the stream integrator) */
+    int cli_bvh;        /* the CLI's tree instead: the widest traversal this CPU runs (bvh_width is
+                           ignored) over leaves the size of its blocks (rs_bvh_wide_leaf_size) */
+    rs_adaptive adaptive;            /* threshold > 0: rs_render_adaptive (the stream integrator) */
     rs_adaptive_stats *adaptive_out; /* its statistics, where not NULL */
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
 } rt_args;
@@ -55,6 +55,61 @@ static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp
     a.sampling = RS_SAMPLING_MIS;
     a.threads = 1;
     return a;
+}
+
+/* The engine's settings for `a` (sizes, depth, seed, sampling, sampler, one thread, its wave
+ * size): the tests that drive the engine themselves. */
+static inline rs_render_settings rt_settings(const rt_args *a)
+{
+    rs_render_settings st;
+    memset(&st, 0, sizeof st);
+    st.width = a->width;
+    st.height = a->height;
+    st.spp = a->spp;
+    st.max_depth = a->max_depth;
+    st.seed = a->seed;
+    st.sampling = a->sampling;
+    st.sampler = a->sampler;
+    st.threads = 1;
+    st.wave_paths = a->wave_paths;
+    return st;
+}
+
+/* A built-in scene, its BVH, one one-thread CPU device with it uploaded and a scheduler over it:
+ * what the tests that drive the engine themselves start from. */
+typedef struct rt_rig {
+    rs_scene *scene;
+    rs_bvh *bvh;
+    rs_device *dev;
+    rs_sched *sched;
+} rt_rig;
+
+/* 0 after printing why. */
+static inline int rt_rig_up(rt_rig *g, const char *scene)
+{
+    rs_geom geom;
+    memset(g, 0, sizeof *g);
+    if (rs_builtin_create(scene, &g->scene) != RS_OK)
+        goto fail;
+    geom = rs_scene_geom(g->scene);
+    if (rs_bvh_build(&geom, NULL, &g->bvh) != RS_OK ||
+        rs_cpu_device_create(1, "cpu", &g->dev) != RS_OK ||
+        rs_device_upload(g->dev, &geom, g->bvh) != RS_OK ||
+        rs_sched_create(&g->dev, 1, NULL, &g->sched) != RS_OK)
+        goto fail;
+    return 1;
+fail:
+    fprintf(stderr, "rt_rig_up(%s): %s\n", scene, rs_error_message());
+    return 0;
+}
+
+static inline void rt_rig_down(rt_rig *g)
+{
+    rs_sched_destroy(g->sched);
+    rs_device_destroy(g->dev);
+    rs_bvh_destroy(g->bvh);
+    rs_scene_destroy(g->scene);
+    memset(g, 0, sizeof *g);
 }
 
 /* Renders a finalized scene the caller owns (a->scene is ignored).  Returns width * height * 3
