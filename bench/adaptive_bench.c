@@ -117,9 +117,9 @@ int main(int argc, char **argv)
             a.adaptive.threshold = rows[m].threshold;
             a.adaptive.min_spp = 16;
             a.adaptive_out = &as;
-            t0 = rs_bench_now();
+            t0 = rs_now_s();
             img = rt_render(&a, NULL);
-            t[m][r] = rs_bench_now() - t0;
+            t[m][r] = rs_now_s() - t0;
             if (!img)
                 return 1;
             if (r == 0) {

@@ -64,12 +64,12 @@ static rs_bvh *build_timed(const rs_geom *g, const rs_bvh_builder *b, uint32_t m
         o.threads = (uint32_t)threads;
         rs_bvh_destroy(bvh);
         bvh = NULL;
-        t0 = rs_bench_now();
+        t0 = rs_now_s();
         if (rs_bvh_build(g, &o, &bvh) != RS_OK) {
             fprintf(stderr, "bvh_bench: %s\n", rs_error_message());
             return NULL;
         }
-        t[k] = rs_bench_now() - t0;
+        t[k] = rs_now_s() - t0;
     }
     *median_s = rs_bench_median(t, runs);
     return bvh;
@@ -79,7 +79,7 @@ static rs_bvh *build_timed(const rs_geom *g, const rs_bvh_builder *b, uint32_t m
 static double trace(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads)
 {
     rs_bvh_view v = rs_bvh_view_of(bvh);
-    double t0 = rs_bench_now();
+    double t0 = rs_now_s();
     long i, n = (long)s->n;
     if (threads == 1) {
         for (i = 0; i < n; ++i)
@@ -89,7 +89,7 @@ static double trace(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads
         for (i = 0; i < n; ++i)
             rs_bvh_closest(&v, g, s->rays[i], &s->hits[i]);
     }
-    return rs_bench_now() - t0;
+    return rs_now_s() - t0;
 }
 
 static double mrays(const rs_bvh *bvh, const rs_geom *g, ray_set *s, int threads, int runs)

@@ -87,7 +87,7 @@ static int run_once(const char *path, int flatten, const br_config *c, float *rg
     rs_bvh *bvh = NULL;
     rs_bvh_build_opts bo;
     rs_render_stats stats;
-    double t0 = rs_bench_now();
+    double t0 = rs_now_s();
     int ok;
     if (rs_scene_load_json(path, &s) != RS_OK ||
         (flatten && (rs_scene_flatten_instances(s) != RS_OK || rs_scene_finalize(s) != RS_OK))) {
@@ -95,18 +95,18 @@ static int run_once(const char *path, int flatten, const br_config *c, float *rg
         rs_scene_destroy(s);
         return 0;
     }
-    out->load_s = rs_bench_now() - t0;
+    out->load_s = rs_now_s() - t0;
     g = rs_scene_geom(s);
     memset(&bo, 0, sizeof bo);
     bo.builder.method = RS_BVH_SAH;
     bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, &g);
-    t0 = rs_bench_now();
+    t0 = rs_now_s();
     if (rs_bvh_build(&g, &bo, &bvh) != RS_OK) {
         fprintf(stderr, "instance_bench: %s\n", rs_error_message());
         rs_scene_destroy(s);
         return 0;
     }
-    out->build_s = rs_bench_now() - t0;
+    out->build_s = rs_now_s() - t0;
     /* the triangles (with materials, UVs, normals) and the trees */
     out->bytes = (double)(s->n_tris + s->n_inst_tris) *
                      (sizeof(rs_tri) + sizeof(uint32_t) + (s->tri_uv || s->inst_tri_uv ? 24 : 0) +
@@ -114,9 +114,9 @@ static int run_once(const char *path, int flatten, const br_config *c, float *rg
                  (double)s->n_instances * sizeof(rs_instance) * 2 +
                  (double)bvh->n_nodes * sizeof(rs_bvh_node) + bvh->n_prims * 4.0 +
                  (double)bvh->n_blas_nodes * sizeof(rs_bvh_node) + s->n_inst_tris * 4.0;
-    t0 = rs_bench_now();
+    t0 = rs_now_s();
     ok = br_render("instance_bench", s, &g, bvh, c, rgb, &stats);
-    out->render_s = rs_bench_now() - t0;
+    out->render_s = rs_now_s() - t0;
     rs_bvh_destroy(bvh);
     rs_scene_destroy(s);
     return ok;

@@ -7,22 +7,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "core/clock.h"
 #include "core/parallel.h"
 #include "gpu/gpu_device.h"
 
 #ifndef RS_BUILD_FLAGS
 #  define RS_BUILD_FLAGS "?"
 #endif
-
-/* Seconds on the monotonic clock. */
-static inline double rs_bench_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static inline int rs_bench_cmp_double(const void *a, const void *b)
 {

@@ -174,9 +174,9 @@ static int render_once(int ranks, const char *scene, uint32_t w, uint32_t h, uin
     argv[k++] = (char *)"--stats-json";
     argv[k++] = json;
     argv[k] = NULL;
-    t0 = rs_bench_now();
+    t0 = rs_now_s();
     rc = run_quiet(argv, ranks == 0);
-    out->wall_s = rs_bench_now() - t0;
+    out->wall_s = rs_now_s() - t0;
     if (rc != 0) {
         fprintf(stderr, "%s: %s render with %d ranks failed (exit %d)\n", prog, scene, ranks, rc);
         return 0;

@@ -570,12 +570,12 @@ int main(int argc, char **argv)
            "fallback); chunk, wave size and waves in flight random; faults after 0-6 chunks\n",
            seconds, (unsigned long long)seed);
     fflush(stdout);
-    t0 = rs_bench_now();
-    while (rs_bench_now() - t0 < seconds)
+    t0 = rs_now_s();
+    while (rs_now_s() - t0 < seconds)
         round_once(&ty, dir);
     rmdir(dir);
 
-    printf("rounds: %ld in %.1f s; renders: %ld (", ty.rounds, rs_bench_now() - t0, ty.renders);
+    printf("rounds: %ld in %.1f s; renders: %ld (", ty.rounds, rs_now_s() - t0, ty.renders);
     for (i = 0; i < N_SETS; ++i)
         printf("%s%s %ld", i ? ", " : "", set_names[i], ty.per_set[i]);
     printf(")\n");

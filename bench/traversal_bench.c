@@ -72,7 +72,7 @@ typedef struct ours_ctx {
 static double trace_ours(const ours_ctx *c, int e, const bs_rays *s, int q, int threads,
                          answers *a)
 {
-    double t0 = rs_bench_now();
+    double t0 = rs_now_s();
     (void)threads; /* read only by the OpenMP clauses (compiled out under ThreadSanitizer) */
     long i, n = (long)s->n;
     if (q == Q_CLOSEST) {
@@ -95,7 +95,7 @@ static double trace_ours(const ours_ctx *c, int e, const bs_rays *s, int q, int 
                                        : e == ENGINE_BVH4 ? rs_bvh4_occluded(c->b4, c->g, s->rays[i])
                                                           : rs_bvh_occluded(&c->v, c->g, s->rays[i]));
     }
-    return rs_bench_now() - t0;
+    return rs_now_s() - t0;
 }
 
 /* ---- Embree -------------------------------------------------------------------------------- */
@@ -220,7 +220,7 @@ static void embree_ray(const rs_ray *r, struct RTCRay *e)
 
 static double trace_embree(const embree_scene *e, const bs_rays *s, int q, int threads, answers *a)
 {
-    double t0 = rs_bench_now();
+    double t0 = rs_now_s();
     long i, n = (long)s->n;
     if (q == Q_CLOSEST) {
 #  pragma omp parallel for schedule(dynamic, CHUNK) num_threads(threads)
@@ -248,7 +248,7 @@ static double trace_embree(const embree_scene *e, const bs_rays *s, int q, int t
             a->occluded[i] = r.tfar < 0.0f;
         }
     }
-    return rs_bench_now() - t0;
+    return rs_now_s() - t0;
 }
 #endif
 
@@ -370,12 +370,12 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     bo.builder = st->builder;
     /* as the CLI builds it for the CPU device */
     bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(0, &sc->g);
-    build_s = rs_bench_now();
+    build_s = rs_now_s();
     if (rs_bvh_build(&sc->g, &bo, &bvh) != RS_OK) {
         fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
         goto out;
     }
-    build_s = rs_bench_now() - build_s;
+    build_s = rs_now_s() - build_s;
     if (rs_bvh4_build(bvh, &sc->g, &bvh4) != RS_OK || rs_bvh8_build(bvh, &sc->g, &bvh8) != RS_OK) {
         fprintf(stderr, "traversal_bench: %s: %s\n", sc->label, rs_error_message());
         goto out;
@@ -395,13 +395,13 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
         if (sc->g.sphere_motion) {
             printf("\n(Embree left out on %s: it has moving spheres)\n", sc->label);
         } else {
-            embree_build_s = rs_bench_now();
+            embree_build_s = rs_now_s();
             if (!embree_build(&es, &sc->g)) {
                 fprintf(stderr, "traversal_bench: %s: Embree could not build the scene\n",
                         sc->label);
                 goto out;
             }
-            embree_build_s = rs_bench_now() - embree_build_s;
+            embree_build_s = rs_now_s() - embree_build_s;
             embree = 1;
             on1[ENGINE_EMBREE] = onn[ENGINE_EMBREE] = 1;
         }

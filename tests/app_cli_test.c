@@ -456,7 +456,7 @@ static void let_it_render(proc *p)
         proc_pump(p, 100);
         if (waitpid(p->pid, &p->status, WNOHANG) == p->pid) {
             p->reaped = 1;
-            p->seconds = now_s() - p->start;
+            p->seconds = rs_now_s() - p->start;
             EXPECT(p, 0, "the long render ended before the signal was sent");
         }
     }
@@ -473,7 +473,7 @@ static void signal_case(const fixture *f, const char *const *args, int sig, doub
 
     proc_start(&p, f->dir, args);
     let_it_render(&p);
-    sent = now_s();
+    sent = rs_now_s();
     assert_int_equal(kill(p.pid, sig), 0);
     proc_finish(&p, (sent - p.start) + limit_s);
     EXPECT(&p, !p.timed_out, "signal %d should end the render within %.0f s", sig, limit_s);
@@ -594,8 +594,8 @@ static void test_second_signal_removes_temp_file(void **state)
         snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)p.pid);
         let_it_render(&p);
         assert_int_equal(kill(p.pid, SIGINT), 0);
-        deadline = now_s() + SIGINT_EXIT_LIMIT_S;
-        while (!seen && now_s() < deadline) {
+        deadline = rs_now_s() + SIGINT_EXIT_LIMIT_S;
+        while (!seen && rs_now_s() < deadline) {
             if (file_exists(tmp)) {
                 seen = 1;
                 kill(p.pid, SIGINT);
@@ -606,7 +606,7 @@ static void test_second_signal_removes_temp_file(void **state)
                 sleep_s(0.0005);
             }
         }
-        proc_finish(&p, (now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
+        proc_finish(&p, (rs_now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
         EXPECT(&p, seen || !exited_with(&p, 130),
                "the image was written without %s ever existing: is core/image_io's temporary "
                "name still OUT.tmp-PID?",
@@ -651,8 +651,8 @@ static void test_reader_gone_keeps_rendering(void **state)
     image im;
     double deadline;
     proc_start(&p, f->dir, args);
-    deadline = now_s() + DEFAULT_TIMEOUT_S;
-    while (!strchr(p.err.data, '\n') && p.err_fd >= 0 && now_s() < deadline)
+    deadline = rs_now_s() + DEFAULT_TIMEOUT_S;
+    while (!strchr(p.err.data, '\n') && p.err_fd >= 0 && rs_now_s() < deadline)
         proc_pump(&p, 20);
     EXPECT(&p, strchr(p.err.data, '\n') != NULL, "expected a progress line on stderr");
     if (p.out_fd >= 0)
@@ -761,7 +761,7 @@ static void test_failed_stats_keeps_image(void **state)
     let_it_render(&p);
     EXPECT(&p, rmdir(path) == 0, "cannot remove %s: %s", path, strerror(errno));
     assert_int_equal(kill(p.pid, SIGINT), 0);
-    proc_finish(&p, (now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
+    proc_finish(&p, (rs_now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
     EXPECT(&p, file_is(f, "good.png", good, n_good), "good.png was replaced by a failed run");
     EXPECT(&p, exited_with(&p, 1), "failing to write the stats is a runtime error: status 1");
     EXPECT(&p, strstr(p.err.data, "st.json") && strstr(p.err.data, "no output was replaced"),
@@ -1463,7 +1463,7 @@ static void test_resume_after_signal(void **state)
     proc_start(&p, f->dir, sig_run);
     let_it_render(&p);
     assert_int_equal(kill(p.pid, SIGINT), 0);
-    proc_finish(&p, (now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
+    proc_finish(&p, (rs_now_s() - p.start) + SIGINT_EXIT_LIMIT_S);
     EXPECT(&p, exited_with(&p, 130), "SIGINT should stop it with status 130");
     samples = json_number(f, "s.json", "samples");
     EXPECT(&p, samples > 0, "s.json should count the samples done: %lld", samples);

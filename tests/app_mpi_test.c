@@ -401,7 +401,7 @@ static void test_ctrl_c_stops_every_rank(void **state)
         argv[k++] = args[i];
     argv[k] = NULL;
     proc_start_prog(&p, f->dir, "mpirun", argv);
-    while (now_s() - p.start < 3.0)
+    while (rs_now_s() - p.start < 3.0)
         proc_pump(&p, 50);
     kill(p.pid, SIGINT);
     proc_finish(&p, 30.0);

@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 #include "core/image_io.h"
 
 #ifndef RS_BINARY
@@ -59,13 +60,6 @@ typedef struct proc {
     int timed_out;
     double start, seconds;
 } proc;
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void sleep_s(double s)
 {
@@ -123,7 +117,7 @@ static void proc_start_prog(proc *p, const char *cwd, const char *prog, const ch
         set_cloexec(out_pipe[i]);
         set_cloexec(err_pipe[i]);
     }
-    p->start = now_s();
+    p->start = rs_now_s();
     p->pid = fork();
     assert_true(p->pid >= 0);
     if (p->pid == 0) {
@@ -201,14 +195,14 @@ static void proc_finish(proc *p, double timeout_s)
         r = waitpid(p->pid, &p->status, WNOHANG);
         if (r == p->pid) {
             p->reaped = 1;
-        } else if (now_s() > deadline) {
+        } else if (rs_now_s() > deadline) {
             kill(p->pid, SIGKILL);
             waitpid(p->pid, &p->status, 0);
             p->reaped = 1;
             p->timed_out = 1;
         }
     }
-    p->seconds = now_s() - p->start;
+    p->seconds = rs_now_s() - p->start;
     /* the child is gone: what is left in the pipes ends in end of file */
     while (p->out_fd >= 0 || p->err_fd >= 0)
         proc_pump(p, 1000);
