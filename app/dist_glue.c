@@ -1,0 +1,349 @@
+/* app/dist_glue.c — `raystream render` under mpirun (docs/distributed.md): every rank runs the
+ * render's setup steps (app/render_run.h), rank 0 hands out passes of samples and gathers the
+ * films (app/distributed.h), then writes the outputs as one render would. */
+#include "app/dist_glue.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "app/signals.h"
+#include "core/alloc.h"
+
+/* Sends stderr to `fd` (flushing first); returns what restores it, or -1 when it could not be
+ * moved. */
+static int stderr_divert(int fd)
+{
+    int saved;
+    fflush(stderr);
+    if ((saved = dup(2)) >= 0)
+        dup2(fd, 2);
+    return saved;
+}
+
+/* Undoes stderr_divert (nothing for -1). */
+static void stderr_restore(int saved)
+{
+    if (saved < 0)
+        return;
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+}
+
+int rs_mpi_parse_options(int argc, char **argv, rs_cli_options *o)
+{
+    int ranks, rank = 0, local, saved = -1, rc;
+    if (rs_dist_launched(&ranks, &rank, &local) && rank > 0) {
+        int null = open("/dev/null", O_WRONLY);
+        if (null >= 0) {
+            saved = stderr_divert(null);
+            close(null);
+        }
+    }
+    rc = rs_cli_parse(argc, argv, o);
+    stderr_restore(saved);
+    return rc;
+}
+
+/* One pass of an MPI job: samples [s0, s0 + n) of every pixel onto `film`, on this rank's
+ * devices, from its render thread. */
+static rs_status dist_render_pass(void *user, uint32_t s0, uint32_t n, rs_film *film,
+                                  const atomic_int *cancel, rs_render_stats *stats)
+{
+    render_run *r = (render_run *)user;
+    rs_render_hooks h;
+    rs_work_plan plan;
+    rs_status st;
+    memset(&h, 0, sizeof h);
+    h.cancel = cancel;
+    if (!rs_work_plan_samples(&plan, (uint64_t)r->st.width * r->st.height, s0, s0 + n))
+        st = rs_error_set(RS_ERR_NOMEM, "out of memory");
+    else
+        st = rs_engine_run(r->engine, &plan, &h, film, stats);
+    rs_work_plan_free(&plan);
+    return st;
+}
+
+/* "host: cpu (2 threads), gpu0" */
+static void dist_describe(const render_run *r, char *out, size_t n)
+{
+    char host[64] = "?";
+    size_t len;
+    int i;
+    gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = 0;
+    len = (size_t)snprintf(out, n, "%s:", host);
+    for (i = 0; i < (r->mk ? 1 : r->n_devs) && len < n; ++i) {
+        const rs_device *d = r->mk ? r->mk : r->devs[i];
+        len += (size_t)snprintf(out + len, n - len, "%s %s", i ? "," : "", d->name);
+    }
+}
+
+/* The options an MPI job cannot honour yet, refused by rank 0 (the others stay quiet). */
+static int dist_check_options(const rs_cli_options *o, int rank, rs_dist_fault *fault)
+{
+    const char *what = NULL;
+    if (rs_dist_fault_parse(getenv("RS_MPI_FAULT"), fault) != RS_OK) {
+        if (rank == 0)
+            rs_app_fail(0, NULL);
+        rs_error_clear();
+        return RS_EXIT_USAGE;
+    }
+    if (o->adaptive > 0)
+        what = "--adaptive (its rounds depend on the whole film)";
+    else if (o->aovs)
+        what = "--aov";
+    if (!what)
+        return RS_EXIT_OK;
+    if (rank == 0)
+        fprintf(stderr, "raystream: %s is not supported under mpirun yet; run one process\n", what);
+    return RS_EXIT_USAGE;
+}
+
+/* The setup steps on one rank: scene, settings, BVH, devices; rank 0 also the outputs and the
+ * film (with --resume).  Returns an exit code. */
+static int dist_setup_steps(const rs_cli_options *o, render_run *r)
+{
+    int code = rs_run_load_scene(o, r);
+    if (code == RS_EXIT_OK) {
+        rs_run_settings(o, r);
+        if (r->rank == 0) {
+            if ((code = rs_run_check_outputs(o, r)) == RS_EXIT_OK)
+                code = rs_run_make_film(o, r);
+        } else if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK) {
+            code = rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
+        }
+    }
+    if (code == RS_EXIT_OK && r->rank == 0)
+        code = rs_run_resume_whole_samples(o, r,
+                                           "under mpirun a render continues whole samples "
+                                           "only (resume it on one process)");
+    if (code == RS_EXIT_OK && (code = rs_run_build_bvh(o, r)) == RS_EXIT_OK)
+        code = rs_run_start_devices(o, r);
+    return code;
+}
+
+/* Every rank: the setup steps.  The others' messages are held back until the ranks agree: when
+ * rank 0 failed too it has said why, and only a rank that failed alone shows its own.  Returns
+ * the job's exit code, the same on every rank. */
+static int dist_setup(const rs_cli_options *o, render_run *r)
+{
+    int code, worst, who = 0, saved = -1;
+    FILE *held = NULL;
+    char desc[RS_DIST_DESC];
+    if ((code = dist_check_options(o, r->rank, &r->dist_fault)) != RS_EXIT_OK)
+        return code;
+    if (r->rank > 0 && (held = tmpfile()) != NULL)
+        saved = stderr_divert(fileno(held));
+    code = dist_setup_steps(o, r);
+    desc[0] = 0;
+    if (code == RS_EXIT_OK)
+        dist_describe(r, desc, sizeof desc);
+    stderr_restore(saved);
+    worst = rs_dist_agree(r->dist, code, &who, desc);
+    if (held) {
+        if (code != RS_EXIT_OK && who == r->rank) { /* rank 0 started: say why this one did not */
+            char line[512];
+            rewind(held);
+            while (fgets(line, sizeof line, held))
+                fprintf(stderr, "raystream: rank %d: %s", r->rank,
+                        strncmp(line, "raystream: ", 11) == 0 ? line + 11 : line);
+        }
+        fclose(held);
+    }
+    if (worst != RS_EXIT_OK && r->rank == 0 && code == RS_EXIT_OK)
+        fprintf(stderr,
+                "raystream: rank %d could not start (its message is above); no rank "
+                "renders\n",
+                who);
+    return worst;
+}
+
+static void on_dist_progress(void *user, uint64_t done, uint64_t total)
+{
+    rs_progress_update(&((render_run *)user)->progress, done, total);
+}
+
+/* The film held r->held, plus the job's finished passes `done` (whole samples). */
+static int dist_held(render_run *r, const uint32_t (*done)[2], uint32_t n_done, rs_path_ranges *out)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    uint32_t i;
+    memset(out, 0, sizeof *out);
+    if (!rs_path_ranges_union(out, &r->held))
+        return 0;
+    for (i = 0; i < n_done; ++i)
+        if (!rs_path_ranges_add(out, npix * done[i][0], npix * (done[i][0] + done[i][1])))
+            return 0;
+    return 1;
+}
+
+/* rank 0, after each periodic flush of an MPI job: the --checkpoint */
+static void on_dist_saved(void *user, const rs_film *film, const uint32_t (*done)[2],
+                          uint32_t n_done)
+{
+    render_run *r = (render_run *)user;
+    rs_path_ranges held;
+    if (dist_held(r, done, n_done, &held))
+        (void)rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 1, &r->key, film, &held);
+    rs_path_ranges_free(&held);
+}
+
+/* Rank 0: the samples the film lacks (all of them, or the gaps of a --resume) as passes
+ * {first sample, samples} into *todo (rs_free it).  RS_EXIT_OK, or an exit code after a
+ * message. */
+static int dist_todo(render_run *r, uint32_t (**todo)[2], uint32_t *n_todo)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    rs_path_ranges lack;
+    uint32_t i;
+    memset(&lack, 0, sizeof lack);
+    *todo = rs_calloc((size_t)r->held.n + 1, sizeof **todo);
+    if (!*todo || !rs_path_ranges_complement(&r->held, npix * r->st.spp, &lack)) {
+        rs_free(*todo);
+        *todo = NULL;
+        rs_path_ranges_free(&lack);
+        return rs_app_fail(RS_EXIT_RUNTIME, "out of memory");
+    }
+    /* every range starts and ends on whole samples (checked at --resume) */
+    for (i = 0; i < lack.n; ++i) {
+        (*todo)[*n_todo][0] = (uint32_t)(lack.r[i][0] / npix);
+        (*todo)[(*n_todo)++][1] = (uint32_t)((lack.r[i][1] - lack.r[i][0]) / npix);
+    }
+    rs_path_ranges_free(&lack);
+    return RS_EXIT_OK;
+}
+
+/* Rank 0, after the job: its result as one render's statistics, the film's ranges for the
+ * final checkpoint.  Returns an exit code. */
+static int dist_gathered(render_run *r, rs_status st)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    rs_path_ranges now;
+    r->stats = r->dres.local;
+    r->stats.seconds = r->dres.seconds;
+    r->stats.paths_total = npix * r->st.spp - r->resumed;
+    r->stats.paths_done = npix * r->dres.samples_done;
+    r->stats.rays_closest = r->dres.rays_closest;
+    r->stats.rays_shadow = r->dres.rays_shadow;
+    r->stats.max_bounce = r->dres.max_bounce;
+    r->stats.time_limited = r->dres.time_limited;
+    if (st != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "render failed");
+    /* what the film holds now, for the final checkpoint (app/checkpoint.h: any ranges) */
+    if (!dist_held(r, (const uint32_t(*)[2])r->dres.done, r->dres.n_done, &now)) {
+        rs_path_ranges_free(&now);
+        return rs_app_fail(RS_EXIT_RUNTIME, "out of memory");
+    }
+    rs_path_ranges_free(&r->held);
+    r->held = now;
+    r->done = NULL;
+    if (r->dres.stopped) {
+        r->interrupted = rs_signals_caught() ? rs_signals_caught() : SIGTERM;
+        return RS_EXIT_SIGNALLED(r->interrupted);
+    }
+    return RS_EXIT_OK;
+}
+
+/* The job: rank 0 hands out the passes and gathers the films, every rank renders.  Rank 0 then
+ * has the frame and the statistics in r.  Returns an exit code. */
+static int dist_run(const rs_cli_options *o, render_run *r)
+{
+    rs_dist_job job;
+    rs_status st;
+    uint32_t(*todo)[2] = NULL, n_todo = 0;
+    int code;
+    rs_signals_install();
+    memset(&job, 0, sizeof job);
+    job.fault = r->dist_fault;
+    job.width = r->st.width;
+    job.height = r->st.height;
+    job.spp = r->st.spp;
+    if (r->rank == 0 && (code = dist_todo(r, &todo, &n_todo)) != RS_EXIT_OK)
+        return code;
+    job.todo = (const uint32_t(*)[2])todo;
+    job.n_todo = n_todo;
+    if (r->ckpt_out) {
+        job.flush_every_s = o->ckpt_every_s;
+        job.saved = on_dist_saved;
+    }
+    job.pass_spp = o->mpi_pass_spp;
+    job.time_limit_s = o->time_limit_s;
+    job.timeout_s = o->mpi_timeout_s;
+    job.cancel = rs_signals_cancel();
+    job.render = dist_render_pass;
+    job.user = r;
+    if (r->rank == 0)
+        job.progress = on_dist_progress;
+    if (r->rank == 0)
+        rs_progress_begin(&r->progress, !o->quiet);
+    st = rs_dist_render(r->dist, &job, r->film, &r->dres);
+    rs_free(todo);
+    if (r->rank == 0)
+        rs_progress_end(&r->progress);
+    if (r->rank > 0)
+        return st == RS_OK ? RS_EXIT_OK : rs_app_fail(RS_EXIT_RUNTIME, NULL);
+    return dist_gathered(r, st);
+}
+
+static int cmd_render_dist(const rs_cli_options *o, render_run *r)
+{
+    int code = dist_setup(o, r);
+    if (code != RS_EXIT_OK)
+        return code;
+    code = dist_run(o, r);
+    if (r->rank == 0 && (code == RS_EXIT_OK || r->interrupted))
+        code = rs_run_write_outputs(o, r, code);
+    rs_dist_result_free(&r->dres);
+    return code;
+}
+
+/* Whether an MPI launcher started this process: then r->dist (and 1), or an exit code. */
+static int start_dist(int *argc, char ***argv, render_run *r, int *code)
+{
+    int ranks = 1, rank = 0, local = 1;
+    *code = RS_EXIT_OK;
+    if (!rs_dist_launched(&ranks, &rank, &local))
+        return 0;
+    if (!rs_dist_built()) {
+        if (ranks <= 1)
+            return 0;
+        if (rank == 0)
+            fprintf(stderr,
+                    "raystream: started by mpirun as %d ranks, but this raystream was "
+                    "built without MPI (install libopenmpi-dev and rebuild; "
+                    "RS_MPI=AUTO finds it): every rank would render the whole frame\n",
+                    ranks);
+        *code = RS_EXIT_USAGE;
+        return 1;
+    }
+    if (rs_dist_init(argc, argv, &r->dist) != RS_OK) {
+        *code = rs_app_fail(RS_EXIT_RUNTIME, "starting MPI");
+        return 1;
+    }
+    r->rank = rs_dist_rank(r->dist);
+    r->local_ranks = local;
+    return 1;
+}
+
+int rs_mpi_render(const rs_cli_options *o, int *argc, char ***argv, render_run *r, int *code)
+{
+    rs_cli_options wo = *o;
+    if (!start_dist(argc, argv, r, code))
+        return 0;
+    if (!r->dist)
+        return 1;
+    if (r->rank > 0)
+        wo.quiet = 1; /* rank 0 shows the progress and the summary */
+    if (rs_fault_parse(getenv("RS_FAULT"), &r->fault) != RS_OK)
+        *code = rs_app_fail(RS_EXIT_USAGE, NULL);
+    else
+        *code = cmd_render_dist(&wo, r);
+    rs_run_release(r);
+    rs_dist_finish(r->dist);
+    return 1;
+}

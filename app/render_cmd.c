@@ -1,0 +1,411 @@
+/* app/render_cmd.c — `raystream render`: the steps of app/render_run.h (scene, settings,
+ * outputs checked, film, BVH, devices, engine), the render itself with the progress bar, the
+ * stop signals and periodic checkpoints, then the outputs.  Under mpirun the same steps run
+ * through app/dist_glue.c. */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/bvh8.h"
+#include "app/devices.h"
+#include "app/dist_glue.h"
+#include "app/render_run.h"
+#include "app/signals.h"
+#include "core/alloc.h"
+#include "core/image_io.h"
+#include "core/parallel.h"
+#include "gpu/gpu_device.h"
+
+/* The image size from the options and the scene's own size. */
+static void settings_size(const rs_cli_options *o, const rs_scene *scene, rs_render_settings *st)
+{
+    st->width = o->width ? o->width : scene->width;
+    st->height = o->height ? o->height : scene->height;
+    if (o->width && !o->height)
+        st->height = (uint32_t)(0.5 + (double)o->width * scene->height / scene->width);
+    if (!o->width && o->height)
+        st->width = (uint32_t)(0.5 + (double)o->height * scene->width / scene->height);
+    if (st->width < 1)
+        st->width = 1;
+    if (st->height < 1)
+        st->height = 1;
+}
+
+/* The render settings from the options and the scene's own size. */
+void rs_run_settings(const rs_cli_options *o, render_run *r)
+{
+    rs_render_settings *st = &r->st;
+    memset(st, 0, sizeof *st);
+    settings_size(o, r->scene, st);
+    st->spp = o->spp;
+    st->max_depth = o->max_depth;
+    st->seed = o->seed;
+    st->sampling = o->sampling;
+    st->sampler = o->sampler;
+    st->wave_paths = o->wave_paths;
+    st->waves_in_flight = o->waves;
+    r->threads = o->threads ? o->threads : rs_cpu_count();
+    /* ranks on one machine share its cores */
+    if (!o->threads && r->local_ranks > 1)
+        r->threads = r->threads / r->local_ranks > 0 ? r->threads / r->local_ranks : 1;
+    /* --integrator megakernel --devices cpu:N runs on N threads */
+    if (o->megakernel && !o->devices_auto && !o->devices[0].is_gpu && o->devices[0].threads)
+        r->threads = o->devices[0].threads;
+    st->threads = r->threads;
+    /* the CPU devices and the shading share `threads` cores (core/cores.h) */
+    rs_cores_init(&r->cores, r->threads);
+    st->cores = &r->cores;
+    st->strategy = o->strategy;
+}
+
+/* Every output is checked before any work (app/outputs.h): a folder, a file that cannot be
+ * written, a missing or read-only folder, two outputs on one file, an output over an input; then
+ * the image's format.  Returns an exit code: RS_EXIT_USAGE, nothing written, for all of them. */
+int rs_run_check_outputs(const rs_cli_options *o, render_run *r)
+{
+    const char *inputs[3];
+    rs_output *out = r->outs;
+    int n = 0, rc;
+    if (o->output) {
+        r->out = o->output;
+    } else {
+        snprintf(r->out_default, sizeof r->out_default, "%s.%s", r->name, o->aovs ? "exr" : "png");
+        r->out = r->out_default;
+    }
+    memset(r->outs, 0, sizeof r->outs);
+    out[n].option = o->output ? "-o" : "the image";
+    out[n++].path = r->out;
+    if (o->stats_json) {
+        out[n].option = "--stats-json";
+        out[n].path = o->stats_json;
+        out[n].may_be_special = 1; /* /dev/stdout */
+        r->stats_out = &out[n++];
+    }
+    if (o->timeline) {
+        out[n].option = "--timeline";
+        out[n].path = o->timeline;
+        r->timeline_out = &out[n++];
+    }
+    if (o->checkpoint) {
+        out[n].option = "--checkpoint";
+        out[n].path = o->checkpoint;
+        out[n].may_replace = o->resume; /* checkpointing on into the file it continues */
+        r->ckpt_out = &out[n++];
+    }
+    r->n_outs = n;
+    inputs[0] = strncmp(o->scene, "builtin:", 8) == 0 ? NULL : o->scene;
+    inputs[1] = o->mesh;
+    inputs[2] = o->resume;
+    if ((rc = rs_outputs_check(out, n, inputs, 3)) != RS_EXIT_OK)
+        return rc;
+    if (rs_image_check_output(r->out) != RS_OK)
+        return rs_app_fail(RS_EXIT_USAGE, NULL);
+    return RS_EXIT_OK;
+}
+
+/* A --resume whose ranges all end on whole samples: RS_EXIT_OK, else one line ending in
+ * `what` and RS_EXIT_USAGE. */
+int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, const char *what)
+{
+    uint64_t npix = (uint64_t)r->st.width * r->st.height;
+    uint32_t i;
+    for (i = 0; i < r->held.n; ++i)
+        if (r->held.r[i][1] % npix != 0) {
+            fprintf(stderr,
+                    "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
+                    "pixels); %s\n",
+                    o->resume, (unsigned long long)r->held.r[i][1], r->st.width, r->st.height,
+                    what);
+            return RS_EXIT_USAGE;
+        }
+    return RS_EXIT_OK;
+}
+
+/* What decides the image, for --checkpoint and --resume. */
+static void make_key(const rs_cli_options *o, render_run *r)
+{
+    rs_checkpoint_key *k = &r->key;
+    memset(k, 0, sizeof *k);
+    /* hashing every byte of a large scene takes a tenth of a second (the living room's 143k
+     * triangles and 5 MB of textures): only where a checkpoint is written or read */
+    if (o->checkpoint || o->resume)
+        k->scene_hash = rs_checkpoint_scene_hash(r->scene);
+    k->seed = r->st.seed;
+    k->width = r->st.width;
+    k->height = r->st.height;
+    k->spp = r->st.spp;
+    k->max_depth = r->st.max_depth;
+    k->rr_depth = r->st.rr_depth ? r->st.rr_depth : 3;
+    k->sampling = (uint32_t)r->st.sampling;
+    k->sampler = (uint32_t)r->st.sampler;
+    k->isect_sphere = o->isect_sphere;
+    k->isect_tri = o->isect_tri;
+    k->isect_aabb = o->isect_aabb;
+    k->scene = o->scene;
+}
+
+/* The film: a fresh one, or with --resume the checkpoint's (app/checkpoint.h), checked against
+ * these settings before any work; the render then starts at the first path it does not hold.
+ * --resume without --spp continues to the spp the checkpoint was started with.  Returns an exit
+ * code. */
+int rs_run_make_film(const rs_cli_options *o, render_run *r)
+{
+    int rc;
+    make_key(o, r);
+    if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
+    if (!o->resume)
+        return RS_EXIT_OK;
+    if (!o->spp_given)
+        r->key.spp = 0; /* the file's */
+    if ((rc = rs_checkpoint_read(o->resume, &r->key, r->film, &r->held)) != RS_EXIT_OK)
+        return rc;
+    r->st.spp = r->key.spp;
+    r->resumed = rs_path_ranges_total(&r->held);
+    if (o->megakernel)
+        return rs_run_resume_whole_samples(o, r,
+                                           "the megakernel continues whole passes only (use "
+                                           "--integrator stream)");
+    return RS_EXIT_OK;
+}
+
+/* Whether the render may trace on a GPU (or its fallback): --devices names one, or auto finds
+ * one. */
+static int any_gpu(const rs_cli_options *o)
+{
+    const char *why = "";
+    int i;
+    if (o->devices_auto)
+        return rs_gpu_count(&why) > 0;
+    for (i = 0; i < o->n_devices; ++i)
+        if (o->devices[i].is_gpu)
+            return 1;
+    return 0;
+}
+
+/* The BVH over the geometry with the chosen intersection tests.  Returns an exit code. */
+int rs_run_build_bvh(const rs_cli_options *o, render_run *r)
+{
+    rs_bvh_build_opts bo;
+    double t0;
+    r->geom = rs_scene_geom(r->scene);
+    r->geom.sphere_algo = o->isect_sphere;
+    r->geom.tri_algo = o->isect_tri;
+    r->geom.aabb_algo = o->isect_aabb;
+    memset(&bo, 0, sizeof bo);
+    bo.builder = o->bvh;
+    bo.threads = (uint32_t)r->threads;
+    if (o->no_bvh) /* one leaf holding everything: each ray tests every primitive */
+        bo.max_leaf = UINT32_MAX;
+    else if (!any_gpu(o)) /* leaves the size of the CPU's wide tree's blocks, which test them
+                             at once; a GPU's binary kernel keeps the classic SAH leaves */
+        bo.leaf_block = bo.max_leaf = rs_bvh_wide_leaf_size(o->bvh_width, &r->geom);
+    if (o->bvh_on_gpu) {
+        const char *why = "";
+        if (rs_gpu_count(&why) > 0)
+            bo.lbvh_sort = rs_gpu_lbvh_sort; /* device 0 */
+        else
+            fprintf(stderr, "raystream: warning: %s; the lbvh is built on the CPU\n", why);
+    }
+    t0 = rs_now_s();
+    if (rs_bvh_build(&r->geom, &bo, &r->bvh) != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "building the BVH");
+    rs_bvh_attach(r->bvh, &r->geom);
+    r->bvh_ms = 1e3 * (rs_now_s() - t0);
+    return RS_EXIT_OK;
+}
+
+/* The devices (one for the megakernel) with the scene uploaded to each.  Returns the count, or
+ * -1 after a message. */
+static int make_devices(const rs_cli_options *o, render_run *r)
+{
+    rs_device **devs = o->megakernel ? &r->mk : r->devs;
+    int n = rs_devices_create(o, &r->fault, r->threads, o->megakernel ? NULL : &r->cores, devs);
+    int i;
+    if (n < 0)
+        return -1;
+    if (!o->megakernel)
+        r->n_devs = n;
+    for (i = 0; i < n; ++i)
+        if (rs_device_upload(devs[i], &r->geom, r->bvh) != RS_OK) {
+            char what[96];
+            snprintf(what, sizeof what, "uploading the scene to %s", devs[i]->name);
+            rs_app_fail(RS_EXIT_RUNTIME, what);
+            return -1;
+        }
+    return n;
+}
+
+/* The devices, the scene uploaded to each, the timeline, the scheduler, the image, the engine.
+ * Returns an exit code. */
+int rs_run_start_devices(const rs_cli_options *o, render_run *r)
+{
+    int n = make_devices(o, r);
+    if (n < 0)
+        return RS_EXIT_RUNTIME;
+    /* about 200 spans per wave and device; the log never grows past this */
+    if (o->timeline && rs_timeline_create(1u << 20, &r->timeline) != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "starting the timeline");
+    r->st.timeline = r->timeline;
+    r->st.timeline_lane = (uint16_t)(o->megakernel ? 1 : n);
+    if (!o->megakernel) {
+        rs_sched_config cfg;
+        memset(&cfg, 0, sizeof cfg);
+        cfg.chunk_size = o->chunk_size;
+        cfg.timeline = r->timeline;
+        if (rs_sched_create(r->devs, n, &cfg, &r->sched) != RS_OK)
+            return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
+    }
+    r->rgb = (float *)rs_alloc((size_t)r->st.width * r->st.height * 3, sizeof *r->rgb);
+    if (!r->rgb) {
+        fprintf(stderr, "raystream: out of memory for a %ux%u image\n", r->st.width, r->st.height);
+        return RS_EXIT_RUNTIME;
+    }
+    /* under mpirun the job's coordinator keeps the time (app/distributed.h) */
+    r->st.time_limit_s = r->dist ? 0.0 : o->time_limit_s;
+    if (rs_engine_create(r->scene, &r->st, r->sched, r->mk, &r->engine) != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
+    return RS_EXIT_OK;
+}
+
+void rs_run_release(render_run *r)
+{
+    int i;
+    rs_engine_destroy(r->engine);
+    rs_sched_destroy(r->sched);
+    for (i = 0; i < r->n_devs; ++i)
+        rs_device_destroy(r->devs[i]);
+    rs_device_destroy(r->mk);
+    rs_timeline_destroy(r->timeline);
+    rs_film_destroy(r->film);
+    rs_free(r->rgb);
+    rs_bvh_destroy(r->bvh);
+    rs_scene_destroy(r->scene);
+    rs_path_ranges_free(&r->held);
+}
+
+/* What the film holds now: the paths held before and what the render under way added.  0 when
+ * out of memory (after a message). */
+static int film_ranges(const render_run *r, rs_path_ranges *out)
+{
+    memset(out, 0, sizeof *out);
+    if (rs_path_ranges_union(out, &r->held) && (!r->done || rs_path_ranges_union(out, r->done)))
+        return 1;
+    fprintf(stderr, "raystream: out of memory for the checkpoint's list of paths\n");
+    rs_path_ranges_free(out);
+    return 0;
+}
+
+int rs_run_write_checkpoint(const render_run *r, int rename_now)
+{
+    rs_path_ranges held;
+    int ok;
+    if (!film_ranges(r, &held))
+        return 0;
+    ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, rename_now, &r->key, r->film,
+                             &held);
+    rs_path_ranges_free(&held);
+    return ok;
+}
+
+static void on_progress(void *user, uint64_t done, uint64_t total)
+{
+    rs_progress_update(&((render_run *)user)->progress, done, total);
+}
+
+/* The render thread, whenever the film holds what it held plus `done`: a periodic checkpoint.
+ * A failed one is reported and the render goes on (the last good file stays). */
+static void on_film_ready(void *user, const rs_film *film, const rs_path_ranges *done)
+{
+    render_run *r = (render_run *)user;
+    double now;
+    (void)film;
+    r->done = done;
+    if (!r->ckpt_out || (now = rs_now_s()) - r->last_ckpt < r->ckpt_every_s ||
+        rs_path_ranges_total(&r->held) + rs_path_ranges_total(done) ==
+            (uint64_t)r->st.width * r->st.height * r->st.spp)
+        return; /* the last is written at the end */
+    r->last_ckpt = now;
+    (void)rs_run_write_checkpoint(r, 1);
+}
+
+/* The engine's run over what the film lacks: everything, or the gaps of a --resume; or the
+ * rounds of --adaptive. */
+static rs_status engine_run(const rs_cli_options *o, render_run *r, const rs_render_hooks *hooks)
+{
+    rs_work_plan plan;
+    rs_status rst;
+    if (o->adaptive > 0) {
+        rs_adaptive a;
+        a.threshold = r->adaptive_t = o->adaptive;
+        a.min_spp = o->adaptive_min_spp;
+        return rs_render_adaptive(r->engine, &a, hooks, r->film, &r->stats, &r->adaptive);
+    }
+    memset(&plan, 0, sizeof plan);
+    if (!rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,
+                                   &plan.todo))
+        rst = rs_error_set(RS_ERR_NOMEM, "out of memory");
+    else
+        rst = rs_engine_run(r->engine, &plan, hooks, r->film, &r->stats);
+    rs_work_plan_free(&plan);
+    return rst;
+}
+
+/* The render itself, with the progress bar and the stop signals (which stay caught until the
+ * program ends: a second one while the outputs are written removes their temporary files).
+ * Returns an exit code: 128 + the signal for an interrupted render. */
+static int run_render(const rs_cli_options *o, render_run *r)
+{
+    rs_render_hooks hooks;
+    rs_status rst;
+    rs_signals_install();
+    rs_progress_begin(&r->progress, !o->quiet);
+    memset(&hooks, 0, sizeof hooks);
+    hooks.progress = on_progress;
+    hooks.user = r;
+    hooks.cancel = rs_signals_cancel();
+    r->ckpt_every_s = o->ckpt_every_s;
+    r->last_ckpt = rs_now_s();
+    if (r->ckpt_out) {
+        hooks.film_ready = on_film_ready;
+        rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
+    }
+    rst = engine_run(o, r, &hooks);
+    r->done = rs_engine_done(r->engine);
+    rs_progress_end(&r->progress);
+    if (rst == RS_ERR_CANCELLED) {
+        rs_error_clear();
+        r->interrupted = rs_signals_caught() ? rs_signals_caught() : SIGINT;
+        return RS_EXIT_SIGNALLED(r->interrupted);
+    }
+    if (rst != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "render failed");
+    return RS_EXIT_OK;
+}
+
+/* `raystream render`: scene, settings, outputs checked, BVH, devices, render, outputs. */
+int rs_cmd_render(const rs_cli_options *o, int *argc, char ***argv)
+{
+    render_run r;
+    int code;
+    memset(&r, 0, sizeof r);
+    if (rs_mpi_render(o, argc, argv, &r, &code))
+        return code;
+    /* RS_FAULT is input like the options: a bad value is a usage error, before any work */
+    if (rs_fault_parse(getenv("RS_FAULT"), &r.fault) != RS_OK)
+        return rs_app_fail(RS_EXIT_USAGE, NULL);
+    if ((code = rs_run_load_scene(o, &r)) == RS_EXIT_OK) {
+        rs_run_settings(o, &r);
+        if ((code = rs_run_check_outputs(o, &r)) == RS_EXIT_OK &&
+            (code = rs_run_make_film(o, &r)) == RS_EXIT_OK &&
+            (code = rs_run_build_bvh(o, &r)) == RS_EXIT_OK &&
+            (code = rs_run_start_devices(o, &r)) == RS_EXIT_OK) {
+            code = run_render(o, &r);
+            if (code == RS_EXIT_OK || r.interrupted)
+                code = rs_run_write_outputs(o, &r, code);
+        }
+    }
+    rs_run_release(&r);
+    return code;
+}

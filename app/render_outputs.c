@@ -1,0 +1,238 @@
+/* app/render_outputs.c — the outputs of a finished render, all or none: the report
+ * (app/report.h) filled once, the --stats table, the --stats-json file, the --timeline
+ * picture, the last --checkpoint, the image with its --aov layers and header, then the summary
+ * line. */
+#include <stdio.h>
+#include <string.h>
+
+#include "app/render_run.h"
+#include "app/report.h"
+#include "app/timeline_svg.h"
+#include "core/alloc.h"
+#include "core/parallel.h"
+#include "shading/aov.h"
+
+/* The devices' rows: the stream engine's (the scheduler's counters) or the megakernel's one,
+ * which traced everything, one path at a time. */
+static void report_devices(const render_run *r, rs_report *rep)
+{
+    int i;
+    if (r->mk) {
+        rs_report_device *d = &rep->dev[0];
+        d->ds.rays = rep->dev_rays = r->stats.rays_closest + r->stats.rays_shadow;
+        d->ds.busy_s = r->stats.seconds;
+        d->ds.chunks = r->stats.waves;
+        d->ds.bytes_to_device = r->mk->stats.bytes_to_device;
+        snprintf(d->name, sizeof d->name, "%s", r->mk->name);
+        d->threads = r->mk->threads;
+        d->alive = 1;
+        rep->n_dev = 1;
+        rep->megakernel = 1;
+        rep->mk_gpu = rs_device_is_gpu(r->mk);
+        return;
+    }
+    for (i = 0; i < r->n_devs; ++i) {
+        rs_report_device *d = &rep->dev[i];
+        rs_sched_device_stats(r->sched, i, &d->ds, &d->alive);
+        snprintf(d->name, sizeof d->name, "%s", r->devs[i]->name);
+        d->threads = r->devs[i]->threads;
+        rep->dev_rays += d->ds.rays;
+    }
+    rep->n_dev = r->n_devs;
+}
+
+/* The report of the render, once the film is final. */
+static void make_report(const rs_cli_options *o, const render_run *r, rs_report *rep)
+{
+    memset(rep, 0, sizeof *rep);
+    rep->scene = o->scene;
+    rep->image = r->out;
+    rep->resume = o->resume;
+    rep->checkpoint = r->ckpt_out ? r->ckpt_out->path : NULL;
+    rep->quiet = o->quiet;
+    rep->strategy = rs_par_strategy_name(o->strategy);
+    rep->width = r->st.width;
+    rep->height = r->st.height;
+    rep->spp = r->st.spp;
+    rep->spp_min = rs_film_min_count(r->film);
+    rep->max_depth = r->st.max_depth;
+    rep->seed = r->st.seed;
+    rep->sampling = r->st.sampling;
+    rep->sampler = r->st.sampler;
+    rep->adaptive = o->adaptive > 0 ? o->adaptive : 0.0;
+    rep->time_limit_s = o->time_limit_s;
+    rep->interrupted = r->interrupted;
+    rep->stats = r->stats;
+    rep->adaptive_stats = r->adaptive;
+    rep->resumed = r->resumed;
+    rep->checkpoint_samples =
+        rs_path_ranges_total(&r->held) + (r->done ? rs_path_ranges_total(r->done) : 0);
+    rep->nonfinite = r->film->nonfinite;
+    rs_bvh_builder_name(&r->bvh->builder, rep->bvh_builder, sizeof rep->bvh_builder);
+    rep->bvh_sah = rs_bvh_sah_cost(r->bvh);
+    rep->bvh_ms = r->bvh_ms;
+    rep->bvh_nodes = r->bvh->n_nodes;
+    rep->bvh_prims = r->bvh->n_prims;
+    rep->blas_nodes = r->bvh->n_blas_nodes;
+    rep->instances = r->scene->n_instances;
+    rep->inst_prims = r->scene->n_inst_prims;
+    rep->inst_tris = r->scene->n_inst_tris;
+    report_devices(r, rep);
+    rep->dist = r->dist ? &r->dres : NULL;
+}
+
+/* The --timeline picture, a lane per device, then the render thread's, into `path`.  0 after
+ * printing why. */
+static int write_timeline(const char *path, const render_run *r, const rs_report *rep)
+{
+    char lanes[RS_MAX_DEVICES + 1][96], title[160];
+    const char *names[RS_MAX_DEVICES + 1];
+    int i, t;
+    for (i = 0; i < rep->n_dev; ++i) {
+        size_t len;
+        rs_report_device_label(rep, i, lanes[i], sizeof lanes[i]);
+        len = strlen(lanes[i]);
+        if ((t = rep->dev[i].threads) > 0)
+            snprintf(lanes[i] + len, sizeof lanes[i] - len, " (%d thread%s)", t, t == 1 ? "" : "s");
+        names[i] = lanes[i];
+    }
+    snprintf(lanes[rep->n_dev], sizeof lanes[rep->n_dev], "shading (render thread)");
+    names[rep->n_dev] = lanes[rep->n_dev];
+    snprintf(title, sizeof title, "raystream render %s, %ux%u, %u spp, %s integrator", rep->scene,
+             rep->width, rep->height, rep->spp, rep->megakernel ? "megakernel" : "stream");
+    if (rs_timeline_write_svg(path, r->timeline, names, rep->n_dev + 1, title) != RS_OK) {
+        rs_app_fail(RS_EXIT_RUNTIME, NULL);
+        return 0;
+    }
+    return 1;
+}
+
+/* The buffers of the --aov layers asked for (rs_free them); 0 when out of memory. */
+static int alloc_aovs(unsigned aovs, size_t npix, float **bufs)
+{
+    if (aovs & RS_AOV_ALBEDO)
+        bufs[0] = (float *)rs_alloc(npix * 3, sizeof(float));
+    if (aovs & RS_AOV_NORMAL)
+        bufs[1] = (float *)rs_alloc(npix * 3, sizeof(float));
+    if (aovs & RS_AOV_DEPTH)
+        bufs[2] = (float *)rs_alloc(npix, sizeof(float));
+    if (aovs & RS_AOV_SAMPLES)
+        bufs[3] = (float *)rs_alloc(npix, sizeof(float));
+    return !(((aovs & RS_AOV_ALBEDO) && !bufs[0]) || ((aovs & RS_AOV_NORMAL) && !bufs[1]) ||
+             ((aovs & RS_AOV_DEPTH) && !bufs[2]) || ((aovs & RS_AOV_SAMPLES) && !bufs[3]));
+}
+
+/* The --aov layers of the finished render (shading/aov.h) into layers[], their buffers in
+ * bufs[] (rs_free them); returns how many, or -1 after a message. */
+static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_layer *layers,
+                     float **bufs)
+{
+    static const char *const names[4] = {"albedo", "normal", "depth", "samples"};
+    static const char *const channels[4] = {"RGB", "XYZ", "Z", "Y"};
+    size_t npix = (size_t)r->st.width * r->st.height;
+    rs_integrator it;
+    int n = 0, k;
+    uint32_t i;
+    bufs[0] = bufs[1] = bufs[2] = bufs[3] = NULL;
+    if (!o->aovs)
+        return 0;
+    if (!alloc_aovs(o->aovs, npix, bufs)) {
+        rs_error_set(RS_ERR_NOMEM, "out of memory for the --aov layers");
+        return -1;
+    }
+    if (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH)) {
+        rs_bvh_view v = rs_bvh_view_of(r->bvh);
+        if (rs_render_constants(r->scene, &r->st, &it) != RS_OK)
+            return -1;
+        rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, bufs[0], bufs[1], bufs[2]);
+    }
+    if (bufs[3])
+        for (i = 0; i < npix; ++i)
+            bufs[3][i] = (float)r->film->count[i];
+    for (k = 0; k < 4; ++k)
+        if (bufs[k]) {
+            layers[n].name = names[k];
+            layers[n].channels = channels[k];
+            layers[n++].data = bufs[k];
+        }
+    return n;
+}
+
+/* The image with its --aov layers and header (rs_image_write: its own temporary file, renamed
+ * into place).  0 after a message. */
+static int write_image(const rs_cli_options *o, const render_run *r, const rs_report *rep)
+{
+    rs_image_layer layers[4];
+    float *bufs[4];
+    rs_report_meta meta;
+    int i, ok = 1, n_layers;
+    rs_report_image_meta(rep, &meta);
+    n_layers = make_aovs(o, r, layers, bufs);
+    if (n_layers < 0) {
+        rs_app_fail(0, NULL);
+        ok = 0;
+        n_layers = 0;
+    }
+    if (ok && rs_image_write_layers(r->out, r->st.width, r->st.height, r->rgb, layers,
+                                    (size_t)n_layers, meta.meta, RS_REPORT_META_N) != RS_OK) {
+        rs_app_fail(0, NULL);
+        ok = 0;
+    }
+    for (i = 0; i < 4; ++i)
+        if (o->aovs)
+            rs_free(bufs[i]);
+    return ok;
+}
+
+/* Tracks every name an output may be written under, so a second signal removes whichever
+ * exist. */
+static void track_outputs(const render_run *r, char *timeline_inner, size_t n)
+{
+    int i;
+    for (i = 0; i < r->n_outs; ++i)
+        if (!r->outs[i].in_place)
+            rs_outputs_track(r->outs[i].staged); /* outs[0]'s is the core's image temporary */
+    if (r->timeline_out) {                       /* rs_timeline_write_svg's own temporary name */
+        snprintf(timeline_inner, n, "%s.tmp", r->timeline_out->staged);
+        rs_outputs_track(timeline_inner);
+    }
+}
+
+/* The outputs, all or none: the stats JSON and the timeline to their staged names, then the
+ * image, then the staged files renamed.  A failure before the image is in place replaces
+ * nothing; a --stats-json that is a special file (/dev/stdout) is written last, in place.
+ * Returns the exit code: `code`, or RS_EXIT_RUNTIME. */
+int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
+{
+    rs_report rep;
+    char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
+    int i, ok = 1, replaced = 0;
+    rs_film_resolve(r->film, r->rgb);
+    make_report(o, r, &rep);
+    if (o->stats)
+        rs_report_print_table(&rep);
+    track_outputs(r, timeline_inner, sizeof timeline_inner);
+    if (r->stats_out && !r->stats_out->in_place)
+        ok = rs_report_write_json(&rep, r->stats_out->staged, r->stats_out->path);
+    if (ok && r->timeline_out)
+        ok = write_timeline(r->timeline_out->staged, r, &rep);
+    if (ok && r->ckpt_out) /* renamed below with the others */
+        ok = rs_run_write_checkpoint(r, 0);
+    if (ok)
+        ok = write_image(o, r, &rep);
+    replaced = ok;
+    for (i = 1; ok && i < r->n_outs; ++i)
+        if (!r->outs[i].in_place)
+            ok = rs_output_commit(&r->outs[i]);
+    if (ok && r->stats_out && r->stats_out->in_place)
+        ok = rs_report_write_json(&rep, r->stats_out->path, r->stats_out->path);
+    rs_outputs_remove_tracked(); /* what was not renamed */
+    rs_outputs_untrack();
+    if (!ok) {
+        fprintf(stderr, "raystream: the run failed; %s\n",
+                replaced ? "some outputs were already replaced" : "no output was replaced");
+        return RS_EXIT_RUNTIME;
+    }
+    rs_report_print_summary(&rep);
+    return code;
+}

@@ -1,0 +1,89 @@
+/* app/render_run.h — what one `raystream render` makes and the named steps that make it, shared
+ * by the render command (render_cmd.c), its outputs (render_outputs.c) and its MPI glue
+ * (dist_glue.c).  Internal to app/.
+ *
+ * The steps run in this order, each returning an exit code (RS_EXIT_*; a failure has printed
+ * one line): rs_run_load_scene, rs_run_settings, rs_run_check_outputs, rs_run_make_film,
+ * rs_run_build_bvh, rs_run_start_devices, then the render, then rs_run_write_outputs.  Whatever
+ * they made is released by rs_run_release, whichever step stopped. */
+#ifndef RS_APP_RENDER_RUN_H
+#define RS_APP_RENDER_RUN_H
+
+#include "app/checkpoint.h"
+#include "app/distributed.h"
+#include "app/options.h"
+#include "app/outputs.h"
+#include "app/progress.h"
+#include "scheduler/adaptive.h"
+#include "scheduler/fault.h"
+#include "scheduler/render.h"
+
+#ifndef RS_VERSION
+#  define RS_VERSION "0.0.0"
+#endif
+
+/* Everything one `raystream render` makes, released by rs_run_release. */
+typedef struct render_run {
+    rs_scene *scene;
+    rs_bvh *bvh;
+    rs_geom geom;
+    double bvh_ms;
+    rs_device *devs[RS_MAX_DEVICES]; /* the stream engine's devices */
+    int n_devs;
+    rs_device *mk; /* the megakernel's one device */
+    rs_sched *sched;
+    rs_engine *engine; /* set up once; every plan of the render runs on it */
+    rs_film *film;
+    rs_timeline *timeline;
+    float *rgb;
+    rs_cores cores;
+    int threads;
+    rs_render_settings st;
+    rs_render_stats stats;
+    rs_adaptive_stats adaptive; /* --adaptive: rounds, samples, pixels stopped */
+    double adaptive_t;          /* --adaptive's threshold, 0: off */
+    char name[64];              /* the scene's stem: default output name */
+    char out_default[96];
+    const char *out;
+    rs_fault_spec fault;            /* RS_FAULT */
+    rs_output outs[RS_OUTPUTS_MAX]; /* the image, then --stats-json and --timeline if asked */
+    int n_outs;
+    rs_output *stats_out, *timeline_out; /* into outs, or NULL */
+    rs_output *ckpt_out;                 /* --checkpoint, into outs, or NULL */
+    int interrupted;                     /* the signal that stopped the render, or 0 */
+    rs_checkpoint_key key;               /* what decides the image, for --checkpoint/--resume */
+    uint64_t resumed;                    /* paths the --resume file held */
+    rs_path_ranges held;                 /* paths the film held before the render under way */
+    const rs_path_ranges *done;          /* ... and what the render has added (the engine's) */
+    double last_ckpt;                    /* when the last checkpoint was written (rs_now_s) */
+    double ckpt_every_s;                 /* --checkpoint-interval */
+    rs_progress progress;
+    rs_dist *dist;            /* under mpirun (app/distributed.h), or NULL */
+    int rank;                 /* this process's rank (0 without MPI) */
+    int local_ranks;          /* ranks on this machine: they share its cores */
+    rs_dist_result dres;      /* rank 0: the job's result */
+    rs_dist_fault dist_fault; /* RS_MPI_FAULT */
+} render_run;
+
+/* Prints "raystream: WHAT: <the first error's message>" and returns `code`. */
+int rs_app_fail(int code, const char *what);
+
+/* The steps (render_cmd.c, render_outputs.c); see the top of this file. */
+int rs_run_load_scene(const rs_cli_options *o, render_run *r); /* under the load watchdog */
+void rs_run_settings(const rs_cli_options *o, render_run *r);
+int rs_run_check_outputs(const rs_cli_options *o, render_run *r);
+int rs_run_make_film(const rs_cli_options *o, render_run *r);
+int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, const char *what);
+int rs_run_build_bvh(const rs_cli_options *o, render_run *r);
+int rs_run_start_devices(const rs_cli_options *o, render_run *r);
+/* The outputs, all or none, then the summary; returns `code` or RS_EXIT_RUNTIME. */
+int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code);
+/* The --checkpoint of the film as it is now; 0 after a message. */
+int rs_run_write_checkpoint(const render_run *r, int rename_now);
+void rs_run_release(render_run *r);
+
+/* The commands (render_cmd.c, scene_load.c). */
+int rs_cmd_render(const rs_cli_options *o, int *argc, char ***argv);
+int rs_cmd_export(const rs_cli_options *o);
+
+#endif

@@ -1,0 +1,69 @@
+/* app/report.h — what a finished render reports, filled once (app/render_outputs.c) and written
+ * four ways: the --stats table, the --stats-json file, the summary line and the .exr header's
+ * attributes.  Internal to app/. */
+#ifndef RS_APP_REPORT_H
+#define RS_APP_REPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "app/distributed.h"
+#include "app/options.h"
+#include "core/image_io.h"
+#include "scheduler/adaptive.h"
+#include "scheduler/render.h"
+
+/* One device: the stream engine's (the scheduler's counters) or the megakernel's one. */
+typedef struct rs_report_device {
+    char name[48]; /* the device's own name */
+    int threads, alive;
+    rs_device_stats ds;
+} rs_report_device;
+
+typedef struct rs_report {
+    /* what was asked: the options' strings (they outlive the report) */
+    const char *scene, *image, *resume, *checkpoint; /* resume, checkpoint: NULL where none */
+    int quiet, megakernel, mk_gpu;                   /* mk_gpu: the megakernel ran on a GPU */
+    const char *strategy;                            /* the megakernel's host thread split */
+    uint32_t width, height, spp, spp_min, max_depth; /* spp asked; spp_min every pixel has */
+    uint64_t seed;
+    rs_sampling sampling;
+    rs_sampler sampler;
+    double adaptive, time_limit_s; /* --adaptive's threshold (0: off), --time-limit */
+    /* what happened */
+    int interrupted; /* the stop signal, or 0 */
+    rs_render_stats stats;
+    rs_adaptive_stats adaptive_stats;
+    uint64_t resumed, checkpoint_samples, nonfinite;
+    /* the BVH and the scene's instances */
+    char bvh_builder[64];
+    double bvh_sah, bvh_ms;
+    uint32_t bvh_nodes, bvh_prims, blas_nodes, instances, inst_prims, inst_tris;
+    /* the devices and their rays, summed */
+    rs_report_device dev[RS_MAX_DEVICES];
+    int n_dev;
+    uint64_t dev_rays;
+    const rs_dist_result *dist; /* rank 0 of an MPI job, else NULL */
+} rs_report;
+
+/* Device i's name as the table, the JSON and the timeline show it. */
+void rs_report_device_label(const rs_report *rep, int i, char *buf, size_t n);
+/* --stats: the device, rank and stage tables on stderr. */
+void rs_report_print_table(const rs_report *rep);
+/* --stats-json into `path` (named `shown` in messages); 0 after printing why it failed. */
+int rs_report_write_json(const rs_report *rep, const char *path, const char *shown);
+/* The summary line on stderr (with --quiet, only a word on an interruption). */
+void rs_report_print_summary(const rs_report *rep);
+
+/* The .exr header's attributes (core/image_io.h): the scene, the spp every pixel has and the
+ * spp asked for, seed, sampling, sampler, max depth, devices, integrator, version, adaptive;
+ * their strings in the struct itself. */
+enum { RS_REPORT_META_N = 11 };
+typedef struct rs_report_meta {
+    rs_image_meta meta[RS_REPORT_META_N];
+    char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];
+    char adaptive[32];
+} rs_report_meta;
+void rs_report_image_meta(const rs_report *rep, rs_report_meta *m);
+
+#endif
