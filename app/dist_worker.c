@@ -233,7 +233,8 @@ rs_status rs_dist_run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film,
                     d->rank, timeout_s);
             d->any_dead = 1;
             local_join(&w.l);
-            rs_film_destroy(w.spare);
+            /* after a flush `spare` may be the caller's film: free the other one */
+            rs_film_destroy(w.spare == film ? w.l.acc : w.spare);
             return rs_error_set(RS_ERR_IO, "rank 0 is gone");
         }
         rs_dist_idle_nap(&nap, active);
