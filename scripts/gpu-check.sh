@@ -34,8 +34,8 @@
 # raystream itself has no "GPU or fail" switch: `--devices gpu` on a machine where the GPU cannot
 # be used warns and runs on the CPU fallback with exit 0, so step 5 reads the warning and the
 # summary.  (An app/ change would make this direct: a `--require-gpu` option, or `gpu!` in
-# --devices, that makes create_devices/create_megakernel_device in app/main.c fail with exit 1
-# and the reason instead of creating rs_gpu_fallback_create's device.)
+# --devices, that makes create_gpu in app/devices.c fail with exit 1 and the reason instead of
+# creating rs_gpu_fallback_create's device.)
 set -eu
 if [ "${1:-}" = "--fetch" ]; then
     mkdir -p .gpu-debs
