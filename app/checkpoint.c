@@ -163,16 +163,6 @@ static void make_adaptive(unsigned char *q, const rs_checkpoint_key *key,
     put32(q + 40, ad->stats.stopped);
 }
 
-/* The film's samples (the paths an adaptive film holds). */
-static uint64_t film_samples(const rs_film *film)
-{
-    size_t i, npix = (size_t)film->width * film->height;
-    uint64_t t = 0;
-    for (i = 0; i < npix; ++i)
-        t += film->count[i];
-    return t;
-}
-
 static int write_file(const char *path, const char *staged, int rename_now,
                       const rs_checkpoint_key *key, const rs_film *film, const rs_path_ranges *held,
                       const rs_adaptive_state *ad)
@@ -199,7 +189,7 @@ static int write_file(const char *path, const char *staged, int rename_now,
     }
     n = make_header(header, key, held, film->nonfinite);
     if (ad) /* no ranges: the paths held are the film's samples */
-        put64(header + 32, film_samples(film));
+        put64(header + 32, rs_film_samples(film));
     ok = put(f, header, n, &sum) && put(f, film->sum, npix * 3 * sizeof *film->sum, &sum) &&
          put(f, film->count, npix * sizeof *film->count, &sum);
     if (ad && ok) {
@@ -510,7 +500,7 @@ static int take_adaptive(const reader *r, const unsigned char *q, const rs_check
     for (i = 0; i < npix; ++i)
         if (!(film->sum_l2[i] >= 0 && film->sum_l2[i] < 1e300))
             break;
-    if (i < npix || film_samples(film) != get64(r->h + 32) ||
+    if (i < npix || rs_film_samples(film) != get64(r->h + 32) ||
         !rs_adaptive_state_fits(ad, film->count, (uint32_t)npix, want->spp))
         return refuse(RS_EXIT_RUNTIME, r->path,
                       "corrupt: the sample counts do not match its adaptive state%s%s", "", "");

@@ -626,8 +626,6 @@ static int check_render_options(rs_cli_options *o)
     if (o->adaptive > 0 && o->megakernel)
         return usage_error("--adaptive runs on the stream integrator, not the megakernel%s%s", "",
                            "");
-    if (o->adaptive > 0 && (o->checkpoint || o->resume))
-        return usage_error("--adaptive cannot be checkpointed or resumed yet%s%s", "", "");
     if (o->adaptive > 0 && !o->adaptive_min_spp)
         o->adaptive_min_spp = 16;
     if (o->aovs && o->output &&

@@ -143,6 +143,10 @@ static void make_key(const rs_cli_options *o, render_run *r)
     k->isect_tri = o->isect_tri;
     k->isect_aabb = o->isect_aabb;
     k->scene = o->scene;
+    if (o->adaptive > 0) {
+        k->adaptive_threshold = o->adaptive;
+        k->adaptive_min_spp = o->adaptive_min_spp;
+    }
 }
 
 /* The film: a fresh one, or with --resume the checkpoint's (app/checkpoint.h), checked against
@@ -158,7 +162,14 @@ int rs_run_make_film(const rs_cli_options *o, render_run *r)
     if (!o->resume)
         return RS_EXIT_OK;
     if (!o->spp_given)
-        r->key.spp = 0; /* the file's */
+        r->key.spp = 0;    /* the file's */
+    if (o->adaptive > 0) { /* the film's first samples, and where adaptive sampling stood */
+        if ((rc = rs_checkpoint_read_adaptive(o->resume, &r->key, r->film, &r->ad)) != RS_EXIT_OK)
+            return rc;
+        r->st.spp = r->key.spp;
+        r->resumed = rs_film_samples(r->film);
+        return RS_EXIT_OK;
+    }
     if ((rc = rs_checkpoint_read(o->resume, &r->key, r->film, &r->held)) != RS_EXIT_OK)
         return rc;
     r->st.spp = r->key.spp;
@@ -283,6 +294,7 @@ void rs_run_release(render_run *r)
     rs_bvh_destroy(r->bvh);
     rs_scene_destroy(r->scene);
     rs_path_ranges_free(&r->held);
+    rs_adaptive_state_free(&r->ad);
 }
 
 /* What the film holds now: the paths held before and what the render under way added.  0 when
@@ -301,6 +313,9 @@ int rs_run_write_checkpoint(const render_run *r, int rename_now)
 {
     rs_path_ranges held;
     int ok;
+    if (r->key.adaptive_threshold > 0) /* the film's counts and the adaptive state */
+        return r->ad.running && rs_checkpoint_write_adaptive(r->ckpt_out->path, r->ckpt_out->staged,
+                                                             rename_now, &r->key, r->film, &r->ad);
     if (!film_ranges(r, &held))
         return 0;
     ok = rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, rename_now, &r->key, r->film,
@@ -340,7 +355,9 @@ static rs_status engine_run(const rs_cli_options *o, render_run *r, const rs_ren
         rs_adaptive a;
         a.threshold = r->adaptive_t = o->adaptive;
         a.min_spp = o->adaptive_min_spp;
-        return rs_render_adaptive(r->engine, &a, hooks, r->film, &r->stats, &r->adaptive);
+        rst = rs_adaptive_run(r->engine, &a, &r->ad, hooks, r->film, &r->stats);
+        r->adaptive = r->ad.stats;
+        return rst;
     }
     memset(&plan, 0, sizeof plan);
     if (!rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,

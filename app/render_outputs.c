@@ -65,8 +65,9 @@ static void make_report(const rs_cli_options *o, const render_run *r, rs_report 
     rep->stats = r->stats;
     rep->adaptive_stats = r->adaptive;
     rep->resumed = r->resumed;
-    rep->checkpoint_samples =
-        rs_path_ranges_total(&r->held) + (r->done ? rs_path_ranges_total(r->done) : 0);
+    rep->checkpoint_samples = o->adaptive > 0 ? rs_film_samples(r->film)
+                                              : rs_path_ranges_total(&r->held) +
+                                                    (r->done ? rs_path_ranges_total(r->done) : 0);
     rep->nonfinite = r->film->nonfinite;
     rs_bvh_builder_name(&r->bvh->builder, rep->bvh_builder, sizeof rep->bvh_builder);
     rep->bvh_sah = rs_bvh_sah_cost(r->bvh);

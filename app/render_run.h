@@ -41,6 +41,7 @@ typedef struct render_run {
     rs_render_settings st;
     rs_render_stats stats;
     rs_adaptive_stats adaptive; /* --adaptive: rounds, samples, pixels stopped */
+    rs_adaptive_state ad;       /* --adaptive: where it stands (a checkpoint saves it) */
     double adaptive_t;          /* --adaptive's threshold, 0: off */
     char name[64];              /* the scene's stem: default output name */
     char out_default[96];

@@ -50,10 +50,7 @@ static inline rs_film_sum to_fixed(double x)
     return (rs_film_sum)v; /* an integer already: 2^62 is past a double's fraction bits */
 }
 
-static inline double from_fixed(rs_film_sum s)
-{
-    return (double)s * (1.0 / RS_FILM_SCALE);
-}
+static inline double from_fixed(rs_film_sum s) { return (double)s * (1.0 / RS_FILM_SCALE); }
 
 void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
 {
@@ -166,6 +163,15 @@ void rs_film_resolve(const rs_film *f, float *rgb)
         rgb[3 * i + 1] = (float)(from_fixed(f->sum[3 * i + 1]) * inv);
         rgb[3 * i + 2] = (float)(from_fixed(f->sum[3 * i + 2]) * inv);
     }
+}
+
+uint64_t rs_film_samples(const rs_film *f)
+{
+    size_t i, n = (size_t)f->width * f->height;
+    uint64_t t = 0;
+    for (i = 0; i < n; ++i)
+        t += f->count[i];
+    return t;
 }
 
 uint32_t rs_film_min_count(const rs_film *f)

@@ -64,6 +64,8 @@ rs_status rs_film_track_variance(rs_film *f);
 double rs_film_rel_error(const rs_film *f, uint32_t pixel);
 /* Fewest samples any pixel has. */
 uint32_t rs_film_min_count(const rs_film *f);
+/* The samples on the film, every pixel's together. */
+uint64_t rs_film_samples(const rs_film *f);
 #ifdef __cplusplus
 }
 #endif

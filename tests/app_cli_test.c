@@ -97,9 +97,6 @@ static void test_usage_errors(void **state)
         {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "0.1", "--integrator",
           "megakernel", NULL},
          {"--adaptive", "megakernel"}},
-        {{"render", "-o", "out.png", "--spp", "1", "--adaptive", "0.1", "--checkpoint", "c.ckpt",
-          NULL},
-         {"--adaptive", "checkpoint"}},
         {{"rendr", "-o", "out.png", NULL}, {"rendr", "command"}},
         {{"render", "-o", "out.png", "--spp", "abc", NULL}, {"--spp", "abc"}},
         {{"render", "-o", "out.png", "--spp", "1", "--width", "12x", NULL}, {"--width", "12x"}},
@@ -1623,6 +1620,66 @@ static void test_adaptive(void **state)
     proc_free(&p);
 }
 
+/* --adaptive with --checkpoint and --resume: stopped by the time limit (twice, the second time
+ * from the first checkpoint into a new one) and resumed on another device set, the image is
+ * the uninterrupted adaptive render's bit for bit; a checkpoint of the other kind, or with
+ * another threshold, is refused with the flag named. */
+static void test_adaptive_resume(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+#define AD "--width", "64", "--height", "48", "--spp", "64", "--adaptive", "0.1", "-q"
+    static const char *const ref[] = {"render", AD, "--devices", "cpu", "-o", "ref.exr", NULL};
+    static const char *const cut1[] = {"render",       AD,     "--devices",    "cpu",
+                                       "--wave-size",  "300",  "--time-limit", "0.1",
+                                       "--checkpoint", "a.ckpt", "-o",         "a.exr",
+                                       NULL};
+    static const char *const cut2[] = {"render",       AD,       "--devices",    "cpu:1,gpu",
+                                       "--resume",     "a.ckpt", "--time-limit", "0.1",
+                                       "--checkpoint", "b.ckpt", "-o",           "b.exr",
+                                       NULL};
+    static const char *const last[] = {"render", AD, "--devices", "cpu,gpu", "--resume",
+                                       "b.ckpt", "--stats-json", "b.json", "-o", "r.exr", NULL};
+    static const char *const no_ad[] = {"render", "--width", "64", "--height", "48",
+                                        "--spp", "64", "-q", "--resume", "a.ckpt",
+                                        "-o", "x.exr", NULL};
+    static const char *const other_t[] = {"render", "--width", "64", "--height", "48",
+                                          "--spp", "64", "-q", "--adaptive", "0.2",
+                                          "--resume", "a.ckpt", "-o", "x.exr", NULL};
+    static const char *const plain[] = {"render", "--width", "64", "--height", "48", "--spp",
+                                        "4", "-q", "--checkpoint", "p.ckpt", "-o", "p.exr", NULL};
+    static const char *const plain_ad[] = {"render", AD, "--resume", "p.ckpt", "-o", "x.exr",
+                                           NULL};
+#undef AD
+    proc p;
+    run_expect(f, ref, 0, &p);
+    proc_free(&p);
+    run_expect(f, cut1, 0, &p);
+    proc_free(&p);
+    run_expect(f, cut2, 0, &p);
+    proc_free(&p);
+    run_expect(f, last, 0, &p);
+    expect_same_image(&p, f, "r.exr", "ref.exr");
+    fprintf(stderr, "  adaptive: %lld of the samples came from the checkpoints\n",
+            json_number(f, "b.json", "resumed_samples"));
+    EXPECT(&p, json_number(f, "b.json", "resumed_samples") > 0,
+           "the last render should continue what the checkpoints hold");
+    proc_free(&p);
+    run_expect(f, no_ad, 2, &p);
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "--adaptive"),
+           "an adaptive checkpoint resumed without --adaptive: one line naming it");
+    proc_free(&p);
+    run_expect(f, other_t, 2, &p);
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "--adaptive") && strstr(p.err.data, "0.2"),
+           "another threshold: one line naming --adaptive and both values");
+    proc_free(&p);
+    run_expect(f, plain, 0, &p);
+    proc_free(&p);
+    run_expect(f, plain_ad, 2, &p);
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "without --adaptive"),
+           "a plain checkpoint resumed with --adaptive: refused");
+    proc_free(&p);
+}
+
 static void test_exr_metadata(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -1808,6 +1865,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_exr_metadata, setup, teardown),
         cmocka_unit_test_setup_teardown(test_aov_layers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_adaptive_resume, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
