@@ -28,7 +28,7 @@ static void report_devices(const render_run *r, rs_report *rep)
         d->alive = 1;
         rep->n_dev = 1;
         rep->megakernel = 1;
-        rep->mk_gpu = rs_device_is_gpu(r->mk);
+        rep->mk_gpu = rs_device_owns_memory(r->mk);
         return;
     }
     for (i = 0; i < r->n_devs; ++i) {

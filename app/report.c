@@ -256,8 +256,8 @@ static void summary_devices(const rs_report *rep)
         fprintf(stderr, "Integrator: megakernel on %s (%s, %d thread%s). ", rep->dev[0].name,
                 rep->strategy, rep->dev[0].threads, rep->dev[0].threads == 1 ? "" : "s");
     else
-        fprintf(stderr, "Shading took %.2f s, tracing %.2f s. ", rep->stats.shade_s,
-                rep->stats.trace_s);
+        fprintf(stderr, "Host stages took %.2f s, waiting for the devices %.2f s. ",
+                rep->stats.host_s, rep->stats.wait_s);
 }
 
 /* The last sentences: MPI, dropped samples, --resume, --checkpoint, what was written. */

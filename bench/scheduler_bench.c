@@ -116,7 +116,7 @@ static int render_once(bench *b, const rs_scene *scene, const rs_bvh *bvh, const
         rs_render(scene, sched, &st, NULL, film, &stats) != RS_OK)
         goto out;
     *sps = (double)stats.paths_total / stats.seconds;
-    *mrays = 1e-6 * (double)(stats.rays_closest + stats.rays_shadow) / stats.trace_s;
+    *mrays = 1e-6 * (double)(stats.rays_closest + stats.rays_shadow) / stats.wait_s;
     *secs = stats.seconds;
     for (i = 0; i < 2; ++i)
         idle[i] = share[i] = 0.0;
@@ -124,7 +124,7 @@ static int render_once(bench *b, const rs_scene *scene, const rs_bvh *bvh, const
         rs_device_stats ds;
         int alive;
         rs_sched_device_stats(sched, i, &ds, &alive);
-        idle[i] = stats.trace_s > 0.0 ? 1.0 - ds.busy_s / stats.trace_s : 0.0;
+        idle[i] = stats.wait_s > 0.0 ? 1.0 - ds.busy_s / stats.wait_s : 0.0;
         if (idle[i] < 0.0)
             idle[i] = 0.0;
         share[i] = (double)ds.rays / (double)(stats.rays_closest + stats.rays_shadow);

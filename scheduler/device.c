@@ -15,4 +15,4 @@ void rs_device_destroy(rs_device *d)
         d->ops->destroy(d);
 }
 
-int rs_device_is_gpu(const rs_device *d) { return (d->flags & RS_DEVICE_OWN_MEMORY) != 0; }
+int rs_device_owns_memory(const rs_device *d) { return (d->flags & RS_DEVICE_OWN_MEMORY) != 0; }

@@ -98,7 +98,7 @@ extern "C" {
 rs_status rs_device_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh);
 void rs_device_destroy(rs_device *d);
 /* 1 if the device traces off the host (RS_DEVICE_OWN_MEMORY). */
-int rs_device_is_gpu(const rs_device *d);
+int rs_device_owns_memory(const rs_device *d);
 #ifdef __cplusplus
 }
 #endif

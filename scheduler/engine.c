@@ -11,8 +11,8 @@ void rs_render_stats_add(rs_render_stats *sum, const rs_render_stats *r)
     int k;
     for (k = 0; k < RS_STAGE_COUNT; ++k)
         sum->stage_s[k] += r->stage_s[k];
-    sum->trace_s += r->trace_s;
-    sum->shade_s += r->shade_s;
+    sum->wait_s += r->wait_s;
+    sum->host_s += r->host_s;
     sum->paths_total += r->paths_total;
     sum->paths_done += r->paths_done;
     sum->rays_closest += r->rays_closest;

@@ -169,7 +169,7 @@ static rs_status run_stage(rs_run *c, rs_slot *sl)
     t1 = rs_now_s();
     if (d->host) {
         rs_cores_release(st->cores, c->ex.threads);
-        c->stats->shade_s += t1 - t0;
+        c->stats->host_s += t1 - t0;
         /* waits are gaps on the render thread's lane: the devices' lanes show the work */
         if (st->timeline) {
             double e = rs_timeline_now(st->timeline);
@@ -177,7 +177,7 @@ static rs_status run_stage(rs_run *c, rs_slot *sl)
                             (uint32_t)sl->wave, e - (t1 - t0), e);
         }
     } else {
-        c->stats->trace_s += t1 - t0;
+        c->stats->wait_s += t1 - t0;
     }
     c->stats->stage_s[sl->stage] += t1 - t0;
     sl->stage = status != RS_OK ? SLOT_IDLE : empty ? d->next_if_empty : d->next;
@@ -308,7 +308,7 @@ static void resolve_settings(rs_render_settings *st, const rs_sched *sched, uint
 {
     int i, gpu = 0, n_dev = rs_sched_device_count(sched);
     for (i = 0; i < n_dev; ++i)
-        gpu |= rs_device_is_gpu(rs_sched_device(sched, i));
+        gpu |= rs_device_owns_memory(rs_sched_device(sched, i));
     if (st->threads < 1)
         st->threads = 1;
     if (st->wave_paths == 0) {

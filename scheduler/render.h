@@ -92,7 +92,8 @@ typedef struct rs_render_stats {
     double seconds;                 /* wall time of the run */
     double stage_s[RS_STAGE_COUNT]; /* seconds the render thread spent in each stage (in the
                                        trace stages: waiting for the devices) */
-    double trace_s, shade_s; /* the trace stages' sum / every other stage's (raygen to film) */
+    double host_s; /* the render thread's own stages (raygen, shade, resolve, compact, film) */
+    double wait_s; /* the render thread waiting for the devices (the trace stages) */
     uint64_t paths_total, paths_done;
     uint64_t rays_closest, rays_shadow;
     uint32_t waves;

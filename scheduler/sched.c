@@ -87,7 +87,7 @@ static uint32_t chunk_size_for(const rs_sched *s, const worker *w, uint64_t left
 /* After a chunk of `rays` took `secs`: update the rate and the next chunk size. */
 static void adapt(worker *w, uint32_t rays, double secs)
 {
-    double target = rs_device_is_gpu(w->dev) ? RS_SCHED_TARGET_GPU_S : RS_SCHED_TARGET_HOST_S;
+    double target = rs_device_owns_memory(w->dev) ? RS_SCHED_TARGET_GPU_S : RS_SCHED_TARGET_HOST_S;
     double r, size;
     if (secs <= 0.0 || rays == 0)
         return;
@@ -223,7 +223,7 @@ rs_status rs_sched_create(rs_device *const *devices, int n_devices, const rs_sch
         w->s = s;
         w->dev = devices[i];
         w->alive = 1;
-        w->chunk = rs_device_is_gpu(devices[i]) ? RS_SCHED_FIRST_GPU : RS_SCHED_FIRST_HOST;
+        w->chunk = rs_device_owns_memory(devices[i]) ? RS_SCHED_FIRST_GPU : RS_SCHED_FIRST_HOST;
     }
     pthread_mutex_lock(&s->lock);
     for (i = 0; i < n_devices; ++i) {
