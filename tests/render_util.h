@@ -160,15 +160,7 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     if (rs_sched_create(devs, n, &cfg, &sched) != RS_OK ||
         rs_film_create(a->width, a->height, &film) != RS_OK)
         goto out;
-    memset(&st, 0, sizeof st);
-    st.width = a->width;
-    st.height = a->height;
-    st.spp = a->spp;
-    st.max_depth = a->max_depth;
-    st.seed = a->seed;
-    st.sampling = a->sampling;
-    st.sampler = a->sampler;
-    st.wave_paths = a->wave_paths;
+    st = rt_settings(a);
     st.waves_in_flight = a->waves;
     st.threads = a->threads;
     st.cores = budget;
