@@ -184,6 +184,33 @@ static void cofactor(const rs_xform *x, double c[3][3])
         }
 }
 
+/* n by the cofactor matrix c, times `sign` (-1 where det < 0: the cofactor's normals point in),
+ * normalised in double and rounded once; a zero normal ("use the face's") stays zero. */
+static void normal_by(const double c[3][3], double sign, const float n[3], float out[3])
+{
+    double r[3], l;
+    int j;
+    for (j = 0; j < 3; ++j)
+        r[j] = c[j][0] * n[0] + c[j][1] * n[1] + c[j][2] * n[2];
+    l = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    if (l > 0)
+        l = sign / l;
+    for (j = 0; j < 3; ++j)
+        out[j] = (float)(r[j] * l);
+}
+
+rs_vec3 rs_xform_normal(const rs_xform *x, rs_vec3 n)
+{
+    double cof[3][3];
+    float in[3], out[3];
+    in[0] = n.x;
+    in[1] = n.y;
+    in[2] = n.z;
+    cofactor(x, cof);
+    normal_by(cof, rs_xform_det(x) < 0 ? -1.0 : 1.0, in, out);
+    return rs_v3(out[0], out[1], out[2]);
+}
+
 static int in_range(rs_vec3 a)
 {
     return isfinite(a.x) && isfinite(a.y) && isfinite(a.z) && fabsf(a.x) <= 1e30f &&
@@ -264,18 +291,8 @@ rs_status rs_scene_transform_since(rs_scene *s, const rs_scene_mark *from, const
         if (s->tri_normal) {
             float *vn = &s->tri_normal[9 * (size_t)i], out[9];
             int k, j;
-            for (k = 0; k < 3; ++k) {
-                double n[3], l;
-                for (j = 0; j < 3; ++j)
-                    n[j] = cof[j][0] * vn[3 * k] + cof[j][1] * vn[3 * k + 1] +
-                           cof[j][2] * vn[3 * k + 2];
-                l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-                /* a zero normal ("use the face's") stays zero; det < 0 flips the cofactor's */
-                if (l > 0)
-                    l = (mirror ? -1.0 : 1.0) / l;
-                for (j = 0; j < 3; ++j)
-                    out[3 * k + j] = (float)(n[j] * l);
-            }
+            for (k = 0; k < 3; ++k)
+                normal_by(cof, mirror ? -1.0 : 1.0, &vn[3 * k], &out[3 * k]);
             /* with v1 and v2 swapped, so are their normals */
             for (j = 0; j < 3; ++j) {
                 vn[j] = out[j];

@@ -49,6 +49,10 @@ int rs_xform_is_similarity(const rs_xform *x, double *scale);
 
 rs_vec3 rs_xform_point(const rs_xform *x, rs_vec3 p);
 rs_vec3 rs_xform_vector(const rs_xform *x, rs_vec3 v);
+/* Surface normal n under x: by the inverse transpose of the linear part (pointing the way the
+ * transformed surface's normal does, whatever the sign of det), normalised in double and rounded
+ * once, as rs_scene_transform_since moves vertex normals; a zero normal stays zero. */
+rs_vec3 rs_xform_normal(const rs_xform *x, rs_vec3 n);
 
 rs_scene_mark rs_scene_mark_now(const rs_scene *s);
 /* Applies x to every primitive added since `from` (spheres, their motion, quads, triangles and

@@ -1,6 +1,8 @@
 /* tests/scenes_transform_test.c — transforms, groups and instances, and mesh objects in scene
  * files:
- *   - the transform steps compose in the stated order and match matrices worked by hand;
+ *   - the transform steps compose in the stated order and match matrices worked by hand; Euler
+ *     angles follow the mesh placement's convention (x, then y, then z, right-handed), and
+ *     rs_xform_normal is the inverse transpose, the one that rs_scene_transform_since uses;
  *   - a transformed sphere, quad, triangle and box land where the transform puts them, and a
  *     mirroring transform keeps every surface's outward normal (quads, triangles and their vertex
  *     normals); vertex normals go by the inverse transpose (a rotation then a non-uniform scale,
@@ -79,6 +81,101 @@ static void test_steps_compose_in_order(void **state)
     assert_null(rs_xform_invalid(&trs));
     /* quarter turns are exact: no 6e-17 left where a 0 belongs */
     assert_true(r.m[0][0] == 0.0 && r.m[0][1] == -1.0 && r.m[1][0] == 1.0);
+}
+
+/* The mesh placement's rotations, as scenes/mesh.c computed them in float before it placed
+ * meshes by rs_xform: about x, then y, then z, right-handed, in degrees.  Kept here as the
+ * reference that rs_xform_rotate_euler has the same convention (order and signs). */
+static rs_vec3 float_rotate_xyz(rs_vec3 p, rs_vec3 deg)
+{
+    const float k = 0.017453292519943295f;
+    float cx = cosf(deg.x * k), sx = sinf(deg.x * k), cy = cosf(deg.y * k), sy = sinf(deg.y * k);
+    float cz = cosf(deg.z * k), sz = sinf(deg.z * k);
+    rs_vec3 a = rs_v3(p.x, cx * p.y - sx * p.z, sx * p.y + cx * p.z);
+    rs_vec3 b = rs_v3(cy * a.x + sy * a.z, a.y, -sy * a.x + cy * a.z);
+    return rs_v3(cz * b.x - sz * b.y, sz * b.x + cz * b.y, b.z);
+}
+
+/* rs_xform_rotate_euler(rx, ry, rz) is the mesh placement's rotation: the float reference above
+ * agrees to float precision for angles of every sign and size (so a swapped order or a flipped
+ * sign, which moves points by O(1), cannot pass); and Euler (90, 0, 90) is exactly the turn by
+ * 120 degrees about (1, 1, 1), which cycles x -> y -> z -> x. */
+static void test_euler_is_mesh_rotation(void **state)
+{
+    static const double d[3] = {1, 1, 1};
+    static const float angles[][3] = {{30, 0, 0},   {0, 40, 0},      {0, 0, 50},
+                                      {30, 45, 60}, {-75, 120, -10}, {200, -33, 91},
+                                      {90, 0, 90},  {-17.5f, 63, 271}, {359, 1, -181}};
+    static const float pts[][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.3f, -1.7f, 2.2f}};
+    rs_xform e, cyc;
+    size_t a, i, j;
+    (void)state;
+    for (a = 0; a < sizeof angles / sizeof angles[0]; ++a) {
+        rs_vec3 deg = rs_v3(angles[a][0], angles[a][1], angles[a][2]);
+        e = rs_xform_rotate_euler(deg.x, deg.y, deg.z);
+        assert_true(fabs(rs_xform_det(&e) - 1.0) < 1e-12);
+        for (i = 0; i < sizeof pts / sizeof pts[0]; ++i) {
+            rs_vec3 p = rs_v3(pts[i][0], pts[i][1], pts[i][2]);
+            rs_vec3 want = float_rotate_xyz(p, deg), got = rs_xform_point(&e, p);
+            if (rs_v3_length(rs_v3_sub(got, want)) > 2e-6f * (1.0f + rs_v3_length(p)))
+                fail_msg("euler (%g, %g, %g) of (%g, %g, %g): (%.9g, %.9g, %.9g), the float "
+                         "placement (%.9g, %.9g, %.9g)",
+                         deg.x, deg.y, deg.z, p.x, p.y, p.z, got.x, got.y, got.z, want.x, want.y,
+                         want.z);
+        }
+    }
+    e = rs_xform_rotate_euler(90, 0, 90);
+    cyc = rs_xform_rotate_axis(d, 120);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            assert_true(e.m[i][j] == ((j + 1) % 3 == i ? 1.0 : 0.0)); /* exact quarter turns */
+            assert_true(fabs(cyc.m[i][j] - e.m[i][j]) < 1e-15);
+        }
+}
+
+/* rs_xform_normal is the inverse transpose, normalised, pointing the way the transformed surface
+ * faces whatever det's sign: M = diag(2, 3, 5), then 120 degrees about (1, 1, 1), takes
+ * n = (0.48, 0.64, 0.6) to R (0.24, 0.64/3, 0.12) = (0.12, 0.24, 0.64/3) over its length; the
+ * mirror diag(-2, 3, 5) then R flips its first step's x.  It equals the vertex normal
+ * rs_scene_transform_since stores, bit for bit (one computation for both). */
+static void test_xform_normal(void **state)
+{
+    static const double d[3] = {1, 1, 1};
+    rs_xform r = rs_xform_rotate_axis(d, 120), sc = rs_xform_scale(2, 3, 5);
+    rs_xform mi = rs_xform_scale(-2, 3, 5), x = rs_xform_compose(&r, &sc);
+    rs_xform xm = rs_xform_compose(&r, &mi);
+    rs_vec3 n = rs_v3(0.48f, 0.64f, 0.6f), got, want;
+    rs_vec3 v[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const float nrm[9] = {0.48f, 0.64f, 0.6f, 0, 0, 1, 0, 0, 0};
+    rs_scene_mark mark;
+    rs_scene *t;
+    int pass, k;
+    double l;
+    (void)state;
+    l = sqrt(0.12 * 0.12 + 0.24 * 0.24 + (0.64 / 3) * (0.64 / 3));
+    got = rs_xform_normal(&x, n);
+    expect_v3(got, (float)(0.12 / l), (float)(0.24 / l), (float)(0.64 / 3 / l));
+    got = rs_xform_normal(&xm, n);
+    expect_v3(got, (float)(0.12 / l), (float)(-0.24 / l), (float)(0.64 / 3 / l));
+    want = rs_xform_normal(&x, rs_v3(0, 0, 0));
+    assert_true(want.x == 0 && want.y == 0 && want.z == 0);
+    for (pass = 0; pass < 2; ++pass) {
+        const rs_xform *xf = pass ? &xm : &x;
+        rs_material m = rs_mat_lambertian(rs_v3_splat(0.5f));
+        uint32_t id;
+        assert_int_equal(rs_scene_create("t", &t), RS_OK);
+        assert_int_equal(rs_scene_add_material(t, &m, &id), RS_OK);
+        mark = rs_scene_mark_now(t);
+        assert_int_equal(rs_scene_add_triangle_full(t, v, NULL, nrm, id), RS_OK);
+        assert_int_equal(rs_scene_transform_since(t, &mark, xf), RS_OK);
+        /* a mirror swaps vertices 1 and 2 with their normals */
+        for (k = 0; k < 3; ++k) {
+            int from = pass && k ? 3 - k : k;
+            want = rs_xform_normal(xf, rs_v3(nrm[3 * from], nrm[3 * from + 1], nrm[3 * from + 2]));
+            assert_memory_equal(&t->tri_normal[3 * k], &want, 3 * sizeof(float));
+        }
+        rs_scene_destroy(t);
+    }
 }
 
 /* Each primitive kind under a transform given as a matrix and as steps. */
@@ -500,6 +597,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_steps_compose_in_order),
+        cmocka_unit_test(test_euler_is_mesh_rotation),
+        cmocka_unit_test(test_xform_normal),
         cmocka_unit_test(test_objects_move),
         cmocka_unit_test(test_mirror_keeps_orientation),
         cmocka_unit_test(test_normals_inverse_transpose),
