@@ -16,7 +16,8 @@
  *   child[4]            interior lane: index of the child node; leaf lane: first prim_ids entry,
  *                       or for a packed leaf the first of its tri4 or quad4 blocks
  *   count[4]            0 for an interior lane, else the leaf's primitive count, or for a packed
- *                       leaf RS_BVH4_PACKED | its number of blocks, with RS_BVH4_QUADS for quad4
+ *                       leaf RS_WIDE_PACKED | its number of blocks, with RS_WIDE_QUADS for quad4
+ *                       (accel/wide.h)
  *   n_lanes             lanes in use (1 to 4), packed from lane 0
  *
  * Packed leaves (SSE builds): a leaf of triangles only (with Möller-Trumbore geometry) keeps
@@ -30,6 +31,9 @@
 
 #include "accel/bvh.h"
 #include "accel/trace.h"
+#include "accel/wide.h"
+
+#include <string.h>
 
 #if defined(__SSE2__) || defined(_M_X64)
 #  include <emmintrin.h>
@@ -65,14 +69,6 @@ typedef struct rs_bvh4 {
     uint32_t n_packed; /* leaves packed as tri4 or quad4 blocks */
 } rs_bvh4;
 
-/* A traversal stack entry refers to an interior node (its index) or to one leaf lane of a node
- * (RS_BVH4_LEAF | node << 2 | lane). */
-#define RS_BVH4_LEAF      0x80000000u
-#define RS_BVH4_PACKED    0x8000u
-#define RS_BVH4_QUADS     0x4000u /* with RS_BVH4_PACKED: the blocks are quad4 (quad8) */
-#define RS_BVH4_SPHERES   0x2000u /* with RS_BVH4_PACKED: sphere8 blocks (8-wide tree only) */
-#define RS_BVH4_BLOCKS    0x1fffu /* a packed count's number of blocks (a longer leaf stays
-                                     unpacked) */
 #define RS_BVH4_MAX_NODES (1u << 29)
 /* Each level of the tree pushes at most 3 entries (closest) or 4 (any hit), and the tree is at
  * most RS_BVH_MAX_DEPTH deep. */
@@ -93,33 +89,36 @@ void rs_bvh4_destroy(rs_bvh4 *b);
 }
 #endif
 
-/* The slab test of the four lanes of `n` against one ray: returns the mask of lanes hit (bit i for
- * lane i) and their entry distances in tn[4].  o and inv_d are the ray's, broadcast. */
+/* The 4-wide primitives accel/wide_walk.h takes: the ray broadcast to four lanes
+ * (rs_bvh4_ray_init), and the slab test of the four lanes of `n` (rs_bvh4_lanes: the mask of
+ * lanes hit, bit i for lane i, and their entry distances, which rs_bvh4_tn_store spills). */
 #ifdef RS_BVH4_SSE
 typedef struct rs_bvh4_ray {
     __m128 o[3], d[3], inv[3];
     int axis_parallel; /* a direction component is 0 (or NaN): slabs may give NaN */
 } rs_bvh4_ray;
 
-static inline rs_bvh4_ray rs_bvh4_ray_of(rs_vec3 o, rs_vec3 d)
+typedef __m128 rs_bvh4_tn;
+
+static inline void rs_bvh4_ray_init(rs_bvh4_ray *r, rs_vec3 o, rs_vec3 d)
 {
-    rs_bvh4_ray r;
     rs_vec3 inv_d = rs_bvh_inv_dir(d);
-    r.o[0] = _mm_set1_ps(o.x);
-    r.o[1] = _mm_set1_ps(o.y);
-    r.o[2] = _mm_set1_ps(o.z);
-    r.d[0] = _mm_set1_ps(d.x);
-    r.d[1] = _mm_set1_ps(d.y);
-    r.d[2] = _mm_set1_ps(d.z);
-    r.inv[0] = _mm_set1_ps(inv_d.x);
-    r.inv[1] = _mm_set1_ps(inv_d.y);
-    r.inv[2] = _mm_set1_ps(inv_d.z);
-    r.axis_parallel = !(d.x != 0.0f && d.y != 0.0f && d.z != 0.0f);
-    return r;
+    r->o[0] = _mm_set1_ps(o.x);
+    r->o[1] = _mm_set1_ps(o.y);
+    r->o[2] = _mm_set1_ps(o.z);
+    r->d[0] = _mm_set1_ps(d.x);
+    r->d[1] = _mm_set1_ps(d.y);
+    r->d[2] = _mm_set1_ps(d.z);
+    r->inv[0] = _mm_set1_ps(inv_d.x);
+    r->inv[1] = _mm_set1_ps(inv_d.y);
+    r->inv[2] = _mm_set1_ps(inv_d.z);
+    r->axis_parallel = !(d.x != 0.0f && d.y != 0.0f && d.z != 0.0f);
 }
 
+static inline void rs_bvh4_tn_store(float tn[4], const rs_bvh4_tn *v) { _mm_storeu_ps(tn, *v); }
+
 static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, float tmin,
-                                     float tmax, float tn_out[4])
+                                     float tmax, rs_bvh4_tn *tn_out)
 {
     __m128 tn = _mm_set1_ps(tmin), tf = _mm_set1_ps(tmax);
     int a;
@@ -140,7 +139,7 @@ static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r
             tf = n_tf;
         }
     }
-    _mm_storeu_ps(tn_out, tn);
+    *tn_out = tn;
     tf = _mm_mul_ps(tf, _mm_set1_ps(RS_BVH_SLACK));
     return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(tn, tf)) & ((1u << n->n_lanes) - 1u);
 }
@@ -149,16 +148,23 @@ typedef struct rs_bvh4_ray {
     rs_vec3 o, inv;
 } rs_bvh4_ray;
 
-static inline rs_bvh4_ray rs_bvh4_ray_of(rs_vec3 o, rs_vec3 d)
+typedef struct rs_bvh4_tn {
+    float t[4];
+} rs_bvh4_tn;
+
+static inline void rs_bvh4_ray_init(rs_bvh4_ray *r, rs_vec3 o, rs_vec3 d)
 {
-    rs_bvh4_ray r;
-    r.o = o;
-    r.inv = rs_bvh_inv_dir(d);
-    return r;
+    r->o = o;
+    r->inv = rs_bvh_inv_dir(d);
+}
+
+static inline void rs_bvh4_tn_store(float tn[4], const rs_bvh4_tn *v)
+{
+    memcpy(tn, v->t, sizeof v->t);
 }
 
 static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, float tmin,
-                                     float tmax, float tn_out[4])
+                                     float tmax, rs_bvh4_tn *tn_out)
 {
     uint32_t i, mask = 0;
     for (i = 0; i < n->n_lanes; ++i) {
@@ -166,7 +172,7 @@ static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r
         rs_slab((n->lo[0][i] - r->o.x) * r->inv.x, (n->hi[0][i] - r->o.x) * r->inv.x, &tn, &tf);
         rs_slab((n->lo[1][i] - r->o.y) * r->inv.y, (n->hi[1][i] - r->o.y) * r->inv.y, &tn, &tf);
         rs_slab((n->lo[2][i] - r->o.z) * r->inv.z, (n->hi[2][i] - r->o.z) * r->inv.z, &tn, &tf);
-        tn_out[i] = tn;
+        tn_out->t[i] = tn;
         mask |= (uint32_t)(tn <= tf * RS_BVH_SLACK) << i;
     }
     return mask;
@@ -268,172 +274,26 @@ static inline uint32_t rs_bvh4_quad4_hit(const rs_bvh4_quad4 *b, const rs_bvh4_r
     return (uint32_t)_mm_movemask_ps(ok);
 }
 
-/* A packed leaf (`count` has RS_BVH4_PACKED) for closest hit: each block's hits taken as
- * rs_bvh_leaf_closest takes them (rs_hit_better; the ray cut just past the best). */
-static inline void rs_bvh4_packed_closest(const rs_bvh4_tri4 *tri4, const rs_bvh4_quad4 *quad4,
-                                          uint32_t first, uint32_t count, const rs_bvh4_ray *r,
-                                          rs_ray *ray, rs_hit *hit)
-{
-    uint32_t i, n = count & RS_BVH4_BLOCKS;
-    for (i = 0; i < n; ++i) {
-        float t[4], u[4], v[4];
-        const uint32_t *prim;
-        uint32_t m;
-        if (count & RS_BVH4_QUADS) {
-            m = rs_bvh4_quad4_hit(&quad4[first + i], r, ray->tmin, ray->tmax, t, u, v);
-            prim = quad4[first + i].prim;
-        } else {
-            m = rs_bvh4_tri4_hit(&tri4[first + i], r, ray->tmin, ray->tmax, t, u, v);
-            prim = tri4[first + i].prim;
-        }
-        while (m) {
-            uint32_t l = (uint32_t)__builtin_ctz(m);
-            m &= m - 1;
-            if (rs_hit_better(t[l], prim[l], hit)) {
-                ray->tmax = rs_float_next_up(t[l]);
-                hit->t = t[l];
-                hit->u = u[l];
-                hit->v = v[l];
-                hit->prim = prim[l];
-            }
-        }
-    }
-}
-
-/* A packed leaf for any hit: 1 when some primitive is hit inside (tmin, tmax). */
-static inline int rs_bvh4_packed_occluded(const rs_bvh4_tri4 *tri4, const rs_bvh4_quad4 *quad4,
-                                          uint32_t first, uint32_t count, const rs_bvh4_ray *r,
-                                          const rs_ray *ray)
-{
-    uint32_t i, n = count & RS_BVH4_BLOCKS;
-    for (i = 0; i < n; ++i) {
-        float t[4], u[4], v[4];
-        if (count & RS_BVH4_QUADS
-                ? rs_bvh4_quad4_hit(&quad4[first + i], r, ray->tmin, ray->tmax, t, u, v)
-                : rs_bvh4_tri4_hit(&tri4[first + i], r, ray->tmin, ray->tmax, t, u, v))
-            return 1;
-    }
-    return 0;
-}
 #endif
 
-/* The stack entry for lane `lane` of node `node`. */
-static inline uint32_t rs_bvh4_ref(const rs_bvh4_node *n, uint32_t node, uint32_t lane)
-{
-    return n->count[lane] ? RS_BVH4_LEAF | node << 2 | lane : n->child[lane];
-}
-
-static inline int rs_bvh4_lowest_bit(uint32_t m) { return __builtin_ctz(m); }
-
-/* Closest hit, as rs_bvh_closest: 1 and *hit on a hit, else hit->prim = RS_NO_HIT and 0.
- * Ordered: the hit lanes are sorted by entry distance, the nearest is visited next and the others
- * pushed far to near with their entry distances; a popped entry that starts beyond the closest
- * hit so far is dropped without touching its node. */
-static inline int rs_bvh4_closest(const rs_bvh4 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
-{
-    uint32_t stack[RS_BVH4_STACK];
-    float stack_t[RS_BVH4_STACK];
-    uint32_t sp = 0, ref = 0;
-    rs_bvh4_ray r = rs_bvh4_ray_of(ray.o, ray.d);
-    hit->prim = RS_NO_HIT;
-    hit->t = ray.tmax;
-    hit->u = hit->v = 0.0f;
-    if (b->n_nodes == 0)
-        return 0;
-    for (;;) {
-        if (!(ref & RS_BVH4_LEAF)) {
-            const rs_bvh4_node *n = &b->nodes[ref];
-            float tn[4];
-            uint32_t mask = rs_bvh4_lanes(n, &r, ray.tmin, ray.tmax, tn);
-            if (mask != 0) {
-                int first = rs_bvh4_lowest_bit(mask);
-                mask &= mask - 1;
-                if (mask == 0) {
-                    ref = rs_bvh4_ref(n, ref, (uint32_t)first);
-                    continue;
-                } else {
-                    /* two to four lanes: insertion sort by entry distance, nearest first */
-                    uint32_t lanes[4], k = 1, i, j;
-                    lanes[0] = (uint32_t)first;
-                    while (mask) {
-                        uint32_t l = (uint32_t)rs_bvh4_lowest_bit(mask);
-                        mask &= mask - 1;
-                        for (j = k; j > 0 && tn[lanes[j - 1]] > tn[l]; --j)
-                            lanes[j] = lanes[j - 1];
-                        lanes[j] = l;
-                        ++k;
-                    }
-                    for (i = k - 1; i > 0; --i) {
-                        RS_ASSERT(sp < RS_BVH4_STACK);
-                        stack[sp] = rs_bvh4_ref(n, ref, lanes[i]);
-                        stack_t[sp++] = tn[lanes[i]];
-                    }
-                    ref = rs_bvh4_ref(n, ref, lanes[0]);
-                    continue;
-                }
-            }
-        } else {
-            const rs_bvh4_node *n = &b->nodes[(ref & ~RS_BVH4_LEAF) >> 2];
-            uint32_t lane = ref & 3u, first = n->child[lane], count = n->count[lane], i;
+/* The walks, from accel/wide_walk.h: rs_bvh4_closest (closest hit, as rs_bvh_closest: 1 and
+ * *hit on a hit, else hit->prim = RS_NO_HIT and 0) and rs_bvh4_occluded (any hit inside (tmin,
+ * tmax), as rs_bvh_occluded), with rs_bvh4_packed_closest / _occluded for packed leaves. */
+#define RS_WIDE_W     4
+#define RS_WIDE_SHIFT 2
+#define RS_WIDE_TREE  rs_bvh4
+#define RS_WIDE_NODE  rs_bvh4_node
+#define RS_WIDE_STACK RS_BVH4_STACK
+#define RS_WIDE_FN(x) rs_bvh4_##x
+#define RS_WIDE_RAY   rs_bvh4_ray
+#define RS_WIDE_TN    rs_bvh4_tn
 #ifdef RS_BVH4_SSE
-            if (count & RS_BVH4_PACKED) {
-                rs_bvh4_packed_closest(b->tri4, b->quad4, first, count, &r, &ray, hit);
-                count = 0;
-            }
+#  define RS_WIDE_TRIS(b)                         ((b)->tri4)
+#  define RS_WIDE_TRI_HIT(blk, r, t0, t1, t, u, v) rs_bvh4_tri4_hit(blk, r, t0, t1, t, u, v)
+#  define RS_WIDE_QUADS_OF(b)                     ((b)->quad4)
+#  define RS_WIDE_QUAD_HIT(blk, r, t0, t1, t, u, v) rs_bvh4_quad4_hit(blk, r, t0, t1, t, u, v)
 #endif
-            for (i = 0; i < count; ++i)
-                rs_bvh_leaf_closest(g, b->prim_ids[first + i], &ray, hit);
-        }
-        /* pop the next entry that can still hold a hit no farther than the best so far */
-        for (;;) {
-            if (sp == 0)
-                return hit->prim != RS_NO_HIT;
-            --sp;
-            if (stack_t[sp] <= ray.tmax * RS_BVH_SLACK)
-                break;
-        }
-        ref = stack[sp];
-    }
-}
-
-/* Any hit inside (tmin, tmax), as rs_bvh_occluded. */
-static inline int rs_bvh4_occluded(const rs_bvh4 *b, const rs_geom *g, rs_ray ray)
-{
-    uint32_t stack[RS_BVH4_STACK];
-    uint32_t sp = 0;
-    rs_bvh4_ray r = rs_bvh4_ray_of(ray.o, ray.d);
-    if (b->n_nodes == 0)
-        return 0;
-    stack[sp++] = 0;
-    while (sp > 0) {
-        uint32_t ref = stack[--sp];
-        if (!(ref & RS_BVH4_LEAF)) {
-            const rs_bvh4_node *n = &b->nodes[ref];
-            float tn[4];
-            uint32_t mask = rs_bvh4_lanes(n, &r, ray.tmin, ray.tmax, tn);
-            while (mask) {
-                uint32_t l = (uint32_t)rs_bvh4_lowest_bit(mask);
-                mask &= mask - 1;
-                RS_ASSERT(sp < RS_BVH4_STACK);
-                stack[sp++] = rs_bvh4_ref(n, ref, l);
-            }
-        } else {
-            const rs_bvh4_node *n = &b->nodes[(ref & ~RS_BVH4_LEAF) >> 2];
-            uint32_t lane = ref & 3u, first = n->child[lane], count = n->count[lane], i;
-#ifdef RS_BVH4_SSE
-            if (count & RS_BVH4_PACKED) {
-                if (rs_bvh4_packed_occluded(b->tri4, b->quad4, first, count, &r, &ray))
-                    return 1;
-                continue;
-            }
-#endif
-            for (i = 0; i < count; ++i)
-                if (rs_bvh_leaf_occluded(g, b->prim_ids[first + i], &ray))
-                    return 1;
-        }
-    }
-    return 0;
-}
+#include "accel/wide_walk.h"
 
 /* rs_trace_one (accel/trace.h) on the 4-wide tree. */
 static inline void rs_bvh4_trace_one(const rs_bvh4 *b, const rs_geom *g,

@@ -24,8 +24,8 @@
  *   child[8]    interior lane: index of the child node; leaf lane: first prim_ids entry, or for a
  *               packed leaf the first of its blocks
  *   count[8]    0 for an interior lane, else the leaf's primitive count, or for a packed leaf
- *               RS_BVH4_PACKED | its number of blocks (with RS_BVH4_QUADS for quad8 blocks,
- *               RS_BVH4_SPHERES for sphere8 blocks)
+ *               RS_WIDE_PACKED | its number of blocks (with RS_WIDE_QUADS for quad8 blocks,
+ *               RS_WIDE_SPHERES for sphere8 blocks)
  *   n_lanes     lanes in use (1 to 8), packed from lane 0; unused lanes hold an empty box */
 #ifndef RS_ACCEL_BVH8_H
 #define RS_ACCEL_BVH8_H
@@ -69,8 +69,7 @@ typedef struct rs_bvh8 {
     uint32_t n_packed; /* leaves packed as blocks */
 } rs_bvh8;
 
-/* A traversal stack entry: an interior node's index, or RS_BVH8_LEAF | node << 3 | lane. */
-#define RS_BVH8_LEAF      0x80000000u
+/* Stack entries and leaf flags: accel/wide.h (leaf entries RS_WIDE_LEAF | node << 3 | lane). */
 #define RS_BVH8_MAX_NODES (1u << 28)
 /* Each level pushes at most 7 entries (closest) or 8 (any hit). */
 #define RS_BVH8_STACK (8 * RS_BVH_STACK)

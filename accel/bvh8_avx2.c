@@ -24,21 +24,21 @@ typedef struct ray8 {
 
 } ray8;
 
-static inline void ray8_init(ray8 *r, const rs_ray *ray)
+static inline void walk8_ray_init(ray8 *r, rs_vec3 o, rs_vec3 d)
 {
-    rs_vec3 inv_d = rs_bvh_inv_dir(ray->d);
+    rs_vec3 inv_d = rs_bvh_inv_dir(d);
     float iv[3], ov[3];
     int a;
     iv[0] = inv_d.x;
     iv[1] = inv_d.y;
     iv[2] = inv_d.z;
-    ov[0] = ray->o.x;
-    ov[1] = ray->o.y;
-    ov[2] = ray->o.z;
+    ov[0] = o.x;
+    ov[1] = o.y;
+    ov[2] = o.z;
     r->general = 0;
     for (a = 0; a < 3; ++a) {
         r->o[a] = _mm256_set1_ps(ov[a]);
-        r->d[a] = _mm256_set1_ps(a == 0 ? ray->d.x : a == 1 ? ray->d.y : ray->d.z);
+        r->d[a] = _mm256_set1_ps(a == 0 ? d.x : a == 1 ? d.y : d.z);
         r->inv[a] = _mm256_set1_ps(iv[a]);
         r->near[a] = 8u * ((size_t)a + (iv[a] < 0.0f ? 3u : 0u));
         r->far[a] = 8u * ((size_t)a + (iv[a] < 0.0f ? 0u : 3u));
@@ -48,8 +48,8 @@ static inline void ray8_init(ray8 *r, const rs_ray *ray)
 }
 
 /* The slab test of the eight lanes of `n`: the mask of lanes hit, their entry distances in *tn. */
-static inline uint32_t lanes8(const rs_bvh8_node *n, const ray8 *r, float tmin, float tmax,
-                              __m256 *tn_out)
+static inline uint32_t walk8_lanes(const rs_bvh8_node *n, const ray8 *r, float tmin,
+                                   float tmax, __m256 *tn_out)
 {
     const float *b = &n->b[0][0];
     __m256 tn, tf;
@@ -88,12 +88,7 @@ static inline uint32_t lanes8(const rs_bvh8_node *n, const ray8 *r, float tmin, 
            ((1u << n->n_lanes) - 1u);
 }
 
-static inline uint32_t ref8(const rs_bvh8_node *n, uint32_t node, uint32_t lane)
-{
-    return n->count[lane] ? RS_BVH8_LEAF | node << 3 | lane : n->child[lane];
-}
-
-static inline uint32_t lowest(uint32_t m) { return (uint32_t)__builtin_ctz(m); }
+static inline void walk8_tn_store(float tn[8], const __m256 *v) { _mm256_storeu_ps(tn, *v); }
 
 /* AVX comparisons that match SSE's: cmpneq is unordered (true for NaN), the others ordered. */
 #  define CMP_NE(a, b) _mm256_cmp_ps(a, b, _CMP_NEQ_UQ)
@@ -206,181 +201,31 @@ static inline uint32_t sphere8_hit(const rs_bvh8_sphere8 *b, const ray8 *r, floa
     return (uint32_t)_mm256_movemask_ps(ok);
 }
 
-/* A packed leaf for closest hit, as rs_bvh4_packed_closest. */
-static inline void packed_closest(const rs_bvh8 *b, uint32_t first, uint32_t count, const ray8 *r,
-                                  rs_ray *ray, rs_hit *hit)
-{
-    uint32_t i, n = count & RS_BVH4_BLOCKS;
-    for (i = 0; i < n; ++i) {
-        float t[8], u[8], v[8];
-        const uint32_t *prim;
-        uint32_t m;
-        if (count & RS_BVH4_SPHERES) {
-            m = sphere8_hit(&b->sphere8[first + i], r, ray->tmin, ray->tmax, t);
-            memset(u, 0, sizeof u); /* rs_geom_intersect's u, v for a sphere */
-            memset(v, 0, sizeof v);
-            prim = b->sphere8[first + i].prim;
-        } else if (count & RS_BVH4_QUADS) {
-            m = quad8_hit(&b->quad8[first + i], r, ray->tmin, ray->tmax, t, u, v);
-            prim = b->quad8[first + i].prim;
-        } else {
-            m = tri8_hit(&b->tri8[first + i], r, ray->tmin, ray->tmax, t, u, v);
-            prim = b->tri8[first + i].prim;
-        }
-        while (m) {
-            uint32_t l = lowest(m);
-            m &= m - 1;
-            if (rs_hit_better(t[l], prim[l], hit)) {
-                ray->tmax = rs_float_next_up(t[l]);
-                hit->t = t[l];
-                hit->u = u[l];
-                hit->v = v[l];
-                hit->prim = prim[l];
-            }
-        }
-    }
-}
-
-/* A packed leaf for any hit. */
-static inline int packed_occluded(const rs_bvh8 *b, uint32_t first, uint32_t count,
-                                  const ray8 *r, const rs_ray *ray)
-{
-    uint32_t i, n = count & RS_BVH4_BLOCKS;
-    for (i = 0; i < n; ++i) {
-        float t[8], u[8], v[8];
-        if (count & RS_BVH4_SPHERES ? sphere8_hit(&b->sphere8[first + i], r, ray->tmin, ray->tmax, t)
-            : count & RS_BVH4_QUADS
-                ? quad8_hit(&b->quad8[first + i], r, ray->tmin, ray->tmax, t, u, v)
-                : tri8_hit(&b->tri8[first + i], r, ray->tmin, ray->tmax, t, u, v))
-            return 1;
-    }
-    return 0;
-}
+/* The walks, from accel/wide_walk.h (walk8_closest, walk8_occluded). */
+#  define RS_WIDE_W                                 8
+#  define RS_WIDE_SHIFT                             3
+#  define RS_WIDE_TREE                              rs_bvh8
+#  define RS_WIDE_NODE                              rs_bvh8_node
+#  define RS_WIDE_STACK                             RS_BVH8_STACK
+#  define RS_WIDE_FN(x)                             walk8_##x
+#  define RS_WIDE_RAY                               ray8
+#  define RS_WIDE_TN                                __m256
+#  define RS_WIDE_TRIS(b)                           ((b)->tri8)
+#  define RS_WIDE_TRI_HIT(blk, r, t0, t1, t, u, v)  tri8_hit(blk, r, t0, t1, t, u, v)
+#  define RS_WIDE_QUADS_OF(b)                       ((b)->quad8)
+#  define RS_WIDE_QUAD_HIT(blk, r, t0, t1, t, u, v) quad8_hit(blk, r, t0, t1, t, u, v)
+#  define RS_WIDE_SPHERES_OF(b)                     ((b)->sphere8)
+#  define RS_WIDE_SPHERE_HIT(blk, r, t0, t1, t)     sphere8_hit(blk, r, t0, t1, t)
+#  include "accel/wide_walk.h"
 
 int rs_bvh8_closest(const rs_bvh8 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
 {
-    uint32_t stack[RS_BVH8_STACK];
-    float stack_t[RS_BVH8_STACK];
-    uint32_t sp = 0, ref = 0;
-    ray8 r;
-    hit->prim = RS_NO_HIT;
-    hit->t = ray.tmax;
-    hit->u = hit->v = 0.0f;
-    if (b->n_nodes == 0)
-        return 0;
-    ray8_init(&r, &ray);
-    for (;;) {
-        if (!(ref & RS_BVH8_LEAF)) {
-            const rs_bvh8_node *n = &b->nodes[ref];
-            __m256 tnv;
-            uint32_t mask = lanes8(n, &r, ray.tmin, ray.tmax, &tnv);
-            if (mask != 0) {
-                float tn[8];
-                uint32_t first = lowest(mask), second;
-                mask &= mask - 1;
-                if (mask == 0) {
-                    ref = ref8(n, ref, first);
-                    continue;
-                }
-                _mm256_storeu_ps(tn, tnv);
-                second = lowest(mask);
-                mask &= mask - 1;
-                if (mask == 0) {
-                    /* two lanes: the nearer next, the other pushed */
-                    if (tn[second] < tn[first]) {
-                        uint32_t s = first;
-                        first = second;
-                        second = s;
-                    }
-                    RS_ASSERT(sp < RS_BVH8_STACK);
-                    stack[sp] = ref8(n, ref, second);
-                    stack_t[sp++] = tn[second];
-                    ref = ref8(n, ref, first);
-                    continue;
-                } else {
-                    /* three to eight: insertion sort by entry distance, pushed far to near */
-                    uint32_t lanes[8], k = 2, i, j;
-                    if (tn[second] < tn[first]) {
-                        lanes[0] = second;
-                        lanes[1] = first;
-                    } else {
-                        lanes[0] = first;
-                        lanes[1] = second;
-                    }
-                    while (mask) {
-                        uint32_t l = lowest(mask);
-                        mask &= mask - 1;
-                        for (j = k; j > 0 && tn[lanes[j - 1]] > tn[l]; --j)
-                            lanes[j] = lanes[j - 1];
-                        lanes[j] = l;
-                        ++k;
-                    }
-                    for (i = k - 1; i > 0; --i) {
-                        RS_ASSERT(sp < RS_BVH8_STACK);
-                        stack[sp] = ref8(n, ref, lanes[i]);
-                        stack_t[sp++] = tn[lanes[i]];
-                    }
-                    ref = ref8(n, ref, lanes[0]);
-                    continue;
-                }
-            }
-        } else {
-            const rs_bvh8_node *n = &b->nodes[(ref & ~RS_BVH8_LEAF) >> 3];
-            uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane], i;
-            if (count & RS_BVH4_PACKED) {
-                packed_closest(b, first, count, &r, &ray, hit);
-                count = 0;
-            }
-            for (i = 0; i < count; ++i)
-                rs_bvh_leaf_closest(g, b->prim_ids[first + i], &ray, hit);
-        }
-        /* pop the next entry that can still hold a hit no farther than the best so far */
-        for (;;) {
-            if (sp == 0)
-                return hit->prim != RS_NO_HIT;
-            --sp;
-            if (stack_t[sp] <= ray.tmax * RS_BVH_SLACK)
-                break;
-        }
-        ref = stack[sp];
-    }
+    return walk8_closest(b, g, ray, hit);
 }
 
 int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray)
 {
-    uint32_t stack[RS_BVH8_STACK];
-    uint32_t sp = 0;
-    ray8 r;
-    if (b->n_nodes == 0)
-        return 0;
-    ray8_init(&r, &ray);
-    stack[sp++] = 0;
-    while (sp > 0) {
-        uint32_t ref = stack[--sp];
-        if (!(ref & RS_BVH8_LEAF)) {
-            const rs_bvh8_node *n = &b->nodes[ref];
-            __m256 tnv;
-            uint32_t mask = lanes8(n, &r, ray.tmin, ray.tmax, &tnv);
-            while (mask) {
-                uint32_t l = lowest(mask);
-                mask &= mask - 1;
-                RS_ASSERT(sp < RS_BVH8_STACK);
-                stack[sp++] = ref8(n, ref, l);
-            }
-        } else {
-            const rs_bvh8_node *n = &b->nodes[(ref & ~RS_BVH8_LEAF) >> 3];
-            uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane], i;
-            if (count & RS_BVH4_PACKED) {
-                if (packed_occluded(b, first, count, &r, &ray))
-                    return 1;
-                continue;
-            }
-            for (i = 0; i < count; ++i)
-                if (rs_bvh_leaf_occluded(g, b->prim_ids[first + i], &ray))
-                    return 1;
-        }
-    }
-    return 0;
+    return walk8_occluded(b, g, ray);
 }
 
 void rs_bvh8_trace(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,

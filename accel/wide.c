@@ -63,15 +63,15 @@ void rs_leaf_packer_init(rs_leaf_packer *p, const rs_bvh *b, const rs_geom *g, u
 #endif
 }
 
-/* How binary leaf `n` is packed: RS_BVH4_PACKED for triangle blocks, RS_BVH4_PACKED |
- * RS_BVH4_QUADS for parallelogram blocks, 0 when it is not (a mix of kinds, spheres, or packing
+/* How binary leaf `n` is packed: RS_WIDE_PACKED for triangle blocks, RS_WIDE_PACKED |
+ * RS_WIDE_QUADS for parallelogram blocks, 0 when it is not (a mix of kinds, spheres, or packing
  * off). */
 static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
 {
     uint32_t i, first_quad = p->g->n_spheres, first_tri = first_quad + p->g->n_quads;
     uint32_t first_inst = first_tri + p->g->n_tris; /* instances are never packed */
     uint32_t tris = 0, quads = 0, spheres = 0;
-    if ((n->count + p->width - 1) / p->width > RS_BVH4_BLOCKS)
+    if ((n->count + p->width - 1) / p->width > RS_WIDE_BLOCKS)
         return 0;
     for (i = 0; i < n->count; ++i) {
         uint32_t prim = p->prim_ids[n->left_first + i];
@@ -82,11 +82,11 @@ static uint32_t pack_kind(const rs_leaf_packer *p, const rs_bvh_node *n)
         spheres += prim < first_quad;
     }
     if (p->pack_tris && tris == n->count)
-        return RS_BVH4_PACKED;
+        return RS_WIDE_PACKED;
     if (p->pack_quads && quads == n->count)
-        return RS_BVH4_PACKED | RS_BVH4_QUADS;
+        return RS_WIDE_PACKED | RS_WIDE_QUADS;
     if (p->pack_spheres && spheres == n->count)
-        return RS_BVH4_PACKED | RS_BVH4_SPHERES;
+        return RS_WIDE_PACKED | RS_WIDE_SPHERES;
     return 0;
 }
 
@@ -166,8 +166,8 @@ int rs_leaf_lane(rs_leaf_packer *p, const rs_bvh_node *l, uint32_t *child, uint1
         *count = (uint16_t)l->count;
         return 0;
     }
-    *child = kind & RS_BVH4_SPHERES ? pack_spheres(p, l)
-             : kind & RS_BVH4_QUADS
+    *child = kind & RS_WIDE_SPHERES ? pack_spheres(p, l)
+             : kind & RS_WIDE_QUADS
                  ? pack(p, l, p->quad, &p->n_quad, p->cap_quad, QUAD_FIELDS, 1)
                  : pack(p, l, p->tri, &p->n_tri, p->cap_tri, TRI_FIELDS, 0);
     *count = (uint16_t)(kind | (l->count + p->width - 1) / p->width);
@@ -187,9 +187,9 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
         if (b->nodes[i].count > 0) {
             uint32_t kind = pack_kind(p, &b->nodes[i]);
             uint32_t blocks = (b->nodes[i].count + p->width - 1) / p->width;
-            if (kind & RS_BVH4_SPHERES)
+            if (kind & RS_WIDE_SPHERES)
                 p->cap_sphere += blocks;
-            else if (kind & RS_BVH4_QUADS)
+            else if (kind & RS_WIDE_QUADS)
                 p->cap_quad += blocks;
             else if (kind)
                 p->cap_tri += blocks;
