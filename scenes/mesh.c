@@ -212,17 +212,6 @@ static int has_empty_face(const struct aiScene *as)
     return 0;
 }
 
-/* Rotation about x, then y, then z (right-handed, degrees). */
-static rs_vec3 rotate_xyz(rs_vec3 p, rs_vec3 deg)
-{
-    const float k = 0.017453292519943295f;
-    float cx = cosf(deg.x * k), sx = sinf(deg.x * k), cy = cosf(deg.y * k), sy = sinf(deg.y * k);
-    float cz = cosf(deg.z * k), sz = sinf(deg.z * k);
-    rs_vec3 a = rs_v3(p.x, cx * p.y - sx * p.z, sx * p.y + cx * p.z);
-    rs_vec3 b = rs_v3(cy * a.x + sy * a.z, a.y, -sy * a.x + cy * a.z);
-    return rs_v3(cz * b.x - sz * b.y, sz * b.x + cz * b.y, b.z);
-}
-
 static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
 /* How a texture's texels are read: colours are sRGB-decoded, data (normals, metallic-roughness)
@@ -581,33 +570,75 @@ static rs_status check_overrides(const struct aiScene *as, const char *path, con
     return RS_OK;
 }
 
-typedef struct placement {
-    rs_vec3 scale, rot, translate;
-    float fit_scale;
-} placement;
+/* ---- placement ----------------------------------------------------------------------------
+ *
+ * A mesh is placed by an rs_xform (scenes/transform.h), the one transform type of scenes: the
+ * options' scale, then the rotations about x, y and z (rs_xform_rotate_euler: right-handed
+ * degrees in that order), then the fit's uniform scale and translation or the options'
+ * translation.  Points go by rs_xform_point and normals by rs_xform_normal (the inverse
+ * transpose), in double, rounded to float once; a placement that mirrors (a negative scale)
+ * keeps each face's outward side, as the scene file's transforms do.
+ *
+ * add_faces takes NULL for "as the file has them": a glTF node's meshes (which
+ * rs_scene_transform_since moves afterwards) and a mesh placed by the identity.  Those are stored
+ * bit for bit as the float placement by the identity (before rs_xform placed meshes) stored
+ * them, so that scenes whose meshes are not placed render as they did: it turned a zero
+ * coordinate's sign to +0, renormalised normals in float, and left their zeros' signs as the
+ * rotations by 0 degrees, written out below, leave them (they matter: core/sampling.h's basis
+ * reads the sign of n.z).  The build has no fast-math (CMakeLists.txt), so `x + 0.0f` and
+ * `0.0f * x` are not folded away. */
 
-static rs_vec3 place(const placement *pl, rs_vec3 p)
-{
-    return rs_v3_add(rs_v3_scale(rotate_xyz(rs_v3_mul(p, pl->scale), pl->rot), pl->fit_scale),
-                     pl->translate);
-}
+static rs_vec3 as_stored_point(rs_vec3 p) { return rs_v3(p.x + 0.0f, p.y + 0.0f, p.z + 0.0f); }
 
-/* Normals transform by the inverse transpose: divide by the scale, then rotate. */
-static rs_vec3 place_normal(const placement *pl, rs_vec3 n)
+static rs_vec3 as_stored_normal(rs_vec3 n)
 {
-    rs_vec3 m = rotate_xyz(rs_v3(n.x / pl->scale.x, n.y / pl->scale.y, n.z / pl->scale.z), pl->rot);
+    /* about x, y, then z by 0 degrees: cos = 1, sin = +0 (so -sin = -0) */
+    rs_vec3 a = rs_v3(n.x, n.y - 0.0f * n.z, 0.0f * n.y + n.z);
+    rs_vec3 b = rs_v3(a.x + 0.0f * a.z, a.y, -0.0f * a.x + a.z);
+    rs_vec3 m = rs_v3(b.x - 0.0f * b.y, 0.0f * b.x + b.y, b.z);
     float l = rs_v3_length(m);
     return l > 0 ? rs_v3_scale(m, 1.0f / l) : rs_v3(0, 0, 0);
 }
 
-/* The triangles of Assimp mesh m, placed by pl, with material mat; faces with an index out of
- * range, a non-finite vertex or no area, or that are not triangles, are dropped and counted in
- * *info (which also gets the triangles added and their bounds). */
-static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const placement *pl, uint32_t mat,
+/* The options' scale, then their rotations about x, y and z. */
+static rs_xform scale_rotate(const rs_mesh_opts *o)
+{
+    rs_xform sc = rs_xform_scale(o->scale.x, o->scale.y, o->scale.z);
+    rs_xform rot = rs_xform_rotate_euler(o->rotate_deg.x, o->rotate_deg.y, o->rotate_deg.z);
+    return rs_xform_compose(&rot, &sc);
+}
+
+/* sr (scale_rotate's) followed by the fit into o's box, given the bounds `raw` of the vertices
+ * sr places (a uniform scale so the largest extent is fit_size, its bottom centre on fit_base),
+ * or by the options' translation. */
+static rs_xform fit_translate(const rs_mesh_opts *o, const rs_xform *sr, rs_aabb raw)
+{
+    rs_xform sf, mv, x = *sr;
+    if (o->fit) {
+        double ex = (double)raw.hi.x - raw.lo.x, ey = (double)raw.hi.y - raw.lo.y;
+        double ez = (double)raw.hi.z - raw.lo.z, big = fmax(ex, fmax(ey, ez));
+        double f = big > 0 ? o->fit_size / big : 1.0;
+        sf = rs_xform_scale(f, f, f);
+        x = rs_xform_compose(&sf, &x);
+        mv = rs_xform_translate(o->fit_base.x - f * 0.5 * ((double)raw.lo.x + raw.hi.x),
+                                o->fit_base.y - f * raw.lo.y,
+                                o->fit_base.z - f * 0.5 * ((double)raw.lo.z + raw.hi.z));
+    } else {
+        mv = rs_xform_translate(o->translate.x, o->translate.y, o->translate.z);
+    }
+    return rs_xform_compose(&mv, &x);
+}
+
+/* The triangles of Assimp mesh m, placed by xf (NULL: as the file has them), with material mat;
+ * faces with an index out of range, a placed vertex that is not finite, no placed area, or that
+ * are not triangles, are dropped and counted in *info (which also gets the triangles added and
+ * their placed bounds). */
+static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const rs_xform *xf, uint32_t mat,
                            rs_mesh_info *info)
 {
     rs_status st = RS_OK;
     uint32_t k;
+    int mirror = xf && rs_xform_det(xf) < 0;
     for (k = 0; k < m->mNumFaces && st == RS_OK; ++k) {
         const struct aiFace *f = &m->mFaces[k];
         rs_vec3 v[3];
@@ -615,14 +646,16 @@ static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const placement 
         int c, ok = f->mNumIndices == 3;
         uint32_t *why = &info->dropped_shape;
         for (c = 0; c < 3 && ok; ++c) {
-            unsigned int idx = f->mIndices[c];
+            /* a mirror takes the corners 0, 2, 1: the face keeps its outward side */
+            unsigned int idx = f->mIndices[mirror && c ? 3 - c : c];
+            rs_vec3 p;
             if (idx >= m->mNumVertices) {
                 ok = 0;
                 why = &info->dropped_index;
                 break;
             }
-            v[c] = place(pl,
-                         rs_v3(m->mVertices[idx].x, m->mVertices[idx].y, m->mVertices[idx].z));
+            p = rs_v3(m->mVertices[idx].x, m->mVertices[idx].y, m->mVertices[idx].z);
+            v[c] = xf ? rs_xform_point(xf, p) : as_stored_point(p);
             ok = finite3(v[c]);
             if (!ok)
                 why = &info->dropped_nonfinite;
@@ -631,8 +664,8 @@ static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const placement 
                 uv[2 * c + 1] = m->mTextureCoords[0][idx].y;
             }
             if (m->mNormals) {
-                rs_vec3 n = place_normal(
-                    pl, rs_v3(m->mNormals[idx].x, m->mNormals[idx].y, m->mNormals[idx].z));
+                rs_vec3 n = rs_v3(m->mNormals[idx].x, m->mNormals[idx].y, m->mNormals[idx].z);
+                n = xf ? rs_xform_normal(xf, n) : as_stored_normal(n);
                 if (!finite3(n))
                     n = rs_v3(0, 0, 0);
                 nrm[3 * c] = n.x;
@@ -847,7 +880,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
                             rs_mesh_info *info)
 {
     const struct aiScene *as;
-    placement pl;
+    rs_xform xf;
     uint32_t *mat_of = NULL, mi, k;
     char dir[1024];
     const char *slash = strrchr(path, '/');
@@ -865,11 +898,8 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     if (st != RS_OK)
         return st;
 
-    /* placement: the raw bounds of the transformed (unfitted) vertices decide a fit */
-    pl.scale = o->scale;
-    pl.rot = o->rotate_deg;
-    pl.translate = rs_v3(0, 0, 0);
-    pl.fit_scale = 1.0f;
+    /* placement: the bounds of the scaled and rotated (unfitted) vertices decide a fit */
+    xf = scale_rotate(o);
     raw.lo = rs_v3_splat(FLT_MAX);
     raw.hi = rs_v3_splat(-FLT_MAX);
     for (mi = 0; mi < as->mNumMeshes; ++mi) {
@@ -877,7 +907,8 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         if (!m->mVertices)
             continue;
         for (k = 0; k < m->mNumVertices; ++k) {
-            rs_vec3 p = place(&pl, rs_v3(m->mVertices[k].x, m->mVertices[k].y, m->mVertices[k].z));
+            rs_vec3 p = rs_xform_point(
+                &xf, rs_v3(m->mVertices[k].x, m->mVertices[k].y, m->mVertices[k].z));
             if (!finite3(p))
                 continue;
             raw.lo = rs_v3_min(raw.lo, p);
@@ -888,17 +919,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         release_scene(as);
         return rs_error_set(RS_ERR_ARG, "%s: no finite vertex in the file", path);
     }
-    if (o->fit) {
-        rs_vec3 ext = rs_v3_sub(raw.hi, raw.lo);
-        float big = rs_v3_max_comp(ext);
-        pl.fit_scale = big > 0 ? o->fit_size / big : 1.0f;
-        pl.translate = rs_v3_sub(
-            o->fit_base,
-            rs_v3_scale(rs_v3((raw.lo.x + raw.hi.x) * 0.5f, raw.lo.y, (raw.lo.z + raw.hi.z) * 0.5f),
-                        pl.fit_scale));
-    } else {
-        pl.translate = o->translate;
-    }
+    xf = fit_translate(o, &xf, raw);
 
     if (o->material == RS_MESH_FILE_MATERIALS) {
         mat_of = (uint32_t *)rs_alloc(as->mNumMaterials ? as->mNumMaterials : 1, sizeof *mat_of);
@@ -939,7 +960,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
             mat = as->mNumMaterials
                       ? mat_of[m->mMaterialIndex < as->mNumMaterials ? m->mMaterialIndex : 0]
                       : mat_of[0];
-        st = add_faces(s, m, &pl, mat, info);
+        st = add_faces(s, m, rs_xform_is_identity(&xf) ? NULL : &xf, mat, info);
     }
     rs_free(mat_of);
     if (as->mFlags & OWN_SCENE) {
@@ -1032,7 +1053,6 @@ static rs_status gltf_node(gltf_ctx *g, const struct aiNode *nd, const rs_xform 
         return rs_error_set(RS_ERR_ARG, "%s: node '%s': %s", g->path, nd->mName.data, why);
     for (k = 0; k < nd->mNumMeshes; ++k) {
         const struct aiMesh *m;
-        placement id = {{1, 1, 1}, {0, 0, 0}, {0, 0, 0}, 1.0f};
         rs_scene_mark mark = rs_scene_mark_now(g->s);
         if (nd->mMeshes[k] >= g->as->mNumMeshes)
             return rs_error_set(RS_ERR_ARG, "%s: node '%s' names mesh %u of %u", g->path,
@@ -1040,7 +1060,7 @@ static rs_status gltf_node(gltf_ctx *g, const struct aiNode *nd, const rs_xform 
         m = g->as->mMeshes[nd->mMeshes[k]];
         if (!m->mVertices || !m->mFaces)
             continue;
-        st = add_faces(g->s, m, &id,
+        st = add_faces(g->s, m, NULL,
                        g->mat_of[m->mMaterialIndex < g->as->mNumMaterials ? m->mMaterialIndex : 0],
                        &g->info);
         if (st == RS_OK && !rs_xform_is_identity(&xf))

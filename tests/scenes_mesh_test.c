@@ -57,16 +57,16 @@ static void test_obj_placement_uv_normals(void **state)
     assert_int_equal(info.triangles, 1u);
     assert_int_equal(info.dropped, 0u);
     t = &s->tris[0];
-    /* v1 = (1,0,0) -> (2,0,0) -> (0,0,-2) -> (10,0,-2); v2 = (0,1,0) -> (0,3,0) -> (10,3,0) */
-    assert_true(near(t->v0.x, 10) && near(t->v0.y, 0) && near(t->v0.z, 0));
-    assert_true(near(t->v1.x, 10) && near(t->v1.y, 0) && near(t->v1.z, -2));
-    assert_true(near(t->v2.x, 10) && near(t->v2.y, 3) && near(t->v2.z, 0));
+    /* v1 = (1,0,0) -> (2,0,0) -> (0,0,-2) -> (10,0,-2); v2 = (0,1,0) -> (0,3,0) -> (10,3,0);
+     * exactly: quarter turns are exact (rs_xform_rotate_euler) and the rest is exact in binary */
+    assert_true(t->v0.x == 10 && t->v0.y == 0 && t->v0.z == 0);
+    assert_true(t->v1.x == 10 && t->v1.y == 0 && t->v1.z == -2);
+    assert_true(t->v2.x == 10 && t->v2.y == 3 && t->v2.z == 0);
     assert_non_null(s->tri_uv);
     assert_true(near(s->tri_uv[2], 1) && near(s->tri_uv[3], 0) && near(s->tri_uv[5], 1));
     /* the normal (0,0,1) scales by 1/4 and rotates to (1,0,0) (then renormalised) */
     assert_non_null(s->tri_normal);
-    assert_true(near(s->tri_normal[0], 1) && near(s->tri_normal[1], 0) &&
-                near(s->tri_normal[2], 0));
+    assert_true(s->tri_normal[0] == 1 && s->tri_normal[1] == 0 && s->tri_normal[2] == 0);
     assert_int_equal(rs_scene_finalize(s), RS_OK);
     rs_scene_destroy(s);
 }
@@ -110,6 +110,140 @@ static void test_obj_normals_inverse_transpose(void **state)
                      -0.64f * k, 0.24f * k, 0.6f * k);
         assert_true(rs_v3_dot(face, rs_v3(nv[0], nv[1], nv[2])) > 1.0f - 1e-5f);
     }
+    rs_scene_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
+/* The three corners of the test triangle of test_placement_nonaxis, and its normal. */
+static const float nonaxis_v[3][3] = {{1, 2, 3}, {2, 2, 3}, {1, 3, 3}};
+
+/* The placement is scale, then rotations about x, y, z, then the translation, in double and
+ * rounded once.  Scale (2, 3, 5), rotations (90, 0, 90) (together the turn by 120 degrees about
+ * (1, 1, 1): (x, y, z) -> (z, x, y)), translation (10, 20, 30): (1, 2, 3) -> (2, 6, 15) ->
+ * (15, 2, 6) -> (25, 22, 36), exactly; (2, 2, 3) -> (25, 24, 36); (1, 3, 3) -> (25, 22, 39).
+ * The normal n = (0.48, 0.64, 0.6) goes by M^-T = R S^-1: (0.24, 0.64/3, 0.12) ->
+ * (0.12, 0.24, 0.64/3), normalised.  Then rotations (30, 45, 60), not quarter turns, against
+ * the rotation written out in double here: each coordinate within one float ulp of it. */
+static void test_placement_nonaxis(void **state)
+{
+    static const double deg[3] = {30, 45, 60};
+    char dir[] = "/tmp/rs_place_XXXXXX", path[256];
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    const rs_tri *t;
+    double l = sqrt(0.12 * 0.12 + 0.24 * 0.24 + (0.64 / 3) * (0.64 / 3));
+    int i, j;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/tri.obj", dir);
+    write_file(path, "v 1 2 3\nv 2 2 3\nv 1 3 3\nvn 0.48 0.64 0.6\nf 1//1 2//1 3//1\n");
+    o.scale = rs_v3(2, 3, 5);
+    o.rotate_deg = rs_v3(90, 0, 90);
+    o.translate = rs_v3(10, 20, 30);
+    assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    t = &s->tris[0];
+    assert_true(t->v0.x == 25 && t->v0.y == 22 && t->v0.z == 36);
+    assert_true(t->v1.x == 25 && t->v1.y == 24 && t->v1.z == 36);
+    assert_true(t->v2.x == 25 && t->v2.y == 22 && t->v2.z == 39);
+    assert_true(info.bounds.lo.y == 22 && info.bounds.hi.z == 39);
+    for (i = 0; i < 3; ++i) {
+        const float *nv = &s->tri_normal[3 * i];
+        if (!(fabs(nv[0] - 0.12 / l) < 1e-7 && fabs(nv[1] - 0.24 / l) < 1e-7 &&
+              fabs(nv[2] - 0.64 / 3 / l) < 1e-7))
+            fail_msg("vertex %d's normal (%.9g, %.9g, %.9g), want (%.9g, %.9g, %.9g)", i, nv[0],
+                     nv[1], nv[2], 0.12 / l, 0.24 / l, 0.64 / 3 / l);
+    }
+
+    o.rotate_deg = rs_v3((float)deg[0], (float)deg[1], (float)deg[2]);
+    assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_OK);
+    t = &s->tris[1];
+    for (i = 0; i < 3; ++i) {
+        const float *v = nonaxis_v[i];
+        const float got[3] = {i == 0 ? t->v0.x : i == 1 ? t->v1.x : t->v2.x,
+                              i == 0 ? t->v0.y : i == 1 ? t->v1.y : t->v2.y,
+                              i == 0 ? t->v0.z : i == 1 ? t->v1.z : t->v2.z};
+        double p[3] = {2.0 * v[0], 3.0 * v[1], 5.0 * v[2]}, q[3];
+        double c[3], sn[3];
+        for (j = 0; j < 3; ++j) {
+            c[j] = cos(deg[j] * (3.14159265358979323846 / 180));
+            sn[j] = sin(deg[j] * (3.14159265358979323846 / 180));
+        }
+        /* about x, then y, then z: right-handed */
+        q[0] = p[0];
+        q[1] = c[0] * p[1] - sn[0] * p[2];
+        q[2] = sn[0] * p[1] + c[0] * p[2];
+        p[0] = c[1] * q[0] + sn[1] * q[2];
+        p[1] = q[1];
+        p[2] = -sn[1] * q[0] + c[1] * q[2];
+        q[0] = c[2] * p[0] - sn[2] * p[1] + 10;
+        q[1] = sn[2] * p[0] + c[2] * p[1] + 20;
+        q[2] = p[2] + 30;
+        for (j = 0; j < 3; ++j)
+            if (!(fabs(got[j] - q[j]) <= ldexp(1.0, ilogb(q[j]) - 23)))
+                fail_msg("vertex %d coordinate %d: %.9g, want %.12g (within an ulp)", i, j,
+                         got[j], q[j]);
+    }
+    rs_scene_destroy(s);
+    remove(path);
+    rmdir(dir);
+}
+
+/* A negative scale mirrors: the face keeps its outward side (its corners 1 and 2 swapped, with
+ * their UVs and normals), as the scene file's transforms keep it, and agrees with its vertex
+ * normals.  tri.obj faces +z; scale (-1, 1, 1) keeps it facing +z. */
+static void test_placement_mirror(void **state)
+{
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    const rs_tri *t;
+    rs_vec3 face;
+    int i;
+    (void)state;
+    o.scale = rs_v3(-1, 1, 1);
+    assert_int_equal(rs_scene_add_mesh(s, DATA "tri.obj", &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    t = &s->tris[0];
+    /* the file's (1,0,0) -> (-1,0,0), now the third corner; (0,1,0) the second */
+    assert_true(t->v1.x == 0 && t->v1.y == 1 && t->v2.x == -1 && t->v2.y == 0);
+    assert_true(s->tri_uv[2] == 0 && s->tri_uv[3] == 1 && s->tri_uv[4] == 1 && s->tri_uv[5] == 0);
+    face = rs_v3_cross(rs_v3_sub(t->v1, t->v0), rs_v3_sub(t->v2, t->v0));
+    assert_true(face.z > 0);
+    for (i = 0; i < 3; ++i)
+        assert_true(s->tri_normal[3 * i] == 0 && s->tri_normal[3 * i + 1] == 0 &&
+                    s->tri_normal[3 * i + 2] == 1);
+    rs_scene_destroy(s);
+}
+
+/* A mesh placed by nothing is stored as the file has it, bit for bit as the float placement by
+ * the identity stored it (so that unplaced meshes and glTF nodes render as they did): a -0
+ * coordinate as +0, and a normal's zero signs as the rotations by 0 degrees left them
+ * ((1, -0, -0) -> (1, +0, -0): core/sampling.h's basis reads the sign of n.z). */
+static void test_unplaced_as_stored(void **state)
+{
+    char dir[] = "/tmp/rs_ident_XXXXXX", path[256];
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    const rs_tri *t;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/tri.obj", dir);
+    write_file(path, "v -0 0.1 -0\nv 0.7 -0 0.3\nv 0.2 0.9 -0.4\nvn 1 -0 -0\nvn 0 0.6 0.8\n"
+                     "vn -0 -0.6 -0.8\nf 1//1 2//2 3//3\n");
+    assert_int_equal(rs_scene_add_mesh(s, path, &o, &info), RS_OK);
+    assert_int_equal(info.triangles, 1u);
+    t = &s->tris[0];
+    assert_true(t->v0.x == 0 && !signbit(t->v0.x) && t->v0.y == 0.1f && !signbit(t->v0.z));
+    assert_true(t->v1.x == 0.7f && !signbit(t->v1.y) && t->v1.z == 0.3f);
+    assert_true(t->v2.x == 0.2f && t->v2.y == 0.9f && t->v2.z == -0.4f);
+    assert_true(s->tri_normal[0] == 1 && !signbit(s->tri_normal[1]) && signbit(s->tri_normal[2]));
     rs_scene_destroy(s);
     remove(path);
     rmdir(dir);
@@ -668,6 +802,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_obj_placement_uv_normals),
         cmocka_unit_test(test_obj_normals_inverse_transpose),
+        cmocka_unit_test(test_placement_nonaxis),
+        cmocka_unit_test(test_placement_mirror),
+        cmocka_unit_test(test_unplaced_as_stored),
         cmocka_unit_test(test_ply_and_gltf),
         cmocka_unit_test(test_fit),
         cmocka_unit_test(test_malformed),
