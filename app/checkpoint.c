@@ -369,8 +369,9 @@ static int read_header(reader *r)
     if (r->version != RS_CHECKPOINT_VERSION && r->version != RS_CHECKPOINT_VERSION_ADAPTIVE) {
         char v[16], want_v[16];
         snprintf(v, sizeof v, "%u", r->version);
-        snprintf(want_v, sizeof want_v, "%u", RS_CHECKPOINT_VERSION);
-        return refuse(rc, r->path, "checkpoint version %s; this raystream reads version %s", v,
+        snprintf(want_v, sizeof want_v, "%u and %u", RS_CHECKPOINT_VERSION,
+                 RS_CHECKPOINT_VERSION_ADAPTIVE);
+        return refuse(rc, r->path, "checkpoint version %s; this raystream reads versions %s", v,
                       want_v);
     }
     r->name_len = get32(r->h + 88);
@@ -408,7 +409,7 @@ static int check_size(const reader *r, const rs_checkpoint_key *want, size_t npi
         return refuse(RS_EXIT_RUNTIME, r->path, "corrupt header (image size %s)%s", "out of range",
                       "");
     if (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE)
-        per_pixel += sizeof(double) + 1;
+        per_pixel += sizeof(rs_film_sq) + 1;
     expect = (uint64_t)r->hdr + (uint64_t)fw * fh * per_pixel + 8 +
              (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE ? ADAPTIVE_FIXED : 0);
     if (r->size != expect) {
@@ -498,7 +499,7 @@ static int take_adaptive(const reader *r, const unsigned char *q, const rs_check
     ad->stats.samples = get64(q + 32);
     ad->stats.stopped = get32(q + 40);
     for (i = 0; i < npix; ++i)
-        if (!(film->sum_l2[i] >= 0 && film->sum_l2[i] < 1e300))
+        if (!(rs_film_pixel_sq(film, (uint32_t)i) <= (double)film->count[i] * 0x1p96))
             break;
     if (i < npix || rs_film_samples(film) != get64(r->h + 32) ||
         !rs_adaptive_state_fits(ad, film->count, (uint32_t)npix, want->spp))

@@ -28,13 +28,14 @@
  *              height)
  *         4*P  the counts, u32 a pixel (must be the ranges' paths of that pixel)
  *           8  FNV-1a 64 of every byte before it
- * Version 3, an adaptive render (--adaptive), is version 2 with no ranges (R = 0; the counts
+ * Version 4, an adaptive render (--adaptive), is version 2 with no ranges (R = 0; the counts
  * say what each pixel holds: its first samples, scheduler/adaptive.h) and, between the counts
  * and the checksum, the adaptive section:
  *           8  the threshold (f64)
  *          40  min spp, n, step, rounds (u32 each), the round's paths on the film (u64), samples
  *              taken (u64), pixels stopped (u32), 4 zero bytes (rs_adaptive_state)
- *         8*P  each pixel's sum of squared luminance (f64; summed in sample order)
+ *        24*P  each pixel's sum of squared luminance (rs_film_sq: a 192-bit integer in units
+ *              of 2^-64, three u64 from the lowest; version 3 had an f64 here and is refused)
  *           P  each pixel's running flag (0 or 1)
  * Everything that decides the image is in the header; the devices, threads, chunk and wave
  * sizes, the BVH builder and the integrator are not (they do not change the image).  spp matters
@@ -51,7 +52,8 @@
 #include "shading/film.h"
 
 #define RS_CHECKPOINT_VERSION          2u /* a render over every pixel */
-#define RS_CHECKPOINT_VERSION_ADAPTIVE 3u /* --adaptive: version 2 and an adaptive section */
+#define RS_CHECKPOINT_VERSION_ADAPTIVE 4u /* --adaptive: version 2 and an adaptive section
+                                             (3 had inexact squared-luminance sums) */
 
 /* The paths a film holds (scheduler/plan.h): at most this many ranges in a file. */
 #define RS_CHECKPOINT_MAX_RANGES RS_PATH_RANGES_MAX

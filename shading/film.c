@@ -52,6 +52,35 @@ static inline rs_film_sum to_fixed(double x)
 
 static inline double from_fixed(rs_film_sum s) { return (double)s * (1.0 / RS_FILM_SCALE); }
 
+/* d (0 <= d < 2^96) in units of 2^-64, the last one rounded to the nearest: each step takes
+ * the whole part of a power-of-two scaling, so every subtraction is exact. */
+static inline rs_film_sq sq_of(double d)
+{
+    rs_film_sq q;
+    double v = d * 0x1p64, hi = floor(v * 0x1p-128), mid, lo;
+    v -= hi * 0x1p128;
+    mid = floor(v * 0x1p-64);
+    lo = v - mid * 0x1p64;
+    q.w[2] = (uint64_t)hi;
+    q.w[1] = (uint64_t)mid;
+    q.w[0] = lo < 0x1p52 ? (uint64_t)(lo + 0.5) : (uint64_t)lo; /* >= 2^52: a whole number */
+    return q;
+}
+
+static inline void sq_add(rs_film_sq *a, const rs_film_sq *b)
+{
+    unsigned __int128 t = (unsigned __int128)a->w[0] + b->w[0];
+    a->w[0] = (uint64_t)t;
+    t = (t >> 64) + a->w[1] + b->w[1];
+    a->w[1] = (uint64_t)t;
+    a->w[2] += b->w[2] + (uint64_t)(t >> 64);
+}
+
+static inline double sq_value(const rs_film_sq *q)
+{
+    return ((double)q->w[2] * 0x1p64 + (double)q->w[1]) + (double)q->w[0] * 0x1p-64;
+}
+
 void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
 {
     rs_film_sum *s = &f->sum[3 * (size_t)pixel];
@@ -68,7 +97,8 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 c)
     s[2] += to_fixed(c.z);
     if (f->sum_l2) {
         double l = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-        f->sum_l2[pixel] += l * l;
+        rs_film_sq q = sq_of(l * l);
+        sq_add(&f->sum_l2[pixel], &q);
     }
 }
 
@@ -76,7 +106,7 @@ rs_status rs_film_track_variance(rs_film *f)
 {
     if (f->sum_l2)
         return RS_OK;
-    f->sum_l2 = (double *)rs_calloc((size_t)f->width * f->height, sizeof *f->sum_l2);
+    f->sum_l2 = (rs_film_sq *)rs_calloc((size_t)f->width * f->height, sizeof *f->sum_l2);
     if (!f->sum_l2)
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the film's variance");
     return RS_OK;
@@ -94,7 +124,7 @@ rs_status rs_film_merge(rs_film *dst, const rs_film *src)
         dst->count[i] += src->count[i];
     if (dst->sum_l2 && src->sum_l2)
         for (i = 0; i < n; ++i)
-            dst->sum_l2[i] += src->sum_l2[i];
+            sq_add(&dst->sum_l2[i], &src->sum_l2[i]);
     dst->nonfinite += src->nonfinite;
     return RS_OK;
 }
@@ -117,6 +147,11 @@ void rs_film_pixel_sum(const rs_film *f, uint32_t pixel, double out[3])
     out[2] = from_fixed(s[2]);
 }
 
+double rs_film_pixel_sq(const rs_film *f, uint32_t pixel)
+{
+    return f->sum_l2 ? sq_value(&f->sum_l2[pixel]) : 0.0;
+}
+
 double rs_film_rel_error(const rs_film *f, uint32_t pixel)
 {
     double s[3];
@@ -126,7 +161,7 @@ double rs_film_rel_error(const rs_film *f, uint32_t pixel)
         return INFINITY;
     rs_film_pixel_sum(f, pixel, s);
     mean = (0.2126 * s[0] + 0.7152 * s[1] + 0.0722 * s[2]) / n;
-    var = (f->sum_l2[pixel] / n - mean * mean) * n / (n - 1);
+    var = (sq_value(&f->sum_l2[pixel]) / n - mean * mean) * n / (n - 1);
     if (!(var > 0))
         return 0.0;
     return sqrt(var / n) / (mean > 1e-3 ? mean : 1e-3);

@@ -23,12 +23,21 @@
  * radiances, which the host adds). */
 __extension__ typedef __int128 rs_film_sum;
 
+/* A pixel's sum of squared luminances l^2, exact like rs_film_sum so that merged films do not
+ * depend on the order (an MPI job's adaptive rounds are decided from merged films): each l^2
+ * (l is a luminance within +-RS_FILM_MAX_SAMPLE, so l^2 < 2^96) rounded once to a multiple of
+ * 2^-64, added into a 192-bit integer, w[0] its lowest 64 bits; 2^32 samples of the largest
+ * still fit. */
+typedef struct rs_film_sq {
+    uint64_t w[3];
+} rs_film_sq;
+
 typedef struct rs_film {
     uint32_t width, height;
     rs_film_sum *sum;   /* 3 per pixel, row-major from the top-left */
     uint32_t *count;    /* samples per pixel */
-    double *sum_l2;     /* per pixel, the sum of the samples' squared luminance (adaptive
-                           sampling's error estimate; not in checkpoints); NULL unless
+    rs_film_sq *sum_l2; /* per pixel, the sum of the samples' squared luminance (adaptive
+                           sampling's error estimate), exact as `sum` is; NULL unless
                            rs_film_track_variance asked for it */
     uint64_t nonfinite; /* samples that were NaN, infinite or beyond RS_FILM_MAX_SAMPLE:
                            counted, contributed zero */
@@ -62,6 +71,9 @@ rs_status rs_film_track_variance(rs_film *f);
  * ever); infinity below two samples or without rs_film_track_variance, 0 for a pixel whose
  * samples are all alike. */
 double rs_film_rel_error(const rs_film *f, uint32_t pixel);
+/* Pixel `pixel`'s sum of squared luminances as a double (rounded; 0 without
+ * rs_film_track_variance). */
+double rs_film_pixel_sq(const rs_film *f, uint32_t pixel);
 /* Fewest samples any pixel has. */
 uint32_t rs_film_min_count(const rs_film *f);
 /* The samples on the film, every pixel's together. */
