@@ -45,6 +45,7 @@ rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)
     t->tri4 = (rs_bvh4_tri4 *)w.tri;
     t->quad4 = (rs_bvh4_quad4 *)w.quad;
     t->prim_ids = b->prim_ids;
+    t->inst_root = w.inst_root;
     t->n_nodes = w.n_nodes;
     t->n_tri4 = w.n_tri;
     t->n_quad4 = w.n_quad;
@@ -59,6 +60,7 @@ void rs_bvh4_destroy(rs_bvh4 *b)
     if (!b)
         return;
     rs_free(b->nodes);
+    rs_free(b->inst_root);
     rs_free(b->tri4);
     rs_free(b->quad4);
     rs_free(b);

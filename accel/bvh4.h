@@ -64,6 +64,8 @@ typedef struct rs_bvh4 {
     rs_bvh4_tri4 *tri4;       /* the packed leaves' triangles */
     rs_bvh4_quad4 *quad4;     /* the packed leaves' parallelograms */
     const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
+    uint32_t *inst_root;      /* per instance: its prototype's bottom level, collapsed like the
+                                 top tree into nodes after the top tree's; NULL without instances */
     uint32_t n_nodes, n_tri4, n_quad4;
     uint32_t depth;    /* in nodes; at most the binary tree's */
     uint32_t n_packed; /* leaves packed as tri4 or quad4 blocks */
@@ -90,11 +92,14 @@ void rs_bvh4_destroy(rs_bvh4 *b);
 #endif
 
 /* The 4-wide primitives accel/wide_walk.h takes: the ray broadcast to four lanes
- * (rs_bvh4_ray_init), and the slab test of the four lanes of `n` (rs_bvh4_lanes: the mask of
- * lanes hit, bit i for lane i, and their entry distances, which rs_bvh4_tn_store spills). */
+ * (rs_bvh4_ray_init; rs_bvh4_ray_widen for an instance's bottom level, whose boxes are widened
+ * by its margin as rs_blas_node_hit widens them), and the slab test of the four lanes of `n`
+ * (rs_bvh4_lanes: the mask of lanes hit, bit i for lane i, and their entry distances, which
+ * rs_bvh4_tn_store spills; `widen` a constant where it is inlined). */
 #ifdef RS_BVH4_SSE
 typedef struct rs_bvh4_ray {
     __m128 o[3], d[3], inv[3];
+    __m128 margin;     /* rs_bvh4_ray_widen's */
     int axis_parallel; /* a direction component is 0 (or NaN): slabs may give NaN */
 } rs_bvh4_ray;
 
@@ -115,16 +120,26 @@ static inline void rs_bvh4_ray_init(rs_bvh4_ray *r, rs_vec3 o, rs_vec3 d)
     r->axis_parallel = !(d.x != 0.0f && d.y != 0.0f && d.z != 0.0f);
 }
 
+static inline void rs_bvh4_ray_widen(rs_bvh4_ray *r, float margin)
+{
+    r->margin = _mm_set1_ps(margin);
+}
+
 static inline void rs_bvh4_tn_store(float tn[4], const rs_bvh4_tn *v) { _mm_storeu_ps(tn, *v); }
 
-static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, float tmin,
-                                     float tmax, rs_bvh4_tn *tn_out)
+RS_HD_HOT uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, int widen, float tmin,
+                                 float tmax, rs_bvh4_tn *tn_out)
 {
     __m128 tn = _mm_set1_ps(tmin), tf = _mm_set1_ps(tmax);
     int a;
     for (a = 0; a < 3; ++a) {
-        __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n->lo[a]), r->o[a]), r->inv[a]);
-        __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n->hi[a]), r->o[a]), r->inv[a]);
+        __m128 lo = _mm_load_ps(n->lo[a]), hi = _mm_load_ps(n->hi[a]), t0, t1;
+        if (widen) {
+            lo = _mm_sub_ps(lo, r->margin);
+            hi = _mm_add_ps(hi, r->margin);
+        }
+        t0 = _mm_mul_ps(_mm_sub_ps(lo, r->o[a]), r->inv[a]);
+        t1 = _mm_mul_ps(_mm_sub_ps(hi, r->o[a]), r->inv[a]);
         /* _mm_min_ps(a, b) is a < b ? a : b, exactly rs_minf */
         __m128 n_tn = _mm_max_ps(_mm_min_ps(t0, t1), tn);
         __m128 n_tf = _mm_min_ps(_mm_max_ps(t0, t1), tf);
@@ -146,6 +161,7 @@ static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r
 #else
 typedef struct rs_bvh4_ray {
     rs_vec3 o, inv;
+    float margin;
 } rs_bvh4_ray;
 
 typedef struct rs_bvh4_tn {
@@ -158,20 +174,27 @@ static inline void rs_bvh4_ray_init(rs_bvh4_ray *r, rs_vec3 o, rs_vec3 d)
     r->inv = rs_bvh_inv_dir(d);
 }
 
+static inline void rs_bvh4_ray_widen(rs_bvh4_ray *r, float margin) { r->margin = margin; }
+
 static inline void rs_bvh4_tn_store(float tn[4], const rs_bvh4_tn *v)
 {
     memcpy(tn, v->t, sizeof v->t);
 }
 
-static inline uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, float tmin,
-                                     float tmax, rs_bvh4_tn *tn_out)
+RS_HD_HOT uint32_t rs_bvh4_lanes(const rs_bvh4_node *n, const rs_bvh4_ray *r, int widen, float tmin,
+                                 float tmax, rs_bvh4_tn *tn_out)
 {
     uint32_t i, mask = 0;
     for (i = 0; i < n->n_lanes; ++i) {
-        float tn = tmin, tf = tmax;
-        rs_slab((n->lo[0][i] - r->o.x) * r->inv.x, (n->hi[0][i] - r->o.x) * r->inv.x, &tn, &tf);
-        rs_slab((n->lo[1][i] - r->o.y) * r->inv.y, (n->hi[1][i] - r->o.y) * r->inv.y, &tn, &tf);
-        rs_slab((n->lo[2][i] - r->o.z) * r->inv.z, (n->hi[2][i] - r->o.z) * r->inv.z, &tn, &tf);
+        float tn = tmin, tf = tmax, lo[3], hi[3];
+        int a;
+        for (a = 0; a < 3; ++a) {
+            lo[a] = widen ? n->lo[a][i] - r->margin : n->lo[a][i];
+            hi[a] = widen ? n->hi[a][i] + r->margin : n->hi[a][i];
+        }
+        rs_slab((lo[0] - r->o.x) * r->inv.x, (hi[0] - r->o.x) * r->inv.x, &tn, &tf);
+        rs_slab((lo[1] - r->o.y) * r->inv.y, (hi[1] - r->o.y) * r->inv.y, &tn, &tf);
+        rs_slab((lo[2] - r->o.z) * r->inv.z, (hi[2] - r->o.z) * r->inv.z, &tn, &tf);
         tn_out->t[i] = tn;
         mask |= (uint32_t)(tn <= tf * RS_BVH_SLACK) << i;
     }

@@ -46,6 +46,7 @@ rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out)
     t->quad8 = (rs_bvh8_quad8 *)w.quad;
     t->sphere8 = w.sphere;
     t->prim_ids = b->prim_ids;
+    t->inst_root = w.inst_root;
     t->n_nodes = w.n_nodes;
     t->n_tri8 = w.n_tri;
     t->n_quad8 = w.n_quad;
@@ -61,6 +62,7 @@ void rs_bvh8_destroy(rs_bvh8 *b)
     if (!b)
         return;
     rs_free(b->nodes);
+    rs_free(b->inst_root);
     rs_free(b->tri8);
     rs_free(b->quad8);
     rs_free(b->sphere8);

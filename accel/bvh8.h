@@ -64,6 +64,8 @@ typedef struct rs_bvh8 {
     rs_bvh8_quad8 *quad8;     /* the packed leaves' parallelograms */
     rs_bvh8_sphere8 *sphere8; /* the packed leaves' spheres */
     const uint32_t *prim_ids; /* the binary BVH's, borrowed: it must outlive this tree */
+    uint32_t *inst_root;      /* per instance: its prototype's bottom level, collapsed like the
+                                 top tree into nodes after the top tree's; NULL without instances */
     uint32_t n_nodes, n_tri8, n_quad8, n_sphere8;
     uint32_t depth;    /* in nodes; at most the binary tree's */
     uint32_t n_packed; /* leaves packed as blocks */

@@ -20,6 +20,7 @@ typedef struct ray8 {
     __m256 o[3], d[3], inv[3];
     size_t near[3], far[3]; /* offsets in floats into rs_bvh8_node.b: each axis's near and far
                                plane's row */
+    __m256 near_m[3], far_m[3], margin; /* walk8_ray_widen's: the margin with each plane's sign */
     int general;              /* some 1 / d is not finite: the slab test's min / max form */
 
 } ray8;
@@ -47,25 +48,43 @@ static inline void walk8_ray_init(ray8 *r, rs_vec3 o, rs_vec3 d)
     }
 }
 
-/* The slab test of the eight lanes of `n`: the mask of lanes hit, their entry distances in *tn. */
-static inline uint32_t walk8_lanes(const rs_bvh8_node *n, const ray8 *r, float tmin,
-                                   float tmax, __m256 *tn_out)
+/* An instance's bottom level: its boxes widened by `margin` (lo - margin, hi + margin, as
+ * rs_blas_node_hit; x + (-m) is x - m exactly). */
+static inline void walk8_ray_widen(ray8 *r, float margin)
+{
+    int a;
+    r->margin = _mm256_set1_ps(margin);
+    for (a = 0; a < 3; ++a) {
+        int flip = r->near[a] >= 24u; /* the near plane is hi */
+        r->near_m[a] = _mm256_set1_ps(flip ? margin : -margin);
+        r->far_m[a] = _mm256_set1_ps(flip ? -margin : margin);
+    }
+}
+
+/* The slab test of the eight lanes of `n` (widened for a bottom level where `widen`, a constant
+ * where it is inlined): the mask of lanes hit, their entry distances in *tn. */
+RS_HD_HOT uint32_t walk8_lanes(const rs_bvh8_node *n, const ray8 *r, int widen, float tmin,
+                               float tmax, __m256 *tn_out)
 {
     const float *b = &n->b[0][0];
     __m256 tn, tf;
     if (!r->general) {
-        __m256 nx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(b + r->near[0]), r->o[0]),
-                                  r->inv[0]);
-        __m256 ny = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(b + r->near[1]), r->o[1]),
-                                  r->inv[1]);
-        __m256 nz = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(b + r->near[2]), r->o[2]),
-                                  r->inv[2]);
-        __m256 fx = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(b + r->far[0]), r->o[0]),
-                                  r->inv[0]);
-        __m256 fy = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(b + r->far[1]), r->o[1]),
-                                  r->inv[1]);
-        __m256 fz = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(b + r->far[2]), r->o[2]),
-                                  r->inv[2]);
+        __m256 pn[3], pf[3], nx, ny, nz, fx, fy, fz;
+        int a;
+        for (a = 0; a < 3; ++a) {
+            pn[a] = _mm256_load_ps(b + r->near[a]);
+            pf[a] = _mm256_load_ps(b + r->far[a]);
+            if (widen) {
+                pn[a] = _mm256_add_ps(pn[a], r->near_m[a]);
+                pf[a] = _mm256_add_ps(pf[a], r->far_m[a]);
+            }
+        }
+        nx = _mm256_mul_ps(_mm256_sub_ps(pn[0], r->o[0]), r->inv[0]);
+        ny = _mm256_mul_ps(_mm256_sub_ps(pn[1], r->o[1]), r->inv[1]);
+        nz = _mm256_mul_ps(_mm256_sub_ps(pn[2], r->o[2]), r->inv[2]);
+        fx = _mm256_mul_ps(_mm256_sub_ps(pf[0], r->o[0]), r->inv[0]);
+        fy = _mm256_mul_ps(_mm256_sub_ps(pf[1], r->o[1]), r->inv[1]);
+        fz = _mm256_mul_ps(_mm256_sub_ps(pf[2], r->o[2]), r->inv[2]);
         tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_set1_ps(tmin)));
         tf = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, _mm256_set1_ps(tmax)));
     } else {
@@ -73,11 +92,15 @@ static inline uint32_t walk8_lanes(const rs_bvh8_node *n, const ray8 *r, float t
         tn = _mm256_set1_ps(tmin);
         tf = _mm256_set1_ps(tmax);
         for (a = 0; a < 3; ++a) {
-            __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n->b[a]), r->o[a]), r->inv[a]);
-            __m256 t1 =
-                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n->b[a + 3]), r->o[a]), r->inv[a]);
+            __m256 lo = _mm256_load_ps(n->b[a]), hi = _mm256_load_ps(n->b[a + 3]), t0, t1, ok;
+            if (widen) {
+                lo = _mm256_sub_ps(lo, r->margin);
+                hi = _mm256_add_ps(hi, r->margin);
+            }
+            t0 = _mm256_mul_ps(_mm256_sub_ps(lo, r->o[a]), r->inv[a]);
+            t1 = _mm256_mul_ps(_mm256_sub_ps(hi, r->o[a]), r->inv[a]);
             /* rs_slab: a slab whose distances are NaN (0 * inf) is skipped */
-            __m256 ok = _mm256_cmp_ps(t0, t1, _CMP_ORD_Q);
+            ok = _mm256_cmp_ps(t0, t1, _CMP_ORD_Q);
             tn = _mm256_blendv_ps(tn, _mm256_max_ps(_mm256_min_ps(t0, t1), tn), ok);
             tf = _mm256_blendv_ps(tf, _mm256_min_ps(_mm256_max_ps(t0, t1), tf), ok);
         }

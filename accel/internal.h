@@ -116,13 +116,17 @@ typedef struct rs_wide_layout {
 typedef struct rs_wide_tree {
     void *nodes, *tri, *quad;
     rs_bvh8_sphere8 *sphere;
+    uint32_t *inst_root; /* per instance of b: the wide root of its bottom level; NULL without */
     uint32_t n_nodes, n_tri, n_quad, n_sphere, depth, n_packed;
 } rs_wide_tree;
 
 /* Collapses `b`, built over `g`, into the wide tree `L` describes: each node takes its binary
  * node's two children and keeps opening the interior child of largest surface area until it has
  * `width` (rs_bvh_wide_lanes); leaf lanes packed by rs_leaf_lane; nodes in depth-first order from
- * the root at 0.  RS_ERR_ARG or RS_ERR_NOMEM (with a message naming L->what; *out holds nothing
+ * the root at 0.  Then, with instances, each prototype's bottom level (b->blas_nodes from an
+ * instance's root) the same way into the nodes that follow, once per prototype, its leaves never
+ * packed (a lane's child indexes b->blas_prim_ids); out->inst_root[i] is instance i's.
+ * RS_ERR_ARG or RS_ERR_NOMEM (with a message naming L->what; *out holds nothing
  * then); an empty tree has no nodes. */
 rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout *L,
                         rs_wide_tree *out);

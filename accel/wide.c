@@ -207,6 +207,8 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
 
 typedef struct collapse {
     const rs_bvh *bin;
+    const rs_bvh_node *bn; /* the binary nodes being collapsed: b->nodes, or b->blas_nodes */
+    int bottom;            /* collapsing a bottom level: leaves never packed */
     const rs_wide_layout *L;
     rs_wide_tree *out;
     rs_leaf_packer pk;
@@ -222,7 +224,7 @@ static unsigned char *node_at(const collapse *c, uint32_t i)
  * alone) and recurses into its interior lanes.  Returns the depth below, in nodes. */
 static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
 {
-    const rs_bvh_node *bn = c->bin->nodes;
+    const rs_bvh_node *bn = c->bn;
     uint32_t lanes[RS_WIDE_MAX], n = rs_bvh_wide_lanes(bn, src, c->L->width, lanes), i,
                                  depth = 0;
     unsigned char *d = node_at(c, dst);
@@ -232,9 +234,17 @@ static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
     *(uint32_t *)(void *)(d + c->L->n_lanes_offset) = n;
     for (i = 0; i < c->L->width; ++i)
         c->L->set_box(d, i, i < n ? &bn[lanes[i]] : NULL);
-    for (i = 0; i < n; ++i)
-        if (bn[lanes[i]].count > 0) /* interior lanes below */
-            c->out->n_packed += (uint32_t)rs_leaf_lane(&c->pk, &bn[lanes[i]], &child[i], &count[i]);
+    for (i = 0; i < n; ++i) {
+        if (bn[lanes[i]].count == 0) /* interior lanes below */
+            continue;
+        if (c->bottom) {
+            child[i] = bn[lanes[i]].left_first;
+            count[i] = (uint16_t)bn[lanes[i]].count;
+        } else {
+            c->out->n_packed +=
+                (uint32_t)rs_leaf_lane(&c->pk, &bn[lanes[i]], &child[i], &count[i]);
+        }
+    }
     for (i = 0; i < n; ++i) {
         if (bn[lanes[i]].count == 0) {
             uint32_t next = c->out->n_nodes++, below;
@@ -249,11 +259,57 @@ static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
     return depth + 1;
 }
 
+/* The bottom levels' checks and node count: every leaf fits a lane, and at most one wide node
+ * per binary node of the pool (a bottom level collapses to at most its interior nodes, or one). */
+static rs_status plan_bottoms(const rs_bvh *b, const rs_geom *g, const rs_wide_layout *L,
+                              uint32_t *cap_nodes)
+{
+    uint32_t i;
+    *cap_nodes = 0;
+    if (!b->instances || g->n_instances == 0)
+        return RS_OK;
+    for (i = 0; i < b->n_blas_nodes; ++i)
+        if (b->blas_nodes[i].count > 0x7fffu)
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: an instance's leaf of %u primitives (at most 32767 fit a lane)",
+                                L->what, b->blas_nodes[i].count);
+    *cap_nodes = b->n_blas_nodes;
+    return RS_OK;
+}
+
+/* Each prototype's bottom level into the nodes after the top tree's, once per prototype (its
+ * instances share the root); out->inst_root[i] for every instance.  `wide_of` has a slot per
+ * node of the pool. */
+static uint32_t collapse_bottoms(collapse *c, const rs_geom *g, uint32_t *wide_of)
+{
+    const rs_bvh *b = c->bin;
+    uint32_t i, depth = 0;
+    c->bn = b->blas_nodes;
+    c->bottom = 1;
+    for (i = 0; i < b->n_blas_nodes; ++i)
+        wide_of[i] = RS_NO_HIT;
+    for (i = 0; i < g->n_instances; ++i) {
+        uint32_t root = b->instances[i].root;
+        RS_ASSERT(root < b->n_blas_nodes);
+        if (wide_of[root] == RS_NO_HIT) {
+            uint32_t dst = c->out->n_nodes++, below;
+            RS_ASSERT(dst < c->cap);
+            wide_of[root] = dst;
+            below = collapse_node(c, root, dst);
+            if (below > depth)
+                depth = below;
+        }
+        c->out->inst_root[i] = wide_of[root];
+    }
+    return depth;
+}
+
 rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout *L,
                         rs_wide_tree *out)
 {
     collapse c;
     rs_status st;
+    uint32_t cap_bottom = 0, *wide_of = NULL;
     memset(out, 0, sizeof *out);
     memset(&c, 0, sizeof c);
     c.bin = b;
@@ -261,8 +317,18 @@ rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout 
     c.out = out;
     rs_leaf_packer_init(&c.pk, b, g, L->width);
     st = rs_bvh_wide_plan(b, &c.pk, L->what, L->max_nodes, &c.cap);
+    if (st == RS_OK && c.cap > 0)
+        st = plan_bottoms(b, g, L, &cap_bottom);
     if (st != RS_OK || c.cap == 0)
         return st;
+    if (cap_bottom > L->max_nodes - c.cap)
+        return rs_error_set(RS_ERR_ARG, "%s: %u nodes and the instances' %u are more than the %u it "
+                            "can index", L->what, c.cap, cap_bottom, L->max_nodes);
+    c.cap += cap_bottom;
+    if (cap_bottom > 0) {
+        out->inst_root = (uint32_t *)rs_alloc(g->n_instances, sizeof *out->inst_root);
+        wide_of = (uint32_t *)rs_alloc(b->n_blas_nodes, sizeof *wide_of);
+    }
     out->nodes = rs_alloc_aligned(c.cap, L->node_size);
     if (c.pk.cap_tri > 0)
         out->tri = rs_alloc_aligned(c.pk.cap_tri, L->tri_size);
@@ -271,7 +337,8 @@ rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout 
     if (c.pk.cap_sphere > 0)
         out->sphere = (rs_bvh8_sphere8 *)rs_alloc_aligned(c.pk.cap_sphere, sizeof *out->sphere);
     if (!out->nodes || (c.pk.cap_tri > 0 && !out->tri) || (c.pk.cap_quad > 0 && !out->quad) ||
-        (c.pk.cap_sphere > 0 && !out->sphere)) {
+        (c.pk.cap_sphere > 0 && !out->sphere) || (cap_bottom > 0 && (!out->inst_root || !wide_of))) {
+        rs_free(wide_of);
         rs_wide_free(out);
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the %s (%u nodes)", L->what, c.cap);
     }
@@ -279,7 +346,13 @@ rs_status rs_wide_build(const rs_bvh *b, const rs_geom *g, const rs_wide_layout 
     c.pk.quad = out->quad;
     c.pk.sphere = out->sphere;
     out->n_nodes = 1;
+    c.bn = b->nodes;
     out->depth = collapse_node(&c, 0, 0);
+    if (cap_bottom > 0) {
+        /* a bottom level's depth is its own walk's: out->depth stays the top tree's */
+        (void)collapse_bottoms(&c, g, wide_of);
+        rs_free(wide_of);
+    }
     out->n_tri = c.pk.n_tri;
     out->n_quad = c.pk.n_quad;
     out->n_sphere = c.pk.n_sphere;
@@ -292,5 +365,6 @@ void rs_wide_free(rs_wide_tree *t)
     rs_free(t->tri);
     rs_free(t->quad);
     rs_free(t->sphere);
+    rs_free(t->inst_root);
     memset(t, 0, sizeof *t);
 }
