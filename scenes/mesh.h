@@ -1,7 +1,10 @@
 /* scenes/mesh.h — triangle meshes from files through Assimp's C API: OBJ (+MTL), PLY, glTF 2.0,
  * FBX, ...  Faces are triangulated; vertex normals and UVs are kept where the file has them
  * (smooth normals are generated where it has none); the mesh is placed by scale, rotations about
- * x, y, z, and a translation, in that order (the thesis's transforms), or fitted into a box.
+ * x, y, z, and a translation, in that order (the thesis's transforms), or fitted into a box: one
+ * rs_xform (scenes/transform.h), points and normals (by the inverse transpose) in double, rounded
+ * once; a negative scale mirrors and keeps the faces' outward side.  A mesh placed by the
+ * identity keeps the file's coordinates exactly (its normals renormalised in float).
  *
  * Bad data never crashes or hangs the import: a file Assimp cannot read is an RS_ERR_ARG naming
  * it; faces with non-finite or out-of-range vertices, of zero area, or that are points or lines,
@@ -25,7 +28,7 @@
 
 typedef struct rs_mesh_opts {
     rs_vec3 scale;      /* per axis (1, 1, 1 for none) */
-    rs_vec3 rotate_deg; /* about x, then y, then z, in degrees */
+    rs_vec3 rotate_deg; /* about x, then y, then z, in degrees (rs_xform_rotate_euler) */
     rs_vec3 translate;
     uint32_t material;  /* a scene material id, or RS_MESH_FILE_MATERIALS */
     int fit;            /* ignore scale/translate: scale uniformly so the largest extent is

@@ -115,7 +115,7 @@ static void test_obj_normals_inverse_transpose(void **state)
     rmdir(dir);
 }
 
-/* The three corners of the test triangle of test_placement_nonaxis, and its normal. */
+/* The corners of test_placement_nonaxis's triangle (as its OBJ writes them). */
 static const float nonaxis_v[3][3] = {{1, 2, 3}, {2, 2, 3}, {1, 3, 3}};
 
 /* The placement is scale, then rotations about x, y, z, then the translation, in double and
@@ -163,9 +163,8 @@ static void test_placement_nonaxis(void **state)
     t = &s->tris[1];
     for (i = 0; i < 3; ++i) {
         const float *v = nonaxis_v[i];
-        const float got[3] = {i == 0 ? t->v0.x : i == 1 ? t->v1.x : t->v2.x,
-                              i == 0 ? t->v0.y : i == 1 ? t->v1.y : t->v2.y,
-                              i == 0 ? t->v0.z : i == 1 ? t->v1.z : t->v2.z};
+        const rs_vec3 *pv = i == 0 ? &t->v0 : i == 1 ? &t->v1 : &t->v2;
+        const float got[3] = {pv->x, pv->y, pv->z};
         double p[3] = {2.0 * v[0], 3.0 * v[1], 5.0 * v[2]}, q[3];
         double c[3], sn[3];
         for (j = 0; j < 3; ++j) {
@@ -184,8 +183,8 @@ static void test_placement_nonaxis(void **state)
         q[2] = p[2] + 30;
         for (j = 0; j < 3; ++j)
             if (!(fabs(got[j] - q[j]) <= ldexp(1.0, ilogb(q[j]) - 23)))
-                fail_msg("vertex %d coordinate %d: %.9g, want %.12g (within an ulp)", i, j,
-                         got[j], q[j]);
+                fail_msg("vertex %d coordinate %d: %.9g, want %.12g (within an ulp)", i, j, got[j],
+                         q[j]);
     }
     rs_scene_destroy(s);
     remove(path);
@@ -217,6 +216,26 @@ static void test_placement_mirror(void **state)
     for (i = 0; i < 3; ++i)
         assert_true(s->tri_normal[3 * i] == 0 && s->tri_normal[3 * i + 1] == 0 &&
                     s->tri_normal[3 * i + 2] == 1);
+    rs_scene_destroy(s);
+}
+
+/* A placement that cannot be one is refused before the file is read, the message unchanged. */
+static void test_placement_refused(void **state)
+{
+    static const float bad[][3] = {{0, 1, 1}, {1, 1, -0.0f}, {NAN, 1, 1}, {1, INFINITY, 1}};
+    uint32_t mat;
+    rs_scene *s = new_scene(&mat);
+    rs_mesh_opts o = rs_mesh_opts_default(mat);
+    rs_mesh_info info;
+    size_t i;
+    (void)state;
+    for (i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        o.scale = rs_v3(bad[i][0], bad[i][1], bad[i][2]);
+        rs_error_clear();
+        assert_int_equal(rs_scene_add_mesh(s, DATA "tri.obj", &o, &info), RS_ERR_ARG);
+        assert_string_equal(rs_error_message(), DATA "tri.obj: scale must be finite and non-zero");
+    }
+    assert_int_equal(s->n_tris, 0u);
     rs_scene_destroy(s);
 }
 
@@ -804,6 +823,7 @@ int main(void)
         cmocka_unit_test(test_obj_normals_inverse_transpose),
         cmocka_unit_test(test_placement_nonaxis),
         cmocka_unit_test(test_placement_mirror),
+        cmocka_unit_test(test_placement_refused),
         cmocka_unit_test(test_unplaced_as_stored),
         cmocka_unit_test(test_ply_and_gltf),
         cmocka_unit_test(test_fit),

@@ -103,8 +103,8 @@ static rs_vec3 float_rotate_xyz(rs_vec3 p, rs_vec3 deg)
 static void test_euler_is_mesh_rotation(void **state)
 {
     static const double d[3] = {1, 1, 1};
-    static const float angles[][3] = {{30, 0, 0},   {0, 40, 0},      {0, 0, 50},
-                                      {30, 45, 60}, {-75, 120, -10}, {200, -33, 91},
+    static const float angles[][3] = {{30, 0, 0},   {0, 40, 0},        {0, 0, 50},
+                                      {30, 45, 60}, {-75, 120, -10},   {200, -33, 91},
                                       {90, 0, 90},  {-17.5f, 63, 271}, {359, 1, -181}};
     static const float pts[][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.3f, -1.7f, 2.2f}};
     rs_xform e, cyc;
