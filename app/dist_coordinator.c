@@ -51,6 +51,7 @@ static void mark_dead(coord *c, int r, const char *why)
     c->finished[r] = 1;
     c->flushing[r] = 0;
     c->d->any_dead = 1;
+    c->d->dead[r] = 1; /* and in the run's later jobs */
     c->res->dead++;
     fprintf(stderr, "\nraystream: rank %d (%s) %s; its passes go to the other ranks\n", r,
             c->d->desc ? c->d->desc[r] : "?", why);
@@ -87,7 +88,7 @@ static rs_status setup(coord *c)
     rs_dist_result *res = c->res;
     const char *kill_after = getenv("OMPI_MCA_odls_base_sigkill_timeout");
     int r, n = c->n;
-    c->pt.npix = job->width * job->height;
+    c->pt.npix = job->pixels ? job->n_pixels : job->width * job->height;
     c->pt.pass_spp = job->pass_spp ? job->pass_spp : passes_auto_spp(job, c->pt.npix, n);
     c->pt.reissued = &res->reissued;
     if (!passes_make(&c->pt, job))
@@ -102,11 +103,15 @@ static rs_status setup(coord *c)
     c->stopped = (int *)rs_calloc((size_t)n, sizeof *c->stopped);
     c->flushing = (int *)rs_calloc((size_t)n, sizeof *c->flushing);
     res->rank = (rs_dist_rank_stats *)rs_calloc((size_t)n, sizeof *res->rank);
+    if (!c->d->dead)
+        c->d->dead = (uint8_t *)rs_calloc((size_t)n, 1);
     if (!c->last_seen || !c->asked || !c->finished || !c->stopped || !c->flushing ||
-        !res->rank || rs_film_create(job->width, job->height, &c->tmp) != RS_OK)
+        !res->rank || !c->d->dead || rs_film_create(job->width, job->height, &c->tmp) != RS_OK ||
+        (job->variance && rs_film_track_variance(c->tmp) != RS_OK))
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the MPI coordinator");
     for (r = 0; r < n; ++r) {
-        res->rank[r].alive = 1;
+        res->rank[r].alive = !c->d->dead[r]; /* found dead in an earlier job: not here */
+        c->finished[r] = c->d->dead[r];
         c->last_seen[r] = c->t0;
         if (c->d->desc)
             snprintf(res->rank[r].desc, RS_DIST_DESC, "%s", c->d->desc[r]);
@@ -241,7 +246,7 @@ static void on_film(coord *c, int r, const uint64_t *h)
 
 typedef void (*coord_handler)(coord *c, int r, const uint64_t *v);
 
-/* by tag; FILM_SUMS and FILM_COUNTS outside a film (one given up on) are dropped unread */
+/* by tag; a film's data outside a film (one given up on) is dropped unread */
 static const coord_handler on_message[T_COUNT] = {
     [T_REQ] = on_req,
     [T_HB] = on_hb,
@@ -261,7 +266,7 @@ static int poll_message(coord *c)
     r = ms.MPI_SOURCE;
     tag = ms.MPI_TAG;
     memset(v, 0, sizeof v);
-    if (tag == T_FILM_SUMS || tag == T_FILM_COUNTS) {
+    if (rs_dist_is_film_data(tag)) {
         rs_dist_drop_data(&ms); /* data of a film given up on */
     } else {
         MPI_Get_count(&ms, MPI_UINT64_T, &cnt);
@@ -477,4 +482,37 @@ rs_status rs_dist_run_coordinator(rs_dist *d, const rs_dist_job *job, rs_film *f
     res->message_bytes = rs_dist_msg_bytes;
     free_coord(&c);
     return st;
+}
+
+int rs_dist_job_begin(rs_dist *d, const uint32_t *pixels, uint32_t n_pixels, double timeout_s)
+{
+    int r;
+    if (!d->dead && !(d->dead = (uint8_t *)rs_calloc((size_t)d->size, 1)))
+        return 0;
+    for (r = 1; r < d->size; ++r) {
+        uint64_t n = pixels ? n_pixels : 0;
+        if (d->dead[r])
+            continue;
+        if (rs_dist_send_small(&n, 1, r, T_JOB) &&
+            (!pixels || rs_dist_send_chunks(pixels, n_pixels, sizeof *pixels, MPI_UINT32_T, r,
+                                            T_JOB_PIXELS, timeout_s)))
+            continue;
+        {
+            d->dead[r] = 1;
+            d->any_dead = 1;
+            fprintf(stderr, "\nraystream: rank %d cannot be reached; the next rounds go on "
+                            "without it\n", r);
+        }
+    }
+    return 1; /* rank 0 renders on alone if it must */
+}
+
+void rs_dist_jobs_end(rs_dist *d)
+{
+    int r;
+    for (r = 1; r < d->size; ++r)
+        if (!d->dead || !d->dead[r]) {
+            uint64_t lost = (uint64_t)d->any_dead;
+            rs_dist_send_small(&lost, 1, r, T_BYE);
+        }
 }

@@ -12,6 +12,7 @@
 
 #include "app/signals.h"
 #include "core/alloc.h"
+#include "core/clock.h"
 
 /* Sends stderr to `fd` (flushing first); returns what restores it, or -1 when it could not be
  * moved. */
@@ -49,21 +50,26 @@ int rs_mpi_parse_options(int argc, char **argv, rs_cli_options *o)
     return rc;
 }
 
-/* One pass of an MPI job: samples [s0, s0 + n) of every pixel onto `film`, on this rank's
+/* One pass of an MPI job: samples [s0, s0 + n) of the job's pixels onto `film`, on this rank's
  * devices, from its render thread. */
-static rs_status dist_render_pass(void *user, uint32_t s0, uint32_t n, rs_film *film,
+static rs_status dist_render_pass(void *user, const uint32_t *pixels, uint32_t n_pixels,
+                                  uint32_t s0, uint32_t n, rs_film *film,
                                   const atomic_int *cancel, rs_render_stats *stats)
 {
     render_run *r = (render_run *)user;
+    uint64_t np = pixels ? n_pixels : (uint64_t)r->st.width * r->st.height;
     rs_render_hooks h;
     rs_work_plan plan;
     rs_status st;
     memset(&h, 0, sizeof h);
     h.cancel = cancel;
-    if (!rs_work_plan_samples(&plan, (uint64_t)r->st.width * r->st.height, s0, s0 + n))
+    if (!rs_work_plan_samples(&plan, np, s0, s0 + n)) {
         st = rs_error_set(RS_ERR_NOMEM, "out of memory");
-    else
+    } else {
+        plan.pixels = pixels;
+        plan.n_pixels = pixels ? n_pixels : 0;
         st = rs_engine_run(r->engine, &plan, &h, film, stats);
+    }
     rs_work_plan_free(&plan);
     return st;
 }
@@ -93,9 +99,7 @@ static int dist_check_options(const rs_cli_options *o, int rank, rs_dist_fault *
         rs_error_clear();
         return RS_EXIT_USAGE;
     }
-    if (o->adaptive > 0)
-        what = "--adaptive (its rounds depend on the whole film)";
-    else if (o->aovs)
+    if (o->aovs)
         what = "--aov";
     if (!what)
         return RS_EXIT_OK;
@@ -249,6 +253,185 @@ static int dist_gathered(render_run *r, rs_status st)
     return RS_EXIT_OK;
 }
 
+/* The settings of a job every rank shares: the samples (rank 0) and the pixels are the
+ * caller's. */
+static void dist_job_init(const rs_cli_options *o, render_run *r, rs_dist_job *job)
+{
+    memset(job, 0, sizeof *job);
+    job->fault = r->dist_fault;
+    job->width = r->st.width;
+    job->height = r->st.height;
+    job->spp = r->st.spp;
+    job->variance = o->adaptive > 0;
+    job->pass_spp = o->mpi_pass_spp;
+    job->time_limit_s = o->time_limit_s;
+    job->timeout_s = o->mpi_timeout_s > 0 ? o->mpi_timeout_s : 60.0;
+    job->cancel = rs_signals_cancel();
+    job->render = dist_render_pass;
+    job->user = r;
+}
+
+/* ---- --adaptive under mpirun ---------------------------------------------------------------
+ * Rank 0 runs the rounds of scheduler/adaptive.h and decides each one from the frame, as one
+ * process does; each round is one job over the ranks (rs_dist_job_begin tells them its pixels).
+ * The film's sums, the squared-luminance ones included, are exact integers, so the frame after
+ * a round, every decision and the image are the one process's bit for bit.  Checkpoints are
+ * written between rounds. */
+
+typedef struct dist_rounds {
+    render_run *r;
+    rs_dist_job job;              /* the settings every round shares */
+    const rs_render_hooks *hooks; /* the adaptive run's, while a round runs */
+    double t0;
+    int uneven;                   /* a stop left gaps in the round under way */
+} dist_rounds;
+
+static rs_status round_pass(void *user, const uint32_t *pixels, uint32_t n_pixels, uint32_t s0,
+                            uint32_t n, rs_film *film, const atomic_int *cancel,
+                            rs_render_stats *stats)
+{
+    return dist_render_pass(((dist_rounds *)user)->r, pixels, n_pixels, s0, n, film, cancel,
+                            stats);
+}
+
+static void round_progress(void *user, uint64_t done, uint64_t total)
+{
+    const rs_render_hooks *h = ((const dist_rounds *)user)->hooks;
+    if (h && h->progress)
+        h->progress(h->user, done, total);
+}
+
+/* The job's result as the round's statistics (rank 0's stages, every rank's rays). */
+static void round_stats(const rs_dist_result *res, uint64_t np, rs_render_stats *stats)
+{
+    *stats = res->local;
+    stats->paths_done = (uint64_t)res->samples_done * np;
+    stats->rays_closest = res->rays_closest;
+    stats->rays_shadow = res->rays_shadow;
+    stats->max_bounce = res->max_bounce;
+    stats->time_limited = res->time_limited;
+    stats->seconds = res->seconds;
+}
+
+/* rs_plan_runner on rank 0: a round, or what a checkpoint left of it, as one job. */
+static rs_status dist_round(void *user, const rs_work_plan *plan, const rs_render_hooks *hooks,
+                            rs_film *film, rs_render_stats *stats)
+{
+    dist_rounds *dr = (dist_rounds *)user;
+    render_run *r = dr->r;
+    uint64_t np = plan->pixels ? plan->n_pixels : (uint64_t)r->st.width * r->st.height;
+    uint64_t lo = plan->todo.n ? plan->todo.r[0][0] : 0, hi = plan->todo.n ? plan->todo.r[0][1] : 0;
+    uint32_t todo[1][2];
+    rs_dist_job job = dr->job;
+    rs_dist_result res;
+    rs_status st;
+    if (plan->todo.n > 1 || lo % np || hi % np)
+        return rs_error_set(RS_ERR_ARG, "under mpirun an adaptive render continues whole "
+                                        "samples of its round only (resume it on one process)");
+    if (lo == hi)
+        return RS_OK;
+    todo[0][0] = (uint32_t)(lo / np);
+    todo[0][1] = (uint32_t)((hi - lo) / np);
+    job.todo = (const uint32_t(*)[2])todo;
+    job.n_todo = 1;
+    job.pixels = plan->pixels;
+    job.n_pixels = plan->n_pixels;
+    if (job.time_limit_s > 0) { /* what is left of it */
+        job.time_limit_s -= rs_now_s() - dr->t0;
+        if (job.time_limit_s < 1e-6)
+            job.time_limit_s = 1e-6;
+    }
+    if (!rs_dist_job_begin(r->dist, plan->pixels, plan->n_pixels, job.timeout_s))
+        return rs_error_set(RS_ERR_NOMEM, "out of memory");
+    dr->hooks = hooks;
+    st = rs_dist_render(r->dist, &job, film, &res);
+    dr->hooks = NULL;
+    round_stats(&res, np, stats);
+    stats->paths_total = hi - lo;
+    if (st == RS_OK && !rs_dist_result_add(&r->dres, &res))
+        st = rs_error_set(RS_ERR_NOMEM, "out of memory");
+    if (st == RS_OK && res.stopped) {
+        /* resumable only if what the round finished is its first samples */
+        dr->uneven = !(res.n_done == 0 || (res.n_done == 1 && res.done[0][0] == todo[0][0]));
+        st = rs_error_set(RS_ERR_CANCELLED, "stopped");
+    } else if (st == RS_OK && res.complete && hooks && hooks->film_ready) {
+        rs_path_ranges done;
+        memset(&done, 0, sizeof done);
+        if (rs_path_ranges_add(&done, lo, hi))
+            hooks->film_ready(hooks->user, film, &done);
+        rs_path_ranges_free(&done);
+    }
+    rs_dist_result_free(&res);
+    return st;
+}
+
+/* Every other rank: the rounds' jobs, until rank 0 says the run is over. */
+static rs_status dist_rounds_work(render_run *r, const rs_dist_job *base)
+{
+    for (;;) {
+        rs_dist_job job = *base;
+        rs_dist_result res;
+        uint32_t *pixels, n_pixels;
+        rs_status st;
+        int go = rs_dist_job_wait(r->dist, &pixels, &n_pixels, base->timeout_s);
+        if (go <= 0)
+            return go == 0 ? RS_OK : rs_error_set(RS_ERR_IO, "rank 0 is gone");
+        job.pixels = pixels;
+        job.n_pixels = n_pixels;
+        st = rs_dist_render(r->dist, &job, r->film, &res);
+        rs_free(pixels);
+        if (st != RS_OK)
+            return st;
+    }
+}
+
+/* Rank 0: the adaptive rounds over the ranks.  Returns an exit code. */
+static int dist_run_adaptive(const rs_cli_options *o, render_run *r, const rs_dist_job *base)
+{
+    dist_rounds dr;
+    rs_adaptive a;
+    rs_render_hooks hooks;
+    rs_status st;
+    memset(&dr, 0, sizeof dr);
+    dr.r = r;
+    dr.job = *base;
+    dr.job.render = round_pass;
+    dr.job.user = &dr;
+    dr.job.progress = round_progress;
+    dr.t0 = rs_now_s();
+    a.threshold = r->adaptive_t = o->adaptive;
+    a.min_spp = o->adaptive_min_spp;
+    memset(&hooks, 0, sizeof hooks);
+    hooks.progress = on_dist_progress;
+    hooks.user = r;
+    hooks.cancel = base->cancel;
+    r->ckpt_every_s = o->ckpt_every_s;
+    r->last_ckpt = rs_now_s();
+    if (r->ckpt_out) {
+        hooks.film_ready = rs_run_on_film_ready;
+        rs_outputs_track(r->ckpt_out->staged); /* a second signal during a write */
+    }
+    rs_progress_begin(&r->progress, !o->quiet);
+    st = rs_adaptive_run_plans(dist_round, &dr, r->st.spp, &a, &r->ad, &hooks, r->film,
+                               &r->stats);
+    rs_progress_end(&r->progress);
+    rs_dist_jobs_end(r->dist);
+    r->adaptive = r->ad.stats;
+    r->done = NULL;
+    if (dr.uneven && r->ckpt_out) {
+        fprintf(stderr, "raystream: --checkpoint %s: not updated: the stop left gaps in the "
+                        "adaptive round under way; the last one written stays\n",
+                r->ckpt_out->path);
+        r->ckpt_out = NULL;
+    }
+    if (st == RS_ERR_CANCELLED) {
+        rs_error_clear();
+        r->interrupted = rs_signals_caught() ? rs_signals_caught() : SIGTERM;
+        return RS_EXIT_SIGNALLED(r->interrupted);
+    }
+    return st == RS_OK ? RS_EXIT_OK : rs_app_fail(RS_EXIT_RUNTIME, "render failed");
+}
+
 /* The job: rank 0 hands out the passes and gathers the films, every rank renders.  Rank 0 then
  * has the frame and the statistics in r.  Returns an exit code. */
 static int dist_run(const rs_cli_options *o, render_run *r)
@@ -258,11 +441,12 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     uint32_t(*todo)[2] = NULL, n_todo = 0;
     int code;
     rs_signals_install();
-    memset(&job, 0, sizeof job);
-    job.fault = r->dist_fault;
-    job.width = r->st.width;
-    job.height = r->st.height;
-    job.spp = r->st.spp;
+    dist_job_init(o, r, &job);
+    if (o->adaptive > 0 && r->rank > 0)
+        return dist_rounds_work(r, &job) == RS_OK ? RS_EXIT_OK
+                                                  : rs_app_fail(RS_EXIT_RUNTIME, NULL);
+    if (o->adaptive > 0)
+        return dist_run_adaptive(o, r, &job);
     if (r->rank == 0 && (code = dist_todo(r, &todo, &n_todo)) != RS_EXIT_OK)
         return code;
     job.todo = (const uint32_t(*)[2])todo;
@@ -271,12 +455,6 @@ static int dist_run(const rs_cli_options *o, render_run *r)
         job.flush_every_s = o->ckpt_every_s;
         job.saved = on_dist_saved;
     }
-    job.pass_spp = o->mpi_pass_spp;
-    job.time_limit_s = o->time_limit_s;
-    job.timeout_s = o->mpi_timeout_s;
-    job.cancel = rs_signals_cancel();
-    job.render = dist_render_pass;
-    job.user = r;
     if (r->rank == 0)
         job.progress = on_dist_progress;
     if (r->rank == 0)

@@ -21,7 +21,12 @@
  *                 HB    (nothing)            a heartbeat, each second
  *                 BYE   lost                 the job is over (after your film): call
  *                                            MPI_Finalize unless a rank was lost (it would
- *                                            wait for the dead)
+ *                                            wait for the dead); between the jobs of a run of
+ *                                            several (rs_dist_job_begin), the run is over
+ *                 JOB   n                    the next job is over n pixels (then JOB_PIXELS
+ *                                            chunks, uint32) or every pixel (n = 0)
+ * A film's data: FILM_SUMS chunks, FILM_COUNTS chunks, and, when its header's H_SQ says so,
+ * FILM_SQ chunks (three uint64 a pixel: rs_film_sq). 
  * Messages between two ranks arrive in the order they were sent, so a worker's DONEs precede
  * its film. */
 #ifndef RS_APP_DIST_INTERNAL_H
@@ -38,6 +43,7 @@ struct rs_dist {
     int rank, size;
     int any_dead;
     char (*desc)[RS_DIST_DESC]; /* rank 0: every rank's */
+    uint8_t *dead;              /* rank 0: ranks found dead in an earlier job (NULL: none) */
 };
 
 /* ---- the wire (dist_wire.c) ---------------------------------------------------------------- */
@@ -54,6 +60,9 @@ enum {
     T_ABORT,
     T_FLUSH,
     T_BYE,
+    T_FILM_SQ,
+    T_JOB,
+    T_JOB_PIXELS,
     T_COUNT /* one past the last tag */
 };
 
@@ -70,6 +79,7 @@ enum {
     H_FAILED,    /* the worker's render failed */
     H_FLUSH,     /* a periodic flush: the worker goes on */
     H_COMM_CPU,  /* double: CPU seconds of its messaging thread so far */
+    H_SQ,        /* 1: FILM_SQ chunks follow the counts */
     H_COUNT
 };
 
@@ -100,6 +110,15 @@ int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s);
  * *bytes.  1 when it all came. */
 int rs_dist_recv_film(int r, const uint64_t *h, rs_film *tmp, double timeout_s,
                       uint64_t *bytes);
+/* n values of `type` (elem bytes each) to rank `to` as `tag` messages of at most DIST_CHUNK
+ * values; 1 when every piece went. */
+int rs_dist_send_chunks(const void *data, size_t n, size_t elem, MPI_Datatype type, int to,
+                        int tag, double timeout_s);
+/* The other side: n values from rank `from` into data.  1 when every piece came. */
+int rs_dist_recv_chunks(void *data, size_t n, size_t elem, MPI_Datatype type, int from, int tag,
+                        double timeout_s);
+/* Whether tag is one of a film's data messages (dropped when they come outside a film). */
+int rs_dist_is_film_data(int tag);
 /* Drops a data message (of a film given up on) that MPI_Iprobe found. */
 void rs_dist_drop_data(const MPI_Status *ms);
 

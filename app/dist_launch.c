@@ -141,5 +141,6 @@ void rs_dist_finish(rs_dist *d)
     if (!d->any_dead)
         MPI_Finalize();
     rs_free(d->desc);
+    rs_free(d->dead);
     rs_free(d);
 }

@@ -85,7 +85,8 @@ static void *local_main(void *arg)
         rs_film_clear(l->scratch);
         memset(&rs, 0, sizeof rs);
         t0 = rs_now_s();
-        st = job->render(job->user, s0, n, l->scratch, &l->cancel, &rs);
+        st = job->render(job->user, job->pixels, job->n_pixels, s0, n, l->scratch, &l->cancel,
+                         &rs);
         t1 = rs_now_s();
         if (st == RS_OK && job->fault.slow_factor > 1 && job->fault.slow_rank == l->rank)
             rs_dist_sleep_s((job->fault.slow_factor - 1) * (t1 - t0));
@@ -108,6 +109,10 @@ rs_status local_start(local *l, const rs_dist_job *job, int rank, rs_film *acc,
     pthread_cond_init(&l->cv, NULL);
     if (rs_film_create(job->width, job->height, &l->scratch) != RS_OK)
         return RS_ERR_NOMEM;
+    if (job->variance && rs_film_track_variance(l->scratch) != RS_OK) {
+        rs_film_destroy(l->scratch);
+        return RS_ERR_NOMEM;
+    }
     if (pthread_create(&l->thread, NULL, local_main, l) != 0) {
         rs_film_destroy(l->scratch);
         return rs_error_set(RS_ERR_NOMEM, "cannot start the render thread");

@@ -107,21 +107,39 @@ static int sums_fit_int64(const rs_film *f)
     return 1;
 }
 
-/* n values of `type` from `data` (elem bytes each) to rank 0 as `tag` messages of at most
- * DIST_CHUNK values; 1 when every piece went */
-static int send_chunks(const void *data, size_t n, size_t elem, MPI_Datatype type, int tag,
-                       double timeout_s)
+int rs_dist_send_chunks(const void *data, size_t n, size_t elem, MPI_Datatype type, int to,
+                        int tag, double timeout_s)
 {
     size_t off;
     int ok = 1;
     for (off = 0; ok && off < n; off += DIST_CHUNK) {
         MPI_Request rq;
         int k = (int)(n - off < DIST_CHUNK ? n - off : DIST_CHUNK);
-        ok = MPI_Isend((const char *)data + off * elem, k, type, 0, tag, MPI_COMM_WORLD, &rq) ==
+        ok = MPI_Isend((const char *)data + off * elem, k, type, to, tag, MPI_COMM_WORLD, &rq) ==
                  MPI_SUCCESS &&
              wait_req(&rq, timeout_s);
     }
     return ok;
+}
+
+int rs_dist_recv_chunks(void *data, size_t n, size_t elem, MPI_Datatype type, int from, int tag,
+                        double timeout_s)
+{
+    size_t off;
+    int ok = 1;
+    for (off = 0; ok && off < n; off += DIST_CHUNK) {
+        MPI_Request rq;
+        int k = (int)(n - off < DIST_CHUNK ? n - off : DIST_CHUNK);
+        ok = MPI_Irecv((char *)data + off * elem, k, type, from, tag, MPI_COMM_WORLD, &rq) ==
+                 MPI_SUCCESS &&
+             wait_req(&rq, timeout_s);
+    }
+    return ok;
+}
+
+int rs_dist_is_film_data(int tag)
+{
+    return tag == T_FILM_SUMS || tag == T_FILM_COUNTS || tag == T_FILM_SQ;
 }
 
 int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s)
@@ -133,6 +151,7 @@ int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s)
     int ok;
     h[H_ENC] = (uint64_t)enc;
     h[H_NONFINITE] = f->nonfinite;
+    h[H_SQ] = f->sum_l2 != NULL;
     /* this runs on the messaging thread */
     h[H_COMM_CPU] = rs_dist_dbits(rs_dist_thread_cpu_s() - rs_dist_cpu0);
     if (!rs_dist_send_small(h, H_COUNT, 0, T_FILM))
@@ -148,8 +167,12 @@ int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s)
             wide[i] = (int64_t)f->sum[i];
         sums = wide;
     }
-    ok = send_chunks(sums, n_sum, sizeof(int64_t), MPI_INT64_T, T_FILM_SUMS, timeout_s) &&
-         send_chunks(f->count, npix, sizeof *f->count, MPI_UINT32_T, T_FILM_COUNTS, timeout_s);
+    ok = rs_dist_send_chunks(sums, n_sum, sizeof(int64_t), MPI_INT64_T, 0, T_FILM_SUMS,
+                             timeout_s) &&
+         rs_dist_send_chunks(f->count, npix, sizeof *f->count, MPI_UINT32_T, 0, T_FILM_COUNTS,
+                             timeout_s) &&
+         (!f->sum_l2 || rs_dist_send_chunks(f->sum_l2, npix * 3, sizeof(uint64_t), MPI_UINT64_T,
+                                            0, T_FILM_SQ, timeout_s));
     rs_free(wide);
     return ok;
 }
@@ -177,18 +200,17 @@ int rs_dist_recv_film(int r, const uint64_t *h, rs_film *tmp, double timeout_s,
             for (i = 0; i < k; ++i)
                 tmp->sum[off + (size_t)i] = buf[i];
     }
-    for (off = 0; ok && off < npix; off += DIST_CHUNK) {
-        MPI_Request rq;
-        int k = (int)(npix - off < DIST_CHUNK ? npix - off : DIST_CHUNK);
-        ok = MPI_Irecv(tmp->count + off, k, MPI_UINT32_T, r, T_FILM_COUNTS, MPI_COMM_WORLD,
-                       &rq) == MPI_SUCCESS &&
-             wait_req(&rq, timeout_s);
-    }
+    ok = ok && rs_dist_recv_chunks(tmp->count, npix, sizeof *tmp->count, MPI_UINT32_T, r,
+                                   T_FILM_COUNTS, timeout_s);
+    /* squared-luminance sums come exactly when both films keep them (an adaptive job's) */
+    ok = ok && !h[H_SQ] == !tmp->sum_l2 &&
+         (!h[H_SQ] || rs_dist_recv_chunks(tmp->sum_l2, npix * 3, sizeof(uint64_t), MPI_UINT64_T,
+                                          r, T_FILM_SQ, timeout_s));
     rs_free(buf);
     if (!ok)
         return 0;
     tmp->nonfinite = h[H_NONFINITE];
-    *bytes = H_COUNT * 8 + n_sum * 8 + npix * 4;
+    *bytes = H_COUNT * 8 + n_sum * 8 + npix * 4 + (h[H_SQ] ? npix * 24 : 0);
     return 1;
 }
 

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "app/dist_internal.h"
+#include "core/alloc.h"
 #include "core/clock.h"
 
 typedef struct worker {
@@ -220,6 +221,11 @@ rs_status rs_dist_run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film,
     rs_film_clear(film);
     if (rs_film_create(film->width, film->height, &w.spare) != RS_OK)
         return RS_ERR_NOMEM;
+    if (job->variance &&
+        (rs_film_track_variance(film) != RS_OK || rs_film_track_variance(w.spare) != RS_OK)) {
+        rs_film_destroy(w.spare);
+        return RS_ERR_NOMEM;
+    }
     if ((st = local_start(&w.l, job, d->rank, film, NULL)) != RS_OK) {
         rs_film_destroy(w.spare);
         return st;
@@ -241,4 +247,41 @@ rs_status rs_dist_run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film,
     }
     end(&w);
     return RS_OK;
+}
+
+int rs_dist_job_wait(rs_dist *d, uint32_t **pixels, uint32_t *n_pixels, double timeout_s)
+{
+    double t0 = rs_now_s(), nap = 1e-4;
+    *pixels = NULL;
+    *n_pixels = 0;
+    while (rs_now_s() - t0 < timeout_s) {
+        uint64_t v[2];
+        int tag = 0, flag = rs_dist_poll_rank0(&tag, v);
+        if (flag < 0)
+            break;
+        if (!flag) {
+            rs_dist_idle_nap(&nap, 0);
+            continue;
+        }
+        if (tag == T_BYE) { /* the run is over */
+            if (v[0])
+                d->any_dead = 1;
+            return 0;
+        }
+        if (tag != T_JOB) /* a heartbeat of the job before */
+            continue;
+        if (v[0] == 0)
+            return 1;
+        *pixels = (uint32_t *)rs_alloc((size_t)v[0], sizeof **pixels);
+        if (*pixels && rs_dist_recv_chunks(*pixels, (size_t)v[0], sizeof **pixels, MPI_UINT32_T,
+                                           0, T_JOB_PIXELS, timeout_s)) {
+            *n_pixels = (uint32_t)v[0];
+            return 1;
+        }
+        rs_free(*pixels);
+        *pixels = NULL;
+        break;
+    }
+    d->any_dead = 1; /* rank 0 is gone: do not wait for it */
+    return -1;
 }

@@ -58,3 +58,51 @@ void rs_dist_result_free(rs_dist_result *res)
     res->rank = NULL;
     res->done = NULL;
 }
+
+int rs_dist_result_add(rs_dist_result *total, const rs_dist_result *job)
+{
+    int r;
+    if (!total->rank) {
+        total->rank = (rs_dist_rank_stats *)rs_calloc((size_t)job->ranks, sizeof *total->rank);
+        if (!total->rank)
+            return 0;
+        total->ranks = job->ranks;
+        for (r = 0; r < job->ranks; ++r) {
+            memcpy(total->rank[r].desc, job->rank[r].desc, RS_DIST_DESC);
+            total->rank[r].alive = 1;
+        }
+    }
+    total->pass_spp = job->pass_spp;
+    total->passes_total += job->passes_total;
+    total->samples_done += job->samples_done;
+    total->complete = job->complete;
+    total->flushes += job->flushes;
+    total->time_limited |= job->time_limited;
+    total->stopped |= job->stopped;
+    total->dead += job->dead;
+    total->reissued += job->reissued;
+    total->bytes_received += job->bytes_received;
+    total->messages = job->messages; /* counted from the start */
+    total->message_bytes = job->message_bytes;
+    total->seconds += job->seconds;
+    rs_render_stats_add(&total->local, &job->local);
+    total->rays_closest += job->rays_closest;
+    total->rays_shadow += job->rays_shadow;
+    if (job->max_bounce > total->max_bounce)
+        total->max_bounce = job->max_bounce;
+    for (r = 0; r < job->ranks && r < total->ranks; ++r) {
+        rs_dist_rank_stats *t = &total->rank[r];
+        const rs_dist_rank_stats *k = &job->rank[r];
+        t->passes += k->passes;
+        t->paths += k->paths;
+        t->busy_s += k->busy_s;
+        t->wall_s += k->wall_s;
+        t->film_bytes += k->film_bytes;
+        t->rays_closest += k->rays_closest;
+        t->rays_shadow += k->rays_shadow;
+        t->comm_cpu_s += k->comm_cpu_s;
+        t->alive &= k->alive;
+        t->failed |= k->failed;
+    }
+    return 1;
+}

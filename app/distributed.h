@@ -66,9 +66,11 @@ typedef struct rs_dist_fault {
 } rs_dist_fault;
 rs_status rs_dist_fault_parse(const char *spec, rs_dist_fault *out);
 
-/* Renders samples [s0, s0 + n) of every pixel onto `film` (empty, the frame's size); stops
- * early with RS_ERR_CANCELLED when *cancel is set.  `stats` as rs_render's. */
-typedef rs_status (*rs_dist_render_fn)(void *user, uint32_t s0, uint32_t n, rs_film *film,
+/* Renders samples [s0, s0 + n) of the job's pixels (`pixels`, n_pixels of them; NULL: every
+ * pixel) onto `film` (empty, the frame's size); stops early with RS_ERR_CANCELLED when *cancel
+ * is set.  `stats` as rs_render's. */
+typedef rs_status (*rs_dist_render_fn)(void *user, const uint32_t *pixels, uint32_t n_pixels,
+                                       uint32_t s0, uint32_t n, rs_film *film,
                                        const atomic_int *cancel, rs_render_stats *stats);
 
 /* rank 0, every `flush_every_s`: the film holds the samples it held before plus `done`
@@ -78,8 +80,13 @@ typedef void (*rs_dist_saved_fn)(void *user, const rs_film *film, const uint32_t
 
 typedef struct rs_dist_job {
     uint32_t width, height, spp;
-    const uint32_t (*todo)[2];  /* rank 0: the samples to render, ranges [s0, s0 + n) of every
-                                   pixel (sorted, disjoint; what the film does not hold) */
+    const uint32_t *pixels;     /* every rank: the job's pixels, increasing (rank 0 tells the
+                                   others with rs_dist_job_begin); NULL: every pixel */
+    uint32_t n_pixels;
+    int variance;               /* every rank: films keep squared-luminance sums (--adaptive) */
+    const uint32_t (*todo)[2];  /* rank 0: the samples to render, ranges [s0, s0 + n) of the
+                                   job's pixels (sorted, disjoint; what the film does not
+                                   hold) */
     uint32_t n_todo;
     uint32_t pass_spp;          /* samples per pass; 0: auto (about 8 passes per rank, at
                                    most about 2^22 paths a pass) */
@@ -135,5 +142,18 @@ typedef struct rs_dist_result {
  * or every rank was lost. */
 rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_dist_result *res);
 void rs_dist_result_free(rs_dist_result *res);
+/* Adds one job's result to a run's (rank 0; `total` zeroed before the first): the counts
+ * summed, the rank table row by row, `done` left out.  0 when out of memory. */
+int rs_dist_result_add(rs_dist_result *total, const rs_dist_result *job);
+
+/* Several jobs in one MPI run, each over pixels rank 0 decides from the frame the jobs before
+ * left (the rounds of --adaptive).  Rank 0, before each job: rs_dist_job_begin tells every live
+ * rank the job's pixels (NULL: all; 0 when no rank is left to tell); after the last job:
+ * rs_dist_jobs_end.  Every other rank, before each job: rs_dist_job_wait, 1 with the next job's
+ * pixels (*pixels rs_alloc'd, NULL for all), 0 after the last job, -1 when rank 0 has been
+ * silent for `timeout_s`.  A rank found dead in one job takes no part in the later ones. */
+int rs_dist_job_begin(rs_dist *d, const uint32_t *pixels, uint32_t n_pixels, double timeout_s);
+void rs_dist_jobs_end(rs_dist *d);
+int rs_dist_job_wait(rs_dist *d, uint32_t **pixels, uint32_t *n_pixels, double timeout_s);
 
 #endif

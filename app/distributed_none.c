@@ -80,3 +80,25 @@ void rs_dist_result_free(rs_dist_result *res)
 {
     (void)res;
 }
+
+int rs_dist_result_add(rs_dist_result *total, const rs_dist_result *job)
+{
+    (void)total, (void)job;
+    return 0;
+}
+
+int rs_dist_job_begin(rs_dist *d, const uint32_t *pixels, uint32_t n_pixels, double timeout_s)
+{
+    (void)d, (void)pixels, (void)n_pixels, (void)timeout_s;
+    return 0;
+}
+
+void rs_dist_jobs_end(rs_dist *d) { (void)d; }
+
+int rs_dist_job_wait(rs_dist *d, uint32_t **pixels, uint32_t *n_pixels, double timeout_s)
+{
+    (void)d, (void)timeout_s;
+    *pixels = NULL;
+    *n_pixels = 0;
+    return -1;
+}

@@ -329,9 +329,7 @@ static void on_progress(void *user, uint64_t done, uint64_t total)
     rs_progress_update(&((render_run *)user)->progress, done, total);
 }
 
-/* The render thread, whenever the film holds what it held plus `done`: a periodic checkpoint.
- * A failed one is reported and the render goes on (the last good file stays). */
-static void on_film_ready(void *user, const rs_film *film, const rs_path_ranges *done)
+void rs_run_on_film_ready(void *user, const rs_film *film, const rs_path_ranges *done)
 {
     render_run *r = (render_run *)user;
     double now;
@@ -385,7 +383,7 @@ static int run_render(const rs_cli_options *o, render_run *r)
     r->ckpt_every_s = o->ckpt_every_s;
     r->last_ckpt = rs_now_s();
     if (r->ckpt_out) {
-        hooks.film_ready = on_film_ready;
+        hooks.film_ready = rs_run_on_film_ready;
         rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
     }
     rst = engine_run(o, r, &hooks);

@@ -81,6 +81,10 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r);
 int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code);
 /* The --checkpoint of the film as it is now; 0 after a message. */
 int rs_run_write_checkpoint(const render_run *r, int rename_now);
+/* rs_render_hooks.film_ready (user: the render_run), whenever the film holds what it held plus
+ * `done`: a periodic checkpoint.  A failed one is reported and the render goes on (the last
+ * good file stays). */
+void rs_run_on_film_ready(void *user, const rs_film *film, const rs_path_ranges *done);
 void rs_run_release(render_run *r);
 
 /* The commands (render_cmd.c, scene_load.c). */

@@ -96,7 +96,9 @@ int rs_adaptive_state_fits(const rs_adaptive_state *s, const uint32_t *count, ui
 
 /* One adaptive render: the engine, the state and what the rounds share. */
 typedef struct adaptive_run {
-    rs_engine *e;
+    rs_plan_runner run; /* runs one plan onto the film */
+    void *run_user;
+    uint32_t spp;
     const rs_adaptive *a;
     rs_adaptive_state *s;
     const rs_render_hooks *outer;
@@ -140,7 +142,8 @@ static rs_status run_round(adaptive_run *r, int *limited)
                             (uint64_t)count * (s->n + s->step)))
         return rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
     r->round_base = s->round_done;
-    st = rs_engine_run(r->e, &plan, &r->hooks, r->film, &one);
+    memset(&one, 0, sizeof one);
+    st = r->run(r->run_user, &plan, &r->hooks, r->film, &one);
     rs_work_plan_free(&plan);
     s->round_done = r->round_base + one.paths_done;
     rs_render_stats_add(r->stats, &one);
@@ -160,7 +163,7 @@ static rs_status run_round(adaptive_run *r, int *limited)
 static uint32_t decide_round(adaptive_run *r)
 {
     rs_adaptive_state *s = r->s;
-    const uint32_t spp = rs_engine_settings(r->e)->spp;
+    const uint32_t spp = r->spp;
     uint32_t step;
     if (s->n >= spp)
         return 0;
@@ -176,8 +179,7 @@ static uint32_t decide_round(adaptive_run *r)
 /* What adaptive sampling needs before it begins or continues; the progress context. */
 static rs_status adaptive_begin(adaptive_run *r, const rs_render_hooks *hooks)
 {
-    const rs_render_settings *set = rs_engine_settings(r->e);
-    const uint32_t npix = set->width * set->height;
+    const uint32_t npix = r->film->width * r->film->height, spp = r->spp;
     rs_adaptive_state *s = r->s;
     uint32_t p;
     rs_status st;
@@ -185,12 +187,12 @@ static rs_status adaptive_begin(adaptive_run *r, const rs_render_hooks *hooks)
         return rs_error_set(RS_ERR_ARG, "adaptive sampling needs a threshold > 0 and at least 2 "
                                         "samples before any pixel stops");
     if (!s->running) {
-        if (set->path_begin)
+        if (rs_film_samples(r->film))
             return rs_error_set(RS_ERR_ARG, "adaptive sampling starts from an empty film");
         if ((st = rs_film_track_variance(r->film)) != RS_OK ||
             (st = rs_adaptive_state_init(s, npix)) != RS_OK)
             return st;
-    } else if (!r->film->sum_l2 || !rs_adaptive_state_fits(s, r->film->count, npix, set->spp)) {
+    } else if (!r->film->sum_l2 || !rs_adaptive_state_fits(s, r->film->count, npix, spp)) {
         return rs_error_set(RS_ERR_ARG, "adaptive sampling continues a film of its own only");
     }
     r->need = (uint8_t *)rs_alloc(npix ? npix : 1, 1);
@@ -199,11 +201,11 @@ static rs_status adaptive_begin(adaptive_run *r, const rs_render_hooks *hooks)
         return rs_error_set(RS_ERR_NOMEM, "out of memory for adaptive sampling");
     /* done so far: the film's samples, and the samples stopped pixels will never take */
     r->pc.outer = hooks;
-    r->pc.total = (uint64_t)npix * set->spp;
+    r->pc.total = (uint64_t)npix * spp;
     r->pc.done_before = 0;
     r->pc.run = r;
     for (p = 0; p < npix; ++p)
-        r->pc.done_before += s->running[p] ? r->film->count[p] : set->spp;
+        r->pc.done_before += s->running[p] ? r->film->count[p] : spp;
     if (hooks)
         r->hooks = *hooks;
     else
@@ -215,8 +217,10 @@ static rs_status adaptive_begin(adaptive_run *r, const rs_render_hooks *hooks)
     return RS_OK;
 }
 
-rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state *state,
-                          const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats)
+rs_status rs_adaptive_run_plans(rs_plan_runner run, void *user, uint32_t spp,
+                                const rs_adaptive *a, rs_adaptive_state *state,
+                                const rs_render_hooks *hooks, rs_film *film,
+                                rs_render_stats *stats)
 {
     adaptive_run r;
     double t0 = rs_now_s();
@@ -224,7 +228,9 @@ rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state 
     int limited = 0;
     memset(stats, 0, sizeof *stats);
     memset(&r, 0, sizeof r);
-    r.e = e;
+    r.run = run;
+    r.run_user = user;
+    r.spp = spp;
     r.a = a;
     r.s = state;
     r.film = film;
@@ -242,6 +248,23 @@ rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state 
     rs_free(r.list);
     stats->seconds = rs_now_s() - t0;
     return st;
+}
+
+static rs_status engine_plan(void *user, const rs_work_plan *plan, const rs_render_hooks *hooks,
+                             rs_film *film, rs_render_stats *stats)
+{
+    return rs_engine_run((rs_engine *)user, plan, hooks, film, stats);
+}
+
+rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state *state,
+                          const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats)
+{
+    if (rs_engine_settings(e)->path_begin) {
+        memset(stats, 0, sizeof *stats);
+        return rs_error_set(RS_ERR_ARG, "adaptive sampling starts from an empty film");
+    }
+    return rs_adaptive_run_plans(engine_plan, e, rs_engine_settings(e)->spp, a, state, hooks,
+                                 film, stats);
 }
 
 rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,

@@ -56,6 +56,18 @@ int rs_adaptive_state_fits(const rs_adaptive_state *s, const uint32_t *count, ui
  * pixel's remaining samples as done.  *stats sums the rounds' (seconds: the whole). */
 rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state *state,
                           const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats);
+/* Runs one plan onto `film` with `hooks`, its statistics into *stats (paths_done, and
+ * time_limited when the time limit cut it short: then the plan's first paths_done paths are on
+ * the film): the engine's rs_engine_run, or an MPI job over the ranks (app/dist_glue.c). */
+typedef rs_status (*rs_plan_runner)(void *user, const rs_work_plan *plan,
+                                    const rs_render_hooks *hooks, rs_film *film,
+                                    rs_render_stats *stats);
+/* rs_adaptive_run with the plans run by `run` (up to `spp` samples a pixel): the rounds are
+ * decided here, from `film`, whoever renders them. */
+rs_status rs_adaptive_run_plans(rs_plan_runner run, void *user, uint32_t spp,
+                                const rs_adaptive *a, rs_adaptive_state *state,
+                                const rs_render_hooks *hooks, rs_film *film,
+                                rs_render_stats *stats);
 /* rs_adaptive_run from a fresh state, its statistics in *astats. */
 rs_status rs_render_adaptive(rs_engine *e, const rs_adaptive *a, const rs_render_hooks *hooks,
                              rs_film *film, rs_render_stats *stats, rs_adaptive_stats *astats);

@@ -18,7 +18,10 @@
  *     the megakernel and under mpirun gives the uninterrupted image bit for bit;
  *   - --checkpoint-interval under mpirun flushes every rank's film to rank 0 on the way;
  *   - Ctrl-C on mpirun ends every rank within seconds, with 128 + the signal or mpirun's code;
- *   - options the job cannot honour (--adaptive) and a bad RS_MPI_FAULT are refused by rank 0
+ *   - --adaptive (rank 0 decides each round from the merged film) with 2 and 3 ranks and odd
+ *     pass sizes, after a rank died in an early round, and stopped by the time limit with a
+ *     checkpoint resumed on one process and under mpirun: the one-process adaptive image;
+ *   - options the job cannot honour (--aov) and a bad RS_MPI_FAULT are refused by rank 0
  *     alone, in one line. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -153,6 +156,87 @@ static void test_same_image_any_ranks(void **state)
     expect_same_as_one(f, 3, stream, "--mpi-pass", "5"); /* passes of 5, 5 and 2 samples */
     expect_same_as_one(f, 2, mega, "--mpi-pass", "1");
     expect_same_as_one(f, 3, zsobol, "--mpi-pass", "3");
+}
+
+/* ---- adaptive sampling: rank 0 decides each round from the merged film ------------------- */
+
+static void test_adaptive_same_image(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    /* a threshold at which pixels stop after different rounds (the summary says how many) */
+    static const char *const args[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                       SIZE, "--spp", "64", "--adaptive", "0.05", "-q", NULL};
+    static const char *const zsobol[] = {"render", "builtin:rtiow-final", "--width", SIZE,
+                                         "--height", SIZE, "--spp", "32", "--adaptive", "0.1",
+                                         "--sampler", "zsobol", "-q", NULL};
+    expect_same_as_one(f, 2, args, NULL, NULL);
+    expect_same_as_one(f, 3, args, "--mpi-pass", "1"); /* each round in one-sample passes */
+    expect_same_as_one(f, 3, zsobol, "--mpi-pass", "3");
+}
+
+/* Stopped by the time limit between or within rounds, with a checkpoint: resumed on one process
+ * and under mpirun, it is the uninterrupted one-process render. */
+static void test_adaptive_checkpoint_resume(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                      "64", "--spp", "256", "--adaptive", "0.02", "-q", NULL};
+    static const char *const cut[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                      "64", "--spp", "256", "--adaptive", "0.02", "--time-limit",
+                                      "0.4", "--mpi-pass", "2", "--checkpoint", "a.ckpt", "-q",
+                                      "-o", "cut.exr", NULL};
+    static const char *const resume[] = {"render", "builtin:cornell", "--width", "64", "--height",
+                                         "64", "--spp", "256", "--adaptive", "0.02", "--resume",
+                                         "a.ckpt", "-q", NULL};
+    const char *argv[MAX_ARGS + 1];
+    image one, again, many;
+    proc p;
+    int k = 0, i;
+    mpirun(&p, f, 2, 0, cut);
+    EXPECT(&p, exited_with(&p, 0), "the time-limited adaptive job failed");
+    proc_free(&p);
+    one = one_process(f, ref, "one.exr");
+    again = one_process(f, resume, "again.exr");
+    EXPECT(&p, same_image(&one, &again),
+           "an adaptive MPI checkpoint resumed on one process is not the one-process image");
+    for (i = 0; resume[i]; ++i)
+        argv[k++] = resume[i];
+    argv[k++] = "-o";
+    argv[k++] = "many.exr";
+    argv[k] = NULL;
+    mpirun(&p, f, 3, 0, argv);
+    EXPECT(&p, exited_with(&p, 0), "resuming the adaptive checkpoint under mpirun failed");
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many),
+           "an adaptive MPI checkpoint resumed under mpirun is not the one-process image");
+    rs_free(one.rgb);
+    rs_free(again.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
+}
+
+/* A rank that dies in an early round: found dead, left out of the later rounds, same image. */
+static void test_adaptive_killed_rank(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                       SIZE, "--spp", "64", "--adaptive", "0.05", "--mpi-pass",
+                                       "1", "--mpi-timeout", "2", "-q", "-o", "many.exr", NULL};
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                      SIZE, "--spp", "64", "--adaptive", "0.05", "-q", NULL};
+    image one, many;
+    proc p;
+    setenv("RS_MPI_FAULT", "die:2:2", 1);
+    mpirun(&p, f, 3, 1, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, exited_with(&p, 0), "the adaptive job with a dead rank failed");
+    EXPECT(&p, strstr(p.err.data, "rank 2") != NULL, "the dead rank was not reported");
+    one = one_process(f, ref, "one.exr");
+    many = read_image(&p, f, "many.exr");
+    EXPECT(&p, same_image(&one, &many), "the adaptive image changed with a dead rank");
+    rs_free(one.rgb);
+    rs_free(many.rgb);
+    proc_free(&p);
 }
 
 /* ---- load balance ------------------------------------------------------------------------ */
@@ -419,17 +503,17 @@ static void test_ctrl_c_stops_every_rank(void **state)
 static void test_unsupported_options(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const args[] = {"render", "builtin:cornell", "--adaptive", "0.01", "-q",
+    static const char *const args[] = {"render", "builtin:cornell", "--aov", "albedo", "-q",
                                        NULL};
     proc p;
     const char *s;
     int lines = 0;
     mpirun(&p, f, 2, 0, args);
-    EXPECT(&p, !exited_with(&p, 0), "--adaptive under mpirun was not refused");
+    EXPECT(&p, !exited_with(&p, 0), "--aov under mpirun was not refused");
     for (s = strstr(p.err.data, "raystream:"); s; s = strstr(s + 1, "raystream:"))
         ++lines;
-    EXPECT(&p, lines == 1 && strstr(p.err.data, "--adaptive"),
-           "not one line from rank 0 naming --adaptive (%d lines)", lines);
+    EXPECT(&p, lines == 1 && strstr(p.err.data, "--aov"),
+           "not one line from rank 0 naming --aov (%d lines)", lines);
     proc_free(&p);
     /* a bad fault spec: one line too */
     {
@@ -474,6 +558,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_same_image_any_ranks, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_adaptive_same_image, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_adaptive_checkpoint_resume, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_adaptive_killed_rank, setup, teardown),
         cmocka_unit_test_setup_teardown(test_slow_rank_gets_fewer_passes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_rank_recovered, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_rank_does_not_hang, setup, teardown),
