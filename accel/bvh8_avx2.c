@@ -231,6 +231,7 @@ static inline uint32_t sphere8_hit(const rs_bvh8_sphere8 *b, const ray8 *r, floa
 #  define RS_WIDE_NODE                              rs_bvh8_node
 #  define RS_WIDE_STACK                             RS_BVH8_STACK
 #  define RS_WIDE_FN(x)                             walk8_##x
+#  define RS_WIDE_ENTRY                             RS_HD_HOT
 #  define RS_WIDE_RAY                               ray8
 #  define RS_WIDE_TN                                __m256
 #  define RS_WIDE_TRIS(b)                           ((b)->tri8)

@@ -7,6 +7,9 @@
  *   RS_WIDE_TREE, RS_WIDE_NODE  the tree (nodes, n_nodes, prim_ids, inst_root and the block
  *                               arrays) and its node (child[W], count[W])
  *   RS_WIDE_STACK               stack entries a walk needs (W per level of the binary tree)
+ *   RS_WIDE_ENTRY               optional: how FN(closest) and FN(occluded) are declared (static
+ *                               inline where not defined; RS_HD_HOT where a thin wrapper calls
+ *                               them, so that the walk is compiled into the wrapper)
  *   RS_WIDE_FN(x)               the generated and the per-width functions' names (prefix ## x)
  *   RS_WIDE_RAY, RS_WIDE_TN     the ray broadcast to W lanes; W entry distances in registers
  *   FN(ray_init)(RAY *, o, d)   the broadcast ray
@@ -42,6 +45,10 @@
 #  error "accel/wide_walk.h: define the width's parameters first"
 #endif
 
+#ifndef RS_WIDE_ENTRY
+#  define RS_WIDE_ENTRY static inline
+#endif
+
 /* The stack entry for lane `lane` of node `n`, number `node`. */
 #define RS_WIDE_REF(n, node, lane)                                                                 \
   ((n)->count[lane] ? RS_WIDE_LEAF | (node) << RS_WIDE_SHIFT | (lane) : (n)->child[lane])
@@ -49,7 +56,7 @@
 #ifdef RS_WIDE_TRI_HIT
 /* A packed leaf (`count` has RS_WIDE_PACKED) for closest hit: each block's hits taken as
  * rs_bvh_leaf_closest takes them (rs_hit_better; the ray cut just past the best). */
-static inline void RS_WIDE_FN(packed_closest)(const RS_WIDE_TREE *b, uint32_t first,
+RS_HD_HOT void RS_WIDE_FN(packed_closest)(const RS_WIDE_TREE *b, uint32_t first,
                                               uint32_t count, const RS_WIDE_RAY *r, rs_ray *ray,
                                               rs_hit *hit)
 {
@@ -88,7 +95,7 @@ static inline void RS_WIDE_FN(packed_closest)(const RS_WIDE_TREE *b, uint32_t fi
 }
 
 /* A packed leaf for any hit: 1 when some primitive is hit inside (tmin, tmax). */
-static inline int RS_WIDE_FN(packed_occluded)(const RS_WIDE_TREE *b, uint32_t first,
+RS_HD_HOT int RS_WIDE_FN(packed_occluded)(const RS_WIDE_TREE *b, uint32_t first,
                                               uint32_t count, const RS_WIDE_RAY *r,
                                               const rs_ray *ray)
 {
@@ -322,7 +329,7 @@ RS_HD_COLD int RS_WIDE_FN(instance_occluded)(const RS_WIDE_TREE *b, const rs_geo
 }
 
 /* Closest hit, as rs_bvh_closest: 1 and *hit on a hit, else hit->prim = RS_NO_HIT and 0. */
-static inline int RS_WIDE_FN(closest)(const RS_WIDE_TREE *b, const rs_geom *g, rs_ray ray,
+RS_WIDE_ENTRY int RS_WIDE_FN(closest)(const RS_WIDE_TREE *b, const rs_geom *g, rs_ray ray,
                                       rs_hit *hit)
 {
     RS_WIDE_RAY r;
@@ -337,7 +344,7 @@ static inline int RS_WIDE_FN(closest)(const RS_WIDE_TREE *b, const rs_geom *g, r
 }
 
 /* Any hit inside (tmin, tmax), as rs_bvh_occluded. */
-static inline int RS_WIDE_FN(occluded)(const RS_WIDE_TREE *b, const rs_geom *g, rs_ray ray)
+RS_WIDE_ENTRY int RS_WIDE_FN(occluded)(const RS_WIDE_TREE *b, const rs_geom *g, rs_ray ray)
 {
     RS_WIDE_RAY r;
     if (b->n_nodes == 0)
@@ -347,6 +354,7 @@ static inline int RS_WIDE_FN(occluded)(const RS_WIDE_TREE *b, const rs_geom *g, 
 }
 
 #undef RS_WIDE_REF
+#undef RS_WIDE_ENTRY
 #undef RS_WIDE_W
 #undef RS_WIDE_SHIFT
 #undef RS_WIDE_TREE
