@@ -40,6 +40,7 @@
 #include "accel/bvh4.h"
 #include "accel/bvh8.h"
 #include "core/alloc.h"
+#include "scenes/scene.h"
 
 #include "test_rand.h"
 
@@ -881,6 +882,102 @@ static void test_ray_in_bounding_plane(void **state)
                  failures);
 }
 
+/* Instances in the wide trees: each prototype's bottom level is collapsed once (instances of one
+ * prototype share a wide root) and walked by the same wide walk as the top tree, the ray in the
+ * instance's object space; the hits are the binary two-level walk's bit for bit (t, u, v,
+ * primitive), rays ending among the instances included, and the any-hit answers agree. */
+static void test_wide_instances(void **state)
+{
+    rs_scene *s = NULL;
+    rs_material m = rs_mat_lambertian(rs_v3(.5f, .5f, .5f));
+    uint32_t mat, first[2], count[2], i, k;
+    uint64_t rng = 0x1a57a2ce;
+    /* two prototypes: a cloud of 300 small triangles (a bottom level of several wide nodes) and
+     * a single triangle (a bottom level that is one leaf) */
+    static const double place[5][12] = {
+        {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+        {0.8, -0.6, 0, 2.5, 0.6, 0.8, 0, 0.25, 0, 0, 1, -1},
+        {-1, 0, 0, -2.5, 0, 2, 0, 0, 0, 0, 0.5, 1.5},
+        {1, 0, 0, 0, 0, 1, 0, 3, 0, 0, 1, 0},
+        {0.5, 0.1, 0, -1, 0, 0.5, 0.2, 1, 0.3, 0, 0.5, -2}};
+    rs_geom g;
+    rs_bvh *b = NULL;
+    rs_bvh4 *b4 = NULL;
+    rs_bvh8 *b8 = NULL;
+    rs_bvh_view v;
+    long hits = 0, inst_hits = 0;
+    (void)state;
+    assert_int_equal(rs_scene_create("wide-instances", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &m, &mat), RS_OK);
+    for (k = 0; k < 2; ++k) {
+        uint32_t from = s->n_tris, n = k == 0 ? 300 : 1;
+        for (i = 0; i < n; ++i) {
+            rs_vec3 c = rnd_box(&rng, 1.0f);
+            assert_int_equal(rs_scene_add_triangle(s, c, rs_v3_add(c, rnd_box(&rng, 0.2f)),
+                                                   rs_v3_add(c, rnd_box(&rng, 0.2f)), mat),
+                             RS_OK);
+        }
+        assert_int_equal(rs_scene_make_prototype(s, from, &first[k], &count[k]), RS_OK);
+    }
+    for (i = 0; i < 5; ++i)
+        assert_int_equal(rs_scene_add_instance(s, first[i == 3], count[i == 3], place[i]), RS_OK);
+    /* and triangles of the scene's own, in the same top tree */
+    for (i = 0; i < 50; ++i) {
+        rs_vec3 c = rnd_box(&rng, 3.0f);
+        assert_int_equal(rs_scene_add_triangle(s, c, rs_v3_add(c, rnd_box(&rng, 0.3f)),
+                                               rs_v3_add(c, rnd_box(&rng, 0.3f)), mat),
+                         RS_OK);
+    }
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    g = rs_scene_geom(s);
+    assert_int_equal(g.n_instances, 5);
+    assert_int_equal(rs_bvh_build(&g, NULL, &b), RS_OK);
+    rs_bvh_attach(b, &g);
+    assert_int_equal(rs_bvh4_build(b, &g, &b4), RS_OK);
+    assert_non_null(b4->inst_root);
+    /* one bottom level per prototype: instances 0, 1, 2 and 4 share theirs */
+    assert_int_equal(b4->inst_root[0], b4->inst_root[1]);
+    assert_int_equal(b4->inst_root[0], b4->inst_root[4]);
+    assert_true(b4->inst_root[0] != b4->inst_root[3]);
+    for (i = 0; i < 5; ++i)
+        assert_true(b4->inst_root[i] > 0 && b4->inst_root[i] < b4->n_nodes);
+    if (rs_bvh8_supported()) {
+        assert_int_equal(rs_bvh8_build(b, &g, &b8), RS_OK);
+        assert_int_equal(b8->inst_root[0], b8->inst_root[2]);
+        assert_true(b8->inst_root[0] != b8->inst_root[3]);
+    }
+    v = rs_bvh_view_of(b);
+    for (i = 0; i < 20000; ++i) {
+        rs_vec3 o = rnd_box(&rng, 6.0f), to = rnd_box(&rng, 3.0f);
+        rs_ray r = mk_ray(o, rs_v3_sub(to, o), 1e-4f, i % 3 == 0 ? 0.9f : T_INF);
+        rs_hit want, got;
+        int occ;
+        rs_bvh_closest(&v, &g, r, &want);
+        occ = rs_bvh_occluded(&v, &g, r);
+        assert_int_equal(occ, want.prim != RS_NO_HIT);
+        rs_bvh4_closest(b4, &g, r, &got);
+        if (memcmp(&got, &want, sizeof got) != 0)
+            fail_msg("ray %u, 4-wide: prim %u t %.9g, binary prim %u t %.9g", i, got.prim, got.t,
+                     want.prim, want.t);
+        assert_int_equal(rs_bvh4_occluded(b4, &g, r), occ);
+        if (b8) {
+            rs_bvh8_closest(b8, &g, r, &got);
+            if (memcmp(&got, &want, sizeof got) != 0)
+                fail_msg("ray %u, 8-wide: prim %u t %.9g, binary prim %u t %.9g", i, got.prim,
+                         got.t, want.prim, want.t);
+            assert_int_equal(rs_bvh8_occluded(b8, &g, r), occ);
+        }
+        hits += occ;
+        inst_hits += want.prim != RS_NO_HIT && want.prim >= rs_geom_own_count(&g);
+    }
+    print_message("wide instances: 20000 rays, %ld hit, %ld on instances\n", hits, inst_hits);
+    assert_true(inst_hits > 2000); /* the rays do reach the instances */
+    rs_bvh8_destroy(b8);
+    rs_bvh4_destroy(b4);
+    rs_bvh_destroy(b);
+    rs_scene_destroy(s);
+}
+
 static void test_build_out_of_memory(void **state)
 {
     /* Fail each allocation of the build in turn: the build reports RS_ERR_NOMEM, hands back
@@ -970,6 +1067,7 @@ int main(void)
         cmocka_unit_test(test_identical_centroids),
         cmocka_unit_test(test_nan_inf_rays_terminate),
         cmocka_unit_test(test_ray_in_bounding_plane),
+        cmocka_unit_test(test_wide_instances),
         cmocka_unit_test(test_build_out_of_memory),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
