@@ -131,7 +131,7 @@ static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_laye
     static const char *const names[4] = {"albedo", "normal", "depth", "samples"};
     static const char *const channels[4] = {"RGB", "XYZ", "Z", "Y"};
     size_t npix = (size_t)r->st.width * r->st.height;
-    rs_integrator it;
+    rs_render_consts it;
     int n = 0, k;
     uint32_t i;
     bufs[0] = bufs[1] = bufs[2] = bufs[3] = NULL;

@@ -5,7 +5,8 @@
  * hit or any hit by the batch's kind), and copied out, in pieces pipelined over two CUDA streams.
  * A chunk of a batch from host_alloc (pinned) is copied by DMA straight from and to the batch's
  * arrays; any other is packed into the stage's pinned buffers first.  The megakernel
- * (pass_begin, render_pass) is gpu/cuda_megakernel.cu; the state both share is gpu/internal.h.
+ * (upload_scene, render_pass) is gpu/cuda_megakernel.cu; the state both share is
+ * gpu/internal.h.
  *
  * Every CUDA call that can fail is checked against its own return value (CUDA_TRY, kernel
  * launches through cudaLaunchKernel) and reported with the call's text, file and line; release
@@ -141,7 +142,7 @@ static rs_status cuda_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
     rs_status st;
     CUDA_TRY(cudaSetDevice(c->ordinal));
     /* a second upload replaces the first (and the megakernel's copy, which borrowed its BVH) */
-    rs_cuda_pass_release(c);
+    rs_cuda_scene_release(c);
     rs_device_geom_release(&c->geom, &rs_cuda_mirror_ops);
     c->uploaded = 0;
     if ((st = rs_device_copy_geom(g, bvh, &rs_cuda_mirror_ops, &c->geom)) != RS_OK)
@@ -291,7 +292,7 @@ static void cuda_destroy(rs_device *d)
         for (k = 0; k < RS_CUDA_STAGES; ++k)
             if (c->st[k].stream)
                 (void)cudaStreamSynchronize(c->st[k].stream);
-        rs_cuda_pass_release(c);
+        rs_cuda_scene_release(c);
         free_staging(c);
         rs_device_geom_release(&c->geom, &rs_cuda_mirror_ops);
         for (k = 0; k < RS_CUDA_STAGES; ++k)
@@ -303,7 +304,7 @@ static void cuda_destroy(rs_device *d)
 }
 
 static const rs_device_ops cuda_ops = {cuda_upload,        cuda_trace,     cuda_destroy,
-                                       cuda_host_alloc,    cuda_host_free, rs_cuda_pass_begin,
+                                       cuda_host_alloc,    cuda_host_free, rs_cuda_upload_scene,
                                        rs_cuda_render_pass};
 
 extern "C" int rs_gpu_compiled(void) { return 1; }

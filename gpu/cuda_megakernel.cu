@@ -1,9 +1,9 @@
-/* gpu/cuda_megakernel.cu — the CUDA device's megakernel (its pass_begin and render_pass): the
+/* gpu/cuda_megakernel.cu — the CUDA device's megakernel (its upload_scene and render_pass): the
  * thesis's CUDA integrator, one thread per pixel tracing its path from the camera to the end
  * with rs_path_radiance (shading/path.h), the very function the CPU megakernel and the
  * wavefront's stages run.
  *
- * pass_begin copies the scene into device memory (scheduler/device_copy.h: the scene's arrays
+ * upload_scene copies the scene into device memory (scheduler/device_copy.h: the scene's arrays
  * once; the tracer's geometry is the mirror's arrays with the uploaded geometry's algorithms, over
  * the uploaded BVH copy) and makes a double buffer.  render_pass runs one kernel per sample on
  * the device's stream and overlaps the host's film add of sample s with the kernel of sample
@@ -26,7 +26,7 @@
 #define RS_WARP 32
 
 __global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
-    rs_megakernel_kernel(rs_integrator it, rs_path_tracer tr, uint32_t sample, rs_vec3 *radiance,
+    rs_megakernel_kernel(rs_render_consts it, rs_path_tracer tr, uint32_t sample, rs_vec3 *radiance,
                          rs_cuda_mk_counts *counts)
 {
     uint32_t pixel = blockIdx.x * blockDim.x + threadIdx.x;
@@ -56,7 +56,7 @@ __global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
 
 const void *rs_cuda_megakernel_entry(void) { return (const void *)rs_megakernel_kernel; }
 
-void rs_cuda_pass_release(rs_cuda_impl *c)
+void rs_cuda_scene_release(rs_cuda_impl *c)
 {
     rs_cuda_mk *mk = &c->mk;
     int k;
@@ -77,8 +77,8 @@ void rs_cuda_pass_release(rs_cuda_impl *c)
     memset(mk, 0, sizeof *mk);
 }
 
-/* Everything pass_begin makes; on failure the caller releases what was made. */
-static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_integrator *it)
+/* Everything upload_scene makes; on failure the caller releases what was made. */
+static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_render_consts *it)
 {
     rs_cuda_mk *mk = &c->mk;
     size_t image = (size_t)it->npix * sizeof(rs_vec3);
@@ -106,18 +106,18 @@ static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_inte
     return RS_OK;
 }
 
-rs_status rs_cuda_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it)
+rs_status rs_cuda_upload_scene(rs_device *d, const rs_scene *scene, const rs_render_consts *it)
 {
     rs_cuda_impl *c = (rs_cuda_impl *)d->impl;
     rs_status st;
     CUDA_TRY(cudaSetDevice(c->ordinal));
-    rs_cuda_pass_release(c);
+    rs_cuda_scene_release(c);
     if (!c->uploaded)
-        return rs_error_set(RS_ERR_ARG, "device %s: pass_begin before upload", d->name);
+        return rs_error_set(RS_ERR_ARG, "device %s: upload_scene before upload", d->name);
     if (it->npix == 0)
         return rs_error_set(RS_ERR_ARG, "device %s: a pass of no pixels", d->name);
     if ((st = pass_make(c, scene, it)) != RS_OK) {
-        rs_cuda_pass_release(c);
+        rs_cuda_scene_release(c);
         return st;
     }
     d->stats.bytes_to_device += c->mk.copy.mirror.made.bytes;
@@ -182,9 +182,9 @@ rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0,
     uint32_t s;
     int k;
     if (!mk->ready)
-        return rs_error_set(RS_ERR_ARG, "device %s: render_pass before pass_begin", d->name);
+        return rs_error_set(RS_ERR_ARG, "device %s: render_pass before upload_scene", d->name);
     if (job->film->width * job->film->height != mk->it.npix)
-        return rs_error_set(RS_ERR_ARG, "device %s: the film is not the pass_begin's image size",
+        return rs_error_set(RS_ERR_ARG, "device %s: the film is not the upload_scene's image size",
                             d->name);
     CUDA_TRY(cudaSetDevice(c->ordinal));
     for (s = s0; s - s0 < n && st == RS_OK; ++s) {

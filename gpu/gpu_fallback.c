@@ -13,8 +13,8 @@
  *                kernel body — rs_trace_one, the RS_HD binary BVH traversal the CUDA kernel runs —
  *                over them on host threads, and copies the answers back ("copy out",
  *                rs_trace_stage_out); the bytes are counted as the CUDA device counts a chunk's;
- *   pass_begin   copies the scene (the same rs_device_copy_scene call as the GPU's; a pass of no
- *                pixels is refused, as there);
+ *   upload_scene copies the scene and the render constants (the same rs_device_copy_scene call
+ *                as the GPU's; a pass of no pixels is refused, as there);
  *   render_pass  the CUDA render_pass's passes: per sample, rs_path_radiance for every pixel
  *                (path index sample * npix + pixel, as the CUDA kernel's thread computes it) into
  *                a radiance buffer (the pixels split among host threads by the job's strategy),
@@ -50,9 +50,9 @@ typedef struct fallback_impl {
     uint8_t *occluded;
     uint32_t cap;
     rs_cores *cores;
-    /* pass_begin */
+    /* upload_scene */
     rs_device_scene scene; /* its own copy of the scene */
-    rs_integrator it;      /* the render's constants, it.scene = scene.scene */
+    rs_render_consts it;   /* the render's constants, it.scene = scene.scene */
     rs_vec3 *radiance;     /* it.npix: one pass */
     int pass_ready;
 } fallback_impl;
@@ -162,13 +162,14 @@ static rs_status fallback_trace(rs_device *d, const rs_trace_batch *batch, uint3
     return RS_OK;
 }
 
-static rs_status fallback_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it)
+static rs_status fallback_upload_scene(rs_device *d, const rs_scene *scene,
+                                       const rs_render_consts *it)
 {
     fallback_impl *f = (fallback_impl *)d->impl;
     rs_status st;
     release_pass(f);
     if (!f->uploaded)
-        return rs_error_set(RS_ERR_ARG, "device %s: pass_begin before upload", d->name);
+        return rs_error_set(RS_ERR_ARG, "device %s: upload_scene before upload", d->name);
     if (it->npix == 0)
         return rs_error_set(RS_ERR_ARG, "device %s: a pass of no pixels", d->name);
     if ((st = rs_device_copy_scene(scene, &f->geom, &rs_device_copy_host_ops, &f->scene)) != RS_OK)
@@ -198,7 +199,7 @@ typedef struct pass_ctx {
 static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
 {
     pass_ctx *p = (pass_ctx *)ctx;
-    const rs_integrator *it = &p->f->it;
+    const rs_render_consts *it = &p->f->it;
     const rs_pass_job *job = p->job;
     rs_path_counts n = {0, 0, 0};
     uint64_t base = (uint64_t)p->sample * it->npix;
@@ -222,9 +223,9 @@ static rs_status fallback_render_pass(rs_device *d, const rs_pass_job *job, uint
     pass_ctx p;
     int threads;
     if (!f->pass_ready)
-        return rs_error_set(RS_ERR_ARG, "device %s: render_pass before pass_begin", d->name);
+        return rs_error_set(RS_ERR_ARG, "device %s: render_pass before upload_scene", d->name);
     if (job->film->width * job->film->height != npix)
-        return rs_error_set(RS_ERR_ARG, "device %s: the film is not the pass_begin's image size",
+        return rs_error_set(RS_ERR_ARG, "device %s: the film is not the upload_scene's image size",
                             d->name);
     memset(&p, 0, sizeof p);
     p.f = f;
@@ -265,7 +266,7 @@ static const rs_device_ops fallback_ops = {fallback_upload,
                                            fallback_destroy,
                                            NULL, /* host_alloc: malloc */
                                            NULL,
-                                           fallback_pass_begin,
+                                           fallback_upload_scene,
                                            fallback_render_pass};
 
 rs_status rs_gpu_fallback_create(int threads, int gpu_index, rs_cores *cores, rs_device **out)

@@ -1,16 +1,17 @@
 /* gpu/internal.h — the CUDA device's state, shared by its two files (the .cu files of gpu/ only):
  * gpu/cuda_device.cu (create, upload, trace, host memory, destroy) and gpu/cuda_megakernel.cu
- * (pass_begin, render_pass).
+ * (upload_scene, render_pass).
  *
  * Memory the device holds, all made once:
- *   at create      two streams (stage 0's is "the device's stream": the megakernel runs on it);
- *   at upload      the geometry + BVH copy (scheduler/device_copy.h, rs_cuda_mirror_ops) and the
- *                  staging of both stages, sized for the largest piece a chunk is cut into
- *                  (rs_gpu_piece_size(RS_SCHED_MAX_CHUNK)): one pinned and one device block
- *                  per stage, carved into the ray, hit and occlusion arrays;
- *   at pass_begin  the scene copy and, per slot of the megakernel's double buffer, a device and
- *                  a pinned radiance image, device and pinned ray counters and an event.
- * Every block is released by destroy; a failed upload or pass_begin releases what it made. */
+ *   at create        two streams (stage 0's is "the device's stream": the megakernel runs on it);
+ *   at upload        the geometry + BVH copy (scheduler/device_copy.h, rs_cuda_mirror_ops) and the
+ *                    staging of both stages, sized for the largest piece a chunk is cut into
+ *                    (rs_gpu_piece_size(RS_SCHED_MAX_CHUNK)): one pinned and one device block
+ *                    per stage, carved into the ray, hit and occlusion arrays;
+ *   at upload_scene  the scene copy and the render constants and, per slot of the megakernel's
+ *                    double buffer, a device and a pinned radiance image, device and pinned ray
+ *                    counters and an event.
+ * Every block is released by destroy; a failed upload or upload_scene releases what it made. */
 #ifndef RS_GPU_INTERNAL_H
 #define RS_GPU_INTERNAL_H
 
@@ -65,7 +66,7 @@ typedef struct rs_cuda_mk_slot {
 
 typedef struct rs_cuda_mk {
     rs_device_scene copy; /* the scene on the device; borrows the upload's BVH copy */
-    rs_integrator it;     /* the render's constants, it.scene = copy.scene (a device pointer) */
+    rs_render_consts it;  /* the render's constants, it.scene = copy.scene (a device pointer) */
     rs_cuda_mk_slot slot[2];
     int block; /* threads per block: the occupancy API's, a multiple of the warp size */
     int ready;
@@ -86,12 +87,12 @@ typedef struct rs_cuda_impl {
  * cudaFree.  Call with the device current. */
 extern const rs_mirror_ops rs_cuda_mirror_ops;
 
-/* gpu/cuda_megakernel.cu: the device's pass_begin and render_pass (scheduler/device.h), and the
- * release of what pass_begin made (a no-op when it made nothing; the device must be current). */
-rs_status rs_cuda_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it);
+/* gpu/cuda_megakernel.cu: the device's upload_scene and render_pass (scheduler/device.h), and the
+ * release of what upload_scene made (a no-op when it made nothing; the device must be current). */
+rs_status rs_cuda_upload_scene(rs_device *d, const rs_scene *scene, const rs_render_consts *it);
 rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                               rs_path_counts *counts);
-void rs_cuda_pass_release(rs_cuda_impl *c);
+void rs_cuda_scene_release(rs_cuda_impl *c);
 /* The megakernel's entry point, for cudaFuncGetAttributes (gpu/cuda_device.cu sizes the stack
  * from it and the trace kernel). */
 const void *rs_cuda_megakernel_entry(void);

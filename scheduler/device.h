@@ -6,7 +6,7 @@
  * each other.
  *
  * Life cycle: create (device-specific constructor) -> upload once -> trace many chunks (from
- * exactly one dispatch thread at a time) and/or pass_begin once per render (the engine's
+ * exactly one dispatch thread at a time) and/or upload_scene once per render (the engine's
  * creation, scheduler/render.h), render_pass many times (from the render thread, for every plan
  * the engine runs) -> destroy.
  *
@@ -16,7 +16,7 @@
  * DMA), and it copies a chunk straight from the caller's arrays without staging.  A host device
  * borrows the caller's arrays: they must outlive it.
  *
- * Thread safety: `trace` is only called from the device's dispatch thread, `pass_begin` and
+ * Thread safety: `trace` is only called from the device's dispatch thread, `upload_scene` and
  * `render_pass` only from the render thread, never both in one render.  `stats` is written by
  * the scheduler under its lock; read it after rs_sched_destroy or through rs_sched_device_stats
  * (scheduler/sched.h). */
@@ -36,7 +36,7 @@ typedef struct rs_device rs_device;
 
 /* One call of the megakernel's pass loop: what render_pass needs besides its sample range. */
 typedef struct rs_pass_job {
-    const rs_integrator *it;  /* the render's constants; it->scene is the host scene */
+    const rs_render_consts *it; /* the render's constants; it->scene is the host scene */
     rs_film *film;            /* each pixel's samples are added in sample order */
     rs_par_strategy strategy; /* how host threads split the pixels */
     /* Polled between pixels (host devices) or passes (GPUs); NULL: never.  Non-zero: stop and
@@ -64,7 +64,7 @@ typedef struct rs_device_ops {
     /* Optional (NULL: the device cannot run the megakernel).  After upload: makes the scene's
      * shading data (materials, textures, lights) available to render_pass, for the constants
      * `it` (copied).  Released by destroy. */
-    rs_status (*pass_begin)(rs_device *d, const rs_scene *scene, const rs_integrator *it);
+    rs_status (*upload_scene)(rs_device *d, const rs_scene *scene, const rs_render_consts *it);
     /* Samples [s0, s0 + n) of every pixel, traced path by path (rs_path_radiance) and added to
      * job->film, each pixel's samples in sample order; the rays traced are added to *counts.
      * Stops early, with RS_OK, when job->cancelled says so. */

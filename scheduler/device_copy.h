@@ -7,7 +7,7 @@
  *
  *   rs_device_copy_geom   at upload: the geometry's arrays (RS_GEOM_ARRAYS, core/geom.h) and the
  *                         BVH view's (RS_BVH_ARRAYS, accel/bvh_traverse.h): what `trace` reads;
- *   rs_device_copy_scene  at pass_begin: the scene's arrays (RS_SCENE_ARRAYS and the images,
+ *   rs_device_copy_scene  at upload_scene: the scene's arrays (RS_SCENE_ARRAYS and the images,
  *                         rs_scene_mirror_create), the mirror's rs_scene struct itself, and the
  *                         tracer the megakernel traces with: the geometry over the mirror's own
  *                         arrays (no array is copied twice) with the uploaded geometry's

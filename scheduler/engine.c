@@ -26,7 +26,7 @@ void rs_render_stats_add(rs_render_stats *sum, const rs_render_stats *r)
 }
 
 rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *st,
-                              rs_integrator *it)
+                              rs_render_consts *it)
 {
     uint64_t npix;
     if (st->width == 0 || st->height == 0 || st->spp == 0 || st->max_depth == 0)

@@ -25,7 +25,7 @@ typedef struct rs_slot {
 struct rs_engine {
     const rs_scene *scene;
     rs_render_settings st; /* the automatic choices made */
-    rs_integrator it;      /* the constants over every pixel */
+    rs_render_consts it;   /* the constants over every pixel */
     rs_sched *sched;       /* the stream engine's devices, or NULL */
     rs_device *mk;         /* the megakernel's device, or NULL */
     rs_slot slots[RS_RENDER_MAX_WAVES];
@@ -39,7 +39,7 @@ struct rs_engine {
 /* One run of a plan. */
 typedef struct rs_run {
     rs_engine *e;
-    rs_integrator it; /* the plan's constants (its pixels) */
+    rs_render_consts it; /* the plan's constants (its pixels) */
     rs_stage_exec ex; /* threads granted to the stage running now */
     const rs_work_plan *plan;
     const rs_render_hooks *hooks;
@@ -69,7 +69,7 @@ rs_status rs_run_on_film(rs_run *c, uint64_t lo, uint64_t hi);
 rs_status rs_stream_setup(rs_engine *e);
 rs_status rs_stream_run(rs_run *c);
 void rs_stream_release(rs_engine *e);
-/* The megakernel: pass_begin (creation) and the run. */
+/* The megakernel: upload_scene (creation) and the run. */
 rs_status rs_passes_setup(rs_engine *e);
 rs_status rs_passes_run(rs_run *c);
 

@@ -55,10 +55,10 @@ static void fault_host_free(rs_device *d, void *p)
     f->inner->ops->host_free(f->inner, p);
 }
 
-static rs_status fault_pass_begin(rs_device *d, const rs_scene *scene, const rs_integrator *it)
+static rs_status fault_upload_scene(rs_device *d, const rs_scene *scene, const rs_render_consts *it)
 {
     fault_impl *f = (fault_impl *)d->impl;
-    return f->inner->ops->pass_begin(f->inner, scene, it);
+    return f->inner->ops->upload_scene(f->inner, scene, it);
 }
 
 static rs_status fault_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
@@ -87,8 +87,8 @@ rs_status rs_fault_wrap(rs_device **d, int after)
         f->ops.host_alloc = fault_host_alloc;
         f->ops.host_free = fault_host_free;
     }
-    if ((*d)->ops->pass_begin)
-        f->ops.pass_begin = fault_pass_begin;
+    if ((*d)->ops->upload_scene)
+        f->ops.upload_scene = fault_upload_scene;
     if ((*d)->ops->render_pass)
         f->ops.render_pass = fault_render_pass;
     w->ops = &f->ops;

@@ -41,7 +41,7 @@ static void pass_progress(void *user, uint64_t paths)
 rs_status rs_passes_setup(rs_engine *e)
 {
     rs_device *d = e->mk;
-    return d->ops->pass_begin ? d->ops->pass_begin(d, e->scene, &e->it) : RS_OK;
+    return d->ops->upload_scene ? d->ops->upload_scene(d, e->scene, &e->it) : RS_OK;
 }
 
 rs_status rs_passes_run(rs_run *c)

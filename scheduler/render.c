@@ -45,7 +45,7 @@ static void submit(rs_run *c, rs_slot *sl, rs_trace_kind kind)
 static int stage_raygen(rs_run *c, rs_slot *sl, rs_status *status)
 {
     (void)status;
-    rs_integrator_raygen(&c->it, &c->ex, sl->start, sl->count, &sl->b.paths, &sl->b.ext[0]);
+    rs_stage_raygen(&c->it, &c->ex, sl->start, sl->count, &sl->b.paths, &sl->b.ext[0]);
     submit(c, sl, RS_TRACE_CLOSEST);
     return 0;
 }
@@ -63,8 +63,8 @@ static int stage_shade(rs_run *c, rs_slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;
     (void)status;
-    rs_integrator_shade(&c->it, &c->ex, sl->start, sl->bounce, &b->ext[sl->cur], &b->hits,
-                        sl->alive, &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
+    rs_stage_shade(&c->it, &c->ex, sl->start, sl->bounce, &b->ext[sl->cur], &b->hits, sl->alive,
+                   &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
     sl->n_shadow = rs_stream_pack_runs(&b->shadow, &b->runs, 1, sl->alive);
     if (sl->n_shadow == 0)
         return 1;
@@ -75,8 +75,7 @@ static int stage_shade(rs_run *c, rs_slot *sl, rs_status *status)
 static int stage_resolve_shadows(rs_run *c, rs_slot *sl, rs_status *status)
 {
     (void)status;
-    rs_integrator_resolve_shadows(&c->ex, &sl->b.shadow, sl->b.occluded, sl->n_shadow,
-                                  &sl->b.paths);
+    rs_stage_resolve_shadows(&c->ex, &sl->b.shadow, sl->b.occluded, sl->n_shadow, &sl->b.paths);
     return 0;
 }
 
@@ -101,7 +100,7 @@ static int stage_compact(rs_run *c, rs_slot *sl, rs_status *status)
 typedef struct flush_ctx {
     const rs_slot *sl;
     rs_film *film;
-    const rs_integrator *it;
+    const rs_render_consts *it;
     uint32_t npix; /* paths per pass */
 } flush_ctx;
 

@@ -126,7 +126,7 @@ typedef struct rs_engine rs_engine;
 /* An engine for rendering `scene` with `settings`: the stream engine through `sched`'s devices
  * (mk NULL), or the megakernel on device `mk` (sched NULL; already uploaded, with render_pass).
  * Checks the settings (RS_ERR_ARG with a message), allocates the wave buffers or runs the
- * device's pass_begin, and starts the time limit's clock.  Used from one thread. */
+ * device's upload_scene, and starts the time limit's clock.  Used from one thread. */
 rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *settings,
                            rs_sched *sched, rs_device *mk, rs_engine **out);
 /* Renders the plan's paths onto `film` (the render's size): each pixel's samples are added in
@@ -155,6 +155,6 @@ rs_status rs_render_passes(const rs_scene *scene, rs_device *d, const rs_render_
  * or more, or path_begin lies past the render's paths) and the render's device-safe constants
  * *it over every pixel (camera, seed, sizes, depths, sampling). */
 rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *settings,
-                              rs_integrator *it);
+                              rs_render_consts *it);
 
 #endif

@@ -3,7 +3,7 @@
 
 #include <math.h>
 
-void rs_aov_render(const rs_integrator *it, const rs_bvh_view *bvh, const rs_geom *g,
+void rs_aov_render(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
                    uint32_t spp, int threads, float *albedo, float *normal, float *depth)
 {
     uint32_t n = spp < RS_AOV_SPP ? spp : RS_AOV_SPP;

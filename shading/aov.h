@@ -27,8 +27,8 @@
  * emission held to [0, 1]; the background's radiance, held likewise, for a miss), the shading
  * normal turned toward the ray's origin (zero for a miss), and the distance t |d| (a miss:
  * infinity). */
-RS_HD void rs_path_aov(const rs_integrator *it, const rs_ray *r, const rs_hit *h, rs_vec3 *albedo,
-                       rs_vec3 *normal, float *depth)
+RS_HD void rs_path_aov(const rs_render_consts *it, const rs_ray *r, const rs_hit *h,
+                       rs_vec3 *albedo, rs_vec3 *normal, float *depth)
 {
     const rs_scene *sc = it->scene;
     rs_vec3 x, ng, n_geo, wo;
@@ -69,7 +69,7 @@ extern "C" {
  * `bvh` over `g` (host arrays, attached: rs_bvh_attach) on `threads` host threads: each pixel's
  * first min(spp, RS_AOV_SPP) camera rays.  albedo and normal: 3 floats a pixel, depth: 1 (each
  * may be NULL when not asked for); row-major from the top-left. */
-void rs_aov_render(const rs_integrator *it, const rs_bvh_view *bvh, const rs_geom *g,
+void rs_aov_render(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
                    uint32_t spp, int threads, float *albedo, float *normal, float *depth);
 #ifdef __cplusplus
 }

@@ -58,7 +58,7 @@ int rs_sampler_parse(const char *text, rs_sampler *out)
  * step from the one before (a step back or past a whole image divides again); the numbers are
  * those of g mod n_active and g div n_active (mapped through it->pixel_of for a plan over some
  * pixels). */
-static void locate(const rs_integrator *it, uint64_t wave_start, const uint32_t *path,
+static void locate(const rs_render_consts *it, uint64_t wave_start, const uint32_t *path,
                    uint32_t p0, uint32_t n, uint32_t *pixel, uint32_t *sample)
 {
     uint32_t i, prev = 0, px = 0, sm = 0, npix = it->n_active;
@@ -85,8 +85,9 @@ static void locate(const rs_integrator *it, uint64_t wave_start, const uint32_t 
 }
 
 /* out[i] = rs_path_rand(it, pixel[i], sample[i], bounce, group), i < n. */
-static void path_rand_batch(const rs_integrator *it, const uint32_t *pixel, const uint32_t *sample,
-                            uint32_t bounce, uint32_t group, uint32_t n, rs_rng_f4 *out)
+static void path_rand_batch(const rs_render_consts *it, const uint32_t *pixel,
+                            const uint32_t *sample, uint32_t bounce, uint32_t group, uint32_t n,
+                            rs_rng_f4 *out)
 {
     uint32_t i;
     if (it->sampler == RS_SAMPLER_SOBOL) {
@@ -102,8 +103,8 @@ static void path_rand_batch(const rs_integrator *it, const uint32_t *pixel, cons
     }
 }
 
-void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
-                          uint32_t count, rs_paths *paths, rs_ray_soa *out)
+void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
+                     uint32_t count, rs_paths *paths, rs_ray_soa *out)
 {
     long blk;
     int threads = ex->threads;
@@ -133,7 +134,7 @@ void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint
 }
 
 typedef struct shade_ctx {
-    const rs_integrator *it;
+    const rs_render_consts *it;
     uint64_t wave_start;
     uint32_t bounce;
     const rs_ray_soa *rays;
@@ -185,10 +186,10 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
     c->runs->end[begin] = end;
 }
 
-void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
-                         uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
-                         uint32_t count, rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
-                         const rs_stream_runs *runs)
+void rs_stage_shade(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
+                    uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
+                    rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
+                    const rs_stream_runs *runs)
 {
     shade_ctx c;
     c.it = it;
@@ -205,8 +206,8 @@ void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint6
     rs_parallel_range(ex->strategy, ex->threads, 0, count, 512, shade_range, &c);
 }
 
-void rs_integrator_resolve_shadows(const rs_stage_exec *ex, const rs_ray_soa *shadow,
-                                   const uint8_t *occluded, uint32_t count, rs_paths *paths)
+void rs_stage_resolve_shadows(const rs_stage_exec *ex, const rs_ray_soa *shadow,
+                              const uint8_t *occluded, uint32_t count, rs_paths *paths)
 {
     long k;
     int threads = ex->threads;

@@ -36,8 +36,8 @@ typedef struct rs_stage_exec {
 } rs_stage_exec;
 
 /* Fills `out` with the camera rays of paths [0, count) and resets their state. */
-void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
-                          uint32_t count, rs_paths *paths, rs_ray_soa *out);
+void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
+                     uint32_t count, rs_paths *paths, rs_ray_soa *out);
 
 /* Shades the hits of `rays` (segment number `bounce`): each path may make its next ray and a
  * shadow ray (its contribution in paths->pending).  The stream is split into ranges (by the
@@ -45,14 +45,14 @@ void rs_integrator_raygen(const rs_integrator *it, const rs_stage_exec *ex, uint
  * shadow rays likewise in `shadow`, in slot order, and records the counts in `runs`
  * (first: next rays, second: shadow rays); rs_stream_pack_runs then packs each stream (the
  * valid entries in slot order, whatever the split). */
-void rs_integrator_shade(const rs_integrator *it, const rs_stage_exec *ex, uint64_t wave_start,
-                         uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
-                         uint32_t count, rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
-                         const rs_stream_runs *runs);
+void rs_stage_shade(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
+                    uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
+                    rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
+                    const rs_stream_runs *runs);
 
 /* Adds each unoccluded shadow ray's pending contribution to its path. */
-void rs_integrator_resolve_shadows(const rs_stage_exec *ex, const rs_ray_soa *shadow,
-                                   const uint8_t *occluded, uint32_t count, rs_paths *paths);
+void rs_stage_resolve_shadows(const rs_stage_exec *ex, const rs_ray_soa *shadow,
+                              const uint8_t *occluded, uint32_t count, rs_paths *paths);
 
 #ifdef __cplusplus
 }

@@ -68,7 +68,7 @@ typedef enum rs_sampler {
  * host and a device (the CUDA device takes a copy whose `scene` points to its mirror of the
  * scene).  Built by rs_render_constants (scheduler/render.h) for both integrators; how many host
  * threads run a stage is not a constant of the render and is not here. */
-typedef struct rs_integrator {
+typedef struct rs_render_consts {
     const rs_scene *scene;
     rs_camera camera;
     uint64_t seed;
@@ -83,15 +83,15 @@ typedef struct rs_integrator {
      * memory: only the stream engine's host stages read it. */
     const uint32_t *pixel_of;
     uint32_t n_active;
-} rs_integrator;
+} rs_render_consts;
 
 /* Pixel and sample of path g. */
-RS_HD uint32_t rs_path_pixel(const rs_integrator *it, uint64_t g)
+RS_HD uint32_t rs_path_pixel(const rs_render_consts *it, uint64_t g)
 {
     uint32_t k = (uint32_t)(g % it->n_active);
     return it->pixel_of ? it->pixel_of[k] : k;
 }
-RS_HD uint32_t rs_path_sample(const rs_integrator *it, uint64_t g)
+RS_HD uint32_t rs_path_sample(const rs_render_consts *it, uint64_t g)
 {
     return (uint32_t)(g / it->n_active);
 }
@@ -113,7 +113,7 @@ RS_HD rs_rng_f4 rs_path_sobol_order(rs_rng_f4 f, uint32_t group)
 /* Four numbers in [0, 1) for decision group `group` (shading/dims.h) of path (pixel, sample)
  * at segment `bounce`, from the render's sampler.  (The host's stream stages make them for many
  * paths at once, shading/integrator.c, with the same result.) */
-RS_HD rs_rng_f4 rs_path_rand(const rs_integrator *it, uint32_t pixel, uint32_t sample,
+RS_HD rs_rng_f4 rs_path_rand(const rs_render_consts *it, uint32_t pixel, uint32_t sample,
                              uint32_t bounce, uint32_t group)
 {
     rs_rng_f4 f;
@@ -133,7 +133,7 @@ RS_HD rs_rng_f4 rs_path_rand(const rs_integrator *it, uint32_t pixel, uint32_t s
 /* The camera ray of path (pixel, sample), and its state reset.  `pre`: its numbers made ahead,
  * pre[0] group RS_DIM_CAMERA and pre[1] RS_DIM_TIME (read only with a shutter interval); NULL:
  * made here. */
-RS_HD rs_ray rs_path_begin_at(const rs_integrator *it, uint32_t pixel, uint32_t sample,
+RS_HD rs_ray rs_path_begin_at(const rs_render_consts *it, uint32_t pixel, uint32_t sample,
                               const rs_rng_f4 *pre, rs_path_state *ps)
 {
     const rs_camera_desc *cd = &it->scene->camera;
@@ -325,7 +325,7 @@ typedef struct rs_vertex {
 /* An emitter hit: its radiance, MIS-weighted against the light sampling that could also have
  * found it when the path came by BSDF sampling (not after a delta bounce or from the camera,
  * where none could). */
-RS_HD void rs_shade_emitter(const rs_integrator *it, const rs_ray *r, float t, uint32_t prim,
+RS_HD void rs_shade_emitter(const rs_render_consts *it, const rs_ray *r, float t, uint32_t prim,
                             const rs_material *m, rs_vec3 ng, rs_vec3 beta, rs_path_state *ps)
 {
     const rs_scene *sc = it->scene;
@@ -417,8 +417,8 @@ RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, c
 
 /* The next direction at a non-delta vertex, by the render's sampling mode; *beta gains f cos /
  * pdf and *pdf is the solid-angle pdf it was drawn with.  0: the path ends here. */
-RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, const rs_ray *r,
-                             rs_rng_f4 rb, rs_rng_f4 rl, rs_vec3 *beta, rs_vec3 *wi, float *pdf)
+RS_HD_HOT int rs_shade_direction(const rs_render_consts *it, const rs_vertex *v, const rs_ray *r,
+                                 rs_rng_f4 rb, rs_rng_f4 rl, rs_vec3 *beta, rs_vec3 *wi, float *pdf)
 {
     const rs_scene *sc = it->scene;
     float ci;
@@ -482,9 +482,10 @@ RS_HD_HOT int rs_shade_direction(const rs_integrator *it, const rs_vertex *v, co
  * light (returns RS_SHADE_SHADOW, *shadow set, its contribution in ps->pending if the ray is
  * unoccluded).  `pre`: the vertex's numbers made ahead, pre[0] group RS_DIM_BSDF and pre[1]
  * RS_DIM_LIGHT (rs_path_rand's); NULL: made here, only where the vertex needs them. */
-RS_HD_HOT uint32_t rs_path_shade_at(const rs_integrator *it, uint32_t pixel, uint32_t sample,
-                                uint32_t bounce, const rs_rng_f4 *pre, const rs_ray *ray,
-                                const rs_hit *h, rs_path_state *ps, rs_ray *next, rs_ray *shadow)
+RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, uint32_t sample,
+                                    uint32_t bounce, const rs_rng_f4 *pre, const rs_ray *ray,
+                                    const rs_hit *h, rs_path_state *ps, rs_ray *next,
+                                    rs_ray *shadow)
 {
     const rs_scene *sc = it->scene;
     rs_ray r = *ray;
@@ -647,7 +648,7 @@ RS_HD int rs_path_occluded(const rs_path_tracer *tr, rs_ray r)
 /* Path g from the camera to its end (the thesis's recursive radiance(), unrolled): each vertex
  * shaded as the wavefront shades it, each shadow ray resolved before the next segment, so the
  * radiance is the wavefront's bit for bit (on the same compiler). */
-RS_HD rs_vec3 rs_path_radiance(const rs_integrator *it, const rs_path_tracer *tr, uint64_t g,
+RS_HD rs_vec3 rs_path_radiance(const rs_render_consts *it, const rs_path_tracer *tr, uint64_t g,
                                rs_path_counts *n)
 {
     /* pixel and sample once per path: a 64-bit division and remainder, not one per vertex */

@@ -361,15 +361,15 @@ static void test_plans_share_the_buffers(void **state)
     free(img);
 }
 
-/* A megakernel device that counts its scene copies (pass_begin) and uploads. */
+/* A megakernel device that counts its scene copies (upload_scene) and uploads. */
 static rs_device_ops g_count_ops;
 static const rs_device_ops *g_count_inner;
-static int g_pass_begins, g_uploads;
+static int g_scene_uploads, g_uploads;
 
-static rs_status pass_begin_counted(rs_device *d, const rs_scene *s, const rs_integrator *it)
+static rs_status upload_scene_counted(rs_device *d, const rs_scene *s, const rs_render_consts *it)
 {
-    g_pass_begins++;
-    return g_count_inner->pass_begin(d, s, it);
+    g_scene_uploads++;
+    return g_count_inner->upload_scene(d, s, it);
 }
 
 static rs_status upload_counted(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
@@ -378,7 +378,7 @@ static rs_status upload_counted(rs_device *d, const rs_geom *g, const rs_bvh *bv
     return g_count_inner->upload(d, g, bvh);
 }
 
-/* The megakernel on the GPU fallback (which copies the scene at pass_begin as the CUDA device
+/* The megakernel on the GPU fallback (which copies the scene at upload_scene as the CUDA device
  * copies it to the GPU): one upload and one scene copy per render, whatever the plans, and the
  * image of the stream engine's one plan. */
 static void test_megakernel_copies_the_scene_once(void **state)
@@ -401,10 +401,10 @@ static void test_megakernel_copies_the_scene_once(void **state)
     assert_int_equal(rs_gpu_fallback_create(1, 0, NULL, &dev), RS_OK);
     g_count_inner = dev->ops;
     g_count_ops = *dev->ops;
-    g_count_ops.pass_begin = pass_begin_counted;
+    g_count_ops.upload_scene = upload_scene_counted;
     g_count_ops.upload = upload_counted;
     dev->ops = &g_count_ops;
-    g_pass_begins = g_uploads = 0;
+    g_scene_uploads = g_uploads = 0;
     assert_int_equal(rs_device_upload(dev, &g, bvh), RS_OK);
     assert_int_equal(rs_film_create(SIZE, SIZE, &film), RS_OK);
     st = rt_settings(&a);
@@ -417,7 +417,7 @@ static void test_megakernel_copies_the_scene_once(void **state)
         rs_work_plan_free(&plan);
     }
     assert_int_equal(g_uploads, 1);
-    assert_int_equal(g_pass_begins, 1);
+    assert_int_equal(g_scene_uploads, 1);
     rs_film_resolve(film, rgb);
     assert_memory_equal(rgb, g_ref, NF * sizeof(float));
     rs_engine_destroy(e);
