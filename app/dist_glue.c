@@ -131,6 +131,25 @@ static int dist_setup_steps(const rs_cli_options *o, render_run *r)
     return code;
 }
 
+/* The set-up on a rank's start-up thread (rs_dist_start): an exit code, the description. */
+typedef struct setup_ctx {
+    const rs_cli_options *o;
+    render_run *r;
+    int code; /* this rank's */
+} setup_ctx;
+
+static int setup_thread(void *user, char *desc, size_t n)
+{
+    setup_ctx *c = (setup_ctx *)user;
+    int code = c->code = dist_setup_steps(c->o, c->r);
+    desc[0] = 0;
+    if (code == RS_EXIT_OK)
+        dist_describe(c->r, desc, n);
+    if (c->r->dist_fault.die_start_rank == c->r->rank)
+        raise(SIGKILL); /* a test of a rank lost while it starts */
+    return code;
+}
+
 /* Every rank: the setup steps.  The others' messages are held back until the ranks agree: when
  * rank 0 failed too it has said why, and only a rank that failed alone shows its own.  Returns
  * the job's exit code, the same on every rank. */
@@ -138,19 +157,18 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
 {
     int code, worst, who = 0, saved = -1;
     FILE *held = NULL;
-    char desc[RS_DIST_DESC];
+    setup_ctx c;
+    memset(&c, 0, sizeof c);
     if ((code = dist_check_options(o, r->rank, &r->dist_fault)) != RS_EXIT_OK)
         return code;
     if (r->rank > 0 && (held = tmpfile()) != NULL)
         saved = stderr_divert(fileno(held));
-    code = dist_setup_steps(o, r);
-    desc[0] = 0;
-    if (code == RS_EXIT_OK)
-        dist_describe(r, desc, sizeof desc);
+    c.o = o;
+    c.r = r;
+    worst = rs_dist_start(r->dist, setup_thread, &c, o->mpi_timeout_s, &who);
     stderr_restore(saved);
-    worst = rs_dist_agree(r->dist, code, &who, desc);
     if (held) {
-        if (code != RS_EXIT_OK && who == r->rank) { /* rank 0 started: say why this one did not */
+        if (worst != RS_EXIT_OK && who == r->rank) { /* rank 0 started: say why this one did not */
             char line[512];
             rewind(held);
             while (fgets(line, sizeof line, held))
@@ -159,7 +177,7 @@ static int dist_setup(const rs_cli_options *o, render_run *r)
         }
         fclose(held);
     }
-    if (worst != RS_EXIT_OK && r->rank == 0 && code == RS_EXIT_OK)
+    if (worst != RS_EXIT_OK && r->rank == 0 && c.code == RS_EXIT_OK && !rs_dist_lost(r->dist))
         fprintf(stderr,
                 "raystream: rank %d could not start (its message is above); no rank "
                 "renders\n",
@@ -480,8 +498,42 @@ static int cmd_render_dist(const rs_cli_options *o, render_run *r)
     return code;
 }
 
+typedef struct init_ctx {
+    int *argc;
+    char ***argv;
+    rs_dist **d;
+} init_ctx;
+
+static int init_mpi(void *arg)
+{
+    init_ctx *c = (init_ctx *)arg;
+    return rs_dist_init(c->argc, c->argv, c->d) == RS_OK;
+}
+
+/* MPI_Init, bounded: with mpirun --enable-recovery a rank that died before it leaves the others
+ * waiting in it for ever.  At least 10 s (a loaded machine), else --mpi-timeout.  1 if it
+ * started. */
+static int start_mpi(const rs_cli_options *o, int *argc, char ***argv, int rank, rs_dist **d)
+{
+    double limit = o->mpi_timeout_s > 10 ? o->mpi_timeout_s : 10;
+    rs_dist_fault f;
+    init_ctx c;
+    char line[256];
+    if (rs_dist_fault_parse(getenv("RS_MPI_FAULT"), &f) == RS_OK && f.die_init_rank == rank)
+        raise(SIGKILL); /* a test of a rank lost before MPI starts */
+    rs_error_clear(); /* a bad spec is reported after the start */
+    c.argc = argc;
+    c.argv = argv;
+    c.d = d;
+    snprintf(line, sizeof line,
+             "raystream: rank %d: MPI did not start within %.0f s (a rank may have died while "
+             "starting); stopping\n",
+             rank, limit);
+    return rs_watch_run(limit, line, init_mpi, &c);
+}
+
 /* Whether an MPI launcher started this process: then r->dist (and 1), or an exit code. */
-static int start_dist(int *argc, char ***argv, render_run *r, int *code)
+static int start_dist(const rs_cli_options *o, int *argc, char ***argv, render_run *r, int *code)
 {
     int ranks = 1, rank = 0, local = 1;
     *code = RS_EXIT_OK;
@@ -499,7 +551,7 @@ static int start_dist(int *argc, char ***argv, render_run *r, int *code)
         *code = RS_EXIT_USAGE;
         return 1;
     }
-    if (rs_dist_init(argc, argv, &r->dist) != RS_OK) {
+    if (!start_mpi(o, argc, argv, rank, &r->dist)) {
         *code = rs_app_fail(RS_EXIT_RUNTIME, "starting MPI");
         return 1;
     }
@@ -511,7 +563,7 @@ static int start_dist(int *argc, char ***argv, render_run *r, int *code)
 int rs_mpi_render(const rs_cli_options *o, int *argc, char ***argv, render_run *r, int *code)
 {
     rs_cli_options wo = *o;
-    if (!start_dist(argc, argv, r, code))
+    if (!start_dist(o, argc, argv, r, code))
         return 0;
     if (!r->dist)
         return 1;

@@ -25,6 +25,12 @@
  *                                            several (rs_dist_job_begin), the run is over
  *                 JOB   n                    the next job is over n pixels (then JOB_PIXELS
  *                                            chunks, uint32) or every pixel (n = 0)
+ * Before any of these, the start-up agreement (rs_dist_start):
+ *   rank -> 0     HB    (nothing)            each second while it sets up
+ *                 READY code, description    set up (RS_EXIT_OK) or not (its exit code)
+ *   0 -> rank     HB    (nothing)            each second
+ *                 GO    worst code, who      every rank is READY (or `who` is dead): go on
+ *                                            when the code is 0, else stop
  * A film's data: FILM_SUMS chunks, FILM_COUNTS chunks, and, when its header's H_SQ says so,
  * FILM_SQ chunks (three uint64 a pixel: rs_film_sq). 
  * Messages between two ranks arrive in the order they were sent, so a worker's DONEs precede
@@ -63,6 +69,8 @@ enum {
     T_FILM_SQ,
     T_JOB,
     T_JOB_PIXELS,
+    T_READY,
+    T_GO,
     T_COUNT /* one past the last tag */
 };
 

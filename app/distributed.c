@@ -12,7 +12,7 @@ rs_status rs_dist_fault_parse(const char *spec, rs_dist_fault *f)
 {
     const char *p = spec;
     memset(f, 0, sizeof *f);
-    f->slow_rank = f->die_rank = -1;
+    f->slow_rank = f->die_rank = f->die_start_rank = f->die_init_rank = -1;
     if (!spec || !*spec)
         return RS_OK;
     while (*p) {
@@ -21,14 +21,19 @@ rs_status rs_dist_fault_parse(const char *spec, rs_dist_fault *f)
         if (sscanf(p, "slow:%d:%lf%n", &rank, &x, &n) == 2 && n > 0 && rank >= 0 && x >= 1) {
             f->slow_rank = rank;
             f->slow_factor = x;
+        } else if (sscanf(p, "die-start:%d%n", &rank, &n) == 1 && n > 0 && rank >= 0) {
+            f->die_start_rank = rank;
+        } else if (sscanf(p, "die-init:%d%n", &rank, &n) == 1 && n > 0 && rank >= 0) {
+            f->die_init_rank = rank;
         } else if (sscanf(p, "die:%d:%lf%n", &rank, &x, &n) == 2 && n > 0 && rank > 0 &&
                    x >= 0 && x < 1e9 && x == (uint32_t)x) {
             f->die_rank = rank;
             f->die_after = (uint32_t)x;
         } else {
             return rs_error_set(RS_ERR_ARG,
-                                "RS_MPI_FAULT: cannot read '%s' (slow:RANK:FACTOR or "
-                                "die:RANK:PASSES, comma-separated)",
+                                "RS_MPI_FAULT: cannot read '%s' (slow:RANK:FACTOR, "
+                                "die:RANK:PASSES, die-start:RANK or die-init:RANK, "
+                                "comma-separated)",
                                 p);
         }
         p += n;

@@ -47,22 +47,32 @@ typedef struct rs_dist rs_dist;
 rs_status rs_dist_init(int *argc, char ***argv, rs_dist **out);
 int rs_dist_rank(const rs_dist *d);
 int rs_dist_size(const rs_dist *d);
-/* Collective, once, after every rank's set-up: the worst exit code over the ranks (0: all
- * started), *who the lowest rank with it; each rank's `desc` kept on rank 0 for the
- * statistics. */
-int rs_dist_agree(rs_dist *d, int code, int *who, const char *desc);
+/* Every rank, once: runs setup(user, desc, n) (the rank's set-up: loading the scene, building
+ * the BVH, starting the devices; an exit code, and the rank's description into desc) on a
+ * thread of its own while this thread, MPI's, keeps in touch with rank 0, then agrees with the
+ * others: returns the worst exit code over the ranks (0: all started), *who the lowest rank
+ * with it; rank 0 keeps each rank's description for the statistics.  Nothing blocks for ever:
+ * a rank silent for timeout_s while starting (dead) ends the start-up on every rank with
+ * RS_EXIT_RUNTIME (rank 0 says which rank), and no rank calls MPI_Finalize. */
+int rs_dist_start(rs_dist *d, int (*setup)(void *user, char *desc, size_t n), void *user,
+                  double timeout_s, int *who);
+/* Whether a rank was found dead (or rank 0 is gone). */
+int rs_dist_lost(const rs_dist *d);
 /* MPI_Finalize when every rank is known to be alive; otherwise nothing (a finalize would wait
  * for the dead).  Frees d. */
 void rs_dist_finish(rs_dist *d);
 
 /* Test faults (RS_MPI_FAULT): "slow:R:F" makes rank R take F times as long per pass (it sleeps
  * after each); "die:R:K" makes rank R kill itself (SIGKILL) after finishing K passes, before it
- * sends them.  Several, comma-separated. */
+ * sends them; "die-start:R" kills rank R at the end of its set-up (having loaded the scene),
+ * "die-init:R" just before it starts MPI.  Several, comma-separated. */
 typedef struct rs_dist_fault {
     int slow_rank;
     double slow_factor; /* 0: none */
     int die_rank;       /* -1: none */
     uint32_t die_after;
+    int die_start_rank; /* -1: none */
+    int die_init_rank;  /* -1: none */
 } rs_dist_fault;
 rs_status rs_dist_fault_parse(const char *spec, rs_dist_fault *out);
 

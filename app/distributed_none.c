@@ -46,12 +46,19 @@ int rs_dist_size(const rs_dist *d)
     return 1;
 }
 
-int rs_dist_agree(rs_dist *d, int code, int *who, const char *desc)
+int rs_dist_start(rs_dist *d, int (*setup)(void *user, char *desc, size_t n), void *user,
+                  double timeout_s, int *who)
+{
+    char desc[RS_DIST_DESC];
+    (void)d, (void)timeout_s;
+    *who = 0;
+    return setup(user, desc, sizeof desc);
+}
+
+int rs_dist_lost(const rs_dist *d)
 {
     (void)d;
-    (void)desc;
-    *who = 0;
-    return code;
+    return 0;
 }
 
 void rs_dist_finish(rs_dist *d)
@@ -63,7 +70,7 @@ rs_status rs_dist_fault_parse(const char *spec, rs_dist_fault *out)
 {
     (void)spec;
     memset(out, 0, sizeof *out);
-    out->slow_rank = out->die_rank = -1;
+    out->slow_rank = out->die_rank = out->die_start_rank = out->die_init_rank = -1;
     return RS_OK;
 }
 

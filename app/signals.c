@@ -76,7 +76,8 @@ typedef struct load_watch {
     pthread_mutex_t mu;
     pthread_cond_t cv;
     int done;
-    const char *what;
+    double limit_s;
+    char line[512];
 } load_watch;
 
 static void *load_watch_main(void *arg)
@@ -84,34 +85,38 @@ static void *load_watch_main(void *arg)
     load_watch *w = (load_watch *)arg;
     struct timespec until;
     clock_gettime(CLOCK_MONOTONIC, &until);
-    until.tv_sec += LOAD_LIMIT_S;
+    until.tv_sec += (time_t)w->limit_s;
+    until.tv_nsec += (long)((w->limit_s - (double)(time_t)w->limit_s) * 1e9);
+    if (until.tv_nsec >= 1000000000L) {
+        until.tv_sec++;
+        until.tv_nsec -= 1000000000L;
+    }
     pthread_mutex_lock(&w->mu);
     while (!w->done)
         if (pthread_cond_timedwait(&w->cv, &w->mu, &until) == ETIMEDOUT && !w->done) {
-            fprintf(stderr,
-                    "raystream: %s: still reading after %d s, giving up (a malformed file?)\n",
-                    w->what, LOAD_LIMIT_S);
-            _exit(RS_EXIT_RUNTIME); /* the loader may hold any lock: no exit handlers */
+            fputs(w->line, stderr);
+            _exit(RS_EXIT_RUNTIME); /* the watched code may hold any lock: no exit handlers */
         }
     pthread_mutex_unlock(&w->mu);
     return NULL;
 }
 
-int rs_load_watch_run(const char *what, int (*load)(void *arg), void *arg)
+int rs_watch_run(double limit_s, const char *line, int (*fn)(void *arg), void *arg)
 {
     load_watch w;
     pthread_condattr_t ca;
     pthread_t t;
     int code, watching;
     memset(&w, 0, sizeof w);
-    w.what = what;
+    w.limit_s = limit_s;
+    snprintf(w.line, sizeof w.line, "%s", line);
     pthread_mutex_init(&w.mu, NULL);
     pthread_condattr_init(&ca);
     pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
     pthread_cond_init(&w.cv, &ca);
     pthread_condattr_destroy(&ca);
     watching = pthread_create(&t, NULL, load_watch_main, &w) == 0;
-    code = load(arg);
+    code = fn(arg);
     if (watching) {
         pthread_mutex_lock(&w.mu);
         w.done = 1;
@@ -122,4 +127,13 @@ int rs_load_watch_run(const char *what, int (*load)(void *arg), void *arg)
     pthread_cond_destroy(&w.cv);
     pthread_mutex_destroy(&w.mu);
     return code;
+}
+
+int rs_load_watch_run(const char *what, int (*load)(void *arg), void *arg)
+{
+    char line[512];
+    snprintf(line, sizeof line,
+             "raystream: %s: still reading after %d s, giving up (a malformed file?)\n", what,
+             LOAD_LIMIT_S);
+    return rs_watch_run(LOAD_LIMIT_S, line, load, arg);
 }

@@ -20,5 +20,9 @@ const char *rs_signal_name(int sig);
  * any real load, prints one line naming `what` and ends the process with RS_EXIT_RUNTIME
  * (unwatched if the watch cannot be started). */
 int rs_load_watch_run(const char *what, int (*load)(void *arg), void *arg);
+/* Runs fn(arg) and returns what it returns; should it take longer than limit_s seconds, prints
+ * `line` and ends the process with RS_EXIT_RUNTIME (unwatched if the watch cannot be
+ * started). */
+int rs_watch_run(double limit_s, const char *line, int (*fn)(void *arg), void *arg);
 
 #endif

@@ -18,6 +18,9 @@
  *     the megakernel and under mpirun gives the uninterrupted image bit for bit;
  *   - --checkpoint-interval under mpirun flushes every rank's film to rank 0 on the way;
  *   - Ctrl-C on mpirun ends every rank within seconds, with 128 + the signal or mpirun's code;
+ *   - a rank that dies while it loads the scene or before MPI starts, under --enable-recovery:
+ *     the others give up within the bound (--mpi-timeout; MPI_Init at least 10 s), one line
+ *     names the rank or says MPI did not start, no image;
  *   - --adaptive (rank 0 decides each round from the merged film) with 2 and 3 ranks and odd
  *     pass sizes, after a rank died in an early round, and stopped by the time limit with a
  *     checkpoint resumed on one process and under mpirun: the one-process adaptive image;
@@ -329,6 +332,37 @@ static void test_killed_rank_does_not_hang(void **state)
     proc_free(&p);
 }
 
+/* A rank that dies while it starts, under --enable-recovery (where nothing ends the job for
+ * us): at the end of its set-up (the scene loaded), and before MPI starts.  The others give up
+ * within the bound, say which rank or why, and write nothing.  (Before the start-up agreement
+ * was bounded, both hung for ever in MPI_Allreduce and MPI_Init.) */
+static void test_rank_dead_while_starting(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "48", "--height",
+                                       "48", "--spp", "8", "--mpi-timeout", "2", "-q", "-o",
+                                       "many.exr", NULL};
+    proc p;
+    char path[256];
+    setenv("RS_MPI_FAULT", "die-start:2", 1);
+    mpirun(&p, f, 3, 1, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, !p.timed_out && p.seconds < 30, "a rank dead while loading hung the others");
+    EXPECT(&p, strstr(p.err.data, "rank 2 has been silent") != NULL,
+           "rank 0 did not name the rank that died while starting");
+    path_in(f, "many.exr", path, sizeof path);
+    EXPECT(&p, !file_exists(path), "an image was written though a rank never started");
+    proc_free(&p);
+    setenv("RS_MPI_FAULT", "die-init:1", 1);
+    mpirun(&p, f, 3, 1, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, !p.timed_out && p.seconds < 40, "a rank dead before MPI_Init hung the others");
+    EXPECT(&p, strstr(p.err.data, "MPI did not start within") != NULL,
+           "no line says MPI did not start");
+    EXPECT(&p, !file_exists(path), "an image was written though a rank never started");
+    proc_free(&p);
+}
+
 /* The number of path ranges a checkpoint holds (app/checkpoint.h: after the scene name), or
  * -1. */
 static int checkpoint_ranges(const fixture *f, const char *name)
@@ -564,6 +598,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_slow_rank_gets_fewer_passes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_rank_recovered, setup, teardown),
         cmocka_unit_test_setup_teardown(test_killed_rank_does_not_hang, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_rank_dead_while_starting, setup, teardown),
         cmocka_unit_test_setup_teardown(test_checkpoint_with_gaps, setup, teardown),
         cmocka_unit_test_setup_teardown(test_periodic_checkpoints, setup, teardown),
         cmocka_unit_test_setup_teardown(test_time_limit_whole_passes, setup, teardown),
