@@ -6,6 +6,7 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -132,435 +133,530 @@ static int parse_devices(const char *text, rs_cli_options *o)
     return RS_EXIT_OK;
 }
 
+/* `raystream export --help`. */
+static void help_export(void)
+{
+    fputs("usage: raystream export SCENE -o FILE.json [--models DIR] [--camera NAME]\n"
+          "\n"
+          "Writes SCENE (builtin:NAME, FILE.json or FILE.gltf) as a scene file\n"
+          "(docs/scene-format.md): the camera, image size, background, textures,\n"
+          "materials (m0, m1, ...) and every primitive as an object.  Image textures\n"
+          "and an environment map go beside it as FILE-image-N.exr.  Numbers keep 9\n"
+          "digits, so the file renders the scene bit for bit.  A scene with what the\n"
+          "format cannot say (glTF's metallic-roughness, emissive and normal textures)\n"
+          "is refused.\n",
+          stdout);
+}
+
+/* `raystream render --help`, 1/5: the scene and the image. */
+static void help_render_scene(void)
+{
+    fputs("usage: raystream render [SCENE] [options]\n"
+          "\n"
+          "Renders SCENE (default builtin:cornell) to an image.\n"
+          "\n"
+          "  SCENE, --scene S    builtin:NAME ('raystream scenes' lists them), FILE.json\n"
+          "                      (docs/scene-format.md) or a glTF 2.0 FILE.gltf / FILE.glb\n"
+          "  --camera NAME       a glTF scene's camera by name (default: its first; a\n"
+          "                      camera framing the model when it has none)\n"
+          "  --envmap FILE       light the scene with an equirectangular environment map\n"
+          "                      (EXR, HDR, PNG, ...) in place of its background\n"
+          "  --envmap-scale S    multiply the map's radiance by S (default 1)\n"
+          "  --mesh FILE         drop a mesh (OBJ, PLY, glTF, FBX, ...) into the Cornell box,\n"
+          "                      scaled to fit, with its own materials\n"
+          "  --models DIR        the test models folder for builtin scenes with meshes\n"
+          "                      (default ../shared/models beside the source tree)\n"
+          "  -o, --output FILE   image to write; the format follows the extension: .png\n"
+          "                      (sRGB, 8-bit), .exr or .hdr (linear float), .jpg, .tif\n"
+          "                      (default: NAME.png)\n"
+          "  --width N, --height N   image size in pixels (default: the scene's, 600x600\n"
+          "                      for the Cornell box; give one to keep the aspect ratio)\n"
+          "  --spp N             samples per pixel (default 64)\n"
+          "  --max-depth N       most ray segments per path, camera ray included (default 50)\n"
+          "  --seed N            random seed; same seed, same image (default 1)\n",
+          stdout);
+}
+
+/* 2/5: devices, stats, sampling, the BVH, the integrator. */
+static void help_render_devices(void)
+{
+    fputs("  --threads N         CPU threads (default: every core)\n"
+          "  --devices LIST      auto (default: the CPU and every CUDA device), or comma-\n"
+          "                      separated cpu, cpu:THREADS, gpu, gpu:INDEX.  A gpu that\n"
+          "                      cannot be used runs on the CPU fallback (one warning).\n"
+          "  --stats             after the render, a table per device: rays, chunks, busy\n"
+          "                      and idle seconds, Mrays/s, share, bytes moved; and the\n"
+          "                      seconds of each named stage\n"
+          "  --stats-json FILE   the same as JSON\n"
+          "  --sampling MODE     mis (default): light + BSDF sampling, power heuristic;\n"
+          "                      mixture: the thesis's light/BSDF mixture pdf;\n"
+          "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
+          "  --sampler NAME      sobol (default): Owen-scrambled Sobol points, 2D-stratified\n"
+          "                      per decision; zsobol: the same, pixels in Morton order on\n"
+          "                      one sequence (blue-noise error, pbrt-v4's ZSobolSampler);\n"
+          "                      independent: independent random numbers\n"
+          "  --bvh NAME          BVH builder: sah (default) or sah:BINS, median, lbvh, or the\n"
+          "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
+          "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
+          "  --integrator NAME   stream (default: the wavefront engine on every device) or\n"
+          "                      megakernel (the thesis's per-pixel loop, on one device: the\n"
+          "                      cpu, or a gpu (CUDA, one thread per pixel); auto picks the\n"
+          "                      gpu where there is one; same image)\n"
+          "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
+          "                      tasks (the thesis's three OpenMP strategies)\n",
+          stdout);
+}
+
+/* 3/5: adaptive sampling, layers, traversal, chunks and waves. */
+static void help_render_engine(void)
+{
+    fputs("  --adaptive T        adaptive sampling: a pixel stops once the relative error\n"
+          "                      of its mean is below T (e.g. 0.01); --spp is then the most\n"
+          "  --adaptive-min-spp N  samples every pixel gets first (default 16)\n"
+          "  --aov LIST          extra EXR layers: albedo, normal, depth, samples or all\n"
+          "                      (comma-separated; -o must be a .exr, the default then)\n"
+          "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
+          "  --flatten-instances copy every instance's triangles into the scene instead of\n"
+          "                      placing shared ones by a two-level BVH (same image)\n"
+          "  --bvh-device D      where --bvh lbvh computes and sorts its Morton codes: cpu\n"
+          "                      (default) or gpu (CUDA device 0; the tree is the same)\n"
+          "  --bvh-width W       the CPU's traversal: 8 (the default where the CPU has AVX2;\n"
+          "                      the binary BVH collapsed to 8-wide nodes), 4 (4-wide nodes,\n"
+          "                      SSE; the default elsewhere) or 2 (the binary BVH, as on\n"
+          "                      the GPU).  Same image either way.\n"
+          "  --isect-sphere A    algebraic (default) or geometric\n"
+          "  --isect-tri A       moller (default), snyder-barr or watertight\n"
+          "  --isect-aabb A      slab (default), branchless, williams, kensler or swap\n"
+          "  --chunk-size N|auto rays per scheduler chunk (default auto: each device's from\n"
+          "                      its measured speed, a few ms of work per chunk)\n"
+          "  --wave-size N|auto  paths in flight: bounds memory (default auto, on the CPU\n"
+          "                      alone: 131072 per thread, 16384 when confined to one\n"
+          "                      core; 1048576 with a GPU or several devices)\n"
+          "  --waves N|auto      waves in flight, 1..4: the CPU shades one while the devices\n"
+          "                      trace another (default auto: 2 with a GPU, else 1)\n",
+          stdout);
+}
+
+/* 4/5: timeline, time limit, checkpoints, MPI, quiet, help. */
+static void help_render_long(void)
+{
+    fputs("  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
+          "                      spans coloured by stage, idle gaps, waves labelled\n"
+          "  --time-limit S      stop after S seconds (a decimal number > 0), at the end of\n"
+          "                      the sample pass under way: every pixel gets the same\n"
+          "                      number of samples; the summary and --stats-json say how\n"
+          "                      many (checked when a wave of paths starts, so the render\n"
+          "                      may run over by one wave; at least one pass is done)\n"
+          "  --checkpoint FILE   save the film to FILE every --checkpoint-interval, when a\n"
+          "                      signal stops the render and at the end (FILE.tmp-PID,\n"
+          "                      then renamed: the last good one stays until then)\n"
+          "  --checkpoint-interval S  seconds between checkpoints (default 60)\n"
+          "  --resume FILE       continue the render saved in FILE to --spp samples (default:\n"
+          "                      the spp it was started with); the image is the one an\n"
+          "                      uninterrupted render gives, bit for bit, on any devices.\n"
+          "                      The scene, size, seed, sampling, sampler, max depth and\n"
+          "                      intersection tests must be the same (and for zsobol the\n"
+          "                      spp): a mismatch is refused with the field named\n"
+          "  --mpi-pass N        under mpirun: samples of every pixel per pass handed to a\n"
+          "                      rank (default: about 8 passes per rank, at most about\n"
+          "                      2 million paths a pass)\n"
+          "  --mpi-timeout S     under mpirun: a rank silent for S seconds is dead and its\n"
+          "                      passes go to the others (default 60; docs/distributed.md)\n"
+          "  -q, --quiet         no progress bar and no summary\n"
+          "  -h, --help          this text\n",
+          stdout);
+}
+
+/* 5/5: outputs, MPI, signals, environment, exit status. */
+static void help_render_notes(void)
+{
+    fputs("\n"
+          "Every output (-o, --stats-json, --timeline, --checkpoint) is checked before the\n"
+          "render: a folder, a file that cannot be written or a missing or read-only folder\n"
+          "is a usage error.  Outputs are written to FILE.tmp-PID and renamed into place\n"
+          "only when all of them are written: a run that fails replaces no file.\n"
+          "\n"
+          "Under mpirun (mpirun -n N raystream render ...) every rank loads the scene and\n"
+          "renders on its own --devices; rank 0 hands out passes, adds the films and\n"
+          "writes the outputs: the image is the one-process image, bit for bit.\n"
+          "\n"
+          "Ctrl-C (SIGINT), SIGTERM or SIGHUP writes the samples finished so far and exits\n"
+          "with 128 + the signal: 130, 143, 129.  A second signal stops at once, also\n"
+          "while the outputs are written: their temporary files are removed.\n"
+          "\n"
+          "Environment: RS_FAULT=cpu:after=N,gpu:after=N makes those devices fail after N\n"
+          "chunks (to test recovery; a bad value is a usage error); RS_MODELS_DIR is the\n"
+          "default --models.\n"
+          "\n"
+          "Exit status: 0 done, 1 runtime error, 2 usage error (nothing written),\n"
+          "130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP.\n",
+          stdout);
+}
+
+/* `raystream --help`: the commands. */
+static void help_commands(void)
+{
+    fputs("usage: raystream COMMAND [options]\n"
+          "\n"
+          "raystream is a heterogeneous CPU+GPU streaming path tracer.\n"
+          "\n"
+          "commands:\n"
+          "  render [SCENE] [options]   render a scene to an image (default builtin:cornell)\n"
+          "  scenes                     list the built-in scenes\n"
+          "  export SCENE -o FILE.json  write a scene (a built-in one, say) as a scene file\n"
+          "                             (image textures beside it as FILE-image-N.exr)\n"
+          "  help [COMMAND]             show help (also -h, --help)\n"
+          "  version                    show the version and the build's features (also\n"
+          "                             --version)\n"
+          "\n"
+          "'raystream render --help' lists the render options.\n",
+          stdout);
+}
+
 void rs_cli_print_help(const char *command)
 {
     if (command && strcmp(command, "export") == 0) {
-        printf("usage: raystream export SCENE -o FILE.json [--models DIR] [--camera NAME]\n"
-               "\n"
-               "Writes SCENE (builtin:NAME, FILE.json or FILE.gltf) as a scene file\n"
-               "(docs/scene-format.md): the camera, image size, background, textures,\n"
-               "materials (m0, m1, ...) and every primitive as an object.  Image textures\n"
-               "and an environment map go beside it as FILE-image-N.exr.  Numbers keep 9\n"
-               "digits, so the file renders the scene bit for bit.  A scene with what the\n"
-               "format cannot say (glTF's metallic-roughness, emissive and normal textures)\n"
-               "is refused.\n");
-        return;
+        help_export();
+    } else if (command && strcmp(command, "render") == 0) {
+        help_render_scene();
+        help_render_devices();
+        help_render_engine();
+        help_render_long();
+        help_render_notes();
+    } else {
+        help_commands();
     }
-    if (command && strcmp(command, "render") == 0) {
-        printf(
-            "usage: raystream render [SCENE] [options]\n"
-            "\n"
-            "Renders SCENE (default builtin:cornell) to an image.\n"
-            "\n"
-            "  SCENE, --scene S    builtin:NAME ('raystream scenes' lists them), FILE.json\n"
-            "                      (docs/scene-format.md) or a glTF 2.0 FILE.gltf / FILE.glb\n"
-            "  --camera NAME       a glTF scene's camera by name (default: its first; a\n"
-            "                      camera framing the model when it has none)\n"
-            "  --envmap FILE       light the scene with an equirectangular environment map\n"
-            "                      (EXR, HDR, PNG, ...) in place of its background\n"
-            "  --envmap-scale S    multiply the map's radiance by S (default 1)\n"
-            "  --mesh FILE         drop a mesh (OBJ, PLY, glTF, FBX, ...) into the Cornell box,\n"
-            "                      scaled to fit, with its own materials\n"
-            "  --models DIR        the test models folder for builtin scenes with meshes\n"
-            "                      (default ../shared/models beside the source tree)\n"
-            "  -o, --output FILE   image to write; the format follows the extension: .png\n"
-            "                      (sRGB, 8-bit), .exr or .hdr (linear float), .jpg, .tif\n"
-            "                      (default: NAME.png)\n"
-            "  --width N, --height N   image size in pixels (default: the scene's, 600x600\n"
-            "                      for the Cornell box; give one to keep the aspect ratio)\n"
-            "  --spp N             samples per pixel (default 64)\n"
-            "  --max-depth N       most ray segments per path, camera ray included (default 50)\n"
-            "  --seed N            random seed; same seed, same image (default 1)\n"
-            "  --threads N         CPU threads (default: every core)\n"
-            "  --devices LIST      auto (default: the CPU and every CUDA device), or comma-\n"
-            "                      separated cpu, cpu:THREADS, gpu, gpu:INDEX.  A gpu that\n"
-            "                      cannot be used runs on the CPU fallback (one warning).\n"
-            "  --stats             after the render, a table per device: rays, chunks, busy\n"
-            "                      and idle seconds, Mrays/s, share, bytes moved; and the\n"
-            "                      seconds of each named stage\n"
-            "  --stats-json FILE   the same as JSON\n"
-            "  --sampling MODE     mis (default): light + BSDF sampling, power heuristic;\n"
-            "                      mixture: the thesis's light/BSDF mixture pdf;\n"
-            "                      bsdf: BSDF sampling only; uniform: no importance sampling\n"
-            "  --sampler NAME      sobol (default): Owen-scrambled Sobol points, 2D-stratified\n"
-            "                      per decision; zsobol: the same, pixels in Morton order on\n"
-            "                      one sequence (blue-noise error, pbrt-v4's ZSobolSampler);\n"
-            "                      independent: independent random numbers\n"
-            "  --bvh NAME          BVH builder: sah (default) or sah:BINS, median, lbvh, or the\n"
-            "                      thesis grid AXIS-PARTITION-KEY: AXIS random|rotational|\n"
-            "                      largest, PARTITION sort|partial|nth, KEY min|max|centroid\n"
-            "  --integrator NAME   stream (default: the wavefront engine on every device) or\n"
-            "                      megakernel (the thesis's per-pixel loop, on one device: the\n"
-            "                      cpu, or a gpu (CUDA, one thread per pixel); auto picks the\n"
-            "                      gpu where there is one; same image)\n"
-            "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
-            "                      tasks (the thesis's three OpenMP strategies)\n"
-            "  --adaptive T        adaptive sampling: a pixel stops once the relative error\n"
-            "                      of its mean is below T (e.g. 0.01); --spp is then the most\n"
-            "  --adaptive-min-spp N  samples every pixel gets first (default 16)\n"
-            "  --aov LIST          extra EXR layers: albedo, normal, depth, samples or all\n"
-            "                      (comma-separated; -o must be a .exr, the default then)\n"
-            "  --no-bvh            no acceleration structure: every ray tests every primitive\n"
-            "  --flatten-instances copy every instance's triangles into the scene instead of\n"
-            "                      placing shared ones by a two-level BVH (same image)\n"
-            "  --bvh-device D      where --bvh lbvh computes and sorts its Morton codes: cpu\n"
-            "                      (default) or gpu (CUDA device 0; the tree is the same)\n"
-            "  --bvh-width W       the CPU's traversal: 8 (the default where the CPU has AVX2;\n"
-            "                      the binary BVH collapsed to 8-wide nodes), 4 (4-wide nodes,\n"
-            "                      SSE; the default elsewhere) or 2 (the binary BVH, as on\n"
-            "                      the GPU).  Same image either way.\n"
-            "  --isect-sphere A    algebraic (default) or geometric\n"
-            "  --isect-tri A       moller (default), snyder-barr or watertight\n"
-            "  --isect-aabb A      slab (default), branchless, williams, kensler or swap\n"
-            "  --chunk-size N|auto rays per scheduler chunk (default auto: each device's from\n"
-            "                      its measured speed, a few ms of work per chunk)\n"
-            "  --wave-size N|auto  paths in flight: bounds memory (default auto, on the CPU\n"
-            "                      alone: 131072 per thread, 16384 when confined to one\n"
-            "                      core; 1048576 with a GPU or several devices)\n"
-            "  --waves N|auto      waves in flight, 1..4: the CPU shades one while the devices\n"
-            "                      trace another (default auto: 2 with a GPU, else 1)\n"
-            "  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
-            "                      spans coloured by stage, idle gaps, waves labelled\n"
-            "  --time-limit S      stop after S seconds (a decimal number > 0), at the end of\n"
-            "                      the sample pass under way: every pixel gets the same\n"
-            "                      number of samples; the summary and --stats-json say how\n"
-            "                      many (checked when a wave of paths starts, so the render\n"
-            "                      may run over by one wave; at least one pass is done)\n"
-            "  --checkpoint FILE   save the film to FILE every --checkpoint-interval, when a\n"
-            "                      signal stops the render and at the end (FILE.tmp-PID,\n"
-            "                      then renamed: the last good one stays until then)\n"
-            "  --checkpoint-interval S  seconds between checkpoints (default 60)\n"
-            "  --resume FILE       continue the render saved in FILE to --spp samples (default:\n"
-            "                      the spp it was started with); the image is the one an\n"
-            "                      uninterrupted render gives, bit for bit, on any devices.\n"
-            "                      The scene, size, seed, sampling, sampler, max depth and\n"
-            "                      intersection tests must be the same (and for zsobol the\n"
-            "                      spp): a mismatch is refused with the field named\n"
-            "  --mpi-pass N        under mpirun: samples of every pixel per pass handed to a\n"
-            "                      rank (default: about 8 passes per rank, at most about\n"
-            "                      2 million paths a pass)\n"
-            "  --mpi-timeout S     under mpirun: a rank silent for S seconds is dead and its\n"
-            "                      passes go to the others (default 60; docs/distributed.md)\n"
-            "  -q, --quiet         no progress bar and no summary\n"
-            "  -h, --help          this text\n"
-            "\n"
-            "Every output (-o, --stats-json, --timeline, --checkpoint) is checked before the\n"
-            "render: a folder, a file that cannot be written or a missing or read-only folder\n"
-            "is a usage error.  Outputs are written to FILE.tmp-PID and renamed into place\n"
-            "only when all of them are written: a run that fails replaces no file.\n"
-            "\n"
-            "Under mpirun (mpirun -n N raystream render ...) every rank loads the scene and\n"
-            "renders on its own --devices; rank 0 hands out passes, adds the films and\n"
-            "writes the outputs: the image is the one-process image, bit for bit.\n"
-            "\n"
-            "Ctrl-C (SIGINT), SIGTERM or SIGHUP writes the samples finished so far and exits\n"
-            "with 128 + the signal: 130, 143, 129.  A second signal stops at once, also\n"
-            "while the outputs are written: their temporary files are removed.\n"
-            "\n"
-            "Environment: RS_FAULT=cpu:after=N,gpu:after=N makes those devices fail after N\n"
-            "chunks (to test recovery; a bad value is a usage error); RS_MODELS_DIR is the\n"
-            "default --models.\n"
-            "\n"
-            "Exit status: 0 done, 1 runtime error, 2 usage error (nothing written),\n"
-            "130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP.\n");
-        return;
-    }
-    printf("usage: raystream COMMAND [options]\n"
-           "\n"
-           "raystream is a heterogeneous CPU+GPU streaming path tracer.\n"
-           "\n"
-           "commands:\n"
-           "  render [SCENE] [options]   render a scene to an image (default builtin:cornell)\n"
-           "  scenes                     list the built-in scenes\n"
-           "  export SCENE -o FILE.json  write a scene (a built-in one, say) as a scene file\n"
-           "                             (image textures beside it as FILE-image-N.exr)\n"
-           "  help [COMMAND]             show help (also -h, --help)\n"
-           "  version                    show the version and the build's features (also\n"
-           "                             --version)\n"
-           "\n"
-           "'raystream render --help' lists the render options.\n");
 }
-
-/* The option being parsed: argv[*i] is `name`, its "=value" part `eq` (or NULL). */
-typedef struct opt_arg {
-    int argc;
-    char **argv;
-    int *i;
-    const char *eq;
-    const char *name;
-} opt_arg;
 
 #define NOT_MINE (-1)
 
-/* Takes the value of the option (either "--opt=value" or "--opt value"). */
-static const char *take_value(opt_arg *x)
+/* ---- the options: one table of rows, each a kind with its field or a small handler ----------
+ * (pbrt-v4's and Mitsuba's option lists read the same way: a name, what it takes, where it
+ * goes).  A row's handler gets the option's name and value and returns RS_EXIT_OK or
+ * RS_EXIT_USAGE after printing why; the messages name the option as it was written. */
+
+typedef int (*opt_handler)(const char *name, const char *v, rs_cli_options *o);
+
+typedef enum opt_kind {
+    OPT_FLAG,     /* no value: the int field becomes 1 */
+    OPT_U32,      /* a whole number in [lo, hi] into a uint32_t field */
+    OPT_U32_AUTO, /* the same, or "auto" for 0 */
+    OPT_U64,      /* a whole number in [lo, hi] into a uint64_t field */
+    OPT_SECONDS,  /* parse_seconds into a double field */
+    OPT_TEXT,     /* a non-empty string into a const char * field; `what` names the value */
+    OPT_CALL      /* the value to `call` */
+} opt_kind;
+
+typedef struct opt_row {
+    const char *name, *alias;
+    opt_kind kind;
+    size_t field; /* offsetof(rs_cli_options, ...) */
+    uint64_t lo, hi;
+    const char *what;
+    opt_handler call;
+} opt_row;
+
+/* --scene S: like the positional SCENE, once. */
+static int opt_scene(const char *name, const char *v, rs_cli_options *o)
 {
-    if (x->eq)
-        return x->eq + 1;
-    if (*x->i + 1 < x->argc)
-        return x->argv[++*x->i];
-    return NULL;
+    if (!*v)
+        return usage_error("%s needs a scene (builtin:NAME or FILE.json), not an empty "
+                           "name%s",
+                           name, "");
+    if (o->scene)
+        return usage_error("more than one scene given ('%s' and '%s')", o->scene, v);
+    o->scene = v;
+    return RS_EXIT_OK;
 }
 
-#define NEEDS_VALUE()                                                                              \
-  v = take_value(x);                                                                               \
-  if (!v)                                                                                          \
-    return usage_error("%s needs a value%s", name, "");
-
-/* The image and the scene: --scene, -o, sizes, spp, depth, seed, sampling, --mesh, --models.
- * Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or NOT_MINE. */
-static int parse_image_option(opt_arg *x, rs_cli_options *o)
+static int opt_spp(const char *name, const char *v, rs_cli_options *o)
 {
-    const char *name = x->name, *v;
-    int rc = RS_EXIT_OK;
-    if (strcmp(name, "--scene") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a scene (builtin:NAME or FILE.json), not an empty "
-                               "name%s",
-                               name, "");
-        if (o->scene)
-            return usage_error("more than one scene given ('%s' and '%s')", o->scene, v);
-        o->scene = v;
-    } else if (strcmp(name, "-o") == 0 || strcmp(name, "--output") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a file name%s", name, "");
-        o->output = v;
-    } else if (strcmp(name, "--width") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 32768, &o->width);
-    } else if (strcmp(name, "--height") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 32768, &o->height);
-    } else if (strcmp(name, "--spp") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 1u << 20, &o->spp);
-        o->spp_given = 1;
-    } else if (strcmp(name, "--max-depth") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 10000, &o->max_depth);
-    } else if (strcmp(name, "--seed") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u64(name, v, 0, UINT64_MAX, &o->seed);
-    } else if (strcmp(name, "--sampling") == 0) {
-        NEEDS_VALUE();
-        if (!rs_sampling_parse(v, &o->sampling))
-            return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
-                               "uniform)",
-                               v, "");
-    } else if (strcmp(name, "--sampler") == 0) {
-        NEEDS_VALUE();
-        if (!rs_sampler_parse(v, &o->sampler))
-            return usage_error("--sampler: unknown sampler '%s'%s (use independent, sobol or "
-                               "zsobol)",
-                               v, "");
-    } else if (strcmp(name, "--mesh") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a file name%s", name, "");
-        o->mesh = v;
-    } else if (strcmp(name, "--camera") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a camera's name%s", name, "");
-        o->camera = v;
-    } else if (strcmp(name, "--envmap") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs an image file%s", name, "");
-        o->envmap = v;
-    } else if (strcmp(name, "--envmap-scale") == 0) {
-        char *end;
-        double val;
-        NEEDS_VALUE();
-        val = strtod(v, &end);
-        if (end == v || *end || !(val >= 0) || val > 1e30)
-            return usage_error("--envmap-scale needs a number >= 0, not '%s'%s", v, "");
-        o->envmap_scale = (float)val;
-        o->envmap_scale_given = 1;
-    } else if (strcmp(name, "--models") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a folder%s", name, "");
-        o->models = v;
-    } else {
-        return NOT_MINE;
-    }
+    o->spp_given = 1;
+    return parse_u32(name, v, 1, 1u << 20, &o->spp);
+}
+
+static int opt_threads(const char *name, const char *v, rs_cli_options *o)
+{
+    uint32_t t = 0;
+    int rc = parse_u32(name, v, 1, 1024, &t);
+    o->threads = (int)t;
     return rc;
 }
 
-/* How it runs: threads, devices, integrator, CPU strategy, stats and timeline, chunks and waves.
- * Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or NOT_MINE. */
-static int parse_engine_option(opt_arg *x, rs_cli_options *o)
+static int opt_devices(const char *name, const char *v, rs_cli_options *o)
 {
-    const char *name = x->name, *v;
-    int rc = RS_EXIT_OK;
-    if (strcmp(name, "--threads") == 0) {
-        uint32_t t = 0;
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 1024, &t);
-        o->threads = (int)t;
-    } else if (strcmp(name, "--devices") == 0) {
-        NEEDS_VALUE();
-        rc = parse_devices(v, o);
-    } else if (strcmp(name, "--integrator") == 0) {
-        NEEDS_VALUE();
-        if (strcmp(v, "stream") != 0 && strcmp(v, "megakernel") != 0)
-            return usage_error("--integrator: '%s'%s (use stream or megakernel)", v, "");
-        o->megakernel = v[0] == 'm';
-    } else if (strcmp(name, "--cpu-strategy") == 0) {
-        NEEDS_VALUE();
-        if (!rs_par_strategy_parse(v, &o->strategy))
-            return usage_error("--cpu-strategy: '%s'%s (use for-dynamic, columns or tasks)", v, "");
-    } else if (strcmp(name, "--stats") == 0) {
-        o->stats = 1;
-    } else if (strcmp(name, "--stats-json") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a file name%s", name, "");
-        o->stats_json = v;
-    } else if (strcmp(name, "--timeline") == 0) {
-        size_t n;
-        NEEDS_VALUE();
-        n = strlen(v);
-        if (n < 5 || strcmp(v + n - 4, ".svg") != 0)
-            return usage_error("--timeline writes an SVG picture: '%s'%s must end in .svg", v, "");
-        o->timeline = v;
-    } else if (strcmp(name, "--adaptive") == 0) {
-        char *end;
-        double val;
-        NEEDS_VALUE();
-        val = strtod(v, &end);
-        if (end == v || *end || !(val > 0) || !(val < 1))
-            return usage_error("--adaptive needs a relative error threshold in (0, 1), such as "
-                               "0.01, not '%s'%s",
-                               v, "");
-        o->adaptive = val;
-    } else if (strcmp(name, "--adaptive-min-spp") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 2, 1u << 20, &o->adaptive_min_spp);
-    } else if (strcmp(name, "--aov") == 0) {
-        char list[128], *tok, *save = NULL;
-        NEEDS_VALUE();
-        snprintf(list, sizeof list, "%s", v);
-        for (tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-            if (strcmp(tok, "albedo") == 0)
-                o->aovs |= RS_AOV_ALBEDO;
-            else if (strcmp(tok, "normal") == 0)
-                o->aovs |= RS_AOV_NORMAL;
-            else if (strcmp(tok, "depth") == 0)
-                o->aovs |= RS_AOV_DEPTH;
-            else if (strcmp(tok, "samples") == 0)
-                o->aovs |= RS_AOV_SAMPLES;
-            else if (strcmp(tok, "all") == 0)
-                o->aovs |= RS_AOV_ALL;
-            else
-                return usage_error("--aov: '%s'%s is not a layer (use albedo, normal, depth, "
-                                   "samples or all, separated by commas)",
-                                   tok, "");
+    (void)name;
+    return parse_devices(v, o);
+}
+
+static int opt_sampling(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_sampling_parse(v, &o->sampling))
+        return usage_error("--sampling: unknown mode '%s'%s (use mis, mixture, bsdf or "
+                           "uniform)",
+                           v, "");
+    return RS_EXIT_OK;
+}
+
+static int opt_sampler(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_sampler_parse(v, &o->sampler))
+        return usage_error("--sampler: unknown sampler '%s'%s (use independent, sobol or "
+                           "zsobol)",
+                           v, "");
+    return RS_EXIT_OK;
+}
+
+static int opt_envmap_scale(const char *name, const char *v, rs_cli_options *o)
+{
+    char *end;
+    double val = strtod(v, &end);
+    (void)name;
+    if (end == v || *end || !(val >= 0) || val > 1e30)
+        return usage_error("--envmap-scale needs a number >= 0, not '%s'%s", v, "");
+    o->envmap_scale = (float)val;
+    o->envmap_scale_given = 1;
+    return RS_EXIT_OK;
+}
+
+static int opt_integrator(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (strcmp(v, "stream") != 0 && strcmp(v, "megakernel") != 0)
+        return usage_error("--integrator: '%s'%s (use stream or megakernel)", v, "");
+    o->megakernel = v[0] == 'm';
+    return RS_EXIT_OK;
+}
+
+static int opt_cpu_strategy(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_par_strategy_parse(v, &o->strategy))
+        return usage_error("--cpu-strategy: '%s'%s (use for-dynamic, columns or tasks)", v, "");
+    return RS_EXIT_OK;
+}
+
+static int opt_timeline(const char *name, const char *v, rs_cli_options *o)
+{
+    size_t n = strlen(v);
+    (void)name;
+    if (n < 5 || strcmp(v + n - 4, ".svg") != 0)
+        return usage_error("--timeline writes an SVG picture: '%s'%s must end in .svg", v, "");
+    o->timeline = v;
+    return RS_EXIT_OK;
+}
+
+static int opt_adaptive(const char *name, const char *v, rs_cli_options *o)
+{
+    char *end;
+    double val = strtod(v, &end);
+    (void)name;
+    if (end == v || *end || !(val > 0) || !(val < 1))
+        return usage_error("--adaptive needs a relative error threshold in (0, 1), such as "
+                           "0.01, not '%s'%s",
+                           v, "");
+    o->adaptive = val;
+    return RS_EXIT_OK;
+}
+
+/* --aov LIST: comma-separated layer names, added to o->aovs. */
+static int opt_aov(const char *name, const char *v, rs_cli_options *o)
+{
+    static const struct {
+        const char *name;
+        unsigned bits;
+    } layers[] = {{"albedo", RS_AOV_ALBEDO},
+                  {"normal", RS_AOV_NORMAL},
+                  {"depth", RS_AOV_DEPTH},
+                  {"samples", RS_AOV_SAMPLES},
+                  {"all", RS_AOV_ALL}};
+    char list[128], *tok, *save = NULL;
+    size_t k;
+    (void)name;
+    snprintf(list, sizeof list, "%s", v);
+    for (tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        for (k = 0; k < sizeof layers / sizeof layers[0] && strcmp(tok, layers[k].name); ++k)
+            ;
+        if (k == sizeof layers / sizeof layers[0])
+            return usage_error("--aov: '%s'%s is not a layer (use albedo, normal, depth, "
+                               "samples or all, separated by commas)",
+                               tok, "");
+        o->aovs |= layers[k].bits;
+    }
+    if (!o->aovs)
+        return usage_error("--aov needs a list of layers%s%s", "", "");
+    return RS_EXIT_OK;
+}
+
+static int opt_bvh(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
+        fprintf(stderr, "raystream: --bvh: %s (see 'raystream render --help')\n",
+                rs_error_message());
+        rs_error_clear();
+        return RS_EXIT_USAGE;
+    }
+    return RS_EXIT_OK;
+}
+
+static int opt_bvh_device(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)
+        return usage_error("--bvh-device: '%s'%s (use cpu or gpu)", v, "");
+    o->bvh_on_gpu = v[0] == 'g';
+    return RS_EXIT_OK;
+}
+
+static int opt_bvh_width(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0 && strcmp(v, "8") != 0)
+        return usage_error("--bvh-width must be 2, 4 or 8, not '%s'%s", v, "");
+    o->bvh_width = (uint32_t)(v[0] - '0');
+    return RS_EXIT_OK;
+}
+
+static int opt_isect_sphere(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_isect_sphere_algo_parse(v, &o->isect_sphere))
+        return usage_error("--isect-sphere: unknown algorithm '%s'%s (use algebraic or "
+                           "geometric)",
+                           v, "");
+    return RS_EXIT_OK;
+}
+
+static int opt_isect_tri(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_isect_tri_algo_parse(v, &o->isect_tri))
+        return usage_error("--isect-tri: unknown algorithm '%s'%s (use moller, snyder-barr "
+                           "or watertight)",
+                           v, "");
+    return RS_EXIT_OK;
+}
+
+static int opt_isect_aabb(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_isect_aabb_algo_parse(v, &o->isect_aabb))
+        return usage_error("--isect-aabb: unknown algorithm '%s'%s (use slab, branchless, "
+                           "williams, kensler or swap)",
+                           v, "");
+    return RS_EXIT_OK;
+}
+
+#define FIELD(f) offsetof(rs_cli_options, f)
+#define ROW_CALL(name, fn)                                                                         \
+    { name, NULL, OPT_CALL, 0, 0, 0, NULL, fn }
+#define ROW_TEXT(name, alias, f, what)                                                             \
+    { name, alias, OPT_TEXT, FIELD(f), 0, 0, what, NULL }
+#define ROW_NUM(name, kind, f, lo, hi)                                                             \
+    { name, NULL, kind, FIELD(f), lo, hi, NULL, NULL }
+
+/* Every option but -h/--help and -q/--quiet (rs_cli_parse), grouped as `render --help` lists
+ * them: the scene and image; how it runs; outputs and long renders; the BVH and the tests. */
+static const opt_row options[] = {
+    ROW_CALL("--scene", opt_scene),
+    ROW_TEXT("-o", "--output", output, "a file name"),
+    ROW_NUM("--width", OPT_U32, width, 1, 32768),
+    ROW_NUM("--height", OPT_U32, height, 1, 32768),
+    ROW_CALL("--spp", opt_spp),
+    ROW_NUM("--max-depth", OPT_U32, max_depth, 1, 10000),
+    ROW_NUM("--seed", OPT_U64, seed, 0, UINT64_MAX),
+    ROW_CALL("--sampling", opt_sampling),
+    ROW_CALL("--sampler", opt_sampler),
+    ROW_TEXT("--mesh", NULL, mesh, "a file name"),
+    ROW_TEXT("--camera", NULL, camera, "a camera's name"),
+    ROW_TEXT("--envmap", NULL, envmap, "an image file"),
+    ROW_CALL("--envmap-scale", opt_envmap_scale),
+    ROW_TEXT("--models", NULL, models, "a folder"),
+
+    ROW_CALL("--threads", opt_threads),
+    ROW_CALL("--devices", opt_devices),
+    ROW_CALL("--integrator", opt_integrator),
+    ROW_CALL("--cpu-strategy", opt_cpu_strategy),
+    ROW_NUM("--stats", OPT_FLAG, stats, 0, 0),
+    ROW_TEXT("--stats-json", NULL, stats_json, "a file name"),
+    ROW_CALL("--timeline", opt_timeline),
+    ROW_CALL("--adaptive", opt_adaptive),
+    ROW_NUM("--adaptive-min-spp", OPT_U32, adaptive_min_spp, 2, 1u << 20),
+    ROW_CALL("--aov", opt_aov),
+    ROW_NUM("--time-limit", OPT_SECONDS, time_limit_s, 0, 0),
+    ROW_NUM("--mpi-pass", OPT_U32, mpi_pass_spp, 1, 1u << 24),
+    ROW_NUM("--mpi-timeout", OPT_SECONDS, mpi_timeout_s, 0, 0),
+    ROW_TEXT("--checkpoint", NULL, checkpoint, "a file name"),
+    ROW_NUM("--checkpoint-interval", OPT_SECONDS, ckpt_every_s, 0, 0),
+    ROW_TEXT("--resume", NULL, resume, "a file name"),
+    ROW_NUM("--chunk-size", OPT_U32_AUTO, chunk_size, 1, 1u << 26),
+    ROW_NUM("--waves", OPT_U32_AUTO, waves, 1, 4),
+    ROW_NUM("--wave-size", OPT_U32_AUTO, wave_paths, 1, 1u << 26),
+
+    ROW_CALL("--bvh", opt_bvh),
+    ROW_NUM("--no-bvh", OPT_FLAG, no_bvh, 0, 0),
+    ROW_NUM("--flatten-instances", OPT_FLAG, flatten_instances, 0, 0),
+    ROW_CALL("--bvh-device", opt_bvh_device),
+    ROW_CALL("--bvh-width", opt_bvh_width),
+    ROW_CALL("--isect-sphere", opt_isect_sphere),
+    ROW_CALL("--isect-tri", opt_isect_tri),
+    ROW_CALL("--isect-aabb", opt_isect_aabb),
+};
+
+#undef ROW_NUM
+#undef ROW_TEXT
+#undef ROW_CALL
+#undef FIELD
+
+/* The option argv[*i], named `name` (its "=value" part `eq`, or NULL): the value is the part
+ * after '=', else the next argument.  Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or
+ * NOT_MINE when no row has that name. */
+static int parse_option(int argc, char **argv, int *i, const char *eq, const char *name,
+                        rs_cli_options *o)
+{
+    const opt_row *r = NULL;
+    char *field;
+    const char *v;
+    size_t k;
+    for (k = 0; k < sizeof options / sizeof options[0] && !r; ++k)
+        if (strcmp(name, options[k].name) == 0 ||
+            (options[k].alias && strcmp(name, options[k].alias) == 0))
+            r = &options[k];
+    if (!r)
+        return NOT_MINE;
+    field = (char *)o + r->field;
+    if (r->kind == OPT_FLAG) {
+        *(int *)(void *)field = 1; /* "--stats=x" ignores the x, as it always has */
+        return RS_EXIT_OK;
+    }
+    v = eq ? eq + 1 : *i + 1 < argc ? argv[++*i] : NULL;
+    if (!v)
+        return usage_error("%s needs a value%s", name, "");
+    switch (r->kind) {
+    case OPT_U32_AUTO:
+        if (strcmp(v, "auto") == 0) {
+            *(uint32_t *)(void *)field = 0;
+            return RS_EXIT_OK;
         }
-        if (!o->aovs)
-            return usage_error("--aov needs a list of layers%s%s", "", "");
-    } else if (strcmp(name, "--time-limit") == 0) {
-        NEEDS_VALUE();
-        rc = parse_seconds(name, v, &o->time_limit_s);
-    } else if (strcmp(name, "--mpi-pass") == 0) {
-        NEEDS_VALUE();
-        rc = parse_u32(name, v, 1, 1u << 24, &o->mpi_pass_spp);
-    } else if (strcmp(name, "--mpi-timeout") == 0) {
-        NEEDS_VALUE();
-        rc = parse_seconds(name, v, &o->mpi_timeout_s);
-    } else if (strcmp(name, "--checkpoint") == 0) {
-        NEEDS_VALUE();
+        /* fall through */
+    case OPT_U32:
+        return parse_u32(name, v, (uint32_t)r->lo, (uint32_t)r->hi, (uint32_t *)(void *)field);
+    case OPT_U64:
+        return parse_u64(name, v, r->lo, r->hi, (uint64_t *)(void *)field);
+    case OPT_SECONDS:
+        return parse_seconds(name, v, (double *)(void *)field);
+    case OPT_TEXT:
         if (!*v)
-            return usage_error("%s needs a file name%s", name, "");
-        o->checkpoint = v;
-    } else if (strcmp(name, "--checkpoint-interval") == 0) {
-        NEEDS_VALUE();
-        rc = parse_seconds(name, v, &o->ckpt_every_s);
-    } else if (strcmp(name, "--resume") == 0) {
-        NEEDS_VALUE();
-        if (!*v)
-            return usage_error("%s needs a file name%s", name, "");
-        o->resume = v;
-    } else if (strcmp(name, "--chunk-size") == 0) {
-        NEEDS_VALUE();
-        if (strcmp(v, "auto") == 0)
-            o->chunk_size = 0;
-        else
-            rc = parse_u32(name, v, 1, 1u << 26, &o->chunk_size);
-    } else if (strcmp(name, "--waves") == 0) {
-        NEEDS_VALUE();
-        if (strcmp(v, "auto") == 0)
-            o->waves = 0;
-        else
-            rc = parse_u32(name, v, 1, 4, &o->waves);
-    } else if (strcmp(name, "--wave-size") == 0) {
-        NEEDS_VALUE();
-        if (strcmp(v, "auto") == 0)
-            o->wave_paths = 0;
-        else
-            rc = parse_u32(name, v, 1, 1u << 26, &o->wave_paths);
-    } else {
-        return NOT_MINE;
+            return usage_error("%s needs %s", name, r->what);
+        *(const char **)(void *)field = v;
+        return RS_EXIT_OK;
+    default:
+        return r->call(name, v, o);
     }
-    return rc;
 }
-
-/* The BVH and the intersection tests.  Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or
- * NOT_MINE. */
-static int parse_accel_option(opt_arg *x, rs_cli_options *o)
-{
-    const char *name = x->name, *v;
-    int rc = RS_EXIT_OK;
-    if (strcmp(name, "--bvh") == 0) {
-        NEEDS_VALUE();
-        if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
-            fprintf(stderr, "raystream: --bvh: %s (see 'raystream render --help')\n",
-                    rs_error_message());
-            rs_error_clear();
-            return RS_EXIT_USAGE;
-        }
-    } else if (strcmp(name, "--no-bvh") == 0) {
-        o->no_bvh = 1;
-    } else if (strcmp(name, "--flatten-instances") == 0) {
-        o->flatten_instances = 1;
-    } else if (strcmp(name, "--bvh-device") == 0) {
-        NEEDS_VALUE();
-        if (strcmp(v, "cpu") != 0 && strcmp(v, "gpu") != 0)
-            return usage_error("--bvh-device: '%s'%s (use cpu or gpu)", v, "");
-        o->bvh_on_gpu = v[0] == 'g';
-    } else if (strcmp(name, "--bvh-width") == 0) {
-        NEEDS_VALUE();
-        if (strcmp(v, "2") != 0 && strcmp(v, "4") != 0 && strcmp(v, "8") != 0)
-            return usage_error("--bvh-width must be 2, 4 or 8, not '%s'%s", v, "");
-        o->bvh_width = (uint32_t)(v[0] - '0');
-    } else if (strcmp(name, "--isect-sphere") == 0) {
-        NEEDS_VALUE();
-        if (!rs_isect_sphere_algo_parse(v, &o->isect_sphere))
-            return usage_error("--isect-sphere: unknown algorithm '%s'%s (use algebraic or "
-                               "geometric)",
-                               v, "");
-    } else if (strcmp(name, "--isect-tri") == 0) {
-        NEEDS_VALUE();
-        if (!rs_isect_tri_algo_parse(v, &o->isect_tri))
-            return usage_error("--isect-tri: unknown algorithm '%s'%s (use moller, snyder-barr "
-                               "or watertight)",
-                               v, "");
-    } else if (strcmp(name, "--isect-aabb") == 0) {
-        NEEDS_VALUE();
-        if (!rs_isect_aabb_algo_parse(v, &o->isect_aabb))
-            return usage_error("--isect-aabb: unknown algorithm '%s'%s (use slab, branchless, "
-                               "williams, kensler or swap)",
-                               v, "");
-    } else {
-        return NOT_MINE;
-    }
-    return rc;
-}
-
-#undef NEEDS_VALUE
 
 /* The command word: sets o->command and returns 1 when argv needs no more parsing. */
 static int parse_command(int argc, char **argv, rs_cli_options *o, int *rc)
@@ -667,7 +763,6 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
         const char *eq = (a[0] == '-' && a[1] == '-') ? strchr(a, '=') : NULL;
         char name[64];
         size_t len = eq ? (size_t)(eq - a) : strlen(a);
-        opt_arg x;
         if (len >= sizeof name)
             len = sizeof name - 1;
         memcpy(name, a, len);
@@ -695,14 +790,7 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
             o->quiet = 1;
             continue;
         }
-        x.argc = argc;
-        x.argv = argv;
-        x.i = &i;
-        x.eq = eq;
-        x.name = name;
-        if ((rc = parse_image_option(&x, o)) == NOT_MINE &&
-            (rc = parse_engine_option(&x, o)) == NOT_MINE &&
-            (rc = parse_accel_option(&x, o)) == NOT_MINE)
+        if ((rc = parse_option(argc, argv, &i, eq, name, o)) == NOT_MINE)
             return usage_error("unknown option '%s'%s", a, "");
         if (rc != RS_EXIT_OK)
             return rc;
