@@ -2,6 +2,7 @@
 #define _DEFAULT_SOURCE /* mkstemps, for a glTF binary's embedded textures */
 #include "scenes/mesh.h"
 #include "scenes/gltf.h"
+#include "scenes/gltf_check.h"
 #include "scenes/ply_header.h"
 #include "scenes/ply_strips.h"
 #include "scenes/transform.h"
@@ -714,7 +715,7 @@ static rs_status check_gltf_start(const char *path)
     if (glb) {
         if (n < 12 || memcmp(b, "glTF", 4) != 0)
             return rs_error_set(RS_ERR_ARG, "%s: not a glTF binary (no 'glTF' magic)", path);
-        return RS_OK;
+        return rs_gltf_preflight(path, 1);
     }
     if (n >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF)
         i = 3; /* a UTF-8 byte order mark */
@@ -723,7 +724,7 @@ static rs_status check_gltf_start(const char *path)
     if (i >= n || b[i] != '{')
         return rs_error_set(RS_ERR_ARG, "%s: not a glTF file (it does not start with a JSON object)",
                             path);
-    return RS_OK;
+    return rs_gltf_preflight(path, 0);
 }
 
 /* A scene of our own making (a PLY of triangle strips) carries this flag; release_scene frees
@@ -979,7 +980,6 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
 
 /* ---- glTF scenes (scenes/gltf.h) ---------------------------------------------------------- */
 
-#define GLTF_MAX_DEPTH 256 /* nodes within nodes */
 
 typedef struct gltf_ctx {
     rs_scene *s;
@@ -1046,9 +1046,9 @@ static rs_status gltf_node(gltf_ctx *g, const struct aiNode *nd, const rs_xform 
     const char *why = rs_xform_invalid(&xf);
     uint32_t k;
     rs_status st;
-    if (depth > GLTF_MAX_DEPTH)
+    if (depth > RS_GLTF_MAX_DEPTH)
         return rs_error_set(RS_ERR_ARG, "%s: nodes nested more than %d deep", g->path,
-                            GLTF_MAX_DEPTH);
+                            RS_GLTF_MAX_DEPTH);
     if (nd->mNumMeshes && why)
         return rs_error_set(RS_ERR_ARG, "%s: node '%s': %s", g->path, nd->mName.data, why);
     for (k = 0; k < nd->mNumMeshes; ++k) {

@@ -591,6 +591,78 @@ static void test_bad_files(void **state)
                "plyish.glb", "not a glTF binary");
 }
 
+/* Files made to hurt (issue 27): refused before Assimp sees them, one line naming the field. */
+static void test_hostile_files(void **state)
+{
+    char buf[8192], p[256];
+    char *deep;
+    size_t k, n;
+    int i;
+    rs_scene *s = (rs_scene *)0x1;
+    unsigned char glb[900];
+    uint32_t u;
+    (void)state;
+    write_full_files();
+    /* a buffer in a folder that is not there: Assimp read quad.bin beside the scene instead */
+    snprintf(buf, sizeof buf, k_full, "");
+    {
+        char *at = strstr(buf, "\"quad.bin\"");
+        memmove(at + 5, at + 1, strlen(at + 1) + 1);
+        memcpy(at + 1, "sub/", 4);
+    }
+    expect_bad("subdir.gltf", buf, "buffers[0].uri 'sub/quad.bin'", "no such file");
+    /* a URL: never fetched, and not a same-named file either */
+    snprintf(buf, sizeof buf, k_full, "");
+    {
+        char *at = strstr(buf, "\"quad.bin\"");
+        char tail[8192];
+        snprintf(tail, sizeof tail, "\"http://example.com/quad.bin\"%s", at + 10);
+        strcpy(at, tail);
+    }
+    expect_bad("url.gltf", buf, "buffers[0].uri 'http://example.com/quad.bin'", "relative");
+    /* nodes nested 30,000 deep: Assimp's recursive reader overflowed the stack */
+    n = 30000;
+    deep = (char *)malloc(n * 40 + 256);
+    k = (size_t)sprintf(deep, "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],"
+                              "\"nodes\":[");
+    for (i = 0; i < (int)n; ++i)
+        k += (size_t)sprintf(deep + k, i + 1 < (int)n ? "{\"children\":[%d]}," : "{}", i + 1);
+    sprintf(deep + k, "]}");
+    expect_bad("deep.gltf", deep, "nest deeper than 256 levels", NULL);
+    free(deep);
+    /* a cycle, and a node with two parents */
+    expect_bad("cycle.gltf",
+               "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"children\":[1]},"
+               "{\"children\":[0]}]}",
+               "cycle", NULL);
+    expect_bad("twice.gltf",
+               "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"children\":[2]},"
+               "{\"children\":[2]},{}]}",
+               "nodes[2] is a child twice", NULL);
+    expect_bad("badchild.gltf",
+               "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"children\":[7]}]}",
+               "nodes[0].children names no node", NULL);
+    /* a 900-byte .glb whose chunk claims 3.75 GiB: refused before anything is allocated */
+    memset(glb, ' ', sizeof glb);
+    memcpy(glb, "glTF", 4);
+    u = 2, memcpy(glb + 4, &u, 4);
+    u = sizeof glb, memcpy(glb + 8, &u, 4);
+    u = 0xF0000000u, memcpy(glb + 12, &u, 4);
+    memcpy(glb + 16, "JSON", 4);
+    write_bytes("huge.glb", glb, sizeof glb);
+    path_of(p, sizeof p, "huge.glb");
+    assert_int_not_equal(rs_scene_load_gltf(p, NULL, &s), RS_OK);
+    assert_non_null(strstr(rs_error_message(), "claims 4026531840 bytes"));
+    rs_error_clear();
+    /* and one whose header claims more bytes than the file has */
+    u = 1u << 31, memcpy(glb + 8, &u, 4);
+    write_bytes("long.glb", glb, sizeof glb);
+    path_of(p, sizeof p, "long.glb");
+    assert_int_not_equal(rs_scene_load_gltf(p, NULL, &s), RS_OK);
+    assert_non_null(strstr(rs_error_message(), "truncated or corrupt"));
+    rs_error_clear();
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -625,6 +697,7 @@ int main(void)
         cmocka_unit_test(test_transmission),
         cmocka_unit_test(test_alpha_cutout),
         cmocka_unit_test(test_bad_files),
+        cmocka_unit_test(test_hostile_files),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -1,0 +1,256 @@
+/* scenes/gltf_check.c — see gltf_check.h.  Built with cJSON (gltf_check_none.c otherwise). */
+#include "scenes/gltf_check.h"
+
+#include <cjson/cJSON.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/alloc.h"
+#include "core/file.h"
+
+#define GLB_MAGIC      0x46546C67u /* "glTF" */
+#define GLB_CHUNK_JSON 0x4E4F534Au /* "JSON" */
+
+static uint32_t le32(const unsigned char *b)
+{
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+/* A .glb's JSON chunk into *json (rs_alloc'd, NUL-terminated), after checking the container's
+ * framing against the file's size: the header's length and every chunk's length must fit, so a
+ * 900-byte file cannot make anyone allocate gigabytes. */
+static rs_status read_glb_json(const char *path, FILE *f, uint64_t size, char **json, size_t *n)
+{
+    unsigned char h[20];
+    uint64_t off = 12;
+    uint32_t total, len, type;
+    if (size < 20 || fread(h, 1, 20, f) != 20)
+        return rs_error_set(RS_ERR_ARG, "%s: a glTF binary shorter than its headers", path);
+    total = le32(h + 8);
+    if (le32(h) != GLB_MAGIC)
+        return rs_error_set(RS_ERR_ARG, "%s: not a glTF binary (no 'glTF' magic)", path);
+    if (le32(h + 4) != 2)
+        return rs_error_set(RS_ERR_ARG, "%s: glTF binary version %u (this reader takes 2)", path,
+                            le32(h + 4));
+    if (total < 20 || total > size)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: its header says %u bytes but the file has %llu (truncated or "
+                            "corrupt)",
+                            path, total, (unsigned long long)size);
+    for (;;) { /* every chunk's length within the file, the first one JSON */
+        unsigned char c[8];
+        const unsigned char *p = off == 12 ? h + 12 : c;
+        if (off != 12 && (fseek(f, (long)off, SEEK_SET) != 0 || fread(c, 1, 8, f) != 8))
+            break;
+        len = le32(p);
+        type = le32(p + 4);
+        if (off + 8 > total || (uint64_t)len > total - off - 8)
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: a chunk at byte %llu claims %u bytes, past the end of the "
+                                "file (%u bytes)",
+                                path, (unsigned long long)off, len, total);
+        if (off == 12 && type != GLB_CHUNK_JSON)
+            return rs_error_set(RS_ERR_ARG, "%s: its first chunk is not JSON", path);
+        off += 8 + (uint64_t)len;
+        if (off + 8 > total)
+            break;
+    }
+    len = le32(h + 12);
+    *json = (char *)rs_alloc((size_t)len + 1, 1);
+    if (!*json)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    if (fseek(f, 20, SEEK_SET) != 0 || fread(*json, 1, len, f) != len) {
+        rs_free(*json);
+        return rs_error_set(RS_ERR_IO, "%s: cannot read its JSON chunk", path);
+    }
+    (*json)[len] = 0;
+    *n = len;
+    return RS_OK;
+}
+
+static rs_status read_text(const char *path, FILE *f, uint64_t size, char **json, size_t *n)
+{
+    *json = (char *)rs_alloc((size_t)size + 1, 1);
+    if (!*json)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+    if (fread(*json, 1, (size_t)size, f) != size) {
+        rs_free(*json);
+        return rs_error_set(RS_ERR_IO, "%s: cannot read it", path);
+    }
+    (*json)[size] = 0;
+    *n = (size_t)size;
+    return RS_OK;
+}
+
+/* ---- the node tree ------------------------------------------------------------------------- */
+
+/* Every node's children are nodes, no node has two parents or is its own ancestor, and no chain
+ * from a root is deeper than RS_GLTF_MAX_DEPTH: walked with a stack of our own, so that the
+ * check cannot overflow the call stack the way a recursive reader does. */
+static rs_status check_nodes(const char *path, const cJSON *root)
+{
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
+    int n = cJSON_IsArray(nodes) ? cJSON_GetArraySize(nodes) : 0, i;
+    int *parent, *depth, *order, n_order = 0;
+    const cJSON **node;
+    rs_status st = RS_OK;
+    if (n == 0)
+        return RS_OK;
+    parent = (int *)rs_alloc((size_t)n, sizeof *parent);
+    depth = (int *)rs_alloc((size_t)n, sizeof *depth);
+    order = (int *)rs_alloc((size_t)n, sizeof *order);
+    node = (const cJSON **)rs_alloc((size_t)n, sizeof *node);
+    if (!parent || !depth || !order || !node) {
+        st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+        goto out;
+    }
+    i = 0;
+    for (const cJSON *nd = nodes->child; nd; nd = nd->next)
+        node[i++] = nd;
+    for (i = 0; i < n; ++i)
+        parent[i] = -1;
+    for (i = 0; i < n && st == RS_OK; ++i) {
+        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node[i], "children"), *k;
+        cJSON_ArrayForEach(k, kids)
+        {
+            double v = cJSON_IsNumber(k) ? k->valuedouble : -1;
+            int c = (int)v;
+            if (!(v >= 0 && v < n && v == c)) {
+                st = rs_error_set(RS_ERR_ARG, "%s: nodes[%d].children names no node", path, i);
+                break;
+            }
+            if (parent[c] >= 0 || c == i) {
+                st = rs_error_set(RS_ERR_ARG,
+                                  "%s: nodes[%d] is a child twice (of nodes[%d] and nodes[%d]) "
+                                  "or of itself: glTF nodes form trees",
+                                  path, c, parent[c] >= 0 ? parent[c] : i, i);
+                break;
+            }
+            parent[c] = i;
+        }
+    }
+    /* depths from the roots down, breadth first; a node never reached sits on a cycle */
+    for (i = 0; i < n && st == RS_OK; ++i)
+        if (parent[i] < 0) {
+            depth[i] = 0;
+            order[n_order++] = i;
+        }
+    for (int q = 0; q < n_order && st == RS_OK; ++q) {
+        const cJSON *kids = cJSON_GetObjectItemCaseSensitive(node[order[q]], "children"), *k;
+        cJSON_ArrayForEach(k, kids)
+        {
+            int c = (int)k->valuedouble;
+            depth[c] = depth[order[q]] + 1;
+            if (depth[c] > RS_GLTF_MAX_DEPTH) {
+                st = rs_error_set(RS_ERR_ARG, "%s: nodes nest deeper than %d levels (nodes[%d])",
+                                  path, RS_GLTF_MAX_DEPTH, c);
+                break;
+            }
+            order[n_order++] = c;
+        }
+    }
+    if (st == RS_OK && n_order < n)
+        st = rs_error_set(RS_ERR_ARG, "%s: its nodes form a cycle (%d of %d nodes are not in a tree)",
+                          path, n - n_order, n);
+out:
+    rs_free(parent);
+    rs_free(depth);
+    rs_free(order);
+    rs_free(node);
+    return st;
+}
+
+/* ---- the files a glTF names ---------------------------------------------------------------- */
+
+static int hex(int c)
+{
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10
+                                          : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                                                 : -1;
+}
+
+/* `uri`, a relative reference, as a path beside the scene (percent escapes decoded); 0 if it
+ * does not fit or an escape is broken. */
+static int uri_path(const char *dir, const char *uri, char *out, size_t n)
+{
+    size_t k = (size_t)snprintf(out, n, "%s/", dir);
+    for (; *uri && k + 1 < n; ++uri) {
+        if (*uri == '%') {
+            int a = hex(uri[1]), b = a >= 0 ? hex(uri[2]) : -1;
+            if (b < 0)
+                return 0;
+            out[k++] = (char)(a * 16 + b);
+            uri += 2;
+        } else {
+            out[k++] = *uri;
+        }
+    }
+    out[k] = 0;
+    return !*uri;
+}
+
+/* Each buffers[i].uri and images[i].uri is a data: URI or a file beside the scene that exists:
+ * Assimp reads a missing one as any file of the same base name in the scene's folder, and would
+ * fetch nothing from a URL. */
+static rs_status check_uris(const char *path, const char *dir, const cJSON *root,
+                            const char *what)
+{
+    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(root, what), *it;
+    int i = 0;
+    cJSON_ArrayForEach(it, arr)
+    {
+        const cJSON *u = cJSON_GetObjectItemCaseSensitive(it, "uri");
+        const char *uri = cJSON_IsString(u) ? u->valuestring : NULL;
+        char file[4096];
+        struct stat sb;
+        if (uri && strncmp(uri, "data:", 5) != 0) {
+            if (strstr(uri, "://") || uri[0] == '/')
+                return rs_error_set(RS_ERR_ARG,
+                                    "%s: %s[%d].uri '%.200s': only files beside the scene (a "
+                                    "relative path) and data: URIs are read",
+                                    path, what, i, uri);
+            if (!uri_path(dir, uri, file, sizeof file))
+                return rs_error_set(RS_ERR_ARG, "%s: %s[%d].uri '%.200s': not a readable path",
+                                    path, what, i, uri);
+            if (stat(file, &sb) != 0 || !S_ISREG(sb.st_mode))
+                return rs_error_set(RS_ERR_ARG, "%s: %s[%d].uri '%.200s': no such file (%s)",
+                                    path, what, i, uri, file);
+        }
+        ++i;
+    }
+    return RS_OK;
+}
+
+rs_status rs_gltf_preflight(const char *path, int glb)
+{
+    FILE *f;
+    uint64_t size;
+    char *json = NULL, dir[4096];
+    const char *slash = strrchr(path, '/');
+    size_t n = 0;
+    cJSON *root;
+    rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
+    if (st != RS_OK)
+        return st;
+    st = glb ? read_glb_json(path, f, size, &json, &n) : read_text(path, f, size, &json, &n);
+    fclose(f);
+    if (st != RS_OK)
+        return st;
+    root = cJSON_ParseWithLength(json, n);
+    rs_free(json);
+    if (!root || !cJSON_IsObject(root)) {
+        cJSON_Delete(root);
+        return rs_error_set(RS_ERR_ARG, "%s: its JSON cannot be read (cut short, or not JSON)",
+                            path);
+    }
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
+    st = check_nodes(path, root);
+    if (st == RS_OK)
+        st = check_uris(path, dir, root, "buffers");
+    if (st == RS_OK)
+        st = check_uris(path, dir, root, "images");
+    cJSON_Delete(root);
+    return st;
+}
