@@ -15,7 +15,7 @@
 #define RS_WIDE_PACKED  0x8000u
 #define RS_WIDE_QUADS   0x4000u /* with RS_WIDE_PACKED: the blocks are parallelograms */
 #define RS_WIDE_SPHERES 0x2000u /* with RS_WIDE_PACKED: sphere blocks (8-wide tree only) */
-#define RS_WIDE_BLOCKS  0x1fffu /* a packed count's number of blocks (a longer leaf stays
-                                   unpacked) */
+/* a packed count's number of blocks (a longer leaf stays unpacked) */
+#define RS_WIDE_BLOCKS  0x1fffu
 
 #endif

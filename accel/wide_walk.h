@@ -39,8 +39,8 @@
 
 #include "accel/wide.h"
 
-#if !defined(RS_WIDE_W) || !defined(RS_WIDE_SHIFT) || !defined(RS_WIDE_TREE) ||                  \
-    !defined(RS_WIDE_NODE) || !defined(RS_WIDE_STACK) || !defined(RS_WIDE_FN) ||                  \
+#if !defined(RS_WIDE_W) || !defined(RS_WIDE_SHIFT) || !defined(RS_WIDE_TREE) ||                    \
+    !defined(RS_WIDE_NODE) || !defined(RS_WIDE_STACK) || !defined(RS_WIDE_FN) ||                   \
     !defined(RS_WIDE_RAY) || !defined(RS_WIDE_TN)
 #  error "accel/wide_walk.h: define the width's parameters first"
 #endif
@@ -56,9 +56,8 @@
 #ifdef RS_WIDE_TRI_HIT
 /* A packed leaf (`count` has RS_WIDE_PACKED) for closest hit: each block's hits taken as
  * rs_bvh_leaf_closest takes them (rs_hit_better; the ray cut just past the best). */
-RS_HD_HOT void RS_WIDE_FN(packed_closest)(const RS_WIDE_TREE *b, uint32_t first,
-                                              uint32_t count, const RS_WIDE_RAY *r, rs_ray *ray,
-                                              rs_hit *hit)
+RS_HD_HOT void RS_WIDE_FN(packed_closest)(const RS_WIDE_TREE *b, uint32_t first, uint32_t count,
+                                          const RS_WIDE_RAY *r, rs_ray *ray, rs_hit *hit)
 {
     uint32_t i, n = count & RS_WIDE_BLOCKS;
     for (i = 0; i < n; ++i) {
@@ -95,9 +94,8 @@ RS_HD_HOT void RS_WIDE_FN(packed_closest)(const RS_WIDE_TREE *b, uint32_t first,
 }
 
 /* A packed leaf for any hit: 1 when some primitive is hit inside (tmin, tmax). */
-RS_HD_HOT int RS_WIDE_FN(packed_occluded)(const RS_WIDE_TREE *b, uint32_t first,
-                                              uint32_t count, const RS_WIDE_RAY *r,
-                                              const rs_ray *ray)
+RS_HD_HOT int RS_WIDE_FN(packed_occluded)(const RS_WIDE_TREE *b, uint32_t first, uint32_t count,
+                                          const RS_WIDE_RAY *r, const rs_ray *ray)
 {
     uint32_t i, n = count & RS_WIDE_BLOCKS;
     for (i = 0; i < n; ++i) {
@@ -110,8 +108,8 @@ RS_HD_HOT int RS_WIDE_FN(packed_occluded)(const RS_WIDE_TREE *b, uint32_t first,
 #  endif
             m = count & RS_WIDE_QUADS ? RS_WIDE_QUAD_HIT(&RS_WIDE_QUADS_OF(b)[first + i], r,
                                                          ray->tmin, ray->tmax, t, u, v)
-                                      : RS_WIDE_TRI_HIT(&RS_WIDE_TRIS(b)[first + i], r,
-                                                        ray->tmin, ray->tmax, t, u, v);
+                                      : RS_WIDE_TRI_HIT(&RS_WIDE_TRIS(b)[first + i], r, ray->tmin,
+                                                        ray->tmax, t, u, v);
         if (m)
             return 1;
     }
@@ -173,8 +171,8 @@ RS_HD_HOT int RS_WIDE_FN(leaf_occluded)(const RS_WIDE_TREE *b, const rs_geom *g,
 }
 
 /* The closest hit under root `root`, if closer than *hit (rs_hit_better); the ray cut just past
- * each hit.  Ordered: the nearest lane hit is visited next and the others pushed far to near with their
- * entry distances (one lane: no sort; two: one compare; more: insertion sort); a popped entry
+ * each hit.  Ordered: the nearest lane hit is visited next and the others pushed far to near with
+ * their entry distances (one lane: no sort; two: one compare; more: insertion sort); a popped entry
  * that starts beyond the closest hit so far is dropped without touching its node. */
 RS_HD_HOT void RS_WIDE_FN(walk_closest)(const RS_WIDE_TREE *b, const rs_geom *g, uint32_t root,
                                         const RS_WIDE_RAY *r, rs_ray *ray, rs_hit *hit,
