@@ -43,7 +43,7 @@ typedef struct rs_bvh_view {
  * a translation unit that defines RS_COUNTERS before including this header or accel/bvh.h (a
  * benchmark's counting pass), as that unit's thread-local tallies.  Everywhere else RS_COUNT is
  * empty, so the traversal the devices run pays nothing. */
-#if defined(RS_COUNTERS) && !defined(__CUDACC__)
+#if defined(RS_COUNTERS) /* host only: never defined in a .cu (_Thread_local is C11) */
 typedef struct rs_trace_counters {
     uint64_t rays, nodes, box_tests, prim_tests;
 } rs_trace_counters;

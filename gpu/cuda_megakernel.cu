@@ -1,7 +1,8 @@
 /* gpu/cuda_megakernel.cu — the CUDA device's megakernel (its upload_scene and render_pass): the
  * thesis's CUDA integrator, one thread per pixel tracing its path from the camera to the end
- * with rs_path_radiance (shading/path.h), the very function the CPU megakernel and the
- * wavefront's stages run.
+ * with rs_gpu_path_radiance (gpu/megakernel_path.h: the binary BVH's traversal around
+ * shading/path.h's path steps, the very shading the CPU megakernel and the wavefront's stages
+ * run; the host fallback runs the same loop).
  *
  * upload_scene copies the scene into device memory (scheduler/device_copy.h: the scene's arrays
  * once; the tracer's geometry is the mirror's arrays with the uploaded geometry's algorithms, over
@@ -18,6 +19,7 @@
  * launch into it).  The ray counters are reduced per warp (shuffles over a full warp; threads
  * past the image count 0) and added with one atomic per warp. */
 #include "gpu/internal.h"
+#include "gpu/megakernel_path.h"
 
 #include <string.h>
 
@@ -38,7 +40,7 @@ __global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
     n.max_bounce = 0;
     /* no early return: every lane of the warp takes part in the shuffles below */
     if (pixel < it.npix)
-        radiance[pixel] = rs_path_radiance(&it, &tr, (uint64_t)sample * it.npix + pixel, &n);
+        radiance[pixel] = rs_gpu_path_radiance(&it, &tr, pixel, sample, &n);
     closest = n.closest;
     shadow = n.shadow;
     max_bounce = n.max_bounce;

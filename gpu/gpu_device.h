@@ -9,7 +9,7 @@
  * Both devices fill every entry of rs_device_ops (scheduler/device.h): upload copies the
  * geometry and BVH into the device's own memory (scheduler/device_copy.h), trace answers chunks,
  * and upload_scene + render_pass run the megakernel (one path per pixel per sample,
- * rs_path_radiance of shading/path.h) — there is no second way to reach the GPU. */
+ * rs_gpu_path_radiance of gpu/megakernel_path.h) — there is no second way to reach the GPU. */
 #ifndef RS_GPU_GPU_DEVICE_H
 #define RS_GPU_GPU_DEVICE_H
 

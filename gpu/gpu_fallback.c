@@ -15,9 +15,9 @@
  *                rs_trace_stage_out); the bytes are counted as the CUDA device counts a chunk's;
  *   upload_scene copies the scene and the render constants (the same rs_device_copy_scene call
  *                as the GPU's; a pass of no pixels is refused, as there);
- *   render_pass  the CUDA render_pass's passes: per sample, rs_path_radiance for every pixel
- *                (path index sample * npix + pixel, as the CUDA kernel's thread computes it) into
- *                a radiance buffer (the pixels split among host threads by the job's strategy),
+ *   render_pass  the CUDA render_pass's passes: per sample, rs_gpu_path_radiance (the CUDA
+ *                kernel's own loop, gpu/megakernel_path.h) for every pixel into a radiance
+ *                buffer (the pixels split among host threads by the job's strategy),
  *                then rs_film_add_image: each pixel's samples added in sample order.  Its image is
  *                the CPU megakernel's, bit for bit.
  * What it does not imitate: the two CUDA streams (its pieces run one after another, so nothing
@@ -38,6 +38,7 @@
 #include "accel/trace.h"
 #include "core/alloc.h"
 #include "core/cores.h"
+#include "gpu/megakernel_path.h"
 #include "scheduler/device_copy.h"
 #include "scheduler/sched.h"
 #include "shading/path_counts.h"
@@ -202,7 +203,6 @@ static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
     const rs_render_consts *it = &p->f->it;
     const rs_pass_job *job = p->job;
     rs_path_counts n = {0, 0, 0};
-    uint64_t base = (uint64_t)p->sample * it->npix;
     uint32_t pixel;
     for (pixel = lo; pixel < hi; ++pixel) {
         /* per pixel: a pass over a large image takes seconds on a few host threads */
@@ -210,7 +210,7 @@ static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
             atomic_store(&p->stopped, 1);
             break;
         }
-        p->f->radiance[pixel] = rs_path_radiance(it, &p->f->scene.tracer, base + pixel, &n);
+        p->f->radiance[pixel] = rs_gpu_path_radiance(it, &p->f->scene.tracer, pixel, p->sample, &n);
     }
     rs_path_counts_atomic_add(&p->counts, &n);
 }

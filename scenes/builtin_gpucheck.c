@@ -1,7 +1,8 @@
 /* scenes/builtin_gpucheck.c — builtin:gpucheck, a small scene made to reach every device function
- * of the megakernel (rs_path_radiance and everything it calls) and every branch of the traversal,
- * so that one render of it compares the CUDA device, its host fallback and the CPU device over all
- * of them (tests/render_gpucheck_test.c on any machine, tests/gpu_trace_test.c on a GPU).
+ * of the megakernel (rs_gpu_path_radiance and everything it calls) and every branch of the
+ * traversal, so that one render of it compares the CUDA device, its host fallback and the CPU
+ * device over all of them (tests/render_gpucheck_test.c on any machine, tests/gpu_trace_test.c on a
+ * GPU).
  *
  * Everything is made here, without files: the textures, the normal map, the metallic-roughness
  * map, the alpha mask and the environment map are computed in code.  What it holds:

@@ -61,12 +61,15 @@ typedef struct rs_device_ops {
      * host_free. */
     void *(*host_alloc)(rs_device *d, size_t bytes);
     void (*host_free)(rs_device *d, void *p);
-    /* Optional (NULL: the device cannot run the megakernel).  After upload: makes the scene's
-     * shading data (materials, textures, lights) available to render_pass, for the constants
-     * `it` (copied).  Released by destroy. */
+    /* Optional (NULL: the device reads the host scene in place; a device with memory of its own
+     * must have it to run the megakernel).  After upload: copies the scene's shading data
+     * (materials, textures, lights) and the constants `it` for render_pass, which reads only
+     * these copies (`it` is plain device-safe data: shading/path.h).  A second call replaces
+     * the first; destroy releases the copy. */
     rs_status (*upload_scene)(rs_device *d, const rs_scene *scene, const rs_render_consts *it);
-    /* Samples [s0, s0 + n) of every pixel, traced path by path (rs_path_radiance) and added to
-     * job->film, each pixel's samples in sample order; the rays traced are added to *counts.
+    /* Samples [s0, s0 + n) of every pixel, each path traced by the device's own loop over
+     * shading/path.h's rs_path_start / rs_path_step with its own traversal, added to job->film,
+     * each pixel's samples in sample order; the rays traced are added to *counts.
      * Stops early, with RS_OK, when job->cancelled says so. */
     rs_status (*render_pass)(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                              rs_path_counts *counts);

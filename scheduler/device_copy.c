@@ -3,6 +3,7 @@
  * the only place that knows which fields are arrays. */
 #include "scheduler/device_copy.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #include "core/alloc.h"
@@ -57,6 +58,35 @@ void rs_device_geom_release(rs_device_geom *c, const rs_mirror_ops *ops)
     memset(c, 0, sizeof *c);
 }
 
+/* The structs a device receives by value (the CUDA kernel's arguments, the fallback's copies)
+ * are exactly their device fields, listed here in order: each starts where the one before it
+ * ends, up to padding too small to hold a pointer, and the struct ends with the last.  A field
+ * added to one of them (a host pointer, say) fails to compile until it is listed here, and so
+ * looked at.  The pointers they hold are the copy's (rs_path_tracer: tests/scenes_mirror_test.c
+ * scans every word) or, for rs_render_consts.scene, set by each device to its mirror. */
+#define RS_FIRST_FIELD(T, a) _Static_assert(offsetof(T, a) == 0, #T " starts with " #a)
+#define RS_NEXT_FIELD(T, a, b)                                                                     \
+  _Static_assert(offsetof(T, b) - (offsetof(T, a) + sizeof(((T *)0)->a)) < sizeof(void *),         \
+                 #T ": " #b " right after " #a)
+#define RS_LAST_FIELD(T, a)                                                                        \
+  _Static_assert(sizeof(T) - (offsetof(T, a) + sizeof(((T *)0)->a)) < sizeof(void *),              \
+                 #T " ends with " #a)
+RS_FIRST_FIELD(rs_render_consts, scene);
+RS_NEXT_FIELD(rs_render_consts, scene, camera);
+RS_NEXT_FIELD(rs_render_consts, camera, seed);
+RS_NEXT_FIELD(rs_render_consts, seed, width);
+RS_NEXT_FIELD(rs_render_consts, width, height);
+RS_NEXT_FIELD(rs_render_consts, height, npix);
+RS_NEXT_FIELD(rs_render_consts, npix, spp);
+RS_NEXT_FIELD(rs_render_consts, spp, max_depth);
+RS_NEXT_FIELD(rs_render_consts, max_depth, rr_depth);
+RS_NEXT_FIELD(rs_render_consts, rr_depth, sampling);
+RS_NEXT_FIELD(rs_render_consts, sampling, sampler);
+RS_LAST_FIELD(rs_render_consts, sampler);
+RS_FIRST_FIELD(rs_path_tracer, bvh);
+RS_NEXT_FIELD(rs_path_tracer, bvh, geom);
+RS_LAST_FIELD(rs_path_tracer, geom);
+
 rs_status rs_device_copy_scene(const rs_scene *s, const rs_device_geom *geom,
                                const rs_mirror_ops *ops, rs_device_scene *out)
 {
@@ -92,8 +122,6 @@ rs_status rs_device_copy_scene(const rs_scene *s, const rs_device_geom *geom,
     out->tracer.geom.blas_nodes = geom->geom.blas_nodes;
     out->tracer.geom.blas_prim_ids = geom->geom.blas_prim_ids;
     out->tracer.bvh = geom->bvh;
-    out->tracer.bvh4 = NULL;
-    out->tracer.bvh8 = NULL;
     return RS_OK;
 }
 

@@ -32,13 +32,21 @@ typedef struct rs_device_geom {
     rs_mirror_blocks made;
 } rs_device_geom;
 
+/* What a megakernel with a copy traces with (gpu/megakernel_path.h): the binary BVH over `geom`.
+ * Passed by value to the CUDA kernel: device-safe data only, every pointer into the copy's
+ * blocks (scheduler/device_copy.c asserts at compile time that it is exactly these two fields;
+ * tests/scenes_mirror_test.c scans its words). */
+typedef struct rs_path_tracer {
+    rs_bvh_view bvh;
+    rs_geom geom;
+} rs_path_tracer;
+
 /* What the megakernel (render_pass) reads. */
 typedef struct rs_device_scene {
     rs_scene_mirror mirror; /* mirror.scene: a host struct of the copies' pointers */
-    const rs_scene *scene;  /* the mirror's struct copied through the ops (the integrator's
+    const rs_scene *scene;  /* the mirror's struct copied through the ops (the render constants'
                                `scene` on the device) */
-    rs_path_tracer tracer;  /* geometry over mirror.scene's arrays, the uploaded BVH copy;
-                               bvh4 NULL */
+    rs_path_tracer tracer;  /* geometry over mirror.scene's arrays, the uploaded BVH copy */
 } rs_device_scene;
 
 #ifdef __cplusplus

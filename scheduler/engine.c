@@ -50,7 +50,6 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     it->height = st->height;
     it->npix = (uint32_t)npix;
     it->spp = st->spp;
-    it->n_active = (uint32_t)npix;
     it->max_depth = st->max_depth;
     it->rr_depth = st->rr_depth ? st->rr_depth : 3;
     it->sampling = (uint32_t)st->sampling;
@@ -151,10 +150,11 @@ rs_status rs_engine_run(rs_engine *e, const rs_work_plan *plan, const rs_render_
         return st;
     memset(&c, 0, sizeof c);
     c.e = e;
-    c.it = e->it;
+    c.map.pixel_of = NULL;
+    c.map.n_active = e->it.npix;
     if (plan->pixels) {
-        c.it.pixel_of = plan->pixels;
-        c.it.n_active = plan->n_pixels;
+        c.map.pixel_of = plan->pixels;
+        c.map.n_active = plan->n_pixels;
     }
     c.plan = plan;
     c.hooks = hooks;
@@ -183,7 +183,7 @@ int rs_run_cancelled(const rs_run *c)
 uint64_t rs_run_time_cut(rs_run *c, uint64_t next)
 {
     const rs_engine *e = c->e;
-    uint64_t n = c->it.n_active, end;
+    uint64_t n = c->map.n_active, end;
     if (!(e->st.time_limit_s > 0) || rs_now_s() - e->t_start < e->st.time_limit_s)
         return UINT64_MAX;
     end = (next + n - 1) / n * n;

@@ -25,7 +25,7 @@ typedef struct rs_slot {
 struct rs_engine {
     const rs_scene *scene;
     rs_render_settings st; /* the automatic choices made */
-    rs_render_consts it;   /* the constants over every pixel */
+    rs_render_consts it;   /* the render's constants, what a device receives */
     rs_sched *sched;       /* the stream engine's devices, or NULL */
     rs_device *mk;         /* the megakernel's device, or NULL */
     rs_slot slots[RS_RENDER_MAX_WAVES];
@@ -39,7 +39,7 @@ struct rs_engine {
 /* One run of a plan. */
 typedef struct rs_run {
     rs_engine *e;
-    rs_render_consts it; /* the plan's constants (its pixels) */
+    rs_path_map map;  /* the plan's pixels (host memory: its stages and film only) */
     rs_stage_exec ex; /* threads granted to the stage running now */
     const rs_work_plan *plan;
     const rs_render_hooks *hooks;

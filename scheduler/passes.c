@@ -49,7 +49,7 @@ rs_status rs_passes_run(rs_run *c)
     rs_engine *e = c->e;
     rs_device *d = e->mk;
     const rs_render_hooks *hooks = c->hooks;
-    const uint64_t npix = c->it.npix;
+    const uint64_t npix = c->e->it.npix;
     rs_pass_job job;
     rs_path_counts counts = {0, 0, 0};
     pass_ctx p;

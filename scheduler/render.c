@@ -45,7 +45,7 @@ static void submit(rs_run *c, rs_slot *sl, rs_trace_kind kind)
 static int stage_raygen(rs_run *c, rs_slot *sl, rs_status *status)
 {
     (void)status;
-    rs_stage_raygen(&c->it, &c->ex, sl->start, sl->count, &sl->b.paths, &sl->b.ext[0]);
+    rs_stage_raygen(&c->e->it, &c->map, &c->ex, sl->start, sl->count, &sl->b.paths, &sl->b.ext[0]);
     submit(c, sl, RS_TRACE_CLOSEST);
     return 0;
 }
@@ -63,8 +63,8 @@ static int stage_shade(rs_run *c, rs_slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;
     (void)status;
-    rs_stage_shade(&c->it, &c->ex, sl->start, sl->bounce, &b->ext[sl->cur], &b->hits, sl->alive,
-                   &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
+    rs_stage_shade(&c->e->it, &c->map, &c->ex, sl->start, sl->bounce, &b->ext[sl->cur], &b->hits,
+                   sl->alive, &b->paths, &b->ext[sl->cur ^ 1], &b->shadow, &b->runs);
     sl->n_shadow = rs_stream_pack_runs(&b->shadow, &b->runs, 1, sl->alive);
     if (sl->n_shadow == 0)
         return 1;
@@ -100,7 +100,7 @@ static int stage_compact(rs_run *c, rs_slot *sl, rs_status *status)
 typedef struct flush_ctx {
     const rs_slot *sl;
     rs_film *film;
-    const rs_render_consts *it;
+    const rs_path_map *map;
     uint32_t npix; /* paths per pass */
 } flush_ctx;
 
@@ -113,7 +113,7 @@ static void flush_range(void *ctx, uint32_t begin, uint32_t end)
     uint32_t k, i;
     for (k = begin; k < end; ++k)
         for (i = k; i < f->sl->count; i += f->npix)
-            rs_film_add(f->film, rs_path_pixel(f->it, f->sl->start + i),
+            rs_film_add(f->film, rs_path_map_pixel(f->map, f->sl->start + i),
                         f->sl->b.paths.radiance[i]);
 }
 
@@ -123,8 +123,8 @@ static int stage_film(rs_run *c, rs_slot *sl, rs_status *status)
     flush_ctx f;
     f.sl = sl;
     f.film = c->film;
-    f.it = &c->it;
-    f.npix = c->it.n_active;
+    f.map = &c->map;
+    f.npix = c->map.n_active;
     rs_parallel_range(RS_PAR_FOR_DYNAMIC, c->ex.threads, 0, sl->count < f.npix ? sl->count : f.npix,
                       4096, flush_range, &f);
     c->stats->paths_done += sl->count;

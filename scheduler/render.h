@@ -29,7 +29,7 @@
  * (docs/scheduler.md).
  *
  * The megakernel (passes.c): the thesis's classic integrator, each sample's path traced from
- * the camera to its end (rs_path_radiance, shading/path.h: the same per-path code and random
+ * the camera to its end (shading/path.h's rs_path_step: the same per-path code and random
  * numbers) on one device through its render_pass entry (scheduler/device.h), in calls of
  * d->pass_samples samples, whole images only.
  *

@@ -1,4 +1,5 @@
-/* shading/integrator.c — raygen, shade and shadow-resolve stages (see integrator.h); the
+/* shading/integrator.c — the stream engine's raygen, shade and shadow-resolve stages (see
+ * integrator.h); the
  * estimators themselves are shading/path.h's. */
 #include "shading/integrator.h"
 
@@ -56,12 +57,12 @@ int rs_sampler_parse(const char *text, rs_sampler *out)
 /* Pixel and sample of paths wave_start + p, for p = path[i] (or p0 + i where path is NULL),
  * i < n.  A stream keeps its paths in increasing order, so after one division each entry is a
  * step from the one before (a step back or past a whole image divides again); the numbers are
- * those of g mod n_active and g div n_active (mapped through it->pixel_of for a plan over some
+ * those of g mod n_active and g div n_active (mapped through map->pixel_of for a plan over some
  * pixels). */
-static void locate(const rs_render_consts *it, uint64_t wave_start, const uint32_t *path,
-                   uint32_t p0, uint32_t n, uint32_t *pixel, uint32_t *sample)
+static void locate(const rs_path_map *map, uint64_t wave_start, const uint32_t *path, uint32_t p0,
+                   uint32_t n, uint32_t *pixel, uint32_t *sample)
 {
-    uint32_t i, prev = 0, px = 0, sm = 0, npix = it->n_active;
+    uint32_t i, prev = 0, px = 0, sm = 0, npix = map->n_active;
     for (i = 0; i < n; ++i) {
         uint32_t p = path ? path[i] : p0 + i, step = p - prev;
         if (i == 0 || p < prev || step >= npix) {
@@ -79,9 +80,9 @@ static void locate(const rs_render_consts *it, uint64_t wave_start, const uint32
         sample[i] = sm;
     }
     /* a plan over some pixels only (adaptive sampling): their indices */
-    if (it->pixel_of)
+    if (map->pixel_of)
         for (i = 0; i < n; ++i)
-            pixel[i] = it->pixel_of[pixel[i]];
+            pixel[i] = map->pixel_of[pixel[i]];
 }
 
 /* out[i] = rs_path_rand(it, pixel[i], sample[i], bounce, group), i < n. */
@@ -103,8 +104,8 @@ static void path_rand_batch(const rs_render_consts *it, const uint32_t *pixel,
     }
 }
 
-void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
-                     uint32_t count, rs_paths *paths, rs_ray_soa *out)
+void rs_stage_raygen(const rs_render_consts *it, const rs_path_map *map, const rs_stage_exec *ex,
+                     uint64_t wave_start, uint32_t count, rs_paths *paths, rs_ray_soa *out)
 {
     long blk;
     int threads = ex->threads;
@@ -115,7 +116,7 @@ void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64
         uint32_t b = (uint32_t)blk * BATCH, n = count - b < BATCH ? count - b : BATCH, k;
         uint32_t pixel[BATCH], sample[BATCH];
         rs_rng_f4 cam[BATCH], tim[BATCH];
-        locate(it, wave_start, NULL, b, n, pixel, sample);
+        locate(map, wave_start, NULL, b, n, pixel, sample);
         path_rand_batch(it, pixel, sample, 0, RS_DIM_CAMERA, n, cam);
         if (shutter)
             path_rand_batch(it, pixel, sample, 0, RS_DIM_TIME, n, tim);
@@ -135,6 +136,7 @@ void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64
 
 typedef struct shade_ctx {
     const rs_render_consts *it;
+    const rs_path_map *map;
     uint64_t wave_start;
     uint32_t bounce;
     const rs_ray_soa *rays;
@@ -156,7 +158,7 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
         uint32_t n = end - b < BATCH ? end - b : BATCH;
         uint32_t pixel[BATCH], sample[BATCH];
         rs_rng_f4 rb[BATCH], rl[BATCH], pre[2];
-        locate(c->it, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
+        locate(c->map, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
         if (draws) {
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_BSDF, n, rb);
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);
@@ -186,13 +188,14 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
     c->runs->end[begin] = end;
 }
 
-void rs_stage_shade(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
-                    uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
-                    rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
-                    const rs_stream_runs *runs)
+void rs_stage_shade(const rs_render_consts *it, const rs_path_map *map, const rs_stage_exec *ex,
+                    uint64_t wave_start, uint32_t bounce, const rs_ray_soa *rays,
+                    const rs_hit_soa *hits, uint32_t count, rs_paths *paths, rs_ray_soa *next,
+                    rs_ray_soa *shadow, const rs_stream_runs *runs)
 {
     shade_ctx c;
     c.it = it;
+    c.map = map;
     c.wave_start = wave_start;
     c.bounce = bounce;
     c.rays = rays;

@@ -1,11 +1,12 @@
-/* shading/integrator.h — the path tracer as wavefront stages: raygen, shade, resolve shadows.
+/* shading/integrator.h — the stream engine's host stages of the path tracer: raygen, shade,
+ * resolve shadows (rs_stage_*), with the host-only constants they read besides the render's.
  *
  * The render loop (scheduler/render.c) owns the buffers and calls the stages in order; devices
  * trace between them.  Each stage is a parallel loop over one stream and writes each path's
  * state only from that path's own slot, so results do not depend on thread count or order.
  *
- * A path is named by its index in the wave; its global index g = wave_start + path gives the
- * pixel (g mod npix) and the sample (g div npix), and with the bounce, the random numbers.
+ * A path is named by its index in the wave; its global index g = wave_start + path gives, through
+ * the plan's rs_path_map, the pixel and the sample, and with the bounce, the random numbers.
  * Each stage is a loop around the RS_HD per-path code of shading/path.h. */
 #ifndef RS_SHADING_INTEGRATOR_H
 #define RS_SHADING_INTEGRATOR_H
@@ -35,9 +36,30 @@ typedef struct rs_stage_exec {
     rs_par_strategy strategy;
 } rs_stage_exec;
 
+/* Which pixel and sample each path of the plan being run is (scheduler/plan.h): host memory,
+ * read only by the stream engine's host stages and its film stage, never by a device (the
+ * megakernel runs only plans over every pixel, scheduler/engine.c).  Path g is pixel
+ * pixel_of[g mod n_active] (NULL: g mod n_active itself, n_active = npix), sample g div
+ * n_active. */
+typedef struct rs_path_map {
+    const uint32_t *pixel_of;
+    uint32_t n_active;
+} rs_path_map;
+
+/* Pixel and sample of path g. */
+static inline uint32_t rs_path_map_pixel(const rs_path_map *m, uint64_t g)
+{
+    uint32_t k = (uint32_t)(g % m->n_active);
+    return m->pixel_of ? m->pixel_of[k] : k;
+}
+static inline uint32_t rs_path_map_sample(const rs_path_map *m, uint64_t g)
+{
+    return (uint32_t)(g / m->n_active);
+}
+
 /* Fills `out` with the camera rays of paths [0, count) and resets their state. */
-void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
-                     uint32_t count, rs_paths *paths, rs_ray_soa *out);
+void rs_stage_raygen(const rs_render_consts *it, const rs_path_map *map, const rs_stage_exec *ex,
+                     uint64_t wave_start, uint32_t count, rs_paths *paths, rs_ray_soa *out);
 
 /* Shades the hits of `rays` (segment number `bounce`): each path may make its next ray and a
  * shadow ray (its contribution in paths->pending).  The stream is split into ranges (by the
@@ -45,10 +67,10 @@ void rs_stage_raygen(const rs_render_consts *it, const rs_stage_exec *ex, uint64
  * shadow rays likewise in `shadow`, in slot order, and records the counts in `runs`
  * (first: next rays, second: shadow rays); rs_stream_pack_runs then packs each stream (the
  * valid entries in slot order, whatever the split). */
-void rs_stage_shade(const rs_render_consts *it, const rs_stage_exec *ex, uint64_t wave_start,
-                    uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits, uint32_t count,
-                    rs_paths *paths, rs_ray_soa *next, rs_ray_soa *shadow,
-                    const rs_stream_runs *runs);
+void rs_stage_shade(const rs_render_consts *it, const rs_path_map *map, const rs_stage_exec *ex,
+                    uint64_t wave_start, uint32_t bounce, const rs_ray_soa *rays,
+                    const rs_hit_soa *hits, uint32_t count, rs_paths *paths, rs_ray_soa *next,
+                    rs_ray_soa *shadow, const rs_stream_runs *runs);
 
 /* Adds each unoccluded shadow ray's pending contribution to its path. */
 void rs_stage_resolve_shadows(const rs_stage_exec *ex, const rs_ray_soa *shadow,

@@ -1,11 +1,13 @@
 /* shading/path.h — one path of the path tracer, written once for the host and the CUDA device
- * (every function RS_HD): its camera ray, the shading of each of its vertices, and the whole
- * path traced to its end for the megakernel integrators.
+ * (every function RS_HD): its camera ray, the shading of each of its vertices, and the step from
+ * one vertex to the next for the megakernel integrators.  Nothing here traces: whoever calls it
+ * owns the traversal.
  *
  * The wavefront stages (shading/integrator.c) call rs_path_begin_at and rs_path_shade_at on each
- * entry of a stream; the megakernels (the devices' render_pass: cpu/cpu_megakernel.c,
- * gpu/cuda_megakernel.cu, gpu/gpu_fallback.c) call rs_path_radiance, which calls the same two
- * with a traversal between.
+ * entry of a stream; the megakernels (the devices' render_pass: cpu/cpu_megakernel.c with the
+ * CPU's wide BVH, gpu/megakernel_path.h with the binary BVH for gpu/cuda_megakernel.cu and
+ * gpu/gpu_fallback.c) loop over rs_path_start, rs_path_step and rs_path_unoccluded, which call
+ * the same two, with their own traversal between.
  * A path is named by its pixel and sample (from its index in a plan, scheduler/plan.h); with the
  * bounce they pick its random numbers, so every integrator makes the same paths.
  *
@@ -25,7 +27,6 @@
 
 #include <float.h>
 
-#include "accel/bvh_traverse.h"
 #include "core/rng.h"
 #include "core/sobol.h"
 #include "core/zsobol.h"
@@ -36,10 +37,6 @@
 #include "shading/spawn.h"
 #include "shading/texture.h"
 #include "streams/paths.h"
-#if !defined(__CUDACC__)
-#  include "accel/bvh4.h" /* SSE: the host's megakernel may trace with the 4-wide BVH */
-#  include "accel/bvh8.h" /* or, with AVX2, the 8-wide one */
-#endif
 
 typedef enum rs_sampling {
     RS_SAMPLING_MIS = 0,     /* light sampling + BSDF sampling, power heuristic (Veach 1998) */
@@ -65,9 +62,12 @@ typedef enum rs_sampler {
 #define RS_SHADE_SHADOW 2u /* a shadow ray *shadow carries ps->pending */
 
 /* The render's constants, shared by every path: fixed-width plain data, the same bytes on the
- * host and a device (the CUDA device takes a copy whose `scene` points to its mirror of the
- * scene).  Built by rs_render_constants (scheduler/render.h) for both integrators; how many host
- * threads run a stage is not a constant of the render and is not here. */
+ * host and a device, passed by value to the CUDA kernel.  `scene` is the only pointer: each
+ * device that has memory of its own points its copy at its mirror of the scene
+ * (scheduler/device_copy.h).  Built by rs_render_constants (scheduler/render.h) for both
+ * integrators.  Nothing host-only belongs here (how many host threads run a stage, the pixels of
+ * the plan being run: shading/integrator.h's rs_path_map); scheduler/device_copy.c asserts at
+ * compile time that the struct is exactly these fields. */
 typedef struct rs_render_consts {
     const rs_scene *scene;
     rs_camera camera;
@@ -78,23 +78,7 @@ typedef struct rs_render_consts {
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     uint32_t sampling;  /* rs_sampling */
     uint32_t sampler;   /* rs_sampler */
-    /* The pixels of the plan being run (scheduler/plan.h): path g is pixel pixel_of[g mod
-     * n_active] (NULL: g mod n_active itself, n_active = npix), sample g div n_active.  Host
-     * memory: only the stream engine's host stages read it. */
-    const uint32_t *pixel_of;
-    uint32_t n_active;
 } rs_render_consts;
-
-/* Pixel and sample of path g. */
-RS_HD uint32_t rs_path_pixel(const rs_render_consts *it, uint64_t g)
-{
-    uint32_t k = (uint32_t)(g % it->n_active);
-    return it->pixel_of ? it->pixel_of[k] : k;
-}
-RS_HD uint32_t rs_path_sample(const rs_render_consts *it, uint64_t g)
-{
-    return (uint32_t)(g / it->n_active);
-}
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the
  * light's point (v[1], v[2]) is one stratified pair, the pick and the mixture choice (v[0],
@@ -604,77 +588,66 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
     return out | RS_SHADE_NEXT;
 }
 
-/* What a megakernel traces with: the binary BVH over `geom` (device pointers on the GPU), or on
- * the host the 8-wide one where `bvh8` is set, the 4-wide one where `bvh4` is. */
-typedef struct rs_path_tracer {
-    rs_bvh_view bvh;
-    rs_geom geom;
-    const void *bvh4; /* const rs_bvh4 * (accel/bvh4.h), host only; NULL: the binary BVH */
-    const void *bvh8; /* const rs_bvh8 * (accel/bvh8.h), host only, AVX2; before bvh4 */
-} rs_path_tracer;
-
 /* Rays a megakernel traced. */
 typedef struct rs_path_counts {
     uint64_t closest, shadow;
     uint32_t max_bounce;
 } rs_path_counts;
 
-RS_HD void rs_path_closest(const rs_path_tracer *tr, rs_ray r, rs_hit *h)
-{
-#if !defined(__CUDACC__)
-    if (tr->bvh8) {
-        rs_bvh8_closest((const rs_bvh8 *)tr->bvh8, &tr->geom, r, h);
-        return;
-    }
-    if (tr->bvh4) {
-        rs_bvh4_closest((const rs_bvh4 *)tr->bvh4, &tr->geom, r, h);
-        return;
-    }
-#endif
-    rs_bvh_closest(&tr->bvh, &tr->geom, r, h);
-}
-
-RS_HD int rs_path_occluded(const rs_path_tracer *tr, rs_ray r)
-{
-#if !defined(__CUDACC__)
-    if (tr->bvh8)
-        return rs_bvh8_occluded((const rs_bvh8 *)tr->bvh8, &tr->geom, r);
-    if (tr->bvh4)
-        return rs_bvh4_occluded((const rs_bvh4 *)tr->bvh4, &tr->geom, r);
-#endif
-    return rs_bvh_occluded(&tr->bvh, &tr->geom, r);
-}
-
-/* Path g from the camera to its end (the thesis's recursive radiance(), unrolled): each vertex
- * shaded as the wavefront shades it, each shadow ray resolved before the next segment, so the
- * radiance is the wavefront's bit for bit (on the same compiler). */
-RS_HD rs_vec3 rs_path_radiance(const rs_render_consts *it, const rs_path_tracer *tr, uint64_t g,
-                               rs_path_counts *n)
-{
-    /* pixel and sample once per path: a 64-bit division and remainder, not one per vertex */
-    const uint32_t pixel = rs_path_pixel(it, g), sample = rs_path_sample(it, g);
+/* One path of a megakernel between its traversals (the thesis's recursive radiance(),
+ * unrolled).  Shading owns the path; the device owns the loop and its traversal:
+ *
+ *     rs_path p;
+ *     rs_path_start(it, pixel, sample, &p);
+ *     for (;;) {
+ *         closest hit of p.ray -> h;                        (count closest, max_bounce = p.bounce)
+ *         made = rs_path_step(it, &p, &h);
+ *         if ((made & RS_SHADE_SHADOW) && !occluded(p.shadow)) (count shadow)
+ *             rs_path_unoccluded(&p);
+ *         if (!(made & RS_SHADE_NEXT)) break;
+ *     }
+ *     radiance: p.ps.radiance
+ *
+ * Each vertex is shaded as the wavefront shades it and each shadow ray resolved before the next
+ * segment, so the radiance is the wavefront's bit for bit (on the same compiler). */
+typedef struct rs_path {
+    uint32_t pixel, sample;
+    uint32_t bounce; /* the segment p.ray is: 0 for the camera ray */
     rs_path_state ps;
-    rs_ray r = rs_path_begin_at(it, pixel, sample, NULL, &ps), next, shadow;
-    next = shadow = r; /* set by rs_path_shade_at where its flags say: this quiets gcc */
-    uint32_t bounce;
-    for (bounce = 0;; ++bounce) {
-        rs_hit h;
-        uint32_t made;
-        rs_path_closest(tr, r, &h);
-        ++n->closest;
-        if (bounce > n->max_bounce)
-            n->max_bounce = bounce;
-        made = rs_path_shade_at(it, pixel, sample, bounce, NULL, &r, &h, &ps, &next, &shadow);
-        if (made & RS_SHADE_SHADOW) {
-            ++n->shadow;
-            if (!rs_path_occluded(tr, shadow))
-                ps.radiance = rs_v3_add(ps.radiance, ps.pending);
-        }
-        if (!(made & RS_SHADE_NEXT))
-            break;
-        r = next;
+    rs_ray ray;    /* the segment to trace next */
+    rs_ray shadow; /* valid where rs_path_step returned RS_SHADE_SHADOW */
+} rs_path;
+
+/* Path (pixel, sample): its camera ray in p->ray, its state reset. */
+RS_HD void rs_path_start(const rs_render_consts *it, uint32_t pixel, uint32_t sample, rs_path *p)
+{
+    p->pixel = pixel;
+    p->sample = sample;
+    p->bounce = 0;
+    p->ray = rs_path_begin_at(it, pixel, sample, NULL, &p->ps);
+    p->shadow = p->ray; /* set by rs_path_step where its flags say: this quiets gcc */
+}
+
+/* Shades h, the closest hit of p->ray: returns rs_path_shade_at's RS_SHADE_* flags.  With
+ * RS_SHADE_SHADOW, p->shadow is to be tested (rs_path_unoccluded if nothing is in the way);
+ * with RS_SHADE_NEXT, p->ray is the next segment and p->bounce its number; without it the path
+ * has ended and p->ps.radiance is its radiance (once a pending shadow ray is resolved). */
+RS_HD uint32_t rs_path_step(const rs_render_consts *it, rs_path *p, const rs_hit *h)
+{
+    rs_ray next = p->ray;
+    uint32_t made = rs_path_shade_at(it, p->pixel, p->sample, p->bounce, NULL, &p->ray, h, &p->ps,
+                                     &next, &p->shadow);
+    if (made & RS_SHADE_NEXT) {
+        p->ray = next;
+        ++p->bounce;
     }
-    return ps.radiance;
+    return made;
+}
+
+/* p->shadow reached its light: the light's contribution is added. */
+RS_HD void rs_path_unoccluded(rs_path *p)
+{
+    p->ps.radiance = rs_v3_add(p->ps.radiance, p->ps.pending);
 }
 
 #endif

@@ -367,7 +367,7 @@ static void test_render_cpu_vs_gpu(void **state)
     }
 }
 
-/* The CUDA megakernel (the device's render_pass: one thread per pixel running rs_path_radiance:
+/* The CUDA megakernel (the device's render_pass: one thread per pixel running rs_gpu_path_radiance:
  * shading, light sampling, textures and traversal all on the GPU) against the CPU megakernel on
  * the scenes with every material and texture, the Cornell box, the bouncing spheres (the scene
  * copy's sphere_motion) and a mesh.  The GPU's own sqrtf/sinf/powf round differently, so a path

@@ -136,7 +136,7 @@ static void test_failure_with_waves_in_flight(void **state)
 }
 
 /* The thesis's three OpenMP strategies, in the CPU device and the shading, and the per-pixel
- * megakernel under each (rs_path_radiance: the stages' own per-path code, each pixel's samples
+ * megakernel under each (rs_path_step: the stages' own per-path code, each pixel's samples
  * added in order), on the CPU and as the GPU megakernel's passes on host threads (its fallback:
  * one sample of every pixel per pass, the binary BVH); and no BVH at all (one leaf: brute force)
  * under both integrators. */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "accel/bvh8.h" /* rs_bvh_wide_leaf_size */
 #include "core/alloc.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"

@@ -12,9 +12,10 @@
  *     original's blocks are recorded from the library allocator (rs_alloc_set_observer) while the
  *     scene and its BVH are built, the copy's from the copy callbacks; then EVERY pointer-sized,
  *     pointer-aligned word of the copied rs_geom, rs_bvh_view, rs_scene (and its rs_image array,
- *     and the megakernel's rs_path_tracer) is checked, not only the fields the array lists name,
- *     so an array missing from a list (RS_SCENE_ARRAYS, RS_GEOM_ARRAYS, RS_BVH_ARRAYS) fails
- *     here; and a copy failing at any step releases every block it made. */
+ *     the megakernel's rs_path_tracer, and the render constants a device holds) is checked, not
+ *     only the fields the array lists name, so an array missing from a list (RS_SCENE_ARRAYS,
+ *     RS_GEOM_ARRAYS, RS_BVH_ARRAYS) fails here; and a copy failing at any step releases every
+ *     block it made. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -411,6 +412,20 @@ static void check_device_copy(const char *builtin)
                &in_copy);
     scan_words(name, "megakernel tracer (rs_path_tracer)", &ds.tracer, sizeof ds.tracer, &o.orig,
                &r.made, &in_copy);
+    {
+        /* the render constants as a device with a copy holds them (gpu/: upload_scene points
+         * `scene` at the copy): no word of them may point into host memory of the original, and
+         * `scene` is the copy's (scheduler/device_copy.c asserts they hold nothing else) */
+        rt_args a = rt_defaults(name, 8, 2);
+        rs_render_settings st = rt_settings(&a);
+        rs_render_consts rc;
+        int rc_in_copy = 0;
+        assert_int_equal(rs_render_constants(o.scene, &st, &rc), RS_OK);
+        rc.scene = ds.scene;
+        scan_words(name, "render constants (rs_render_consts)", &rc, sizeof rc, &o.orig, &r.made,
+                   &rc_in_copy);
+        assert_int_equal(rc_in_copy, 1);
+    }
     if (ms->n_images)
         scan_words(name, "the mirror's images (rs_image[])", ms->images,
                    ms->n_images * sizeof *ms->images, &o.orig, &r.made, &in_copy);
