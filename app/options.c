@@ -184,6 +184,14 @@ static void help_render_devices(void)
           "  --devices LIST      auto (default: the CPU and every CUDA device), or comma-\n"
           "                      separated cpu, cpu:THREADS, gpu, gpu:INDEX.  A gpu that\n"
           "                      cannot be used runs on the CPU fallback (one warning).\n"
+          "                      Under mpirun, auto deals a machine's GPUs out to its ranks\n"
+          "                      round robin (2 ranks, 4 GPUs: rank 0 takes gpu 0 and 2,\n"
+          "                      rank 1 gpu 1 and 3); with more ranks than GPUs each rank\n"
+          "                      takes one, shared (3 ranks, 2 GPUs: ranks 0 and 2 share\n"
+          "                      gpu 0).  Every rank also takes its share of the cores.\n"
+          "  --require-gpu       GPU or fail: a gpu that cannot be used, or auto finding no\n"
+          "                      CUDA device, is an error (exit 1, before the render), not\n"
+          "                      the CPU fallback\n"
           "  --stats             after the render, a table per device: rays, chunks, busy\n"
           "                      and idle seconds, Mrays/s, share, bytes moved; and the\n"
           "                      seconds of each named stage\n"
@@ -578,6 +586,7 @@ static const opt_row options[] = {
 
     ROW_CALL("--threads", opt_threads),
     ROW_CALL("--devices", opt_devices),
+    ROW_NUM("--require-gpu", OPT_FLAG, require_gpu, 0, 0),
     ROW_CALL("--integrator", opt_integrator),
     ROW_CALL("--cpu-strategy", opt_cpu_strategy),
     ROW_NUM("--stats", OPT_FLAG, stats, 0, 0),
@@ -691,12 +700,25 @@ static int parse_command(int argc, char **argv, rs_cli_options *o, int *rc)
     return 0;
 }
 
+/* Whether --devices lists a gpu. */
+static int any_gpu_listed(const rs_cli_options *o)
+{
+    int i;
+    for (i = 0; i < o->n_devices; ++i)
+        if (o->devices[i].is_gpu)
+            return 1;
+    return 0;
+}
+
 /* What no single option can check: combinations, and the defaults that depend on them. */
 static int check_render_options(rs_cli_options *o)
 {
     if (o->megakernel && !o->devices_auto && o->n_devices > 1)
         return usage_error("--integrator megakernel runs on one device%s%s (use --devices cpu or "
                            "--devices gpu[:INDEX])",
+                           "", "");
+    if (o->require_gpu && !o->devices_auto && !any_gpu_listed(o))
+        return usage_error("--require-gpu needs a gpu in --devices (gpu, gpu:INDEX or auto)%s%s",
                            "", "");
     if (o->ckpt_every_s > 0 && !o->checkpoint)
         return usage_error("--checkpoint-interval needs --checkpoint FILE%s%s", "", "");

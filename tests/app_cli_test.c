@@ -119,6 +119,8 @@ static void test_usage_errors(void **state)
         {{"render", "-o", "out.png", "--spp", "1", "--integrator", "megakernel", "--devices",
           "cpu,gpu", NULL},
          {"megakernel", "one device"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--devices", "cpu", "--require-gpu", NULL},
+         {"--require-gpu", "--devices"}},
         {{"render", "-o", "out.png", "--spp", "1", "--chunk-size", "big", NULL},
          {"--chunk-size", "big"}},
         {{"render", "-o", "out.png", "--spp", "1", "--bvh-device", "tpu", NULL},
@@ -903,6 +905,44 @@ static void test_gpu_fallback(void **state)
     proc_free(&q);
     proc_free(&r);
 }
+/* --require-gpu ("GPU or fail"): a gpu that cannot be used is one line naming it and the flag,
+ * exit 1, before the render and with no file written, for the stream engine and the megakernel
+ * (gpu:63 is no device on any machine here); where no CUDA device can be used, --devices auto
+ * with it fails the same way.  Without the flag the fallback stays (test_gpu_fallback). */
+static void test_require_gpu(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const cases[][16] = {
+        {"render", "--width", "24", "--spp", "1", "-q", "--devices", "cpu:1,gpu:63",
+         "--require-gpu", "-o", "x.png", NULL},
+        {"render", "--width", "24", "--spp", "1", "-q", "--integrator", "megakernel", "--devices",
+         "gpu:63", "--require-gpu", "-o", "x.png", NULL},
+        {"render", "--width", "24", "--spp", "1", "-q", "--require-gpu", "-o", "x.png", NULL},
+        {"render", "--width", "24", "--spp", "1", "-q", "--integrator", "megakernel",
+         "--require-gpu", "-o", "x.png", NULL}};
+    static const char *const words[][2] = {
+        {"gpu:63", "cannot be used"}, {"megakernel", "gpu:63"}, {"auto", "no CUDA device"},
+        {"auto", "no CUDA device"}};
+    const char *why = "";
+    char names[512];
+    size_t c, n = sizeof cases / sizeof cases[0];
+    proc p;
+    if (rs_gpu_count(&why) > 0)
+        n = 2; /* auto finds a device: only the missing gpu:63 can fail */
+    for (c = 0; c < n; ++c) {
+        run(&p, f->dir, DEFAULT_TIMEOUT_S, cases[c]);
+        EXPECT(&p, exited_with(&p, 1), "--require-gpu with no usable gpu should exit 1");
+        EXPECT(&p,
+               one_line(&p.err) && strstr(p.err.data, "--require-gpu") &&
+                   strstr(p.err.data, words[c][0]) && strstr(p.err.data, words[c][1]),
+               "expected one line naming --require-gpu, '%s' and '%s'", words[c][0],
+               words[c][1]);
+        EXPECT(&p, !contains_ci(p.err.data, "warning"), "no fallback warning with --require-gpu");
+        EXPECT(&p, list_dir(f->dir, names, sizeof names) == 0, "files were written: %s", names);
+        proc_free(&p);
+    }
+}
+
 /* Scene files and meshes from the command line: a good JSON scene and a mesh render; a bad
  * JSON scene and an unreadable mesh give one line naming the file and exit 1; a mesh with bad
  * faces renders with one warning line counting them. */
@@ -1855,6 +1895,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_threads_and_chunks_change_nothing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_device_fault_and_stats, setup, teardown),
         cmocka_unit_test_setup_teardown(test_gpu_fallback, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_require_gpu, setup, teardown),
         cmocka_unit_test_setup_teardown(test_user_scenes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_files_and_meshes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_stage_stats_and_timeline, setup, teardown),
