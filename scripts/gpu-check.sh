@@ -22,20 +22,21 @@
 #     4. the host tests that compare the GPU's fallback and devices (render_gpucheck_test,
 #        scheduler_stream_test, render_determinism_test, scenes_mirror_test);
 #     5. builtin:gpucheck rendered by the CLI with --devices cpu, gpu, cpu,gpu (stream) and the
-#        GPU megakernel: each GPU render must run on cuda:0 (a "runs on the CPU fallback" warning,
-#        or no cuda:0 in its summary, fails), and the three stream images must be one, byte for
-#        byte (.pfm); --timeline pictures of the GPU renders;
+#        GPU megakernel: each GPU render runs with --require-gpu, so a GPU it cannot use stops it
+#        with exit 1 and the reason; as second guards a "runs on the CPU fallback" warning, or no
+#        cuda:0 in its summary, fails it too; the three stream images must be one, byte for byte
+#        (.pfm); --timeline pictures of the GPU renders;
 #     with --bench, the GPU benchmarks as well (scheduler, parallel, ablation; --quick: shorter).
 # Logs go to gpu-results/ (or, on the lent machine, /tmp/gpu-check, and then into $OUT, which
 # brings back at most 8 files: summary.txt, gpu_trace_test.txt, memcheck.txt and logs.tar.gz
 # with everything, renders and timelines included); a summary is printed.  Sized for about 5
 # minutes on a 16-core H200 machine, build included: run it with timeout_s 540.
 #
-# raystream itself has no "GPU or fail" switch: `--devices gpu` on a machine where the GPU cannot
-# be used warns and runs on the CPU fallback with exit 0, so step 5 reads the warning and the
-# summary.  (An app/ change would make this direct: a `--require-gpu` option, or `gpu!` in
-# --devices, that makes create_gpu in app/devices.c fail with exit 1 and the reason instead of
-# creating rs_gpu_fallback_create's device.)
+# "GPU or fail" is raystream's --require-gpu: without it `--devices gpu` on a machine where the
+# GPU cannot be used warns and runs on the CPU fallback with exit 0; with it create_gpu in
+# app/devices.c stops with exit 1 and one line naming the device and why, before the render.
+# Step 5 uses it, and still reads the summary and the warning (cheap, and a guard against a
+# raystream whose --require-gpu lets a fallback through).
 set -eu
 if [ "${1:-}" = "--fetch" ]; then
     mkdir -p .gpu-debs
@@ -158,14 +159,16 @@ for args in "--devices cpu" "--devices gpu" "--devices cpu,gpu" "--integrator me
     name=$(echo "$args" | sed 's/--devices //; s/--integrator //; s/ /-/g; s/,/+/g')
     log="$out/render-$name.txt"
     extra=
-    case "$args" in *gpu*) extra="--timeline $out/timeline-$name.svg" ;; esac
+    case "$args" in *gpu*) extra="--require-gpu --timeline $out/timeline-$name.svg" ;; esac
     rc=0
     # shellcheck disable=SC2086
     build-gpu/raystream render builtin:gpucheck --width 384 --height 256 --spp 64 --stats \
         $args -o "$out/render-$name.$ext" $extra >"$log" 2>&1 || rc=$?
     on_gpu=1
     case "$args" in *gpu*) grep -q '^Rendered.*cuda:0' "$log" || on_gpu=0 ;; esac
-    if [ $rc != 0 ]; then
+    if [ $rc != 0 ] && grep -q -- '--require-gpu' "$log"; then
+        failed "render $args: the GPU cannot be used: $(grep -h -- '--require-gpu' "$log" | head -1)"
+    elif [ $rc != 0 ]; then
         failed "render $args: exit $rc (see $log)"
     elif grep -q 'CPU fallback' "$log"; then
         failed "render $args fell back to the CPU: $(grep -h 'CPU fallback' "$log")"
