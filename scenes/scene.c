@@ -478,6 +478,90 @@ static float prim_area(const rs_scene *s, uint32_t prim)
     }
 }
 
+static int within(rs_vec3 p, float lim)
+{
+    return fabsf(p.x) <= lim && fabsf(p.y) <= lim && fabsf(p.z) <= lim;
+}
+
+/* Refuses part `part` number `index` with a message; the reader can name it as its file does. */
+static rs_status refuse_part(rs_scene *s, uint32_t part, uint32_t index, const char *what)
+{
+    static const char *const k_names[] = {"",         "sphere",   "quad",  "triangle",
+                                          "instance", "material", "light", "environment map"};
+    s->bad_part = part;
+    s->bad_index = index;
+    if (part == RS_PART_ENVIRONMENT)
+        return rs_error_set(RS_ERR_ARG, "%s: %s", k_names[part], what);
+    return rs_error_set(RS_ERR_ARG, "%s %u: %s", k_names[part], index, what);
+}
+
+/* The ranges of scene.h (RS_SCENE_MAX_COORD, RS_SCENE_MAX_RADIANCE). */
+static rs_status check_ranges(rs_scene *s)
+{
+    const float lim = RS_SCENE_MAX_COORD, most = RS_SCENE_MAX_RADIANCE;
+    char why[160];
+    uint32_t i;
+    snprintf(why, sizeof why, "a point beyond +-%.0e, where the intersection tests' float "
+                              "arithmetic no longer holds (scale the scene down)", (double)lim);
+    for (i = 0; i < s->n_spheres; ++i) {
+        rs_vec3 c = s->spheres[i].center, r = rs_v3_splat(s->spheres[i].radius);
+        rs_vec3 e = s->sphere_motion ? rs_v3_add(c, s->sphere_motion[i]) : c;
+        if (!within(rs_v3_add(c, r), lim) || !within(rs_v3_sub(c, r), lim) ||
+            !within(rs_v3_add(e, r), lim) || !within(rs_v3_sub(e, r), lim))
+            return refuse_part(s, RS_PART_SPHERE, i, why);
+    }
+    for (i = 0; i < s->n_quads; ++i) {
+        const rs_quad *q = &s->quads[i];
+        if (!within(q->q, lim) || !within(rs_v3_add(q->q, q->u), lim) ||
+            !within(rs_v3_add(q->q, q->v), lim) ||
+            !within(rs_v3_add(rs_v3_add(q->q, q->u), q->v), lim))
+            return refuse_part(s, RS_PART_QUAD, i, why);
+    }
+    for (i = 0; i < s->n_tris; ++i)
+        if (!within(s->tris[i].v0, lim) || !within(s->tris[i].v1, lim) ||
+            !within(s->tris[i].v2, lim))
+            return refuse_part(s, RS_PART_TRIANGLE, i, why);
+    for (i = 0; i < s->n_instances; ++i)
+        if (!within(s->instances[i].box.lo, lim) || !within(s->instances[i].box.hi, lim))
+            return refuse_part(s, RS_PART_INSTANCE, i, why);
+    snprintf(why, sizeof why, "above %.0e, more than the film holds (a sample beyond 2^48 "
+                              "would be dropped)", (double)most);
+    for (i = 0; i < s->n_materials; ++i)
+        if (rs_v3_max_comp(s->materials[i].emission) > most) {
+            char w[200];
+            snprintf(w, sizeof w, "emission %g %s", (double)rs_v3_max_comp(s->materials[i].emission),
+                     why);
+            return refuse_part(s, RS_PART_MATERIAL, i, w);
+        }
+    for (i = 0; i < s->n_punctuals; ++i) {
+        const rs_punctual *p = &s->punctuals[i];
+        char w[200];
+        if (rs_v3_max_comp(p->intensity) > most) {
+            snprintf(w, sizeof w, "intensity %g %s", (double)rs_v3_max_comp(p->intensity), why);
+            return refuse_part(s, RS_PART_LIGHT, i, w);
+        }
+        if (p->type != RS_PUNCTUAL_DIRECTIONAL && !within(p->pos, lim)) {
+            snprintf(w, sizeof w, "a position beyond +-%.0e (scale the scene down)", (double)lim);
+            return refuse_part(s, RS_PART_LIGHT, i, w);
+        }
+    }
+    if (s->env_image != RS_NO_TEXTURE && s->env_image < s->n_images) {
+        const rs_image *im = &s->images[s->env_image];
+        float top = 0, sc = rs_v3_max_comp(s->env_scale);
+        size_t k, n = (size_t)im->width * im->height * 3;
+        for (k = 0; k < n; ++k)
+            if (im->rgb[k] > top)
+                top = im->rgb[k];
+        if ((double)top * sc > most) {
+            char w[240];
+            snprintf(w, sizeof w, "its brightest texel times the scale is %g, %s",
+                     (double)top * sc, why);
+            return refuse_part(s, RS_PART_ENVIRONMENT, 0, w);
+        }
+    }
+    return RS_OK;
+}
+
 rs_status rs_scene_finalize(rs_scene *s)
 {
     uint32_t i, n = rs_scene_prim_count(s), nl = 0;
@@ -485,14 +569,14 @@ rs_status rs_scene_finalize(rs_scene *s)
     for (i = 0; i < s->n_spheres; ++i)
         if (!finite3(s->spheres[i].center) || !isfinite(s->spheres[i].radius) ||
             !(s->spheres[i].radius > 0.0f))
-            return rs_error_set(RS_ERR_ARG, "sphere %u: non-finite centre or radius <= 0", i);
+            return refuse_part(s, RS_PART_SPHERE, i, "non-finite centre or radius <= 0");
     for (i = 0; i < s->n_quads; ++i)
         if (!finite3(s->quads[i].q) || !finite3(s->quads[i].w) ||
             rs_v3_is_zero(rs_v3_cross(s->quads[i].u, s->quads[i].v)))
-            return rs_error_set(RS_ERR_ARG, "quad %u: non-finite or degenerate (zero area)", i);
+            return refuse_part(s, RS_PART_QUAD, i, "non-finite or degenerate (zero area)");
     for (i = 0; i < s->n_tris; ++i)
         if (!finite3(s->tris[i].v0) || !finite3(s->tris[i].v1) || !finite3(s->tris[i].v2))
-            return rs_error_set(RS_ERR_ARG, "triangle %u: non-finite vertex", i);
+            return refuse_part(s, RS_PART_TRIANGLE, i, "non-finite vertex");
     for (i = 0; i < s->n_inst_tris; ++i) {
         const rs_material *m;
         if (!finite3(s->inst_tris[i].v0) || !finite3(s->inst_tris[i].v1) ||
@@ -505,6 +589,12 @@ rs_status rs_scene_finalize(rs_scene *s)
         if (rs_material_is_light(m))
             return rs_error_set(RS_ERR_ARG, "prototype triangle %u emits light: emitters are "
                                             "copied, never instanced", i);
+    }
+    s->bad_part = RS_PART_NONE;
+    {
+        rs_status st = check_ranges(s);
+        if (st != RS_OK)
+            return st;
     }
     {
         /* instances' triangles are numbered after the scene's own, in instance order */
@@ -534,26 +624,25 @@ rs_status rs_scene_finalize(rs_scene *s)
         if ((m->type == RS_MAT_CONDUCTOR || m->type == RS_MAT_ROUGH_DIELECTRIC ||
              m->type == RS_MAT_PBR) &&
             !(m->alpha >= 0.0f && m->alpha <= 1.0f && m->metallic >= 0.0f && m->metallic <= 1.0f))
-            return rs_error_set(RS_ERR_ARG, "material %u: alpha and metallic must be in [0, 1]", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "alpha and metallic must be in [0, 1]");
         if (m->type == RS_MAT_CONDUCTOR && !(m->flags & RS_MAT_F0_COLOR) &&
             !(m->eta.x > 0 && m->eta.y > 0 && m->eta.z > 0 && m->k.x >= 0 && m->k.y >= 0 &&
               m->k.z >= 0 && finite3(m->eta) && finite3(m->k)))
-            return rs_error_set(RS_ERR_ARG, "material %u: a conductor's eta must be > 0, k >= 0",
-                                i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "a conductor's eta must be > 0, k >= 0");
         if (m->type == RS_MAT_ROUGH_DIELECTRIC && !(m->ior > 0.0f && isfinite(m->ior)))
-            return rs_error_set(RS_ERR_ARG, "material %u: index of refraction must be > 0", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "index of refraction must be > 0");
         if (!finite3(m->albedo) || !finite3(m->emission) || !finite3(m->specular) ||
             m->albedo.x < 0 || m->albedo.y < 0 || m->albedo.z < 0 || m->emission.x < 0 ||
             m->emission.y < 0 || m->emission.z < 0)
-            return rs_error_set(RS_ERR_ARG, "material %u: colours must be finite and >= 0", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "colours must be finite and >= 0");
         if (m->type == RS_MAT_DIELECTRIC && !(m->ior > 0.0f && isfinite(m->ior)))
-            return rs_error_set(RS_ERR_ARG, "material %u: index of refraction must be > 0", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "index of refraction must be > 0");
         if (m->type == RS_MAT_PHONG && !(m->exponent >= 0.0f && isfinite(m->exponent)))
-            return rs_error_set(RS_ERR_ARG, "material %u: Phong exponent must be >= 0", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "Phong exponent must be >= 0");
         if (m->type == RS_MAT_METAL && !(m->fuzz >= 0.0f && m->fuzz <= 1.0f))
-            return rs_error_set(RS_ERR_ARG, "material %u: metal fuzz must be in [0, 1]", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "metal fuzz must be in [0, 1]");
         if (m->type == RS_MAT_DISNEY_DIFFUSE && !(m->roughness >= 0.0f && m->roughness <= 1.0f))
-            return rs_error_set(RS_ERR_ARG, "material %u: roughness must be in [0, 1]", i);
+            return refuse_part(s, RS_PART_MATERIAL, i, "roughness must be in [0, 1]");
         if (m->alpha_mask > s->n_masks)
             return rs_error_set(RS_ERR_ARG, "material %u: no alpha mask %u", i, m->alpha_mask);
     }

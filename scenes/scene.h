@@ -206,6 +206,9 @@ typedef struct rs_scene {
                                (1 without punctual lights) */
     int32_t *prim_light; /* per global primitive: index into lights, or -1 */
     int finalized;
+    /* What rs_scene_finalize refused, for a reader to name it as its file does (the JSON
+     * reader: objects[3], materials.lamp): an rs_scene_part and its index; RS_PART_NONE. */
+    uint32_t bad_part, bad_index;
 
     /* The environment map (rs_scene_set_environment): an equirectangular image of the radiance
      * arriving from each direction, importance-sampled by luminance times sin(theta) like a
@@ -483,6 +486,29 @@ rs_status rs_scene_push_instance(rs_scene *s, const rs_instance *in);
  * numbers, shades and renders every triangle as the instanced scene does.  Before finalize. */
 rs_status rs_scene_flatten_instances(rs_scene *s);
 
+/* Where the renderer's arithmetic holds, checked by rs_scene_finalize: every point of the
+ * geometry (sphere centres and extents along their motion, the corners of quads, triangles and
+ * instances' world boxes, point and spot light positions) within +-RS_SCENE_MAX_COORD, so that
+ * no intersection test's float products overflow (a sphere 1.8e19 away vanished); every
+ * emission, light intensity and environment radiance (map times scale) at most
+ * RS_SCENE_MAX_RADIANCE, far inside what the film's exact sums hold (shading/film.h: a sample
+ * above 2^48 is dropped). */
+#define RS_SCENE_MAX_COORD    1e9f
+#define RS_SCENE_MAX_RADIANCE 1e12f
+
+typedef enum rs_scene_part {
+    RS_PART_NONE = 0,
+    RS_PART_SPHERE,
+    RS_PART_QUAD,
+    RS_PART_TRIANGLE,
+    RS_PART_INSTANCE,
+    RS_PART_MATERIAL,
+    RS_PART_LIGHT, /* a punctual light */
+    RS_PART_ENVIRONMENT
+} rs_scene_part;
+
+/* Checks the scene and builds its light tables.  RS_ERR_ARG naming the part (and bad_part,
+ * bad_index saying which) for a scene outside what the renderer holds. */
 rs_status rs_scene_finalize(rs_scene *s);
 
 /* A copy of a finalized scene's arrays in memory that `ops` allocates and fills: the host's, or

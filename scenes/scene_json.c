@@ -70,6 +70,10 @@ typedef struct ctx {
     uint32_t n_textures;
     named materials[MAX_NAMES];
     uint32_t n_materials;
+    /* per top-level object, the scene's spheres, quads, triangles and instances before it: a
+     * primitive rs_scene_finalize refuses is named as the object that made it */
+    uint32_t (*obj_start)[4];
+    uint32_t n_obj;
 } ctx;
 
 #define FAIL(c, path, ...) field_error((c), (path), __VA_ARGS__)
@@ -1345,6 +1349,35 @@ static rs_status check_tree(const ctx *c, const cJSON *it, const char *path)
     return RS_OK;
 }
 
+/* The file's name for what rs_scene_finalize refused (scene->bad_part, bad_index): the object
+ * that made the primitive (objects[3]), the material's name, the background.  0 if none. */
+static int part_path(const ctx *c, char *out, size_t n)
+{
+    const rs_scene *s = c->scene;
+    uint32_t k = 0, i;
+    switch (s->bad_part) {
+    case RS_PART_SPHERE: k = 0; break;
+    case RS_PART_QUAD: k = 1; break;
+    case RS_PART_TRIANGLE: k = 2; break;
+    case RS_PART_INSTANCE: k = 3; break;
+    case RS_PART_MATERIAL:
+        for (i = 0; i < c->n_materials; ++i)
+            if (c->materials[i].id == s->bad_index) {
+                snprintf(out, n, "materials.%s", c->materials[i].name);
+                return 1;
+            }
+        return 0;
+    case RS_PART_ENVIRONMENT: snprintf(out, n, "background.map"); return 1;
+    default: return 0;
+    }
+    for (i = c->n_obj; i-- > 0;)
+        if (c->obj_start[i][k] <= s->bad_index) {
+            snprintf(out, n, "objects[%u]", i);
+            return 1;
+        }
+    return 0;
+}
+
 static rs_status build(ctx *c, const cJSON *root)
 {
     static const char *const keys[] = {"camera",    "image",   "background", "textures",
@@ -1387,8 +1420,15 @@ static rs_status build(ctx *c, const cJSON *root)
         return FAIL(c, "(top level)", "missing 'objects'");
     if (!cJSON_IsArray(objs))
         return FAIL(c, "objects", "expected an array");
+    c->obj_start = (uint32_t(*)[4])rs_calloc((size_t)cJSON_GetArraySize(objs) + 1,
+                                             sizeof *c->obj_start);
+    if (!c->obj_start)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", c->label);
     for (it = objs->child; it; it = it->next, ++i) {
         char p[64];
+        const rs_scene *sc = c->scene;
+        uint32_t *st = c->obj_start[c->n_obj++];
+        st[0] = sc->n_spheres, st[1] = sc->n_quads, st[2] = sc->n_tris, st[3] = sc->n_instances;
         snprintf(p, sizeof p, "objects[%d]", i);
         RS_TRY(read_object(c, it, p, &id));
     }
@@ -1456,11 +1496,17 @@ rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label
     if (st == RS_OK) {
         st = rs_scene_finalize(c->scene);
         if (st != RS_OK) {
-            /* finalize names the primitive or material; prefix the file */
-            char msg[400];
+            /* finalize names the primitive or material as the scene holds it; name it as the
+             * file does, and prefix the file */
+            char msg[400], where[160];
             snprintf(msg, sizeof msg, "%s", rs_error_message());
             rs_error_clear();
-            st = rs_error_set(st, "%s: %s", label, msg);
+            if (part_path(c, where, sizeof where)) {
+                const char *why = strstr(msg, ": "); /* after the scene's own name for it */
+                st = rs_error_set(st, "%s: %s: %s", label, where, why ? why + 2 : msg);
+            } else {
+                st = rs_error_set(st, "%s: %s", label, msg);
+            }
         }
     }
     if (st == RS_OK)
@@ -1476,6 +1522,7 @@ rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label
         }
         rs_free(c->meshes);
     }
+    rs_free(c->obj_start);
     rs_free(c);
     return st;
 }

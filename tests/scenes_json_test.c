@@ -398,6 +398,60 @@ static void expect_load_error(const char *scene, const char *a, const char *b)
     rs_error_clear();
 }
 
+/* Values the reader's syntax takes but the renderer cannot render right (issue 27): refused
+ * at load, naming the object as the file does.  A light of 1e20 rendered black (its samples
+ * beyond what the film holds were dropped), a sphere 3e19 away or a quad 2e10 wide vanished
+ * (a float square overflowed), and errors named "quad 0" where the file said objects[1]. */
+static void test_ranges_named(void **state)
+{
+    char dir[] = "/tmp/rs_json_XXXXXX", path[256], json[2048], map[256];
+    static const char *const head =
+        "{\"camera\": {\"from\": [0,0,5], \"at\": [0,0,0], \"vfov\": 40},"
+        "\"materials\": {\"w\": {\"type\": \"lambertian\", \"albedo\": [0.5,0.5,0.5]},"
+        "\"lamp\": {\"type\": \"light\", \"emission\": [%s]}},%s"
+        "\"objects\": [{\"type\": \"sphere\", \"center\": [%s], \"radius\": 1, "
+        "\"material\": \"w\"},"
+        "{\"type\": \"quad\", \"q\": [-1,3,-1], \"u\": [%s], \"v\": [0,0,2], "
+        "\"material\": \"lamp\"}]}";
+    static const float px[12] = {1, 1, 1, 2, 2, 2, 3, 3, 3, 1e9f, 1, 1};
+    rs_scene *s;
+    FILE *f;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/s.json", dir);
+    snprintf(map, sizeof map, "%s/sky.exr", dir);
+    assert_int_equal(rs_image_write(map, 2, 2, px), RS_OK);
+#define SCENE(emit, bg, centre, u)                                                              \
+    do {                                                                                       \
+        snprintf(json, sizeof json, head, emit, bg, centre, u);                                \
+        f = fopen(path, "w");                                                                  \
+        assert_non_null(f);                                                                    \
+        fputs(json, f);                                                                        \
+        fclose(f);                                                                             \
+    } while (0)
+    /* the limits themselves load */
+    SCENE("1e12, 1e12, 1e12", "", "0, 0, -999999999", "2, 0, 0");
+    assert_int_equal(rs_scene_load_json(path, &s), RS_OK);
+    rs_scene_destroy(s);
+    SCENE("1e20, 1e20, 1e20", "", "0, 0, 0", "2, 0, 0");
+    expect_load_error(path, "materials.lamp: emission 1e+20", "film");
+    SCENE("5, 5, 5", "", "0, 0, -3e19", "2, 0, 0");
+    expect_load_error(path, "objects[0]: a point beyond", NULL);
+    SCENE("5, 5, 5", "", "0, 0, 0", "2e10, 0, 0");
+    expect_load_error(path, "objects[1]: a point beyond", NULL);
+    /* a map of texels up to 1e9 is fine; scaled by 1e4 it is not */
+    {
+        char bg[512];
+        snprintf(bg, sizeof bg, "\"background\": {\"map\": \"%s\", \"scale\": 1e4},", map);
+        SCENE("5, 5, 5", bg, "0, 0, 0", "2, 0, 0");
+    }
+    expect_load_error(path, "background.map", "brightest texel");
+#undef SCENE
+    remove(path);
+    remove(map);
+    rmdir(dir);
+}
+
 /* Scene files and textures that are not regular files of a sane size are refused by name,
  * without being read: a FIFO (opening one for reading blocks until a writer comes), /dev/zero
  * (never ends), a folder, a socket, a sparse file of 300 MiB.  alarm() turns a regression (a
@@ -518,6 +572,7 @@ int main(void)
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_image_texture_relative),
         cmocka_unit_test(test_file_kinds),
+        cmocka_unit_test(test_ranges_named),
         cmocka_unit_test(test_mutations_never_crash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
