@@ -130,7 +130,7 @@ static void make_key(const rs_cli_options *o, render_run *r)
     /* hashing every byte of a large scene takes a tenth of a second (the living room's 143k
      * triangles and 5 MB of textures): only where a checkpoint is written or read */
     if (o->checkpoint || o->resume)
-        k->scene_hash = rs_checkpoint_scene_hash(r->scene);
+        k->scene_hash = r->scene_hash ? r->scene_hash : rs_checkpoint_scene_hash(r->scene);
     k->seed = r->st.seed;
     k->width = r->st.width;
     k->height = r->st.height;

@@ -25,6 +25,8 @@
 /* Everything one `raystream render` makes, released by rs_run_release. */
 typedef struct render_run {
     rs_scene *scene;
+    uint64_t scene_hash;   /* the scene as loaded, before --flatten-instances (the checkpoint
+                              key: flattening changes no pixel); 0: hash r->scene when needed */
     rs_bvh *bvh;
     rs_geom geom;
     double bvh_ms;

@@ -5,6 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "app/checkpoint.h"
 #include "app/render_run.h"
 #include "app/signals.h"
 #include "core/file.h"
@@ -71,9 +72,13 @@ static int load_scene(const rs_cli_options *o, render_run *r)
     } else if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK) {
         return rs_app_fail(RS_EXIT_RUNTIME, NULL);
     }
-    if (o->flatten_instances && r->scene->n_instances &&
-        (rs_scene_flatten_instances(r->scene) != RS_OK || rs_scene_finalize(r->scene) != RS_OK))
-        return rs_app_fail(RS_EXIT_RUNTIME, "flattening the instances");
+    if (o->flatten_instances && r->scene->n_instances) {
+        /* the image is the instanced scene's bit for bit: so is its checkpoint key */
+        if (o->checkpoint || o->resume)
+            r->scene_hash = rs_checkpoint_scene_hash(r->scene);
+        if (rs_scene_flatten_instances(r->scene) != RS_OK || rs_scene_finalize(r->scene) != RS_OK)
+            return rs_app_fail(RS_EXIT_RUNTIME, "flattening the instances");
+    }
     file_stem(o->scene, r->name, sizeof r->name);
     return RS_EXIT_OK;
 }

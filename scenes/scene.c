@@ -436,7 +436,15 @@ rs_status rs_scene_push_instance(rs_scene *s, const rs_instance *in)
 
 rs_status rs_scene_flatten_instances(rs_scene *s)
 {
+    uint64_t total = rs_scene_prim_count(s);
     uint32_t i, k;
+    for (i = 0; i < s->n_instances; ++i)
+        total += s->instances[i].n_tris;
+    if (total > RS_SCENE_MAX_COPIED_PRIMS) /* checked before a single copy is made */
+        return rs_error_set(RS_ERR_ARG,
+                            "flattening %u instances would make %llu primitives, more than "
+                            "2^24 (leave them instanced)",
+                            s->n_instances, (unsigned long long)total);
     for (i = 0; i < s->n_instances; ++i) {
         const rs_instance *in = &s->instances[i];
         for (k = in->first_tri; k < in->first_tri + in->n_tris; ++k) {

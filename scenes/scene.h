@@ -494,6 +494,9 @@ rs_status rs_scene_flatten_instances(rs_scene *s);
  * RS_SCENE_MAX_RADIANCE, far inside what the film's exact sums hold (shading/film.h: a sample
  * above 2^48 is dropped). */
 #define RS_SCENE_MAX_COORD    1e9f
+/* The most primitives a reader or --flatten-instances copies into the scene (instancing places
+ * more without copying them). */
+#define RS_SCENE_MAX_COPIED_PRIMS (1u << 24)
 #define RS_SCENE_MAX_RADIANCE 1e12f
 
 typedef enum rs_scene_part {

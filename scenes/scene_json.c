@@ -23,7 +23,7 @@
 /* Groups that are not instanced are copied into the scene (and nested groups into their
  * prototype): this bounds what a file of a few lines can make (ten groups of ten instances of each
  * other would be 10^10 primitives).  Placed triangles are bounded by RS_MAX_INST_PRIMS. */
-#define MAX_PRIMS       (1u << 24)
+#define MAX_PRIMS       RS_SCENE_MAX_COPIED_PRIMS
 
 typedef struct named {
     const char *name;

@@ -1664,6 +1664,34 @@ static void test_adaptive(void **state)
  * from the first checkpoint into a new one) and resumed on another device set, the image is
  * the uninterrupted adaptive render's bit for bit; a checkpoint of the other kind, or with
  * another threshold, is refused with the flag named. */
+/* --flatten-instances renders the instanced scene's image bit for bit, so a checkpoint of one
+ * resumes with the other (it was refused as "made for another scene"). */
+static void test_resume_flattened(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+#define SC RS_SOURCE_DIR "/scenes/examples/instances.json", "--width", "64", "--height", "48", "-q"
+    static const char *const ref[] = {"render", SC, "--spp", "8", "-o", "ref.exr", NULL};
+    static const char *const cut[] = {"render", SC, "--spp", "4", "--checkpoint", "i.ckpt",
+                                      "-o", "a.exr", NULL};
+    static const char *const flat[] = {"render", SC, "--spp", "8", "--flatten-instances",
+                                       "--resume", "i.ckpt", "--checkpoint", "f.ckpt", "-o",
+                                       "f.exr", NULL};
+    static const char *const back[] = {"render", SC, "--spp", "8", "--resume", "f.ckpt", "-o",
+                                       "b.exr", NULL};
+#undef SC
+    proc p;
+    run_expect(f, ref, 0, &p);
+    proc_free(&p);
+    run_expect(f, cut, 0, &p);
+    proc_free(&p);
+    run_expect(f, flat, 0, &p);
+    expect_same_image(&p, f, "f.exr", "ref.exr");
+    proc_free(&p);
+    run_expect(f, back, 0, &p); /* a flattened render's checkpoint, resumed instanced */
+    expect_same_image(&p, f, "b.exr", "ref.exr");
+    proc_free(&p);
+}
+
 static void test_adaptive_resume(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -1907,6 +1935,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_aov_layers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive_resume, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_resume_flattened, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }

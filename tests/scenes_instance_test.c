@@ -379,6 +379,37 @@ static void test_bad_instances(void **state)
                  "objects[1]: the transform moves a coordinate beyond 1e30");
 }
 
+/* --flatten-instances copies at most 2^24 primitives, checked before the first copy: 20,000
+ * placements of a 1,000-triangle group (2e7) are refused at once, and the scene is unchanged
+ * (it started to copy 10^8 triangles before). */
+static void test_flatten_capped(void **state)
+{
+    rs_scene *s;
+    uint32_t i, mat, first, count;
+    double m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    rs_material w = rs_mat_lambertian(rs_v3(0.5f, 0.5f, 0.5f));
+    (void)state;
+    assert_int_equal(rs_scene_create("capped", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &w, &mat), RS_OK);
+    for (i = 0; i < 1000; ++i)
+        assert_int_equal(rs_scene_add_triangle(s, rs_v3((float)i, 0, 0), rs_v3((float)i + 1, 0, 0),
+                                               rs_v3((float)i, 1, 0), mat),
+                         RS_OK);
+    assert_int_equal(rs_scene_make_prototype(s, 0, &first, &count), RS_OK);
+    for (i = 0; i < 20000; ++i) {
+        m[11] = (double)i;
+        assert_int_equal(rs_scene_add_instance(s, first, count, m), RS_OK);
+    }
+    rs_error_clear();
+    assert_int_equal(rs_scene_flatten_instances(s), RS_ERR_ARG);
+    print_message("%s\n", rs_error_message());
+    assert_non_null(strstr(rs_error_message(), "more than 2^24"));
+    assert_int_equal(s->n_instances, 20000u);
+    assert_int_equal(s->n_tris, 0u);
+    rs_error_clear();
+    rs_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -387,6 +418,7 @@ int main(void)
         cmocka_unit_test(test_hits_match_brute_force),
         cmocka_unit_test(test_placing_equals_copying),
         cmocka_unit_test(test_bad_instances),
+        cmocka_unit_test(test_flatten_capped),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
