@@ -1445,6 +1445,57 @@ static rs_status build(ctx *c, const cJSON *root)
     return RS_OK;
 }
 
+/* The bytes of a scene file before cJSON reads them: UTF-8 throughout, no control byte but
+ * tab, newline and carriage return (cJSON took NUL and others for white space), and no NUL
+ * character in a string, escaped or not (cJSON cut "w\u0000junk" to "w").  Line numbers in the
+ * message. */
+static rs_status check_text(const char *label, const char *text, size_t len)
+{
+    const unsigned char *b = (const unsigned char *)text;
+    size_t i = 0, line = 1;
+    if (len >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF)
+        i = 3; /* a byte order mark */
+    while (i < len) {
+        unsigned c = b[i];
+        size_t k, n = c < 0x80 ? 1 : (c & 0xE0) == 0xC0 ? 2 : (c & 0xF0) == 0xE0 ? 3
+                                   : (c & 0xF8) == 0xF0 ? 4 : 0;
+        unsigned cp = n == 1 ? c : n == 2 ? c & 0x1F : n == 3 ? c & 0x0F : c & 0x07;
+        if (c == '\n')
+            ++line;
+        if (c < 0x20 && c != '\t' && c != '\n' && c != '\r')
+            return rs_error_set(RS_ERR_ARG,
+                                "%s:%zu: a control byte (0x%02x) in the text: a scene file is "
+                                "UTF-8 text",
+                                label, line, c);
+        if (c == 0x7f)
+            return rs_error_set(RS_ERR_ARG, "%s:%zu: a control byte (0x7f) in the text", label,
+                                line);
+        if (c == '\\' && i + 5 < len && b[i + 1] == 'u' && b[i + 2] == '0' && b[i + 3] == '0' &&
+            b[i + 4] == '0' && b[i + 5] == '0')
+            return rs_error_set(RS_ERR_ARG, "%s:%zu: a NUL character (\\u0000) in a string",
+                                label, line);
+        if (c == '\\' && i + 1 < len) { /* an escape: its next byte is not a new escape */
+            i += 2;
+            continue;
+        }
+        for (k = 1; n && k < n; ++k) {
+            if (i + k >= len || (b[i + k] & 0xC0) != 0x80) {
+                n = 0;
+                break;
+            }
+            cp = cp << 6 | (b[i + k] & 0x3F);
+        }
+        /* overlong forms, surrogates and code points past U+10FFFF are not UTF-8 either */
+        if (!n || (n == 2 && cp < 0x80) || (n == 3 && cp < 0x800) || (n == 4 && cp < 0x10000) ||
+            (cp >= 0xD800 && cp <= 0xDFFF) || cp > 0x10FFFF)
+            return rs_error_set(RS_ERR_ARG,
+                                "%s:%zu: not UTF-8 (byte 0x%02x): save the scene file as UTF-8",
+                                label, line, c);
+        i += n;
+    }
+    return RS_OK;
+}
+
 rs_status rs_scene_parse_json(const char *text, size_t len, const char *label, const char *base_dir,
                               rs_scene **out)
 {
@@ -1459,6 +1510,8 @@ rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label
     ctx *c;
     rs_status st;
     *out = NULL;
+    if ((st = check_text(label, text, len)) != RS_OK)
+        return st;
     root = cJSON_ParseWithLengthOpts(text, len, &end, 0);
     if (!root) {
         /* the line of the syntax error: count newlines up to where parsing stopped */

@@ -341,8 +341,46 @@ static void test_bad_inputs(void **state)
         rs_scene *s = (rs_scene *)0x1;
         assert_int_equal(rs_scene_parse_json(nul, sizeof nul - 1, "t.json", NULL, &s), RS_ERR_ARG);
         assert_null(s);
-        assert_non_null(strstr(rs_error_message(), "t.json:2: unexpected content after"));
+        assert_non_null(strstr(rs_error_message(), "t.json:2: a control byte (0x00)"));
         rs_error_clear();
+    }
+    {
+        /* bytes cJSON took quietly (issue 27): NUL and other control bytes as white space, a
+         * string cut at an escaped NUL ("w\u0000junk" picked material w), text not UTF-8 */
+        static const struct {
+            const char *text;
+            size_t len;
+            const char *want;
+        } k[] = {
+            {"{\0" CAM "," MAT ",\"objects\":[]}", 0, "t.json:1: a control byte (0x00)"},
+            {"{\n\x01" CAM "," MAT ",\"objects\":[]}", 0, "t.json:2: a control byte (0x01)"},
+            {"{" CAM "," MAT ",\"objects\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1,"
+             "\"material\":\"w\\u0000junk\"}]}",
+             0, "a NUL character"},
+            {"{" CAM "," MAT ",\"objects\":[],\"name\":\"caf\xe9\"}", 0, "not UTF-8 (byte 0xe9)"},
+            {"{" CAM "," MAT ",\"objects\":[],\"name\":\"\xc0\xaf\"}", 0, "not UTF-8 (byte 0xc0)"},
+        };
+        size_t i;
+        for (i = 0; i < sizeof k / sizeof k[0]; ++i) {
+            rs_scene *s = (rs_scene *)0x1;
+            size_t n = i == 0 ? 1 + strlen(k[i].text + 2) + 1 : strlen(k[i].text);
+            assert_int_equal(rs_scene_parse_json(k[i].text, n, "t.json", NULL, &s), RS_ERR_ARG);
+            assert_null(s);
+            if (!strstr(rs_error_message(), k[i].want))
+                fail_msg("case %zu: '%s' lacks '%s'", i, rs_error_message(), k[i].want);
+            rs_error_clear();
+        }
+        {
+            /* and UTF-8 itself is fine, in names and strings */
+            static const char ok[] =
+                "{" CAM ",\"materials\":{\"caf\xc3\xa9 \xe2\x9c\x93\":{\"type\":\"lambertian\","
+                "\"albedo\":[0.5,0.5,0.5]}},\"objects\":[{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1,"
+                "\"material\":\"caf\xc3\xa9 \xe2\x9c\x93\"}]}";
+            rs_scene *s = NULL;
+            if (rs_scene_parse_json(ok, strlen(ok), "t.json", NULL, &s) != RS_OK)
+                fail_msg("UTF-8 names refused: %s", rs_error_message());
+            rs_scene_destroy(s);
+        }
     }
 }
 
