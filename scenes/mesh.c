@@ -1178,6 +1178,24 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
     if (st == RS_OK)
         st = gltf_node(&g, g.as->mRootNode, &id, 0, opts ? opts->camera : NULL);
     if (st == RS_OK && opts && opts->camera && !g.camera) {
+        for (k = 0; k < g.as->mNumCameras && st == RS_OK; ++k) {
+            const struct aiCamera *c = g.as->mCameras[k];
+            if (strcmp(c->mName.data, opts->camera) != 0)
+                continue;
+            /* there, but not a camera raystream can look through */
+            if (c->mOrthographicWidth > 0)
+                st = rs_error_set(RS_ERR_ARG,
+                                  "%s: camera '%s' is orthographic; raystream's cameras are "
+                                  "perspective (give the file a perspective camera)",
+                                  path, opts->camera);
+            else
+                st = rs_error_set(RS_ERR_ARG,
+                                  "%s: camera '%s' has a field of view of 0 (its yfov must be "
+                                  "above 0)",
+                                  path, opts->camera);
+        }
+    }
+    if (st == RS_OK && opts && opts->camera && !g.camera) {
         char have[512] = "";
         for (k = 0; k < g.as->mNumCameras; ++k)
             if (strlen(have) + g.as->mCameras[k]->mName.length + 5 < sizeof have) {

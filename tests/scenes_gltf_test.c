@@ -642,6 +642,37 @@ static void test_hostile_files(void **state)
     expect_bad("badchild.gltf",
                "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"children\":[7]}]}",
                "nodes[0].children names no node", NULL);
+    /* --camera naming a camera that is there but cannot be looked through: said so (it was
+     * "no camera named 'side' (the file has: 'cam', 'side')") */
+    {
+        static const char *const kinds[][2] = {
+            {"{\"type\":\"orthographic\",\"orthographic\":{\"xmag\":1,\"ymag\":1,"
+             "\"znear\":0.1,\"zfar\":100}}",
+             "camera 'side' is orthographic"},
+            {"{\"type\":\"perspective\",\"perspective\":{\"yfov\":0,\"znear\":0.1}}",
+             "camera 'side' has a field of view of 0"}};
+        int c;
+        for (c = 0; c < 2; ++c) {
+            rs_gltf_opts go;
+            char *at, tail[8192];
+            snprintf(buf, sizeof buf, k_full, "");
+            at = strstr(buf, "{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.9");
+            assert_non_null(at);
+            snprintf(tail, sizeof tail, "%s%s", kinds[c][0], strstr(at, "}}") + 2);
+            strcpy(at, tail);
+            write_text("cams.gltf", buf);
+            path_of(p, sizeof p, "cams.gltf");
+            memset(&go, 0, sizeof go);
+            go.camera = "side";
+            s = (rs_scene *)0x1;
+            rs_error_clear();
+            assert_int_not_equal(rs_scene_load_gltf(p, &go, &s), RS_OK);
+            print_message("%s\n", rs_error_message());
+            if (!strstr(rs_error_message(), kinds[c][1]))
+                fail_msg("'%s' lacks '%s'", rs_error_message(), kinds[c][1]);
+            rs_error_clear();
+        }
+    }
     /* a 900-byte .glb whose chunk claims 3.75 GiB: refused before anything is allocated */
     memset(glb, ' ', sizeof glb);
     memcpy(glb, "glTF", 4);
