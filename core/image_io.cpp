@@ -20,6 +20,79 @@
 namespace
 {
 
+// OpenImageIO's readers let some libraries print failures themselves (libpng's default handler
+// writes "libpng error: ..." to stderr), before and beside the message it gives us.  While a
+// file is read, stderr goes to a temporary file; what landed there becomes the reason in our
+// one line (reads happen while a scene loads, with no other thread printing).
+class stderr_capture
+{
+  public:
+    stderr_capture()
+    {
+        std::fflush(stderr);
+        tmp_ = std::tmpfile();
+        if (tmp_ && (saved_ = dup(2)) >= 0)
+            dup2(fileno(tmp_), 2);
+    }
+    ~stderr_capture() { end(); }
+    // Restores stderr; what was printed meanwhile, its lines joined by "; ".
+    std::string end()
+    {
+        std::string text;
+        char line[512];
+        if (saved_ >= 0) {
+            std::fflush(stderr);
+            dup2(saved_, 2);
+            close(saved_);
+            saved_ = -1;
+        }
+        if (!tmp_)
+            return text;
+        std::rewind(tmp_);
+        while (std::fgets(line, sizeof line, tmp_)) {
+            size_t n = std::strlen(line);
+            while (n && (line[n - 1] == '\n' || line[n - 1] == '\r'))
+                line[--n] = 0;
+            if (n && text.size() < 400)
+                text += (text.empty() ? "" : "; ") + std::string(line);
+        }
+        std::fclose(tmp_);
+        tmp_ = nullptr;
+        return text;
+    }
+
+  private:
+    FILE *tmp_ = nullptr;
+    int saved_ = -1;
+};
+
+// A failed read's reason: OpenImageIO's words, or where it has none, what is most likely.
+std::string why(const std::string &oiio)
+{
+    std::string w;
+    for (char c : oiio) /* its lines, one after another */
+        if (c == '\n')
+            w += w.empty() || w.back() == ' ' ? "" : "; ";
+        else
+            w += c;
+    while (!w.empty() && (w.back() == ' ' || w.back() == ';'))
+        w.pop_back();
+    return w.empty() ? std::string("the file is cut short or corrupt") : w;
+}
+
+// `st` from reading `path`, with what the libraries printed during the read (`said`) put into
+// our message where the read failed; nothing printed is lost or shown twice.
+rs_status with_said(rs_status st, const std::string &said)
+{
+    if (st == RS_OK || said.empty())
+        return st;
+    std::string msg = rs_error_message();
+    if (msg.find(said) != std::string::npos)
+        return st;
+    rs_error_clear();
+    return rs_error_set(st, "%s (%s)", msg.c_str(), said.c_str());
+}
+
 std::string lower_ext(const char *path)
 {
     const char *slash = std::strrchr(path, '/');
@@ -185,12 +258,16 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
 
 extern "C" rs_status rs_image_read(const char *path, uint32_t *w, uint32_t *h, float **rgb)
 {
-    return read_image(path, w, h, rgb, false);
+    stderr_capture cap;
+    rs_status st = read_image(path, w, h, rgb, false);
+    return with_said(st, cap.end());
 }
 
 extern "C" rs_status rs_image_read_linear(const char *path, uint32_t *w, uint32_t *h, float **rgb)
 {
-    return read_image(path, w, h, rgb, true);
+    stderr_capture cap;
+    rs_status st = read_image(path, w, h, rgb, true);
+    return with_said(st, cap.end());
 }
 
 // Opens `path` for reading; a file OpenImageIO cannot open is the status `fail`.  OpenImageIO
@@ -217,10 +294,16 @@ static rs_status open_image(const char *path, OIIO::ImageInput::unique_ptr *in)
     const OIIO::ImageSpec &spec = (*in)->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
         return rs_error_set(RS_ERR_IO, "%s: empty image", path);
-    if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE ||
-        (uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
-        return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d is too large (at most %llu pixels)",
-                            path, spec.width, spec.height, (unsigned long long)RS_IMAGE_MAX_PIXELS);
+    if (spec.width > RS_IMAGE_MAX_SIDE || spec.height > RS_IMAGE_MAX_SIDE)
+        return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d has a side over %d pixels, the most "
+                                        "either side may have",
+                            path, spec.width, spec.height, RS_IMAGE_MAX_SIDE);
+    if ((uint64_t)spec.width * (uint64_t)spec.height > RS_IMAGE_MAX_PIXELS)
+        return rs_error_set(RS_ERR_ARG, "%s: image of %dx%d has %llu pixels, more than the %llu "
+                                        "an image may have",
+                            path, spec.width, spec.height,
+                            (unsigned long long)spec.width * (unsigned long long)spec.height,
+                            (unsigned long long)RS_IMAGE_MAX_PIXELS);
     return RS_OK;
 }
 
@@ -234,7 +317,7 @@ static rs_status read_one_channel(const char *path, OIIO::ImageInput *in, int ch
         return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
     if (!in->read_image(0, 0, ch, ch + 1, OIIO::TypeDesc::FLOAT, o)) {
         rs_free(o);
-        return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
+        return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, why(in->geterror()).c_str());
     }
     *out = o;
     return RS_OK;
@@ -253,7 +336,8 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
         int nc = spec.nchannels < 3 ? spec.nchannels : 3; // only RGB is kept
         std::vector<float> all(npix * (size_t)nc);
         if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
-            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path, in->geterror().c_str());
+            return rs_error_set(RS_ERR_IO, "%s: read failed: %s", path,
+                                why(in->geterror()).c_str());
         float *o = (float *)rs_alloc(npix * 3, sizeof(float));
         if (!o)
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading the image", path);
@@ -292,8 +376,7 @@ static rs_status read_image(const char *path, uint32_t *w, uint32_t *h, float **
     }
 }
 
-extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t *h,
-                                         float **alpha)
+static rs_status rs_image_read_alpha_inner(const char *path, uint32_t *w, uint32_t *h, float **alpha)
 {
     *alpha = nullptr;
     try {
@@ -317,8 +400,15 @@ extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t
     }
 }
 
-extern "C" rs_status rs_image_read_channel(const char *path, const char *channel, uint32_t *w,
-                                           uint32_t *h, float **data)
+extern "C" rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t *h,
+                                         float **alpha)
+{
+    stderr_capture cap;
+    rs_status st = rs_image_read_alpha_inner(path, w, h, alpha);
+    return with_said(st, cap.end());
+}
+
+static rs_status rs_image_read_channel_inner(const char *path, const char *channel, uint32_t *w,   uint32_t *h, float **data)
 {
     *data = nullptr;
     try {
@@ -341,6 +431,14 @@ extern "C" rs_status rs_image_read_channel(const char *path, const char *channel
     } catch (...) {
         return rs_error_set(RS_ERR_IO, "%s: unknown error reading the image", path);
     }
+}
+
+extern "C" rs_status rs_image_read_channel(const char *path, const char *channel, uint32_t *w,
+                                           uint32_t *h, float **data)
+{
+    stderr_capture cap;
+    rs_status st = rs_image_read_channel_inner(path, channel, w, h, data);
+    return with_said(st, cap.end());
 }
 
 extern "C" rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n)

@@ -490,6 +490,79 @@ static void test_ranges_named(void **state)
     rmdir(dir);
 }
 
+/* Images that fail to read say why in our one line, and nothing else reaches stderr (issue
+ * 27): a corrupt PNG printed libpng's own line first, a truncated map said "read failed:" and
+ * nothing more, a 10^6 x 1 map "too large (at most 268435456 pixels)". */
+static void test_image_messages(void **state)
+{
+    static const unsigned char bad_png[] = {
+        0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0, 16,
+        0,    0,   0,   16,  8,     2,     0,    0,    0, 0x90, 0x91, 0x68, 0x36, 0, 0, 0, 5,
+        'I',  'D', 'A', 'T', 'x',   'x',   'x',  'x',  'x'};
+    char dir[] = "/tmp/rs_img_XXXXXX", png[256], pfm[256], wide[256], err[256], said[512];
+    uint32_t w, h;
+    float *rgb = NULL;
+    FILE *f;
+    int saved;
+    size_t n;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(png, sizeof png, "%s/bad.png", dir);
+    snprintf(pfm, sizeof pfm, "%s/cut.pfm", dir);
+    snprintf(wide, sizeof wide, "%s/wide.pfm", dir);
+    snprintf(err, sizeof err, "%s/stderr.txt", dir);
+    f = fopen(png, "wb");
+    fwrite(bad_png, 1, sizeof bad_png, f);
+    fclose(f);
+    f = fopen(pfm, "wb");
+    fputs("PF\n4 4\n-1.0\n", f);
+    fwrite("0123456789", 1, 10, f); /* 192 bytes of pixels are due */
+    fclose(f);
+    f = fopen(wide, "wb");
+    fputs("PF\n1000000 1\n-1.0\n", f);
+    {
+        static float row[3000];
+        int k;
+        for (k = 0; k < 1000; ++k)
+            fwrite(row, sizeof row[0], 3000, f);
+    }
+    fclose(f);
+    /* stderr into a file while the images are read: it must stay empty */
+    fflush(stderr);
+    saved = dup(2);
+    f = fopen(err, "w");
+    dup2(fileno(f), 2);
+    assert_int_not_equal(rs_image_read_linear(png, &w, &h, &rgb), RS_OK);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    fclose(f);
+    f = fopen(err, "r");
+    n = fread(said, 1, sizeof said - 1, f);
+    fclose(f);
+    said[n] = 0;
+    print_message("%s\n", rs_error_message());
+    assert_int_equal(n, 0);
+    assert_non_null(strstr(rs_error_message(), "bad.png"));
+    assert_non_null(strstr(rs_error_message(), "IDAT"));
+    assert_null(strchr(rs_error_message(), '\n'));
+    rs_error_clear();
+    assert_int_not_equal(rs_image_read(pfm, &w, &h, &rgb), RS_OK);
+    print_message("%s\n", rs_error_message());
+    assert_non_null(strstr(rs_error_message(), "cut short or corrupt"));
+    rs_error_clear();
+    assert_int_not_equal(rs_image_read(wide, &w, &h, &rgb), RS_OK);
+    print_message("%s\n", rs_error_message());
+    assert_non_null(strstr(rs_error_message(), "has a side over 65536"));
+    rs_error_clear();
+    assert_null(rgb);
+    remove(png);
+    remove(pfm);
+    remove(wide);
+    remove(err);
+    rmdir(dir);
+}
+
 /* Scene files and textures that are not regular files of a sane size are refused by name,
  * without being read: a FIFO (opening one for reading blocks until a writer comes), /dev/zero
  * (never ends), a folder, a socket, a sparse file of 300 MiB.  alarm() turns a regression (a
@@ -611,6 +684,7 @@ int main(void)
         cmocka_unit_test(test_image_texture_relative),
         cmocka_unit_test(test_file_kinds),
         cmocka_unit_test(test_ranges_named),
+        cmocka_unit_test(test_image_messages),
         cmocka_unit_test(test_mutations_never_crash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
