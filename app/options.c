@@ -480,18 +480,25 @@ static int opt_aov(const char *name, const char *v, rs_cli_options *o)
                   {"depth", RS_AOV_DEPTH},
                   {"samples", RS_AOV_SAMPLES},
                   {"all", RS_AOV_ALL}};
-    char list[128], *tok, *save = NULL;
+    const char *tok = v;
     size_t k;
     (void)name;
-    snprintf(list, sizeof list, "%s", v);
-    for (tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        for (k = 0; k < sizeof layers / sizeof layers[0] && strcmp(tok, layers[k].name); ++k)
+    while (*tok) { /* the list read in place: any length (a copy of 128 bytes cut it) */
+        size_t len = strcspn(tok, ",");
+        for (k = 0; k < sizeof layers / sizeof layers[0] &&
+                    !(strlen(layers[k].name) == len && strncmp(tok, layers[k].name, len) == 0);
+             ++k)
             ;
-        if (k == sizeof layers / sizeof layers[0])
+        if (len && k == sizeof layers / sizeof layers[0]) {
+            char bad[64];
+            snprintf(bad, sizeof bad, "%.*s", (int)(len < 60 ? len : 60), tok);
             return usage_error("--aov: '%s'%s is not a layer (use albedo, normal, depth, "
                                "samples or all, separated by commas)",
-                               tok, "");
-        o->aovs |= layers[k].bits;
+                               bad, len > 60 ? "..." : "");
+        }
+        if (len)
+            o->aovs |= layers[k].bits;
+        tok += len + (tok[len] == ',');
     }
     if (!o->aovs)
         return usage_error("--aov needs a list of layers%s%s", "", "");

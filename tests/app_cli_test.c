@@ -1628,6 +1628,21 @@ static void test_aov_layers(void **state)
     EXPECT(&p, exited_with(&p, 2) && one_line(&p.err) && strstr(p.err.data, "'shadows'"),
            "--aov with an unknown layer: a usage error naming it");
     proc_free(&p);
+    {
+        /* a list past 127 characters is read whole (the layers after the cut were missing) */
+        char list[400] = "";
+        const char *argv[] = {"render", "--width", "8", "--height", "8", "--spp", "1", "-q",
+                              "--aov", list, "-o", "long.exr", NULL};
+        float *d;
+        for (k = 0; k < 30; ++k)
+            strcat(list, "albedo,");
+        strcat(list, "depth");
+        run_expect(f, argv, 0, &p);
+        d = read_channel(&p, f, "long.exr", "depth.Z", &w, &h);
+        EXPECT(&p, d && w == 8 && h == 8, "the layer after 210 characters of --aov is missing");
+        rs_free(d);
+        proc_free(&p);
+    }
 }
 
 /* --adaptive: pixels stop at different sample counts (the samples layer shows them, from 16 to
