@@ -84,7 +84,7 @@ static const rs_device_ops cpu_ops = {
     .upload = cpu_upload,
     .trace = cpu_trace,
     .destroy = cpu_destroy,
-    .render_pass = rs_cpu_render_pass, /* host memory, no scene copy: no pass_begin */
+    .render_pass = rs_cpu_render_pass, /* host memory, no scene copy: no upload_scene */
 };
 
 rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
