@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/devices.h"
 #include "app/dist_internal.h"
 #include "app/options.h"
 #include "core/alloc.h"
@@ -34,7 +35,8 @@ int rs_dist_launched(int *ranks, int *rank, int *local_ranks)
 {
     static const char *const size_vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE",
                                             "MPI_LOCALNRANKS", "SLURM_NTASKS"};
-    const char *v = NULL, *r, *l;
+    const char *v = NULL, *r;
+    int lr = 0, ls = 1;
     size_t i;
     for (i = 0; i < sizeof size_vars / sizeof size_vars[0] && !v; ++i)
         v = getenv(size_vars[i]);
@@ -45,12 +47,13 @@ int rs_dist_launched(int *ranks, int *rank, int *local_ranks)
         r = getenv("PMI_RANK");
     if (!r)
         r = getenv("PMIX_RANK");
-    l = getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-    if (!l)
-        l = getenv("MPI_LOCALNRANKS");
     *ranks = v ? atoi(v) : 1;
     *rank = r ? atoi(r) : 0;
-    *local_ranks = l && atoi(l) > 0 ? atoi(l) : 1;
+    /* the ranks on this machine: one list of the launchers' variables (app/devices.c), which
+     * deals out the GPUs by the same count */
+    if (!rs_devices_local_rank(&lr, &ls) || ls < 1)
+        ls = 1;
+    *local_ranks = ls;
     return 1;
 }
 

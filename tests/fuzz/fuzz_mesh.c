@@ -3,8 +3,9 @@
  * The bytes are written to FUZZ.obj and to FUZZ.ply in a folder of its own, and each is loaded
  * the way `raystream render --mesh FILE` loads it: rs_builtin_create_ex("cornell-mesh") ->
  * rs_scene_add_mesh (the PLY header check or the strip reader, Assimp through our aiFileIO) ->
- * rs_scene_finalize; and to FUZZ.gltf, loaded as `raystream render FUZZ.gltf` loads it
- * (rs_scene_load_gltf: nodes, cameras, lights, materials and textures).
+ * rs_scene_finalize; and to FUZZ.gltf and FUZZ.glb, loaded as `raystream render FUZZ.gltf`
+ * loads it (rs_scene_load_gltf: our own check of the container, the node tree and the files it
+ * names, then nodes, cameras, lights, materials and textures; seeds in tests/fuzz/seeds/mesh).
  * Any input must give a scene or be refused with one line naming the file; never a crash, a
  * hang, a leak or a sanitizer report, and every file opened for Assimp must be closed again
  * (tests/fuzz/lsan.supp says why that is checked here).  Built with -DRS_FUZZ=ON (scripts/fuzz.sh).
@@ -49,5 +50,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     load_as(data, size, "obj", 0);
     load_as(data, size, "ply", 0);
     load_as(data, size, "gltf", 1);
+    load_as(data, size, "glb", 1); /* the container's lengths and the JSON inside it */
     return 0;
 }
