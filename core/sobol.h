@@ -85,7 +85,7 @@ RS_HD uint32_t rs_hash_u32(uint32_t x)
 /* Point `index` of the first two Sobol dimensions, each Owen-scrambled with a seed made from
  * `seed`.  (The scramble of dimension d is reverse(lk(reverse(sobol_d))), and reverse(sobol_d) is
  * the index itself or its superset-XOR, so each dimension costs one bit reversal.) */
-RS_HD void rs_owen_sobol2(uint32_t seed, uint32_t index, float *x0, float *x1)
+RS_HD_HOT void rs_owen_sobol2(uint32_t seed, uint32_t index, float *x0, float *x1)
 {
     *x0 = rs_rng_to_float(rs_reverse_bits(rs_lk_permute(index, rs_hash_u32(seed + 1u))));
     *x1 = rs_rng_to_float(

@@ -94,7 +94,7 @@ RS_HD rs_surface_point rs_sphere_point(rs_vec3 c, float r, rs_vec3 rel)
  * rounded: its tilt is a few ulps times |u| |v| / |u x v| (the sine of the angle between the
  * edges, as for triangles), so a point an edge away from q can be off that plane by
  * about gamma(12) (|u| + |v|) |u| |v| / |u x v|; |u x v| = 1 / |w|. */
-RS_HD rs_surface_point rs_quad_point(const rs_quad *qd, float a, float b)
+RS_HD_HOT rs_surface_point rs_quad_point(const rs_quad *qd, float a, float b)
 {
     rs_surface_point s;
     rs_vec3 au = rs_v3_scale(qd->u, a), bv = rs_v3_scale(qd->v, b);
