@@ -495,10 +495,11 @@ static int within(rs_vec3 p, float lim)
 static rs_status refuse_part(rs_scene *s, uint32_t part, uint32_t index, const char *what)
 {
     static const char *const k_names[] = {"",         "sphere",   "quad",  "triangle",
-                                          "instance", "material", "light", "environment map"};
+                                          "instance", "material", "light", "environment map",
+                                          "camera"};
     s->bad_part = part;
     s->bad_index = index;
-    if (part == RS_PART_ENVIRONMENT)
+    if (part == RS_PART_ENVIRONMENT || part == RS_PART_CAMERA)
         return rs_error_set(RS_ERR_ARG, "%s: %s", k_names[part], what);
     return rs_error_set(RS_ERR_ARG, "%s %u: %s", k_names[part], index, what);
 }
@@ -532,6 +533,8 @@ static rs_status check_ranges(rs_scene *s)
     for (i = 0; i < s->n_instances; ++i)
         if (!within(s->instances[i].box.lo, lim) || !within(s->instances[i].box.hi, lim))
             return refuse_part(s, RS_PART_INSTANCE, i, why);
+    if (!within(s->camera.from, lim)) /* the rays' origin */
+        return refuse_part(s, RS_PART_CAMERA, 0, why);
     snprintf(why, sizeof why, "above %.0e, more than the film holds (a sample beyond 2^48 "
                               "would be dropped)", (double)most);
     for (i = 0; i < s->n_materials; ++i)

@@ -488,7 +488,7 @@ rs_status rs_scene_flatten_instances(rs_scene *s);
 
 /* Where the renderer's arithmetic holds, checked by rs_scene_finalize: every point of the
  * geometry (sphere centres and extents along their motion, the corners of quads, triangles and
- * instances' world boxes, point and spot light positions) within +-RS_SCENE_MAX_COORD, so that
+ * instances' world boxes, point and spot light positions, the camera) within +-RS_SCENE_MAX_COORD, so that
  * no intersection test's float products overflow (a sphere 1.8e19 away vanished); every
  * emission, light intensity and environment radiance (map times scale) at most
  * RS_SCENE_MAX_RADIANCE, far inside what the film's exact sums hold (shading/film.h: a sample
@@ -507,7 +507,8 @@ typedef enum rs_scene_part {
     RS_PART_INSTANCE,
     RS_PART_MATERIAL,
     RS_PART_LIGHT, /* a punctual light */
-    RS_PART_ENVIRONMENT
+    RS_PART_ENVIRONMENT,
+    RS_PART_CAMERA
 } rs_scene_part;
 
 /* Checks the scene and builds its light tables.  RS_ERR_ARG naming the part (and bad_part,

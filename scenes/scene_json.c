@@ -1368,6 +1368,7 @@ static int part_path(const ctx *c, char *out, size_t n)
             }
         return 0;
     case RS_PART_ENVIRONMENT: snprintf(out, n, "background.map"); return 1;
+    case RS_PART_CAMERA: snprintf(out, n, "camera.from"); return 1;
     default: return 0;
     }
     for (i = c->n_obj; i-- > 0;)

@@ -477,6 +477,23 @@ static void test_ranges_named(void **state)
     expect_load_error(path, "objects[0]: a point beyond", NULL);
     SCENE("5, 5, 5", "", "0, 0, 0", "2e10, 0, 0");
     expect_load_error(path, "objects[1]: a point beyond", NULL);
+    /* the camera is the rays' origin: a sphere near the origin seen from 3e19 vanished too */
+    {
+        char far[2048];
+        SCENE("5, 5, 5", "", "0, 0, 0", "2, 0, 0");
+        snprintf(far, sizeof far, "%s", json);
+        {
+            char *at = strstr(far, "[0,0,5]");
+            assert_non_null(at);
+            memmove(at + 12, at + 7, strlen(at + 7) + 1);
+            memcpy(at, "[0,0,3e19]", 10);
+            at[10] = ' ', at[11] = ' ';
+        }
+        f = fopen(path, "w");
+        fputs(far, f);
+        fclose(f);
+        expect_load_error(path, "camera.from: a point beyond", NULL);
+    }
     /* a map of texels up to 1e9 is fine; scaled by 1e4 it is not */
     {
         char bg[512];
