@@ -46,7 +46,7 @@ found=0
 for h in $harnesses; do
     case "$h" in
     scene_json) seeds="scenes/examples tests/fuzz/seeds/scene_json"; max_len=65536 ;;
-    mesh) seeds="tests/data tests/fuzz/seeds/mesh"; max_len=16384 ;;
+    mesh) seeds="tests/data"; max_len=16384 ;;
     cli_options) seeds="tests/fuzz/seeds/cli_options"; max_len=1024 ;;
     *)
         echo "fuzz.sh: unknown harness '$h' (scene_json, mesh, cli_options)" >&2

@@ -5,7 +5,7 @@
  * rs_scene_add_mesh (the PLY header check or the strip reader, Assimp through our aiFileIO) ->
  * rs_scene_finalize; and to FUZZ.gltf and FUZZ.glb, loaded as `raystream render FUZZ.gltf`
  * loads it (rs_scene_load_gltf: our own check of the container, the node tree and the files it
- * names, then nodes, cameras, lights, materials and textures; seeds in tests/fuzz/seeds/mesh).
+ * names, then nodes, cameras, lights, materials and textures; seeds in tests/data).
  * Any input must give a scene or be refused with one line naming the file; never a crash, a
  * hang, a leak or a sanitizer report, and every file opened for Assimp must be closed again
  * (tests/fuzz/lsan.supp says why that is checked here).  Built with -DRS_FUZZ=ON (scripts/fuzz.sh).
