@@ -1,0 +1,379 @@
+/* bench/denoise_bench.c — what denoising with Intel Open Image Denoise buys (core/denoise.h,
+ * --denoise; docs/denoise.md): a low-spp render, denoised, against a converged reference.
+ *
+ * For each scene: a reference at --ref-spp, the beauty at --spp (the Sobol sampler and MIS, as
+ * the CLI renders by default) with the albedo and normal AOVs exactly as `--aov albedo,normal`
+ * makes them (shading/aov.c), then rs_denoise three ways: beauty only; beauty, albedo and normal
+ * with cleanAux on (what --denoise does: our AOVs are first-hit values averaged over up to 16
+ * camera rays, so carry no path-tracing noise); and the same with cleanAux off.  Each row, against
+ * the reference: the RMSE of values clamped to [0, 1] (the display range: what a viewer sees),
+ * the ratio of the noisy image's to the row's (issue 28 asks for >= 4x), the spp a plain render
+ * would need for the same error (spp x ratio^2, error falling as 1/sqrt(spp)); the RMSE of the
+ * linear values and its ratio; the relative RMSE (each value's error over max(reference, 0.01));
+ * and the median time of --runs denoises.  The linear RMSE is printed but not the criterion: in
+ * a scene that sees its light, a few pixels on the emitter's edge (15 against an interior below
+ * 1, and moved by +-1..2 by the denoiser) outweigh all the noise elsewhere.  The reference's own
+ * error is printed beside it: it bounds how large a ratio can be measured.
+ *
+ * Validates first: the reference and the renders are finite and not black, the AOVs finite with
+ * normals of length <= 1, every denoised image finite, and repeated denoises bit-identical (OIDN
+ * is deterministic on one device and version).  Then the cleanAux row must reach the ratio
+ * (--min-ratio: 4 at full size, 2 at --quick, whose reference is noisier): exit 1 otherwise.
+ * Without OIDN it prints why and exits 0 (sh scripts/install-deps.sh installs it).
+ *
+ *   denoise_bench [--quick] [--size N] [--spp N] [--ref-spp N] [--runs N] [--threads N]
+ *                 [--gpu] [--scenes LIST] [--models DIR] [--min-ratio X] [--dump DIR]
+ *
+ * Full: 256x256, 16 spp against 4096, builtin:cornell and builtin:cornell-bunny-teapot (the
+ * shared models; skipped with a message when ../shared/models is absent).  --quick: 64x64 against
+ * 1024 spp. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_render.h"
+#include "core/alloc.h"
+#include "core/denoise.h"
+#include "core/image_io.h"
+#include "machine.h"
+#include "shading/aov.h"
+
+#define MAX_RUNS 9
+
+typedef struct scene_ctx {
+    rs_scene *scene;
+    rs_geom g;
+    rs_bvh *bvh;
+} scene_ctx;
+
+static void settings_for(uint32_t size, uint32_t spp, int threads, rs_cores *cores,
+                         rs_render_settings *st)
+{
+    memset(st, 0, sizeof *st);
+    st->width = st->height = size;
+    st->spp = spp;
+    st->max_depth = 50;
+    st->seed = 1;
+    st->sampling = RS_SAMPLING_MIS;
+    st->sampler = RS_SAMPLER_SOBOL;
+    st->threads = threads;
+    rs_cores_init(cores, threads);
+    st->cores = cores;
+}
+
+/* The stream engine on one CPU device with `threads` threads; rgb receives the image; *seconds
+ * the render's time.  Returns 0 after printing why. */
+static int render(const scene_ctx *s, uint32_t size, uint32_t spp, int threads, float *rgb,
+                  double *seconds)
+{
+    rs_device *dev = NULL;
+    rs_sched *sched = NULL;
+    rs_film *film = NULL;
+    rs_render_settings st;
+    rs_render_stats stats;
+    rs_cpu_device_opts co;
+    rs_cores cores;
+    int ok = 0;
+    settings_for(size, spp, threads, &cores, &st);
+    memset(&co, 0, sizeof co);
+    co.threads = threads;
+    co.cores = &cores;
+    if (rs_cpu_device_create_opts(&co, &dev) == RS_OK &&
+        rs_device_upload(dev, &s->g, s->bvh) == RS_OK &&
+        rs_sched_create(&dev, 1, NULL, &sched) == RS_OK &&
+        rs_film_create(size, size, &film) == RS_OK &&
+        rs_render(s->scene, sched, &st, NULL, film, &stats) == RS_OK) {
+        rs_film_resolve(film, rgb);
+        *seconds = stats.seconds;
+        ok = 1;
+    } else {
+        fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
+    }
+    rs_sched_destroy(sched);
+    rs_device_destroy(dev);
+    rs_film_destroy(film);
+    return ok;
+}
+
+/* The --aov albedo,normal layers of the spp render, as app/render_outputs.c makes them. */
+static int aovs(const scene_ctx *s, uint32_t size, uint32_t spp, int threads, float *albedo,
+                float *normal)
+{
+    rs_render_settings st;
+    rs_render_consts it;
+    rs_cores cores;
+    rs_bvh_view v = rs_bvh_view_of(s->bvh);
+    settings_for(size, spp, threads, &cores, &st);
+    if (rs_render_constants(s->scene, &st, &it) != RS_OK) {
+        fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
+        return 0;
+    }
+    rs_aov_render(&it, &v, &s->g, spp, threads, albedo, normal, NULL);
+    return 1;
+}
+
+static int all_finite(const float *v, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+static double mean(const float *v, size_t n)
+{
+    double s = 0;
+    size_t i;
+    for (i = 0; i < n; ++i)
+        s += v[i];
+    return s / (double)n;
+}
+
+typedef struct errs {
+    double clamped, linear, rel;
+} errs;
+
+static double clamp01(double v) { return v < 0 ? 0 : v > 1 ? 1 : v; }
+
+static errs errors(const float *img, const float *ref, size_t n)
+{
+    double c = 0, s = 0, r = 0;
+    size_t i;
+    errs e;
+    for (i = 0; i < n; ++i) {
+        double d = (double)img[i] - ref[i], m = ref[i] > 0.01f ? ref[i] : 0.01;
+        double dc = clamp01(img[i]) - clamp01(ref[i]);
+        c += dc * dc;
+        s += d * d;
+        r += (d / m) * (d / m);
+    }
+    e.clamped = sqrt(c / (double)n);
+    e.linear = sqrt(s / (double)n);
+    e.rel = sqrt(r / (double)n);
+    return e;
+}
+
+typedef struct opts {
+    uint32_t size, spp, ref_spp;
+    int runs, threads, gpu;
+    double min_ratio;
+    const char *models;
+    const char *dump; /* --dump DIR: SCENE-{reference,noisy,albedo,normal,ROW}.exr */
+} opts;
+
+static void dump(const opts *o, const char *spec, const char *what, const float *rgb)
+{
+    char path[4096];
+    if (!o->dump)
+        return;
+    snprintf(path, sizeof path, "%s/%s-%s.exr", o->dump, spec, what);
+    if (rs_image_write(path, o->size, o->size, rgb) != RS_OK) {
+        fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
+        rs_error_clear();
+    }
+}
+
+/* One scene's table; returns 1 (done or skipped), 0 on a failed check, -1 on an error. */
+static int bench_scene(const char *spec, const opts *o)
+{
+    scene_ctx s;
+    size_t n = (size_t)o->size * o->size * 3, k;
+    float *ref = NULL, *noisy = NULL, *albedo = NULL, *normal = NULL, *out = NULL, *again = NULL;
+    double t_ref = 0, t_noisy = 0, e_ref_floor;
+    errs e0;
+    int rc = -1, r, row, loaded;
+    char used[512] = "";
+    static const char *const labels[3] = {"beauty only", "+ albedo, normal, cleanAux on",
+                                          "+ albedo, normal, cleanAux off"};
+    memset(&s, 0, sizeof s);
+    loaded = br_load_scene("denoise_bench", spec, o->models, 0, &s.scene, &s.g, &s.bvh);
+    if (loaded <= 0)
+        return loaded == 0 ? 1 : -1;
+    rs_bvh_attach(s.bvh, &s.g);
+    ref = (float *)rs_alloc(n, sizeof(float));
+    noisy = (float *)rs_alloc(n, sizeof(float));
+    albedo = (float *)rs_alloc(n, sizeof(float));
+    normal = (float *)rs_alloc(n, sizeof(float));
+    out = (float *)rs_alloc(n, sizeof(float));
+    again = (float *)rs_alloc(n, sizeof(float));
+    if (!ref || !noisy || !albedo || !normal || !out || !again) {
+        fprintf(stderr, "denoise_bench: out of memory\n");
+        goto done;
+    }
+    printf("scene builtin:%s, %ux%u, %u spp against a %u-spp reference (sobol, MIS, depth 50), "
+           "%d thread%s\n",
+           spec, o->size, o->size, o->spp, o->ref_spp, o->threads, o->threads == 1 ? "" : "s");
+    if (!render(&s, o->size, o->ref_spp, o->threads, ref, &t_ref) ||
+        !render(&s, o->size, o->spp, o->threads, noisy, &t_noisy) ||
+        !aovs(&s, o->size, o->spp, o->threads, albedo, normal))
+        goto done;
+    /* validate the inputs */
+    rc = 0;
+    if (!all_finite(ref, n) || mean(ref, n) <= 0 || !all_finite(noisy, n) || mean(noisy, n) <= 0) {
+        printf("FAIL: the reference or the %u-spp render is black or not finite\n", o->spp);
+        goto done;
+    }
+    if (!all_finite(albedo, n) || !all_finite(normal, n)) {
+        printf("FAIL: the AOVs are not finite\n");
+        goto done;
+    }
+    for (k = 0; k < n; k += 3)
+        if (normal[k] * normal[k] + normal[k + 1] * normal[k + 1] + normal[k + 2] * normal[k + 2] >
+            1.001f) {
+            printf("FAIL: a normal longer than 1 at pixel %zu\n", k / 3);
+            goto done;
+        }
+    dump(o, spec, "reference", ref);
+    dump(o, spec, "noisy", noisy);
+    dump(o, spec, "albedo", albedo);
+    dump(o, spec, "normal", normal);
+    e0 = errors(noisy, ref, n);
+    e_ref_floor = e0.clamped * sqrt((double)o->spp / o->ref_spp);
+    printf("render: reference %.2f s, %u spp %.2f s; the reference's own RMSE is about %.5f "
+           "(the %u-spp RMSE x sqrt(%u/%u))\n",
+           t_ref, o->spp, t_noisy, e_ref_floor, o->spp, o->spp, o->ref_spp);
+    printf("  %-31s %9s %7s %9s %10s %7s %9s %9s\n", "image", "RMSE", "ratio", "~spp same",
+           "RMSE lin", "ratio", "rel RMSE", "denoise s");
+    printf("  %-31s %9.5f %6.2fx %9u %10.5f %6.2fx %9.4f %9s\n", "noisy", e0.clamped, 1.0, o->spp,
+           e0.linear, 1.0, e0.rel, "-");
+    for (row = 0; row < 3; ++row) {
+        const float *a = row == 0 ? NULL : albedo, *nm = row == 0 ? NULL : normal;
+        int clean = row == 1;
+        double t[MAX_RUNS], ratio;
+        errs e;
+        for (r = 0; r < o->runs; ++r) {
+            double t0 = rs_now_s();
+            rs_error_clear();
+            if (rs_denoise(noisy, a, nm, o->size, o->size, clean, o->gpu, r ? again : out, used,
+                           sizeof used) != RS_OK) {
+                fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
+                rc = -1;
+                goto done;
+            }
+            t[r] = rs_now_s() - t0;
+            if (r && memcmp(again, out, n * sizeof(float)) != 0) {
+                printf("FAIL: two denoises of the same image differ (%s)\n", used);
+                goto done;
+            }
+        }
+        if (!all_finite(out, n)) {
+            printf("FAIL: the denoised image (%s) is not finite\n", labels[row]);
+            goto done;
+        }
+        {
+            static const char *const files[3] = {"beauty-only", "aux-clean", "aux-noisy"};
+            dump(o, spec, files[row], out);
+        }
+        e = errors(out, ref, n);
+        ratio = e0.clamped / e.clamped;
+        printf("  %-31s %9.5f %6.2fx %9.0f %10.5f %6.2fx %9.4f %9.3f\n", labels[row], e.clamped,
+               ratio, o->spp * ratio * ratio, e.linear, e0.linear / e.linear, e.rel,
+               rs_bench_median(t, o->runs));
+        if (row == 1 && ratio < o->min_ratio) {
+            printf(
+                "FAIL: denoised with clean AOVs only %.2fx below the noisy RMSE in [0,1] (want >= "
+                "%.1fx)\n",
+                ratio, o->min_ratio);
+            goto done;
+        }
+    }
+    printf("  denoised on: %s\n\n", used);
+    rc = 1;
+done:
+    rs_free(ref);
+    rs_free(noisy);
+    rs_free(albedo);
+    rs_free(normal);
+    rs_free(out);
+    rs_free(again);
+    rs_bvh_destroy(s.bvh);
+    rs_scene_destroy(s.scene);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    opts o;
+    const char *scenes = "cornell,cornell-bunny-teapot";
+    char why[512], name[128];
+    const char *p, *end;
+    int quick = 0, i, ok = 1, min_ratio_set = 0;
+    memset(&o, 0, sizeof o);
+    o.size = 256;
+    o.spp = 16;
+    o.ref_spp = 4096;
+    o.runs = 3;
+    o.threads = rs_cpu_count();
+    for (i = 1; i < argc; ++i)
+        if (strcmp(argv[i], "--quick") == 0) {
+            /* the quick sizes first, so that explicit options override them */
+            quick = 1;
+            o.size = 64;
+            o.ref_spp = 1024;
+            o.runs = 2;
+        }
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--quick") == 0)
+            continue;
+        else if (strcmp(argv[i], "--gpu") == 0)
+            o.gpu = 1;
+        else if (i + 1 < argc && strcmp(argv[i], "--size") == 0)
+            o.size = (uint32_t)atoi(argv[++i]);
+        else if (i + 1 < argc && strcmp(argv[i], "--spp") == 0)
+            o.spp = (uint32_t)atoi(argv[++i]);
+        else if (i + 1 < argc && strcmp(argv[i], "--ref-spp") == 0)
+            o.ref_spp = (uint32_t)atoi(argv[++i]);
+        else if (i + 1 < argc && strcmp(argv[i], "--runs") == 0)
+            o.runs = atoi(argv[++i]);
+        else if (i + 1 < argc && strcmp(argv[i], "--threads") == 0)
+            o.threads = atoi(argv[++i]);
+        else if (i + 1 < argc && strcmp(argv[i], "--scenes") == 0)
+            scenes = argv[++i];
+        else if (i + 1 < argc && strcmp(argv[i], "--dump") == 0)
+            o.dump = argv[++i];
+        else if (i + 1 < argc && strcmp(argv[i], "--models") == 0)
+            o.models = argv[++i];
+        else if (i + 1 < argc && strcmp(argv[i], "--min-ratio") == 0) {
+            o.min_ratio = atof(argv[++i]);
+            min_ratio_set = 1;
+        } else {
+            fprintf(stderr, "usage: denoise_bench [--quick] [--size N] [--spp N] [--ref-spp N] "
+                            "[--runs N] [--threads N] [--gpu] [--scenes LIST] [--models DIR] "
+                            "[--min-ratio X] [--dump DIR]\n");
+            return 2;
+        }
+    }
+    if (!min_ratio_set)
+        o.min_ratio = quick ? 2.0 : 4.0;
+    if (o.size < 8 || o.size > 8192 || o.spp < 1 || o.ref_spp <= o.spp || o.runs < 1 ||
+        o.runs > MAX_RUNS || o.threads < 1) {
+        fprintf(stderr, "denoise_bench: bad settings (size 8..8192, ref-spp > spp, runs 1..%d)\n",
+                MAX_RUNS);
+        return 2;
+    }
+    rs_bench_print_machine(stdout);
+    if (!rs_denoise_available(why, sizeof why)) {
+        printf("denoise_bench: skipped: %s\n", why);
+        return 0;
+    }
+    printf("denoiser: Open Image Denoise, RT filter, hdr; %s device requested; %d run%s per row "
+           "(median)\n\n",
+           o.gpu ? "CUDA" : "CPU", o.runs, o.runs == 1 ? "" : "s");
+    for (p = scenes; *p; p = *end ? end + 1 : end) {
+        int r;
+        end = strchr(p, ',');
+        if (!end)
+            end = p + strlen(p);
+        snprintf(name, sizeof name, "%.*s", (int)(end - p), p);
+        if (!name[0])
+            continue;
+        r = bench_scene(name, &o);
+        if (r < 0)
+            return 1;
+        if (r == 0)
+            ok = 0;
+    }
+    return ok ? 0 : 1;
+}
