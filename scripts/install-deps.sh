@@ -40,6 +40,12 @@ OIDN_SHA256=32ad13368f8de1ef63001942ad05b02a00cd732d1206d97f352d3a3f606d823e
 OIDN_LIBS="libOpenImageDenoise.so.2.5.1 libOpenImageDenoise_core.so.2.5.1
 libOpenImageDenoise_device_cpu.so.2.5.1 libOpenImageDenoise_device_cuda.so.2.5.1 libtbb.so.12"
 
+# The one line a failed OIDN install prints (never a failure of the script).
+oidn_warn() {
+    echo "install-deps.sh: warning: Open Image Denoise not installed ($1);" \
+        "raystream works without it, but not --denoise" >&2
+}
+
 oidn_installed() {
     [ "$(cat "$OIDN_DIR/WHEEL-SHA256" 2>/dev/null)" = "$OIDN_SHA256" ] || return 1
     for f in $OIDN_LIBS; do
@@ -50,7 +56,7 @@ oidn_installed() {
 
 # Fetches, checks and unpacks the wheel; returns 1 after printing why on one line.
 oidn_install() {
-    tmp=$(mktemp -d) || { echo "install-deps.sh: warning: OIDN not installed (no temporary folder); --denoise will be unavailable" >&2; return 1; }
+    tmp=$(mktemp -d) || { oidn_warn "no temporary folder"; return 1; }
     why=
     if ! command -v python3 >/dev/null 2>&1; then
         why="python3 is missing"
@@ -87,7 +93,7 @@ PY
     fi
     rm -rf "$tmp"
     if [ -n "$why" ]; then
-        echo "install-deps.sh: warning: Open Image Denoise not installed ($why); raystream works without it, but not --denoise" >&2
+        oidn_warn "$why"
         return 1
     fi
     echo "install-deps.sh: installed Open Image Denoise 2.5.1 in $OIDN_DIR/lib" >&2
@@ -110,7 +116,7 @@ if [ "$(id -u)" -ne 0 ]; then
         echo "install-deps.sh: missing packages:$missing; run this script as root" >&2
         exit 1
     else
-        echo "install-deps.sh: warning: Open Image Denoise not installed in $OIDN_DIR (run this script as root); raystream works without it, but not --denoise" >&2
+        oidn_warn "$OIDN_DIR needs root: run this script as root"
         exit 0
     fi
 else
