@@ -2,6 +2,7 @@
 #include "app/checkpoint.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,7 +132,7 @@ static size_t make_header(unsigned char *h, const rs_checkpoint_key *key,
     memcpy(h + FIXED_HEADER, key->scene, name_len);
     at = FIXED_HEADER + name_len;
     put32(h + at, held->n);
-    put32(h + at + 4, 0);
+    put32(h + at + 4, key->filter);
     for (i = 0; i < (int)held->n; ++i) {
         put64(h + at + 8 + 16 * (size_t)i, held->r[i][0]);
         put64(h + at + 16 + 16 * (size_t)i, held->r[i][1]);
@@ -261,6 +262,26 @@ static int mismatch_s(const char *path, const char *field, const char *in_file, 
     return RS_EXIT_USAGE;
 }
 
+uint32_t rs_checkpoint_filter_code(const rs_filter *f)
+{
+    if (f->kind == RS_FILTER_BOX && f->width == 1.0f)
+        return 0;
+    return f->kind << 24 | (uint32_t)lrintf(f->width * 1000.0f);
+}
+
+/* "mitchell:4" for a header's filter code. */
+static void filter_code_name(uint32_t code, char *buf, size_t n)
+{
+    rs_filter f;
+    memset(&f, 0, sizeof f);
+    f.kind = code ? code >> 24 : RS_FILTER_BOX;
+    f.width = code ? (float)(code & 0xffffffu) / 1000.0f : 1.0f;
+    if (f.kind > RS_FILTER_MITCHELL)
+        snprintf(buf, n, "an unknown filter (%08x)", code);
+    else
+        rs_filter_describe(&f, buf, n);
+}
+
 /* The header against `want`.  Returns RS_EXIT_OK or the exit code after one line. */
 static int check_header(const char *path, const unsigned char *h, const char *name, uint64_t end,
                         rs_checkpoint_key *want)
@@ -290,6 +311,12 @@ static int check_header(const char *path, const unsigned char *h, const char *na
     if (u[6] != want->sampler)
         return mismatch_s(path, "--sampler", rs_sampler_name((rs_sampler)u[6]),
                           rs_sampler_name((rs_sampler)want->sampler));
+    if (get32(h + FIXED_HEADER + get32(h + 88) + 4) != want->filter) {
+        char a[48], b[48];
+        filter_code_name(get32(h + FIXED_HEADER + get32(h + 88) + 4), a, sizeof a);
+        filter_code_name(want->filter, b, sizeof b);
+        return mismatch_s(path, "--filter", a, b);
+    }
     if (u[7] != want->isect_sphere)
         return mismatch_s(path, "--isect-sphere", rs_isect_sphere_algo_name(u[7]),
                           rs_isect_sphere_algo_name(want->isect_sphere));

@@ -21,7 +21,9 @@
  *    48    40  width, height, spp, max depth, rr depth, sampling, sampler, sphere test,
  *              triangle test, box test (u32 each)
  *    88     4  scene name bytes n (< 4096), then the name as given on the command line
- *  92+n     4  ranges R (1..65536; 0 for an empty film), then 4 zero bytes
+ *  92+n     4  ranges R (1..65536; 0 for an empty film), then the pixel filter (u32:
+ *              0 for a box of 1 pixel, the only filter before raystream 0.9, whose files
+ *              hold 0 here; else kind << 24 | the width in thousandths of a pixel)
  *  100+n 16*R  the paths held: R ranges [lo, hi) (u64 each), sorted, disjoint, not touching,
  *              each starting at a whole sample (lo a multiple of P)
  *  hdr   48*P  the sums, 3 signed 128-bit integers a pixel in film units (2^-40; P = width *
@@ -50,6 +52,7 @@
 #include "scheduler/adaptive.h"
 #include "scheduler/plan.h"
 #include "shading/film.h"
+#include "shading/filter.h"
 
 #define RS_CHECKPOINT_VERSION          2u /* a render over every pixel */
 #define RS_CHECKPOINT_VERSION_ADAPTIVE 4u /* --adaptive: version 2 and an adaptive section
@@ -64,11 +67,16 @@ typedef struct rs_checkpoint_key {
     uint64_t seed;
     uint32_t width, height, spp, max_depth, rr_depth;
     uint32_t sampling, sampler;
+    uint32_t filter; /* rs_checkpoint_filter_code */
     uint32_t isect_sphere, isect_tri, isect_aabb;
     double adaptive_threshold; /* --adaptive: > 0 (its min spp below); 0: not adaptive */
     uint32_t adaptive_min_spp;
     const char *scene; /* the scene's name on the command line (messages only) */
 } rs_checkpoint_key;
+
+/* The pixel filter as the header holds it: 0 for box:1, else kind << 24 | width in
+ * thousandths of a pixel. */
+uint32_t rs_checkpoint_filter_code(const rs_filter *f);
 
 /* FNV-1a 64 over every array and setting of a finalized scene that shading reads. */
 uint64_t rs_checkpoint_scene_hash(const rs_scene *s);

@@ -159,9 +159,27 @@ static void help_render_scene(void)
           "                      (docs/scene-format.md) or a glTF 2.0 FILE.gltf / FILE.glb\n"
           "  --camera NAME       a glTF scene's camera by name (default: its first; a\n"
           "                      camera framing the model when it has none)\n"
-          "  --envmap FILE       light the scene with an equirectangular environment map\n"
-          "                      (EXR, HDR, PNG, ...) in place of its background\n"
+          "  --background B      what rays leaving the scene see, in place of its own\n"
+          "                      background: a grey 0.5 or R,G,B (linear radiance), an\n"
+          "                      equirectangular image FILE (EXR, HDR, PNG, ...) or sky\n"
+          "                      (a sun and sky, docs/sky.md: sky:elevation=E,azimuth=A,\n"
+          "                      turbidity=T,intensity=I,sun=0|1).  A glTF file has none\n"
+          "                      of its own: it gets the default sky\n"
+          "  --envmap FILE       the same as --background FILE\n"
           "  --envmap-scale S    multiply the map's radiance by S (default 1)\n"
+          "  --filter F[:W]      pixel filter, drawn by filter importance sampling: box,\n"
+          "                      gaussian, blackman-harris or mitchell, W its full width in\n"
+          "                      pixels (default blackman-harris:1.5, as Cycles; box:1 is\n"
+          "                      the 1-pixel box of raystream before 0.9; docs/filters.md)\n"
+          "  --view NAME         view transform of 8-bit outputs (PNG, JPEG, TIFF): standard\n"
+          "                      (clip and sRGB, the default), filmic (AgX-like: highlights\n"
+          "                      desaturate instead of clipping) or pbr-neutral (Khronos PBR\n"
+          "                      Neutral); with $OCIO, also that config's views.  EXR and\n"
+          "                      HDR stay scene-linear (docs/view.md)\n"
+          "  --exposure EV       scale 8-bit outputs by 2^EV before the view (default 0)\n"
+          "  --denoise           denoise with Intel Open Image Denoise (the albedo and\n"
+          "                      normal layers guide it; an EXR keeps the raw image as the\n"
+          "                      layer 'noisy'; docs/denoise.md)\n"
           "  --mesh FILE         drop a mesh (OBJ, PLY, glTF, FBX, ...) into the Cornell box,\n"
           "                      scaled to fit, with its own materials\n"
           "  --models DIR        the test models folder for builtin scenes with meshes\n"
@@ -429,6 +447,81 @@ static int opt_envmap_scale(const char *name, const char *v, rs_cli_options *o)
     return RS_EXIT_OK;
 }
 
+/* --background COLOR|FILE|sky[:k=v,...]: a grey "0.5" or "R,G,B" (linear radiance), the sky
+ * (checked when the scene is made, scenes/sky.h), or else an image file (as --envmap). */
+static int opt_background(const char *name, const char *v, rs_cli_options *o)
+{
+    float c[3];
+    int n = 0;
+    char *end;
+    const char *at = v;
+    (void)name;
+    if (!*v)
+        return usage_error("--background needs a colour, an image file or sky%s%s", "", "");
+    if (o->background_kind != RS_BG_NONE)
+        return usage_error("the background is given twice (--background or --envmap '%s')%s", v,
+                           "");
+    if (strcmp(v, "sky") == 0 || strncmp(v, "sky:", 4) == 0) {
+        o->background_kind = RS_BG_SKY;
+        o->background = v;
+        return RS_EXIT_OK;
+    }
+    while (n < 3) {
+        double x = strtod(at, &end);
+        if (end == at || !(x >= 0.0 && x <= 1e12) || (*end && *end != ','))
+            break;
+        c[n++] = (float)x;
+        if (!*end)
+            break;
+        at = end + 1;
+    }
+    if ((n == 1 || n == 3) && !*end) {
+        o->background_kind = RS_BG_COLOR;
+        o->background = v;
+        o->background_rgb[0] = c[0];
+        o->background_rgb[1] = n == 3 ? c[1] : c[0];
+        o->background_rgb[2] = n == 3 ? c[2] : c[0];
+        return RS_EXIT_OK;
+    }
+    o->background_kind = RS_BG_FILE;
+    o->background = o->envmap = v;
+    return RS_EXIT_OK;
+}
+
+/* --envmap FILE: --background FILE. */
+static int opt_envmap(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!*v)
+        return usage_error("--envmap needs an image file%s%s", "", "");
+    if (o->background_kind != RS_BG_NONE)
+        return usage_error("the background is given twice (--background or --envmap '%s')%s", v,
+                           "");
+    o->background_kind = RS_BG_FILE;
+    o->background = o->envmap = v;
+    return RS_EXIT_OK;
+}
+
+static int opt_filter(const char *name, const char *v, rs_cli_options *o)
+{
+    char why[200];
+    (void)name;
+    if (!rs_filter_parse(v, &o->filter, why, sizeof why))
+        return usage_error("--filter: %s%s", why, "");
+    return RS_EXIT_OK;
+}
+
+static int opt_exposure(const char *name, const char *v, rs_cli_options *o)
+{
+    char *end;
+    double val = strtod(v, &end);
+    (void)name;
+    if (end == v || *end || !(val >= -64.0 && val <= 64.0))
+        return usage_error("--exposure needs a number of stops in [-64, 64], not '%s'%s", v, "");
+    o->exposure = (float)val;
+    return RS_EXIT_OK;
+}
+
 static int opt_integrator(const char *name, const char *v, rs_cli_options *o)
 {
     (void)name;
@@ -587,8 +680,13 @@ static const opt_row options[] = {
     ROW_CALL("--sampler", opt_sampler),
     ROW_TEXT("--mesh", NULL, mesh, "a file name"),
     ROW_TEXT("--camera", NULL, camera, "a camera's name"),
-    ROW_TEXT("--envmap", NULL, envmap, "an image file"),
+    ROW_CALL("--background", opt_background),
+    ROW_CALL("--envmap", opt_envmap),
     ROW_CALL("--envmap-scale", opt_envmap_scale),
+    ROW_CALL("--filter", opt_filter),
+    ROW_TEXT("--view", NULL, view, "a view's name"),
+    ROW_CALL("--exposure", opt_exposure),
+    ROW_NUM("--denoise", OPT_FLAG, denoise, 0, 0),
     ROW_TEXT("--models", NULL, models, "a folder"),
 
     ROW_CALL("--threads", opt_threads),
@@ -758,7 +856,7 @@ static int check_render_options(rs_cli_options *o)
         return usage_error("--aov writes layers into an EXR file; '%s'%s is not a .exr", o->output,
                            "");
     if (o->envmap_scale_given && !o->envmap)
-        return usage_error("--envmap-scale needs --envmap FILE%s%s", "", "");
+        return usage_error("--envmap-scale needs --envmap FILE or --background FILE%s%s", "", "");
     if (!o->envmap_scale_given)
         o->envmap_scale = 1.0f;
     return RS_EXIT_OK;
@@ -781,6 +879,7 @@ int rs_cli_parse(int argc, char **argv, rs_cli_options *o)
     o->waves = 0; /* auto */
     o->devices_auto = 1;
     o->n_devices = 0;
+    rs_filter_default(&o->filter);
     if (parse_command(argc, argv, o, &rc))
         return rc;
     if (o->command == RS_CMD_EXPORT) {

@@ -25,6 +25,9 @@ typedef enum rs_cli_command {
     RS_CMD_EXPORT
 } rs_cli_command;
 
+/* What --background (or --envmap) put in place of the scene's background. */
+enum { RS_BG_NONE = 0, RS_BG_COLOR, RS_BG_SKY, RS_BG_FILE };
+
 typedef struct rs_device_spec {
     int is_gpu;  /* 0: cpu, 1: gpu */
     int index;   /* gpu: CUDA device index */
@@ -51,6 +54,16 @@ typedef struct rs_cli_options {
     const char *envmap;    /* --envmap FILE: light the scene with this environment map */
     float envmap_scale;    /* --envmap-scale S (default 1) */
     int envmap_scale_given;
+    int background_kind;   /* --background: RS_BG_NONE (the scene's own), RS_BG_COLOR
+                              (background_rgb), RS_BG_SKY (background: "sky[:...]", the part
+                              after "sky" parsed by scenes/sky.h) or RS_BG_FILE (envmap) */
+    const char *background;
+    float background_rgb[3];
+    rs_filter filter;      /* --filter NAME[:WIDTH] (default blackman-harris:1.5) */
+    const char *view;      /* --view NAME: the display outputs' view transform (core/view.h);
+                              NULL: standard */
+    float exposure;        /* --exposure EV: display outputs scaled by 2^EV first */
+    int denoise;           /* --denoise: OIDN on the beauty, with the albedo and normal */
     const char *models;    /* --models DIR */
     rs_bvh_builder bvh;    /* --bvh NAME */
     int bvh_on_gpu;        /* --bvh-device gpu: Morton codes and sort on CUDA device 0 */

@@ -43,6 +43,7 @@ void rs_run_settings(const rs_cli_options *o, render_run *r)
     st->seed = o->seed;
     st->sampling = o->sampling;
     st->sampler = o->sampler;
+    st->filter = o->filter;
     st->wave_paths = o->wave_paths;
     st->waves_in_flight = o->waves;
     r->threads = o->threads ? o->threads : rs_cpu_count();
@@ -139,6 +140,7 @@ static void make_key(const rs_cli_options *o, render_run *r)
     k->rr_depth = r->st.rr_depth ? r->st.rr_depth : 3;
     k->sampling = (uint32_t)r->st.sampling;
     k->sampler = (uint32_t)r->st.sampler;
+    k->filter = rs_checkpoint_filter_code(&r->st.filter);
     k->isect_sphere = o->isect_sphere;
     k->isect_tri = o->isect_tri;
     k->isect_aabb = o->isect_aabb;

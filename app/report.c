@@ -225,12 +225,13 @@ static void summary_render(const rs_report *rep)
                  "shared triangles)",
                  rep->instances, rep->inst_prims, rep->blas_nodes, rep->inst_tris);
     fprintf(stderr,
-            "%s %s at %ux%u, %s (%s sampling, %s sampler, max depth %u, seed %llu) in %.2f s: "
+            "%s %s at %ux%u, %s (%s sampling, %s sampler, %s filter, max depth %u, seed %llu) "
+            "in %.2f s: "
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
             "BVH (%s, SAH cost %.1f): %u nodes over %u primitives%s, built in %.2f ms. ",
             rep->interrupted ? "Partial render (interrupted):" : "Rendered", rep->scene, rep->width,
             rep->height, spp, rs_sampling_name(rep->sampling), rs_sampler_name(rep->sampler),
-            rep->max_depth, (unsigned long long)rep->seed, s->seconds, sps, rps, rays,
+            rep->filter, rep->max_depth, (unsigned long long)rep->seed, s->seconds, sps, rps, rays,
             (unsigned long long)s->rays_closest, (unsigned long long)s->rays_shadow,
             rep->bvh_builder, rep->bvh_sah, rep->bvh_nodes, rep->bvh_prims, inst, rep->bvh_ms);
 }
@@ -312,7 +313,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     static const char *const keys[RS_REPORT_META_N] = {
         "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
         "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
-        "raystream:integrator", "raystream:version", "raystream:adaptive"};
+        "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter"};
     const char *values[RS_REPORT_META_N];
     size_t used = 0;
     int i;
@@ -343,6 +344,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     values[8] = rep->megakernel ? "megakernel" : "stream";
     values[9] = RS_VERSION;
     values[10] = m->adaptive;
+    values[11] = rep->filter;
     for (i = 0; i < RS_REPORT_META_N; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];

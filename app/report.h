@@ -29,6 +29,9 @@ typedef struct rs_report {
     uint64_t seed;
     rs_sampling sampling;
     rs_sampler sampler;
+    char filter[40];       /* "blackman-harris:1.5" */
+    const char *lighting;  /* how the scene was lit when the file said nothing ("the default
+                              sky: ..."), or NULL */
     double adaptive, time_limit_s; /* --adaptive's threshold (0: off), --time-limit */
     /* what happened */
     int interrupted; /* the stop signal, or 0 */
@@ -56,9 +59,10 @@ int rs_report_write_json(const rs_report *rep, const char *path, const char *sho
 void rs_report_print_summary(const rs_report *rep);
 
 /* The .exr header's attributes (core/image_io.h): the scene, the spp every pixel has and the
- * spp asked for, seed, sampling, sampler, max depth, devices, integrator, version, adaptive;
+ * spp asked for, seed, sampling, sampler, max depth, devices, integrator, version, adaptive,
+ * the pixel filter;
  * their strings in the struct itself. */
-enum { RS_REPORT_META_N = 11 };
+enum { RS_REPORT_META_N = 12 };
 typedef struct rs_report_meta {
     rs_image_meta meta[RS_REPORT_META_N];
     char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];

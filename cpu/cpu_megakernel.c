@@ -63,7 +63,7 @@ static inline rs_vec3 path_radiance(const rs_render_consts *it, const cpu_impl *
                 rs_path_unoccluded(&p);
         }
         if (!(made & RS_SHADE_NEXT))
-            return p.ps.radiance;
+            return rs_path_result(p.ps.radiance, p.ps.flags);
     }
 }
 

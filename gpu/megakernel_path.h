@@ -35,7 +35,7 @@ RS_HD rs_vec3 rs_gpu_path_radiance(const rs_render_consts *it, const rs_path_tra
                 rs_path_unoccluded(&p);
         }
         if (!(made & RS_SHADE_NEXT))
-            return p.ps.radiance;
+            return rs_path_result(p.ps.radiance, p.ps.flags);
     }
 }
 

@@ -114,7 +114,7 @@ static void flush_range(void *ctx, uint32_t begin, uint32_t end)
     for (k = begin; k < end; ++k)
         for (i = k; i < f->sl->count; i += f->npix)
             rs_film_add(f->film, rs_path_map_pixel(f->map, f->sl->start + i),
-                        f->sl->b.paths.radiance[i]);
+                        rs_path_result(f->sl->b.paths.radiance[i], f->sl->b.paths.flags[i]));
 }
 
 /* The wave onto the film in path order (run only for the next wave in wave order). */

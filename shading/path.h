@@ -32,6 +32,7 @@
 #include "core/zsobol.h"
 #include "shading/bsdf.h"
 #include "shading/camera.h"
+#include "shading/filter.h"
 #include "shading/dims.h"
 #include "shading/lights.h"
 #include "shading/spawn.h"
@@ -56,6 +57,8 @@ typedef enum rs_sampler {
 
 /* Path flags. */
 #define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
+#define RS_PATH_NEGATIVE 2u /* the camera sample fell under a negative lobe of the pixel filter
+                               (shading/filter.h): the film takes -radiance (rs_path_result) */
 
 /* What rs_path_shade_at made. */
 #define RS_SHADE_NEXT   1u /* the path goes on with *next */
@@ -78,6 +81,7 @@ typedef struct rs_render_consts {
     uint32_t rr_depth;  /* Russian roulette from this segment on */
     uint32_t sampling;  /* rs_sampling */
     uint32_t sampler;   /* rs_sampler */
+    rs_filter filter;   /* the pixel filter the camera samples are drawn from */
 } rs_render_consts;
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the
@@ -122,22 +126,32 @@ RS_HD rs_ray rs_path_begin_at(const rs_render_consts *it, uint32_t pixel, uint32
 {
     const rs_camera_desc *cd = &it->scene->camera;
     rs_rng_f4 r = pre ? pre[0] : rs_path_rand(it, pixel, sample, 0, RS_DIM_CAMERA);
-    rs_ray ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, r.v[0], r.v[1],
-                               r.v[2], r.v[3]);
+    float jx, jy, w;
+    rs_ray ray;
     float time = cd->shutter_open;
+    rs_filter_sample(&it->filter, r.v[0], r.v[1], &jx, &jy);
+    ray = rs_camera_ray(&it->camera, pixel % it->width, pixel / it->width, jx, jy, r.v[2], r.v[3]);
+    w = rs_filter_weight(&it->filter, r.v[0], r.v[1]);
     if (cd->shutter_close != cd->shutter_open) {
         rs_rng_f4 rt = pre ? pre[1] : rs_path_rand(it, pixel, sample, 0, RS_DIM_TIME);
         time += rt.v[0] * (cd->shutter_close - cd->shutter_open);
     }
     ray.time = time;
-    ps->throughput = rs_v3_splat(1.0f);
+    ps->throughput = rs_v3_splat(w < 0.0f ? -w : w);
     ps->radiance = rs_v3_splat(0.0f);
     ps->pending = rs_v3_splat(0.0f);
     ps->bsdf_pdf = 0.0f;
     ps->env_pdf = 0.0f;
     ps->time = time;
-    ps->flags = (uint8_t)RS_PATH_SPECULAR;
+    ps->flags = (uint8_t)(RS_PATH_SPECULAR | (w < 0.0f ? RS_PATH_NEGATIVE : 0u));
     return ray;
+}
+
+/* What a finished path adds to its pixel: its radiance, negated when its camera sample fell under
+ * a negative lobe of the filter.  (`flags` is the path's last rs_path_state flags.) */
+RS_HD rs_vec3 rs_path_result(rs_vec3 radiance, uint32_t flags)
+{
+    return flags & RS_PATH_NEGATIVE ? rs_v3_scale(radiance, -1.0f) : radiance;
 }
 
 RS_HD float rs_power_heuristic(float a, float b)
@@ -584,7 +598,7 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
     ps->throughput = beta;
     ps->bsdf_pdf = pdf;
     ps->env_pdf = sc->env_uniform && !specular ? sc->env_pick * rs_env_pdf_at(sc, v.n, wi) : 0.0f;
-    ps->flags = (uint8_t)(specular ? RS_PATH_SPECULAR : 0);
+    ps->flags = (uint8_t)((ps->flags & RS_PATH_NEGATIVE) | (specular ? RS_PATH_SPECULAR : 0u));
     return out | RS_SHADE_NEXT;
 }
 
@@ -606,7 +620,7 @@ typedef struct rs_path_counts {
  *             rs_path_unoccluded(&p);
  *         if (!(made & RS_SHADE_NEXT)) break;
  *     }
- *     radiance: p.ps.radiance
+ *     radiance: rs_path_result(p.ps.radiance, p.ps.flags)
  *
  * Each vertex is shaded as the wavefront shades it and each shadow ray resolved before the next
  * segment, so the radiance is the wavefront's bit for bit (on the same compiler). */
