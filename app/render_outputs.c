@@ -10,6 +10,7 @@
 #include "app/timeline_svg.h"
 #include "core/alloc.h"
 #include "core/parallel.h"
+#include "core/view.h"
 #include "shading/aov.h"
 
 /* The devices' rows: the stream engine's (the scheduler's counters) or the megakernel's one,
@@ -167,16 +168,24 @@ static int write_image(const rs_cli_options *o, const render_run *r, const rs_re
     rs_image_layer layers[4];
     float *bufs[4];
     rs_report_meta meta;
+    rs_view view;
+    char why[512];
     int i, ok = 1, n_layers;
     rs_report_image_meta(rep, &meta);
+    /* --view and --exposure (checked when the options were read): an 8-bit image gets the
+     * view's display values; an .exr stays linear and records the view (core/image_io.h) */
+    if (!rs_view_from_name(o->view, o->exposure, &view, why, sizeof why)) {
+        fprintf(stderr, "raystream: %s\n", why);
+        return 0;
+    }
     n_layers = make_aovs(o, r, layers, bufs);
     if (n_layers < 0) {
         rs_app_fail(0, NULL);
         ok = 0;
         n_layers = 0;
     }
-    if (ok && rs_image_write_layers(r->out, r->st.width, r->st.height, r->rgb, layers,
-                                    (size_t)n_layers, meta.meta, RS_REPORT_META_N) != RS_OK) {
+    if (ok && rs_image_write_view(r->out, r->st.width, r->st.height, r->rgb, layers,
+                                  (size_t)n_layers, meta.meta, RS_REPORT_META_N, &view) != RS_OK) {
         rs_app_fail(0, NULL);
         ok = 0;
     }

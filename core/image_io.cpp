@@ -1,5 +1,6 @@
-// core/image_io.cpp — the OpenImageIO shim (see image_io.h).  The only C++ file of the project;
-// every entry point catches all exceptions and turns them into rs_status + message.
+// core/image_io.cpp — the OpenImageIO shim (see image_io.h).  With core/view_ocio.cpp, one of the
+// two C++ files of the project; every entry point catches all exceptions and turns them into
+// rs_status + message.
 #include "core/image_io.h"
 
 #include <OpenImageIO/imageio.h>
@@ -181,6 +182,25 @@ extern "C" rs_status rs_image_write_layers(const char *path, uint32_t w, uint32_
                                            size_t n_layers, const rs_image_meta *meta,
                                            size_t n_meta)
 {
+    return rs_image_write_view(path, w, h, rgb, layers, n_layers, meta, n_meta, nullptr);
+}
+
+extern "C" int rs_image_is_display_format(const char *path)
+{
+    try {
+        return is_8bit_format(lower_ext(path)) ? 1 : 0;
+    } catch (...) {
+        return 0;
+    }
+}
+
+extern "C" rs_status rs_image_write_view(const char *path, uint32_t w, uint32_t h,
+                                         const float *rgb, const rs_image_layer *layers,
+                                         size_t n_layers, const rs_image_meta *meta,
+                                         size_t n_meta, const rs_view *view)
+{
+    if (view && rs_view_is_default(view))
+        view = nullptr; // today's clamp + sRGB curve, byte for byte
     std::string tmp = temp_name(path);
     try {
         std::string e = lower_ext(path);
@@ -206,6 +226,12 @@ extern "C" rs_status rs_image_write_layers(const char *path, uint32_t w, uint32_
             if (e == "exr")
                 for (size_t i = 0; i < n_meta; ++i)
                     spec.attribute(meta[i].key, meta[i].value);
+            if (e == "exr" && view) { // the pixels stay linear: the view is only recorded
+                char ev[32];
+                std::snprintf(ev, sizeof ev, "%g", (double)view->exposure);
+                spec.attribute("raystream:view", view->name);
+                spec.attribute("raystream:exposure", ev);
+            }
             if (n_layers == 0) {
                 ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, rgb);
             } else {
@@ -226,8 +252,17 @@ extern "C" rs_status rs_image_write_layers(const char *path, uint32_t w, uint32_
             }
         } else {
             std::vector<unsigned char> px(n);
-            for (size_t i = 0; i < n; ++i)
-                px[i] = (unsigned char)std::lround(255.0f * rs_srgb_encode(rgb[i]));
+            if (!view) {
+                for (size_t i = 0; i < n; ++i)
+                    px[i] = (unsigned char)std::lround(255.0f * rs_srgb_encode(rgb[i]));
+            } else { // display values in [0, 1]: no second encoding
+                std::vector<float> disp(n);
+                rs_status st = rs_view_apply(view, rgb, (size_t)w * h, disp.data());
+                if (st != RS_OK)
+                    return st;
+                for (size_t i = 0; i < n; ++i)
+                    px[i] = (unsigned char)std::lround(255.0f * disp[i]);
+            }
             OIIO::ImageSpec spec((int)w, (int)h, 3, OIIO::TypeDesc::UINT8);
             spec.attribute("oiio:ColorSpace", "sRGB");
             ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::UINT8, px.data());

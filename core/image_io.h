@@ -2,9 +2,10 @@
  *
  * The format follows the file extension.  Float formats (.exr, .hdr, .pfm) get linear radiance;
  * 8-bit formats (.png, .jpg, .jpeg, .tif, .tiff, .bmp, .tga) get the sRGB transfer curve after
- * clamping to [0, 1].  Writes go to a temporary file beside the target that is renamed over it
- * only once complete, so a failed or interrupted write never leaves a partial file and never
- * clobbers a good one.  C++ exceptions stop at this API's edge. */
+ * clamping to [0, 1], or a view's display values (rs_image_write_view, core/view.h).  Writes go
+ * to a temporary file beside the target that is renamed over it only once complete, so a failed
+ * or interrupted write never leaves a partial file and never clobbers a good one.  C++ exceptions
+ * stop at this API's edge. */
 #ifndef RS_CORE_IMAGE_IO_H
 #define RS_CORE_IMAGE_IO_H
 
@@ -12,6 +13,7 @@
 #include <stdint.h>
 
 #include "core/status.h"
+#include "core/view.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -48,6 +50,20 @@ typedef struct rs_image_layer {
 rs_status rs_image_write_layers(const char *path, uint32_t width, uint32_t height,
                                 const float *rgb, const rs_image_layer *layers, size_t n_layers,
                                 const rs_image_meta *meta, size_t n_meta);
+
+/* rs_image_write_layers through a view (core/view.h).  An 8-bit format stores the view's
+ * display values (rs_view_apply, then round(255 v)) with no second sRGB encoding; a float format
+ * (.exr, .hdr, .pfm) stays scene-linear, neither exposed nor tone mapped, and an .exr records
+ * the view as the attributes "raystream:view" (its name) and "raystream:exposure" (EV, "%g").
+ * `view` NULL or the default view (rs_view_is_default: standard at 0 EV) writes exactly what
+ * rs_image_write_layers writes, byte for byte, with no attribute added. */
+rs_status rs_image_write_view(const char *path, uint32_t width, uint32_t height, const float *rgb,
+                              const rs_image_layer *layers, size_t n_layers,
+                              const rs_image_meta *meta, size_t n_meta, const rs_view *view);
+
+/* 1 when `path`'s extension is an 8-bit display format (.png .jpg .jpeg .tif .tiff .bmp .tga,
+ * any case): the files a view applies to. */
+int rs_image_is_display_format(const char *path);
 
 /* Channel `channel` ("R", "albedo.G", "depth.Z") of image `path`: width * height floats
  * (rs_alloc).  RS_ERR_ARG when the file has no such channel. */
