@@ -3,6 +3,8 @@
 
 #include "shading/aov.h"
 #include "scenes/gltf.h"
+#include "scenes/sky.h"
+#include "core/view.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -462,6 +464,10 @@ static int opt_background(const char *name, const char *v, rs_cli_options *o)
         return usage_error("the background is given twice (--background or --envmap '%s')%s", v,
                            "");
     if (strcmp(v, "sky") == 0 || strncmp(v, "sky:", 4) == 0) {
+        rs_sky_params p;
+        char why[200];
+        if (!rs_sky_parse(v + 3, &p, why, sizeof why))
+            return usage_error("--background %s: %s", v, why);
         o->background_kind = RS_BG_SKY;
         o->background = v;
         return RS_EXIT_OK;
@@ -855,6 +861,12 @@ static int check_render_options(rs_cli_options *o)
         (strlen(o->output) < 4 || strcasecmp(o->output + strlen(o->output) - 4, ".exr") != 0))
         return usage_error("--aov writes layers into an EXR file; '%s'%s is not a .exr", o->output,
                            "");
+    if (o->view || o->exposure != 0.0f) {
+        rs_view v;
+        char why[300];
+        if (!rs_view_from_name(o->view, o->exposure, &v, why, sizeof why))
+            return usage_error("--view: %s%s", why, "");
+    }
     if (o->envmap_scale_given && !o->envmap)
         return usage_error("--envmap-scale needs --envmap FILE or --background FILE%s%s", "", "");
     if (!o->envmap_scale_given)

@@ -234,6 +234,8 @@ static void summary_render(const rs_report *rep)
             rep->filter, rep->max_depth, (unsigned long long)rep->seed, s->seconds, sps, rps, rays,
             (unsigned long long)s->rays_closest, (unsigned long long)s->rays_shadow,
             rep->bvh_builder, rep->bvh_sah, rep->bvh_nodes, rep->bvh_prims, inst, rep->bvh_ms);
+    if (rep->lighting)
+        fprintf(stderr, "Lit by %s. ", rep->lighting);
 }
 
 /* The devices' sentence and the integrator's. */
@@ -313,7 +315,8 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     static const char *const keys[RS_REPORT_META_N] = {
         "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
         "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
-        "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter"};
+        "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter",
+        "raystream:lighting"};
     const char *values[RS_REPORT_META_N];
     size_t used = 0;
     int i;
@@ -345,6 +348,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     values[9] = RS_VERSION;
     values[10] = m->adaptive;
     values[11] = rep->filter;
+    values[12] = rep->lighting ? rep->lighting : "the scene's own";
     for (i = 0; i < RS_REPORT_META_N; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];

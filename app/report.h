@@ -60,9 +60,9 @@ void rs_report_print_summary(const rs_report *rep);
 
 /* The .exr header's attributes (core/image_io.h): the scene, the spp every pixel has and the
  * spp asked for, seed, sampling, sampler, max depth, devices, integrator, version, adaptive,
- * the pixel filter;
+ * the pixel filter, the lighting when the scene's file gave none;
  * their strings in the struct itself. */
-enum { RS_REPORT_META_N = 12 };
+enum { RS_REPORT_META_N = 13 };
 typedef struct rs_report_meta {
     rs_image_meta meta[RS_REPORT_META_N];
     char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];

@@ -13,6 +13,7 @@
 #include "scenes/gltf.h"
 #include "scenes/scene_export.h"
 #include "scenes/scene_json.h"
+#include "scenes/sky.h"
 
 /* The stem of a file name: dir/bunny.ply -> bunny. */
 static void file_stem(const char *path, char *out, size_t n)
@@ -83,6 +84,55 @@ static int load_scene(const rs_cli_options *o, render_run *r)
     return RS_EXIT_OK;
 }
 
+static int apply_envmap(const rs_cli_options *o, render_run *r);
+
+/* --background sky[:...], or a glTF file's default sky (a glTF file has no environment). */
+static int apply_sky(const rs_cli_options *o, render_run *r)
+{
+    rs_sky_params p;
+    char why[200];
+    if (o->background_kind == RS_BG_SKY) {
+        if (!rs_sky_parse(o->background + 3, &p, why, sizeof why)) {
+            fprintf(stderr, "raystream: --background %s: %s\n", o->background, why);
+            return RS_EXIT_USAGE;
+        }
+    } else {
+        const rs_camera_desc *c = &r->scene->camera;
+        rs_sky_default_for_camera(c->from, c->at, &p);
+        snprintf(r->lighting, sizeof r->lighting,
+                 "the default sky (sky:elevation=45,azimuth=%.0f: the sun behind the camera, to "
+                 "its left; a glTF file has no environment: --background to change)",
+                 (double)p.azimuth_deg);
+    }
+    if (rs_scene_set_sky(r->scene, &p) != RS_OK || rs_scene_finalize(r->scene) != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "the sky");
+    return RS_EXIT_OK;
+}
+
+/* --background R,G,B: a constant radiance, sampled as a light when not black. */
+static int apply_color(const rs_cli_options *o, render_run *r)
+{
+    r->scene->env_image = RS_NO_TEXTURE;
+    r->scene->background_sky = 0;
+    r->scene->background =
+        rs_v3(o->background_rgb[0], o->background_rgb[1], o->background_rgb[2]);
+    if (rs_scene_finalize(r->scene) != RS_OK)
+        return rs_app_fail(RS_EXIT_RUNTIME, "--background");
+    return RS_EXIT_OK;
+}
+
+/* --background (or --envmap) in place of the scene's own; with neither, a glTF file gets the
+ * default sky. */
+static int apply_background(const rs_cli_options *o, render_run *r)
+{
+    if (o->background_kind == RS_BG_SKY ||
+        (o->background_kind == RS_BG_NONE && rs_is_gltf_path(o->scene)))
+        return apply_sky(o, r);
+    if (o->background_kind == RS_BG_COLOR)
+        return apply_color(o, r);
+    return apply_envmap(o, r);
+}
+
 /* --envmap FILE: the scene's background becomes the map, sampled as a light. */
 static int apply_envmap(const rs_cli_options *o, render_run *r)
 {
@@ -115,7 +165,7 @@ static int load_and_light(void *arg)
     load_args *a = (load_args *)arg;
     int code = load_scene(a->o, a->r);
     if (code == RS_EXIT_OK)
-        code = apply_envmap(a->o, a->r);
+        code = apply_background(a->o, a->r);
     return code;
 }
 

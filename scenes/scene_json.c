@@ -3,6 +3,7 @@
  * Every object is checked against the keys it may have; every value against its type and range.
  * Paths in messages are JSON paths: objects[3].radius, materials.glass.ior. */
 #include "scenes/scene_json.h"
+#include "scenes/sky.h"
 
 #include <cjson/cJSON.h>
 #include <float.h>
@@ -408,12 +409,38 @@ static rs_status read_envmap(ctx *c, const cJSON *bg)
     return RS_OK;
 }
 
+/* "background": {"sky": {"elevation": .., "azimuth": .., "turbidity": .., "intensity": ..,
+ * "sun": true}}: the sun and sky of scenes/sky.h (each key optional: its default). */
+static rs_status read_sky(ctx *c, const cJSON *bg)
+{
+    static const char *const keys[] = {"sky", NULL};
+    static const char *const sky_keys[] = {"elevation", "azimuth", "turbidity", "intensity", "sun",
+                                           NULL};
+    const cJSON *sky = cJSON_GetObjectItemCaseSensitive(bg, "sky");
+    rs_sky_params p;
+    RS_TRY(check_keys(c, bg, "background", keys));
+    if (!cJSON_IsObject(sky))
+        return FAIL(c, "background.sky", "expected {\"elevation\": .., \"azimuth\": .., ...} or {}");
+    RS_TRY(check_keys(c, sky, "background.sky", sky_keys));
+    rs_sky_defaults(&p); /* the ranges are scenes/sky.h's */
+    RS_TRY(get_num(c, sky, "background.sky", "elevation", 0, p.elevation_deg, 0, 90,
+                   &p.elevation_deg));
+    RS_TRY(get_num(c, sky, "background.sky", "azimuth", 0, p.azimuth_deg, -360, 360,
+                   &p.azimuth_deg));
+    RS_TRY(get_num(c, sky, "background.sky", "turbidity", 0, p.turbidity, 2, 10, &p.turbidity));
+    RS_TRY(get_num(c, sky, "background.sky", "intensity", 0, p.intensity, 0, 1e6, &p.intensity));
+    RS_TRY(get_bool(c, sky, "background.sky", "sun", 1, &p.sun));
+    return rs_scene_set_sky(c->scene, &p);
+}
+
 static rs_status read_background(ctx *c, const cJSON *bg)
 {
     static const char *const keys[] = {"horizon", "zenith", NULL};
     rs_scene *s = c->scene;
     if (cJSON_IsObject(bg) && cJSON_GetObjectItemCaseSensitive(bg, "map"))
         return read_envmap(c, bg);
+    if (cJSON_IsObject(bg) && cJSON_GetObjectItemCaseSensitive(bg, "sky"))
+        return read_sky(c, bg);
     if (cJSON_IsArray(bg)) {
         RS_TRY(vec3_of(c, bg, "background", &s->background));
         if (s->background.x < 0 || s->background.y < 0 || s->background.z < 0)

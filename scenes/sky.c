@@ -16,6 +16,8 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/try.h"
+#include "scenes/scene.h"
 
 #define PI 3.14159265358979323846
 
@@ -531,4 +533,33 @@ int rs_sky_parse(const char *spec, rs_sky_params *out, char *why, size_t n)
     }
     *out = p;
     return 1;
+}
+
+rs_status rs_scene_set_sky(struct rs_scene *s, const rs_sky_params *p)
+{
+    float *rgb = NULL;
+    uint32_t id;
+    rs_status st;
+    RS_TRY(rs_sky_image(p, RS_SKY_WIDTH, RS_SKY_HEIGHT, &rgb));
+    st = rs_scene_add_image(s, RS_SKY_WIDTH, RS_SKY_HEIGHT, rgb, &id);
+    rs_free(rgb);
+    if (st == RS_OK)
+        st = rs_scene_set_environment(s, id, rs_v3_splat(1.0f), NULL);
+    return st;
+}
+
+void rs_sky_default_for_camera(rs_vec3 from, rs_vec3 at, rs_sky_params *p)
+{
+    /* behind the camera: -forward, turned 30 degrees toward the camera's left (about +y,
+     * counter-clockwise seen from above) */
+    double bx = -(double)(at.x - from.x), bz = -(double)(at.z - from.z), len = sqrt(bx * bx + bz * bz);
+    const double turn = 30.0 * 3.14159265358979323846 / 180.0;
+    rs_sky_defaults(p);
+    if (len > 0.0) {
+        double c = cos(turn), sn = sin(turn);
+        /* looking along f, the camera's left is f turned +90 degrees about +y; behind it and to
+         * the left, -f turned by -turn toward that side */
+        double hx = (bx * c - bz * sn) / len, hz = (bx * sn + bz * c) / len;
+        p->azimuth_deg = (float)(atan2(hx, -hz) * 180.0 / 3.14159265358979323846);
+    }
 }

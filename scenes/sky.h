@@ -78,6 +78,18 @@ rs_vec3 rs_sky_radiance(const rs_sky_params *p, rs_vec3 d);
 /* The unit direction toward the sun's centre. */
 rs_vec3 rs_sky_sun_direction(const rs_sky_params *p);
 
+struct rs_scene;
+/* Lights scene `s` with the sky: its RS_SKY_WIDTH x RS_SKY_HEIGHT image as the environment map
+ * (importance-sampled with MIS like any map, shading/envmap.h), in place of the background.
+ * The caller finalizes the scene. */
+rs_status rs_scene_set_sky(struct rs_scene *s, const rs_sky_params *p);
+
+/* The default sky of a scene whose file says nothing of its lighting (a glTF file): the defaults
+ * (45 degrees, turbidity 3) with the sun behind a camera looking from `from` to `at`, 30 degrees
+ * to its left (a key light over the left shoulder); a camera looking straight up or down takes
+ * azimuth 0. */
+void rs_sky_default_for_camera(rs_vec3 from, rs_vec3 at, rs_sky_params *p);
+
 /* The sun disc's radiance (RGB, renderer units, intensity included) whether or not p->sun. */
 rs_vec3 rs_sky_sun_radiance(const rs_sky_params *p);
 

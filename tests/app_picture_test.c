@@ -1,0 +1,252 @@
+/* tests/app_picture_test.c — the finished picture from the command line (issue 28): pixel
+ * filters, backgrounds and the default lighting of a glTF file, run through the `raystream`
+ * binary.
+ *
+ *   - --filter: the default is Blackman-Harris 1.5 (the EXR header says so); every filter gives
+ *     the same image bit for bit on the stream engine, the megakernel and the CPU + GPU-fallback
+ *     device set (the filter is drawn in the one RS_HD camera step); filters differ from each
+ *     other; a checkpoint made with one filter is refused with another, naming --filter, and
+ *     resumed with its own equals the uninterrupted render;
+ *   - --background: a grey is exactly that radiance where rays leave the scene; a glTF file
+ *     with no --background is lit by the default sky (the summary and the header say so) where
+ *     --background 0 leaves it black; sky parameters are checked before the render (one line
+ *     naming the key, status 2); a scene file's "background": {"sky": ...} is read, and a bad
+ *     key is named with the file. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef RS_SOURCE_DIR
+#  define RS_SOURCE_DIR "."
+#endif
+
+#include "cli_harness.h"
+
+static void run_expect(const fixture *f, const char *const *args, int code, proc *p)
+{
+    run(p, f->dir, DEFAULT_TIMEOUT_S, args);
+    EXPECT(p, exited_with(p, code), "expected exit status %d", code);
+}
+
+/* Renders builtin:cornell small with `filter` and the extra args (NULL-terminated, up to 6)
+ * into `out`. */
+static void render_cornell(const fixture *f, const char *filter, const char *out,
+                           const char *const *extra)
+{
+    const char *args[24] = {"render", "builtin:cornell", "--width", "40", "--height", "30",
+                            "--spp", "4", "-q", "-o", out};
+    int n = 11, k;
+    proc p;
+    if (filter) {
+        args[n++] = "--filter";
+        args[n++] = filter;
+    }
+    for (k = 0; extra && extra[k]; ++k)
+        args[n++] = extra[k];
+    args[n] = NULL;
+    run_expect(f, args, 0, &p);
+    proc_free(&p);
+}
+
+static int same_files_pixels(const fixture *f, const char *a, const char *b)
+{
+    proc dummy;
+    image x, y;
+    int same;
+    memset(&dummy, 0, sizeof dummy);
+    x = read_image(&dummy, f, a);
+    y = read_image(&dummy, f, b);
+    same = same_image(&x, &y);
+    rs_free(x.rgb);
+    rs_free(y.rgb);
+    return same;
+}
+
+static void test_filters_same_on_every_integrator(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const mk[] = {"--integrator", "megakernel", "--devices", "cpu", NULL};
+    static const char *const fb[] = {"--devices", "cpu:1,gpu", NULL};
+    static const char *const filters[] = {"box:2", "gaussian", "blackman-harris:2", "mitchell"};
+    char path[256], value[64];
+    proc p;
+    size_t k;
+    memset(&p, 0, sizeof p);
+    render_cornell(f, NULL, "default.exr", NULL);
+    render_cornell(f, "blackman-harris:1.5", "bh.exr", NULL);
+    path_in(f, "default.exr", path, sizeof path);
+    EXPECT(&p, rs_image_read_meta(path, "raystream:filter", value, sizeof value) == RS_OK &&
+                   strcmp(value, "blackman-harris:1.5") == 0,
+           "the default filter is '%s' in the header, not blackman-harris:1.5", value);
+    EXPECT(&p, same_files_pixels(f, "default.exr", "bh.exr"),
+           "the default is not blackman-harris:1.5");
+    render_cornell(f, "box", "box.exr", NULL);
+    EXPECT(&p, !same_files_pixels(f, "default.exr", "box.exr"), "box and blackman-harris agree");
+    for (k = 0; k < sizeof filters / sizeof filters[0]; ++k) {
+        render_cornell(f, filters[k], "s.exr", NULL);
+        render_cornell(f, filters[k], "m.exr", mk);
+        render_cornell(f, filters[k], "g.exr", fb);
+        EXPECT(&p, same_files_pixels(f, "s.exr", "m.exr"),
+               "--filter %s: the megakernel's image is not the stream engine's", filters[k]);
+        EXPECT(&p, same_files_pixels(f, "s.exr", "g.exr"),
+               "--filter %s: cpu + gpu-fallback is not the cpu's image", filters[k]);
+        EXPECT(&p, !same_files_pixels(f, "s.exr", "box.exr"), "--filter %s is the box",
+               filters[k]);
+    }
+}
+
+static void test_filter_in_checkpoint(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const half[] = {"render", "builtin:cornell", "--width", "40", "--height",
+                                       "30", "--spp", "2", "--filter", "mitchell", "--checkpoint",
+                                       "c.ckpt", "-q", "-o", "half.exr", NULL};
+    static const char *const other[] = {"render", "builtin:cornell", "--width", "40", "--height",
+                                        "30", "--spp", "4", "--filter", "gaussian", "--resume",
+                                        "c.ckpt", "-q", "-o", "r.exr", NULL};
+    static const char *const same[] = {"render", "builtin:cornell", "--width", "40", "--height",
+                                       "30", "--spp", "4", "--filter", "mitchell", "--resume",
+                                       "c.ckpt", "-q", "-o", "r.exr", NULL};
+    proc p;
+    run_expect(f, half, 0, &p);
+    proc_free(&p);
+    run_expect(f, other, 2, &p);
+    EXPECT(&p, strstr(p.err.data, "--filter mitchell:4") && strstr(p.err.data, "gaussian:3"),
+           "the resume with another filter does not name both filters");
+    proc_free(&p);
+    run_expect(f, same, 0, &p);
+    proc_free(&p);
+    render_cornell(f, "mitchell", "whole.exr", NULL);
+    EXPECT(&p, same_files_pixels(f, "r.exr", "whole.exr"),
+           "a resumed Mitchell render is not the uninterrupted one");
+}
+
+/* The value at pixel (x, y), channel c. */
+static float pixel_of(const image *im, uint32_t x, uint32_t y, int c)
+{
+    return im->rgb[3 * ((size_t)y * im->w + x) + c];
+}
+
+static void test_background_and_gltf_default(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const lit[] = {"render", RS_SOURCE_DIR "/tests/data/tri.gltf", "--width",
+                                      "32", "--height", "32", "--spp", "4", "-o", "lit.exr", NULL};
+    static const char *const dark[] = {"render", RS_SOURCE_DIR "/tests/data/tri.gltf",
+                                       "--width", "32", "--height", "32", "--spp", "4",
+                                       "--background", "0", "-q", "-o", "dark.exr", NULL};
+    static const char *const grey[] = {"render", RS_SOURCE_DIR "/tests/data/tri.gltf",
+                                       "--width", "32", "--height", "32", "--spp", "4",
+                                       "--background", "0.25,0.5,0.75", "-q", "-o", "grey.exr",
+                                       NULL};
+    char path[256], value[256];
+    image a, b, g;
+    proc p;
+    run_expect(f, lit, 0, &p);
+    EXPECT(&p, strstr(p.err.data, "Lit by the default sky") != NULL,
+           "the summary does not say the glTF file was lit by the default sky");
+    path_in(f, "lit.exr", path, sizeof path);
+    EXPECT(&p, rs_image_read_meta(path, "raystream:lighting", value, sizeof value) == RS_OK &&
+                   strstr(value, "default sky") != NULL,
+           "the header's raystream:lighting is '%s'", value);
+    a = read_image(&p, f, "lit.exr");
+    proc_free(&p);
+    run_expect(f, dark, 0, &p);
+    b = read_image(&p, f, "dark.exr");
+    EXPECT(&p, image_mean(&b) == 0.0 && image_mean(&a) > 0.05,
+           "the default sky lights the triangle (mean %g) where --background 0 leaves it black "
+           "(mean %g)",
+           image_mean(&a), image_mean(&b));
+    proc_free(&p);
+    run_expect(f, grey, 0, &p);
+    g = read_image(&p, f, "grey.exr");
+    /* the corner sees only the background: every sample is exactly that radiance */
+    EXPECT(&p, pixel_of(&g, 0, 0, 0) == 0.25f && pixel_of(&g, 0, 0, 1) == 0.5f &&
+                   pixel_of(&g, 0, 0, 2) == 0.75f,
+           "--background 0.25,0.5,0.75 gives (%g, %g, %g) where rays leave the scene",
+           (double)pixel_of(&g, 0, 0, 0), (double)pixel_of(&g, 0, 0, 1),
+           (double)pixel_of(&g, 0, 0, 2));
+    proc_free(&p);
+    rs_free(a.rgb);
+    rs_free(b.rgb);
+    rs_free(g.rgb);
+}
+
+static void write_text(const fixture *f, const char *name, const char *text)
+{
+    char path[256];
+    FILE *fp;
+    path_in(f, name, path, sizeof path);
+    fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs(text, fp);
+    fclose(fp);
+}
+
+static void test_sky_options_checked(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const bad_key[] = {"render", "--background", "sky:height=3", "-o",
+                                          "x.png", NULL};
+    static const char *const bad_value[] = {"render", "--background", "sky:turbidity=20",
+                                            "-o", "x.png", NULL};
+    static const char *const twice[] = {"render", "--background", "0.5", "--envmap", "a.exr",
+                                        "-o", "x.png", NULL};
+    static const char *const json_sky[] = {"render", "sky.json", "--spp", "2", "-q", "-o",
+                                           "sky.exr", NULL};
+    static const char *const json_bad[] = {"render", "bad.json", "-q", "-o", "bad.exr", NULL};
+    static const char *const scene =
+        "{\"camera\": {\"from\": [0, 1, 4], \"at\": [0, 0.5, 0], \"vfov\": 40},"
+        " \"image\": {\"width\": 24, \"height\": 16},"
+        " \"background\": {\"sky\": {\"elevation\": 20, \"azimuth\": 60%s}},"
+        " \"materials\": {\"w\": {\"type\": \"lambertian\", \"albedo\": [0.7, 0.7, 0.7]}},"
+        " \"objects\": [{\"type\": \"sphere\", \"center\": [0, 0.5, 0], \"radius\": 0.5,"
+        " \"material\": \"w\"}]}";
+    char text[1024];
+    image im;
+    proc p;
+    run_expect(f, bad_key, 2, &p);
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "height"), "a bad sky key is not named");
+    proc_free(&p);
+    run_expect(f, bad_value, 2, &p);
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "turbidity") && strstr(p.err.data, "2..10"),
+           "an out-of-range turbidity is not named with its range");
+    proc_free(&p);
+    run_expect(f, twice, 2, &p);
+    EXPECT(&p, strstr(p.err.data, "background is given twice") != NULL,
+           "two backgrounds are not refused");
+    proc_free(&p);
+    snprintf(text, sizeof text, scene, "");
+    write_text(f, "sky.json", text);
+    run_expect(f, json_sky, 0, &p);
+    im = read_image(&p, f, "sky.exr");
+    EXPECT(&p, image_mean(&im) > 0.05 && first_bad_value(&im) < 0,
+           "a scene file's sky lights nothing (mean %g)", image_mean(&im));
+    rs_free(im.rgb);
+    proc_free(&p);
+    snprintf(text, sizeof text, scene, ", \"haze\": 3");
+    write_text(f, "bad.json", text);
+    run_expect(f, json_bad, 1, &p);
+    EXPECT(&p, strstr(p.err.data, "bad.json") && strstr(p.err.data, "background.sky") &&
+                   strstr(p.err.data, "haze"),
+           "a scene file's bad sky key is not named with the file");
+    proc_free(&p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_filters_same_on_every_integrator, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_filter_in_checkpoint, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_background_and_gltf_default, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_sky_options_checked, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, group_setup, NULL);
+}
