@@ -11,6 +11,7 @@
 #include "app/devices.h"
 #include "app/dist_glue.h"
 #include "app/render_run.h"
+#include "core/denoise.h"
 #include "app/signals.h"
 #include "core/alloc.h"
 #include "core/image_io.h"
@@ -102,6 +103,13 @@ int rs_run_check_outputs(const rs_cli_options *o, render_run *r)
         return rc;
     if (rs_image_check_output(r->out) != RS_OK)
         return rs_app_fail(RS_EXIT_USAGE, NULL);
+    if (o->denoise) { /* OIDN is loaded at run time: its absence stops the run here */
+        char why[400];
+        if (!rs_denoise_available(why, sizeof why)) {
+            fprintf(stderr, "raystream: --denoise: %s\n", why);
+            return RS_EXIT_RUNTIME;
+        }
+    }
     return RS_EXIT_OK;
 }
 
@@ -293,6 +301,7 @@ void rs_run_release(render_run *r)
     rs_timeline_destroy(r->timeline);
     rs_film_destroy(r->film);
     rs_free(r->rgb);
+    rs_free(r->denoised);
     rs_bvh_destroy(r->bvh);
     rs_scene_destroy(r->scene);
     rs_path_ranges_free(&r->held);

@@ -4,11 +4,13 @@
  * line. */
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include "app/render_run.h"
 #include "app/report.h"
 #include "app/timeline_svg.h"
 #include "core/alloc.h"
+#include "core/denoise.h"
 #include "core/parallel.h"
 #include "core/view.h"
 #include "shading/aov.h"
@@ -62,6 +64,7 @@ static void make_report(const rs_cli_options *o, const render_run *r, rs_report 
     rep->sampler = r->st.sampler;
     rs_filter_describe(&r->st.filter, rep->filter, sizeof rep->filter);
     rep->lighting = r->lighting[0] ? r->lighting : NULL;
+    rep->denoised = r->denoised ? r->denoise_device : NULL;
     rep->adaptive = o->adaptive > 0 ? o->adaptive : 0.0;
     rep->time_limit_s = o->time_limit_s;
     rep->interrupted = r->interrupted;
@@ -162,11 +165,60 @@ static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_laye
     return n;
 }
 
+static int is_exr(const char *path)
+{
+    size_t n = strlen(path);
+    return n >= 4 && strcasecmp(path + n - 4, ".exr") == 0;
+}
+
+/* Whether the render traced on a GPU of its own (not the CPU fallback). */
+static int used_gpu(const render_run *r)
+{
+    int i;
+    if (r->mk)
+        return rs_device_owns_memory(r->mk);
+    for (i = 0; i < r->n_devs; ++i)
+        if (rs_device_owns_memory(r->devs[i]))
+            return 1;
+    return 0;
+}
+
+/* --denoise: r->denoised from r->rgb with OIDN, guided by the first-hit albedo and normal
+ * (averaged over the render's spp camera samples, so taken as clean: cleanAux; bench/
+ * denoise_bench measures both), on OIDN's CUDA device when the render used a GPU.  0 after a
+ * message. */
+static int denoise(render_run *r)
+{
+    size_t npix = (size_t)r->st.width * r->st.height;
+    float *albedo = (float *)rs_alloc(npix * 3, sizeof(float));
+    float *normal = (float *)rs_alloc(npix * 3, sizeof(float));
+    rs_render_consts it;
+    rs_bvh_view v = rs_bvh_view_of(r->bvh);
+    int ok = 0;
+    r->denoised = (float *)rs_alloc(npix * 3, sizeof(float));
+    if (!albedo || !normal || !r->denoised)
+        rs_error_set(RS_ERR_NOMEM, "out of memory for --denoise (%ux%u)", r->st.width,
+                     r->st.height);
+    else if (rs_render_constants(r->scene, &r->st, &it) == RS_OK) {
+        rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, albedo, normal, NULL);
+        ok = rs_denoise(r->rgb, albedo, normal, r->st.width, r->st.height, 1, used_gpu(r),
+                        r->denoised, r->denoise_device, sizeof r->denoise_device) == RS_OK;
+    }
+    rs_free(albedo);
+    rs_free(normal);
+    if (!ok) {
+        rs_free(r->denoised);
+        r->denoised = NULL;
+        rs_app_fail(0, "--denoise");
+    }
+    return ok;
+}
+
 /* The image with its --aov layers and header (rs_image_write: its own temporary file, renamed
  * into place).  0 after a message. */
 static int write_image(const rs_cli_options *o, const render_run *r, const rs_report *rep)
 {
-    rs_image_layer layers[4];
+    rs_image_layer layers[5];
     float *bufs[4];
     rs_report_meta meta;
     rs_view view;
@@ -185,7 +237,13 @@ static int write_image(const rs_cli_options *o, const render_run *r, const rs_re
         ok = 0;
         n_layers = 0;
     }
-    if (ok && rs_image_write_view(r->out, r->st.width, r->st.height, r->rgb, layers,
+    if (r->denoised && is_exr(r->out)) { /* the raw image beside the denoised one */
+        layers[n_layers].name = "noisy";
+        layers[n_layers].channels = "RGB";
+        layers[n_layers++].data = r->rgb;
+    }
+    if (ok && rs_image_write_view(r->out, r->st.width, r->st.height,
+                                  r->denoised ? r->denoised : r->rgb, layers,
                                   (size_t)n_layers, meta.meta, RS_REPORT_META_N, &view) != RS_OK) {
         rs_app_fail(0, NULL);
         ok = 0;
@@ -220,6 +278,8 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
     char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
     int i, ok = 1, replaced = 0;
     rs_film_resolve(r->film, r->rgb);
+    if (o->denoise && !denoise(r))
+        return RS_EXIT_RUNTIME;
     make_report(o, r, &rep);
     if (o->stats)
         rs_report_print_table(&rep);

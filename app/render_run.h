@@ -38,6 +38,8 @@ typedef struct render_run {
     rs_film *film;
     rs_timeline *timeline;
     float *rgb;
+    float *denoised;             /* --denoise: the denoised image (rgb stays the raw one) */
+    char denoise_device[160];    /* --denoise: the OIDN device that ran it */
     rs_cores cores;
     int threads;
     rs_render_settings st;

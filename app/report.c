@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include "app/signals.h"
 
@@ -236,6 +237,12 @@ static void summary_render(const rs_report *rep)
             rep->bvh_builder, rep->bvh_sah, rep->bvh_nodes, rep->bvh_prims, inst, rep->bvh_ms);
     if (rep->lighting)
         fprintf(stderr, "Lit by %s. ", rep->lighting);
+    if (rep->denoised)
+        fprintf(stderr, "Denoised with Open Image Denoise on %s%s. ", rep->denoised,
+                rep->image && strlen(rep->image) > 4 &&
+                        strcasecmp(rep->image + strlen(rep->image) - 4, ".exr") == 0
+                    ? " (the raw image: the layer 'noisy')"
+                    : "");
 }
 
 /* The devices' sentence and the integrator's. */
@@ -316,7 +323,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
         "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
         "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
         "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter",
-        "raystream:lighting"};
+        "raystream:lighting",   "raystream:denoised"};
     const char *values[RS_REPORT_META_N];
     size_t used = 0;
     int i;
@@ -349,6 +356,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     values[10] = m->adaptive;
     values[11] = rep->filter;
     values[12] = rep->lighting ? rep->lighting : "the scene's own";
+    values[13] = rep->denoised ? rep->denoised : "no";
     for (i = 0; i < RS_REPORT_META_N; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];

@@ -11,7 +11,10 @@
  *     with no --background is lit by the default sky (the summary and the header say so) where
  *     --background 0 leaves it black; sky parameters are checked before the render (one line
  *     naming the key, status 2); a scene file's "background": {"sky": ...} is read, and a bad
- *     key is named with the file. */
+ *     key is named with the file;
+ *   - --denoise: without OIDN, one line saying how to get it and no image; with it, the EXR's
+ *     layer "noisy" is the render without --denoise bit for bit, the header and summary name the
+ *     device, and the denoised image is closer to a 1024-spp reference than the noisy one. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -240,6 +243,86 @@ static void test_sky_options_checked(void **state)
     proc_free(&p);
 }
 
+static double clamp01(float x) { return x < 0.0f ? 0.0 : x > 1.0f ? 1.0 : (double)x; }
+
+/* The root mean square difference of two same-size images in the display range [0, 1] (the
+ * light itself, 15 against an interior below 1, would weigh its border's few pixels above all
+ * the rest: docs/denoise.md). */
+static double rmse(const image *a, const image *b)
+{
+    size_t i, n = (size_t)a->w * a->h * 3;
+    double s = 0.0;
+    for (i = 0; i < n; ++i)
+        s += (clamp01(a->rgb[i]) - clamp01(b->rgb[i])) * (clamp01(a->rgb[i]) - clamp01(b->rgb[i]));
+    return sqrt(s / (double)n);
+}
+
+static void test_denoise(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const den[] = {"render", "builtin:cornell", "--width", "48", "--height",
+                                      "48", "--spp", "16", "--denoise", "-o", "d.exr", NULL};
+    static const char *const raw[] = {"render", "builtin:cornell", "--width", "48", "--height",
+                                      "48", "--spp", "16", "-q", "-o", "raw.exr", NULL};
+    static const char *const ref[] = {"render", "builtin:cornell", "--width", "48", "--height",
+                                      "48", "--spp", "1024", "-q", "-o", "ref.exr", NULL};
+    static const char *const missing[] = {"render", "--denoise", "-q", "-o", "never.png", NULL};
+    char path[256], value[200];
+    image d, n, r, q;
+    float *noisy[3];
+    uint32_t w, h;
+    int c;
+    proc p;
+    setenv("RS_OIDN_LIBRARY", "/nonexistent/libOpenImageDenoise.so.2", 1);
+    run_expect(f, missing, 1, &p);
+    unsetenv("RS_OIDN_LIBRARY");
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "--denoise") &&
+                   strstr(p.err.data, "install-deps.sh"),
+           "--denoise without OIDN does not say how to get it in one line");
+    path_in(f, "never.png", path, sizeof path);
+    EXPECT(&p, !file_exists(path), "--denoise without OIDN wrote an image");
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, den);
+    if (exited_with(&p, 1) && strstr(p.err.data, "not loaded")) {
+        proc_free(&p);
+        skip(); /* no OIDN here: sh scripts/install-deps.sh installs it */
+    }
+    EXPECT(&p, exited_with(&p, 0), "--denoise failed");
+    EXPECT(&p, strstr(p.err.data, "Denoised with Open Image Denoise on CPU") != NULL,
+           "the summary does not say the image was denoised on the CPU");
+    path_in(f, "d.exr", path, sizeof path);
+    EXPECT(&p, rs_image_read_meta(path, "raystream:denoised", value, sizeof value) == RS_OK &&
+                   strncmp(value, "CPU", 3) == 0,
+           "the header's raystream:denoised is '%s'", value);
+    proc_free(&p);
+    run_expect(f, raw, 0, &p);
+    proc_free(&p);
+    run_expect(f, ref, 0, &p);
+    d = read_image(&p, f, "d.exr");
+    r = read_image(&p, f, "raw.exr");
+    q = read_image(&p, f, "ref.exr");
+    /* the raw beauty is kept as the layer "noisy", bit for bit the render without --denoise */
+    n = r;
+    for (c = 0; c < 3; ++c) {
+        static const char *const ch[3] = {"noisy.R", "noisy.G", "noisy.B"};
+        uint32_t i;
+        EXPECT(&p, rs_image_read_channel(path, ch[c], &w, &h, &noisy[c]) == RS_OK,
+               "d.exr has no channel %s", ch[c]);
+        for (i = 0; i < w * h; ++i)
+            EXPECT(&p, memcmp(&noisy[c][i], &r.rgb[3 * i + c], sizeof(float)) == 0,
+                   "d.exr's %s differs from the render without --denoise at pixel %u", ch[c], i);
+        rs_free(noisy[c]);
+    }
+    printf("  16 spp against 1024: RMSE %.4f noisy, %.4f denoised\n", rmse(&n, &q), rmse(&d, &q));
+    EXPECT(&p, rmse(&d, &q) < 0.7 * rmse(&n, &q) && first_bad_value(&d) < 0,
+           "the denoised image (RMSE %g) is not closer to the reference than the noisy one (%g)",
+           rmse(&d, &q), rmse(&n, &q));
+    rs_free(d.rgb);
+    rs_free(r.rgb);
+    rs_free(q.rgb);
+    proc_free(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -247,6 +330,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_filter_in_checkpoint, setup, teardown),
         cmocka_unit_test_setup_teardown(test_background_and_gltf_default, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sky_options_checked, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_denoise, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
