@@ -1,19 +1,20 @@
 /* bench/denoise_bench.c — what denoising with Intel Open Image Denoise buys (core/denoise.h,
  * --denoise; docs/denoise.md): a low-spp render, denoised, against a converged reference.
  *
- * For each scene: a reference at --ref-spp, the beauty at --spp (the Sobol sampler and MIS, as
- * the CLI renders by default) with the albedo and normal AOVs exactly as `--aov albedo,normal`
- * makes them (shading/aov.c), then rs_denoise three ways: beauty only; beauty, albedo and normal
- * with cleanAux on (what --denoise does: our AOVs are first-hit values averaged over up to 16
- * camera rays, so carry no path-tracing noise); and the same with cleanAux off.  Each row, against
- * the reference: the RMSE of values clamped to [0, 1] (the display range: what a viewer sees),
- * the ratio of the noisy image's to the row's (issue 28 asks for >= 4x), the spp a plain render
- * would need for the same error (spp x ratio^2, error falling as 1/sqrt(spp)); the RMSE of the
- * linear values and its ratio; the relative RMSE (each value's error over max(reference, 0.01));
- * and the median time of --runs denoises.  The linear RMSE is printed but not the criterion: in
- * a scene that sees its light, a few pixels on the emitter's edge (15 against an interior below
- * 1, and moved by +-1..2 by the denoiser) outweigh all the noise elsewhere.  The reference's own
- * error is printed beside it: it bounds how large a ratio can be measured.
+ * For each scene: a reference at --ref-spp (Sobol), the beauty at --spp (MIS; the Sobol sampler,
+ * the CLI's default, then the independent one, noisier at equal spp) with the albedo and normal
+ * AOVs exactly as `--aov albedo,normal` makes them (shading/aov.c), then rs_denoise three ways:
+ * beauty only; beauty, albedo and normal with cleanAux on (what --denoise does: our AOVs are
+ * first-hit values averaged over up to 16 camera rays, so carry no path-tracing noise); and the
+ * same with cleanAux off.  Each row, against the reference: the RMSE of values clamped to [0, 1]
+ * (the display range: what a viewer sees), the ratio of the noisy image's to the row's (issue 28
+ * asks for >= 4x), the spp a plain render would need for the same error (spp x ratio^2, error
+ * falling as 1/sqrt(spp)); the RMSE of the linear values and its ratio; the relative RMSE (each
+ * value's error over max(reference, 0.01)); and the median time of --runs denoises.  The linear
+ * RMSE is printed but not the criterion: in a scene that sees its light, a few pixels on the
+ * emitter's edge (15 against an interior below 1, and moved by +-1..2 by the denoiser) outweigh all
+ * the noise elsewhere.  The reference's own error is printed beside it: it bounds how large a ratio
+ * can be measured.
  *
  * Validates first: the reference and the renders are finite and not black, the AOVs finite with
  * normals of length <= 1, every denoised image finite, and repeated denoises bit-identical (OIDN
@@ -24,6 +25,9 @@
  *
  *   denoise_bench [--quick] [--size N] [--spp N] [--ref-spp N] [--runs N] [--threads N]
  *                 [--gpu] [--scenes LIST] [--models DIR] [--min-ratio X] [--dump DIR]
+ *
+ * --dump DIR writes every image as DIR/SCENE-reference.exr, SCENE-SAMPLER-{noisy,albedo,normal,
+ * beauty-only,aux-clean,aux-noisy}.exr.
  *
  * Full: 256x256, 16 spp against 4096, builtin:cornell and builtin:cornell-bunny-teapot (the
  * shared models; skipped with a message when ../shared/models is absent).  --quick: 64x64 against
@@ -48,8 +52,8 @@ typedef struct scene_ctx {
     rs_bvh *bvh;
 } scene_ctx;
 
-static void settings_for(uint32_t size, uint32_t spp, int threads, rs_cores *cores,
-                         rs_render_settings *st)
+static void settings_for(uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
+                         rs_cores *cores, rs_render_settings *st)
 {
     memset(st, 0, sizeof *st);
     st->width = st->height = size;
@@ -57,7 +61,7 @@ static void settings_for(uint32_t size, uint32_t spp, int threads, rs_cores *cor
     st->max_depth = 50;
     st->seed = 1;
     st->sampling = RS_SAMPLING_MIS;
-    st->sampler = RS_SAMPLER_SOBOL;
+    st->sampler = sampler;
     st->threads = threads;
     rs_cores_init(cores, threads);
     st->cores = cores;
@@ -65,8 +69,8 @@ static void settings_for(uint32_t size, uint32_t spp, int threads, rs_cores *cor
 
 /* The stream engine on one CPU device with `threads` threads; rgb receives the image; *seconds
  * the render's time.  Returns 0 after printing why. */
-static int render(const scene_ctx *s, uint32_t size, uint32_t spp, int threads, float *rgb,
-                  double *seconds)
+static int render(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
+                  float *rgb, double *seconds)
 {
     rs_device *dev = NULL;
     rs_sched *sched = NULL;
@@ -76,7 +80,7 @@ static int render(const scene_ctx *s, uint32_t size, uint32_t spp, int threads, 
     rs_cpu_device_opts co;
     rs_cores cores;
     int ok = 0;
-    settings_for(size, spp, threads, &cores, &st);
+    settings_for(size, spp, sampler, threads, &cores, &st);
     memset(&co, 0, sizeof co);
     co.threads = threads;
     co.cores = &cores;
@@ -98,14 +102,14 @@ static int render(const scene_ctx *s, uint32_t size, uint32_t spp, int threads, 
 }
 
 /* The --aov albedo,normal layers of the spp render, as app/render_outputs.c makes them. */
-static int aovs(const scene_ctx *s, uint32_t size, uint32_t spp, int threads, float *albedo,
-                float *normal)
+static int aovs(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
+                float *albedo, float *normal)
 {
     rs_render_settings st;
     rs_render_consts it;
     rs_cores cores;
     rs_bvh_view v = rs_bvh_view_of(s->bvh);
-    settings_for(size, spp, threads, &cores, &st);
+    settings_for(size, spp, sampler, threads, &cores, &st);
     if (rs_render_constants(s->scene, &st, &it) != RS_OK) {
         fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
         return 0;
@@ -161,7 +165,7 @@ typedef struct opts {
     int runs, threads, gpu;
     double min_ratio;
     const char *models;
-    const char *dump; /* --dump DIR: SCENE-{reference,noisy,albedo,normal,ROW}.exr */
+    const char *dump; /* --dump DIR (see the top) */
 } opts;
 
 static void dump(const opts *o, const char *spec, const char *what, const float *rgb)
@@ -176,18 +180,82 @@ static void dump(const opts *o, const char *spec, const char *what, const float 
     }
 }
 
-/* One scene's table; returns 1 (done or skipped), 0 on a failed check, -1 on an error. */
+/* The rows for one noisy image against `ref`: noisy, then the three denoises.  Returns 1, 0
+ * after a failed check (printed), -1 after an error (printed). */
+static int denoise_rows(const char *spec, const char *tag, const opts *o, const float *ref,
+                        const float *noisy, const float *albedo, const float *normal, float *out,
+                        float *again)
+{
+    static const char *const labels[3] = {"beauty only", "+ albedo, normal, cleanAux on",
+                                          "+ albedo, normal, cleanAux off"};
+    static const char *const files[3] = {"beauty-only", "aux-clean", "aux-noisy"};
+    size_t n = (size_t)o->size * o->size * 3;
+    double clean_ratio = 0;
+    char used[512] = "", what[64];
+    errs e0 = errors(noisy, ref, n);
+    int r, row;
+    printf("  %-31s %9s %7s %9s %10s %7s %9s %9s\n", "image", "RMSE", "ratio", "~spp same",
+           "RMSE lin", "ratio", "rel RMSE", "denoise s");
+    printf("  %-31s %9.5f %6.2fx %9u %10.5f %6.2fx %9.4f %9s\n", "noisy", e0.clamped, 1.0, o->spp,
+           e0.linear, 1.0, e0.rel, "-");
+    for (row = 0; row < 3; ++row) {
+        const float *a = row == 0 ? NULL : albedo, *nm = row == 0 ? NULL : normal;
+        double t[MAX_RUNS], ratio;
+        errs e;
+        for (r = 0; r < o->runs; ++r) {
+            double t0 = rs_now_s();
+            rs_error_clear();
+            if (rs_denoise(noisy, a, nm, o->size, o->size, row == 1, o->gpu, r ? again : out, used,
+                           sizeof used) != RS_OK) {
+                fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
+                return -1;
+            }
+            t[r] = rs_now_s() - t0;
+            if (r && memcmp(again, out, n * sizeof(float)) != 0) {
+                printf("FAIL: two denoises of the same image differ (%s)\n", used);
+                return 0;
+            }
+        }
+        if (!all_finite(out, n)) {
+            printf("FAIL: the denoised image (%s) is not finite\n", labels[row]);
+            return 0;
+        }
+        snprintf(what, sizeof what, "%s-%s", tag, files[row]);
+        dump(o, spec, what, out);
+        e = errors(out, ref, n);
+        ratio = e0.clamped / e.clamped;
+        printf("  %-31s %9.5f %6.2fx %9.0f %10.5f %6.2fx %9.4f %9.3f\n", labels[row], e.clamped,
+               ratio, o->spp * ratio * ratio, e.linear, e0.linear / e.linear, e.rel,
+               rs_bench_median(t, o->runs));
+        if (row == 1)
+            clean_ratio = ratio;
+    }
+    printf("  denoised on: %s\n", used);
+    printf("  issue 28's target, RMSE in [0,1] >= 4x lower with the AOVs and cleanAux: %s "
+           "(%.2fx)\n\n",
+           clean_ratio >= 4.0 ? "met" : "not met", clean_ratio);
+    if (clean_ratio < o->min_ratio) {
+        printf("FAIL: denoised with clean AOVs only %.2fx below the noisy RMSE in [0,1] (want >= "
+               "%.1fx)\n",
+               clean_ratio, o->min_ratio);
+        return 0;
+    }
+    return 1;
+}
+
+/* One scene's tables (the default Sobol sampler, then the independent one, noisier at the same
+ * spp, against one Sobol reference); returns 1 (done or skipped), 0 on a failed check, -1 on an
+ * error. */
 static int bench_scene(const char *spec, const opts *o)
 {
+    static const rs_sampler samplers[2] = {RS_SAMPLER_SOBOL, RS_SAMPLER_INDEPENDENT};
+    static const char *const sampler_names[2] = {"sobol", "independent"};
     scene_ctx s;
     size_t n = (size_t)o->size * o->size * 3, k;
     float *ref = NULL, *noisy = NULL, *albedo = NULL, *normal = NULL, *out = NULL, *again = NULL;
-    double t_ref = 0, t_noisy = 0, e_ref_floor, clean_ratio = 0;
-    errs e0;
-    int rc = -1, r, row, loaded;
-    char used[512] = "";
-    static const char *const labels[3] = {"beauty only", "+ albedo, normal, cleanAux on",
-                                          "+ albedo, normal, cleanAux off"};
+    double t_ref = 0, t_noisy = 0;
+    int rc = -1, loaded, j;
+    char what[64];
     memset(&s, 0, sizeof s);
     loaded = br_load_scene("denoise_bench", spec, o->models, 0, &s.scene, &s.g, &s.bvh);
     if (loaded <= 0)
@@ -206,84 +274,55 @@ static int bench_scene(const char *spec, const opts *o)
     printf("scene builtin:%s, %ux%u, %u spp against a %u-spp reference (sobol, MIS, depth 50), "
            "%d thread%s\n",
            spec, o->size, o->size, o->spp, o->ref_spp, o->threads, o->threads == 1 ? "" : "s");
-    if (!render(&s, o->size, o->ref_spp, o->threads, ref, &t_ref) ||
-        !render(&s, o->size, o->spp, o->threads, noisy, &t_noisy) ||
-        !aovs(&s, o->size, o->spp, o->threads, albedo, normal))
+    if (!render(&s, o->size, o->ref_spp, RS_SAMPLER_SOBOL, o->threads, ref, &t_ref))
         goto done;
-    /* validate the inputs */
     rc = 0;
-    if (!all_finite(ref, n) || mean(ref, n) <= 0 || !all_finite(noisy, n) || mean(noisy, n) <= 0) {
-        printf("FAIL: the reference or the %u-spp render is black or not finite\n", o->spp);
+    if (!all_finite(ref, n) || mean(ref, n) <= 0) {
+        printf("FAIL: the reference is black or not finite\n");
         goto done;
     }
-    if (!all_finite(albedo, n) || !all_finite(normal, n)) {
-        printf("FAIL: the AOVs are not finite\n");
-        goto done;
-    }
-    for (k = 0; k < n; k += 3)
-        if (normal[k] * normal[k] + normal[k + 1] * normal[k + 1] + normal[k + 2] * normal[k + 2] >
-            1.001f) {
-            printf("FAIL: a normal longer than 1 at pixel %zu\n", k / 3);
-            goto done;
-        }
     dump(o, spec, "reference", ref);
-    dump(o, spec, "noisy", noisy);
-    dump(o, spec, "albedo", albedo);
-    dump(o, spec, "normal", normal);
-    e0 = errors(noisy, ref, n);
-    e_ref_floor = e0.clamped * sqrt((double)o->spp / o->ref_spp);
-    printf("render: reference %.2f s, %u spp %.2f s; the reference's own RMSE is about %.5f "
-           "(the %u-spp RMSE x sqrt(%u/%u))\n",
-           t_ref, o->spp, t_noisy, e_ref_floor, o->spp, o->spp, o->ref_spp);
-    printf("  %-31s %9s %7s %9s %10s %7s %9s %9s\n", "image", "RMSE", "ratio", "~spp same",
-           "RMSE lin", "ratio", "rel RMSE", "denoise s");
-    printf("  %-31s %9.5f %6.2fx %9u %10.5f %6.2fx %9.4f %9s\n", "noisy", e0.clamped, 1.0, o->spp,
-           e0.linear, 1.0, e0.rel, "-");
-    for (row = 0; row < 3; ++row) {
-        const float *a = row == 0 ? NULL : albedo, *nm = row == 0 ? NULL : normal;
-        int clean = row == 1;
-        double t[MAX_RUNS], ratio;
-        errs e;
-        for (r = 0; r < o->runs; ++r) {
-            double t0 = rs_now_s();
-            rs_error_clear();
-            if (rs_denoise(noisy, a, nm, o->size, o->size, clean, o->gpu, r ? again : out, used,
-                           sizeof used) != RS_OK) {
-                fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
-                rc = -1;
-                goto done;
-            }
-            t[r] = rs_now_s() - t0;
-            if (r && memcmp(again, out, n * sizeof(float)) != 0) {
-                printf("FAIL: two denoises of the same image differ (%s)\n", used);
-                goto done;
-            }
-        }
-        if (!all_finite(out, n)) {
-            printf("FAIL: the denoised image (%s) is not finite\n", labels[row]);
+    printf("reference: %.2f s\n", t_ref);
+    for (j = 0; j < 2; ++j) {
+        double floor;
+        rc = -1;
+        if (!render(&s, o->size, o->spp, samplers[j], o->threads, noisy, &t_noisy) ||
+            !aovs(&s, o->size, o->spp, samplers[j], o->threads, albedo, normal))
+            goto done;
+        /* validate the inputs */
+        rc = 0;
+        if (!all_finite(noisy, n) || mean(noisy, n) <= 0) {
+            printf("FAIL: the %u-spp render is black or not finite\n", o->spp);
             goto done;
         }
-        {
-            static const char *const files[3] = {"beauty-only", "aux-clean", "aux-noisy"};
-            dump(o, spec, files[row], out);
+        if (!all_finite(albedo, n) || !all_finite(normal, n)) {
+            printf("FAIL: the AOVs are not finite\n");
+            goto done;
         }
-        e = errors(out, ref, n);
-        ratio = e0.clamped / e.clamped;
-        printf("  %-31s %9.5f %6.2fx %9.0f %10.5f %6.2fx %9.4f %9.3f\n", labels[row], e.clamped,
-               ratio, o->spp * ratio * ratio, e.linear, e0.linear / e.linear, e.rel,
-               rs_bench_median(t, o->runs));
-        if (row == 1)
-            clean_ratio = ratio;
-    }
-    printf("  denoised on: %s\n", used);
-    printf("  issue 28's target, RMSE in [0,1] >= 4x lower with the AOVs and cleanAux: %s "
-           "(%.2fx)\n\n",
-           clean_ratio >= 4.0 ? "met" : "not met", clean_ratio);
-    if (clean_ratio < o->min_ratio) {
-        printf("FAIL: denoised with clean AOVs only %.2fx below the noisy RMSE in [0,1] (want >= "
-               "%.1fx)\n",
-               clean_ratio, o->min_ratio);
-        goto done;
+        for (k = 0; k < n; k += 3)
+            if (normal[k] * normal[k] + normal[k + 1] * normal[k + 1] +
+                    normal[k + 2] * normal[k + 2] >
+                1.001f) {
+                printf("FAIL: a normal longer than 1 at pixel %zu\n", k / 3);
+                goto done;
+            }
+        snprintf(what, sizeof what, "%s-noisy", sampler_names[j]);
+        dump(o, spec, what, noisy);
+        snprintf(what, sizeof what, "%s-albedo", sampler_names[j]);
+        dump(o, spec, what, albedo);
+        snprintf(what, sizeof what, "%s-normal", sampler_names[j]);
+        dump(o, spec, what, normal);
+        /* the reference's own error: a Sobol render's at ref_spp, from this one's at spp */
+        floor = errors(noisy, ref, n).clamped * sqrt((double)o->spp / o->ref_spp);
+        printf("%s sampler%s: %u spp in %.2f s", sampler_names[j], j == 0 ? " (the default)" : "",
+               o->spp, t_noisy);
+        if (j == 0)
+            printf("; the reference's own RMSE is about %.5f (this RMSE x sqrt(%u/%u))", floor,
+                   o->spp, o->ref_spp);
+        printf("\n");
+        rc = denoise_rows(spec, sampler_names[j], o, ref, noisy, albedo, normal, out, again);
+        if (rc <= 0)
+            goto done;
     }
     rc = 1;
 done:
