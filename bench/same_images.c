@@ -3,7 +3,11 @@
  * with the same scene, sampler and estimator on the first device set, and, given --old BIN, with
  * what another build (the commit before a change) renders.
  *
- *   same_images [--quick] [--new BIN] [--old BIN] [--keep DIR]
+ *   same_images [--quick] [--new BIN] [--old BIN] [--args ARGS] [--new-args ARGS]
+ *
+ * --args: more options for every render (e.g. "--filter mitchell": the matrix with that filter);
+ * --new-args: more options for the new build's renders only (e.g. "--filter box" against a build
+ * from before pixel filters, whose only filter was that box).
  *
  * The matrix: scenes x samplers x estimators x {stream on the CPU, stream on the CPU and the GPU
  * fallback, the megakernel on the CPU, the megakernel on the fallback} (a real GPU where there
@@ -36,11 +40,14 @@ typedef struct image {
 } image;
 
 /* Runs `bin` with `args` writing `out`; 0 after a message when it fails. */
+static const char *g_args = "", *g_new_args = "", *g_new_bin = "";
+
 static int render(const char *bin, const char *args, const char *out)
 {
     char cmd[4096];
     int rc;
-    snprintf(cmd, sizeof cmd, "%s render %s -q -o %s 2>/dev/null", bin, args, out);
+    snprintf(cmd, sizeof cmd, "%s render %s %s %s -q -o %s 2>/dev/null", bin, args, g_args,
+             strcmp(bin, g_new_bin) == 0 ? g_new_args : "", out);
     rc = system(cmd);
     if (rc != 0) {
         fprintf(stderr, "same_images: failed (%d): %s\n", rc, cmd);
@@ -149,8 +156,13 @@ int main(int argc, char **argv)
             c.new_bin = argv[++i];
         else if (strcmp(argv[i], "--old") == 0 && i + 1 < argc)
             c.old_bin = argv[++i];
+        else if (strcmp(argv[i], "--args") == 0 && i + 1 < argc)
+            g_args = argv[++i];
+        else if (strcmp(argv[i], "--new-args") == 0 && i + 1 < argc)
+            g_new_args = argv[++i];
         else {
-            fprintf(stderr, "usage: same_images [--quick] [--new BIN] [--old BIN]\n");
+            fprintf(stderr, "usage: same_images [--quick] [--new BIN] [--old BIN] [--args ARGS] "
+                            "[--new-args ARGS]\n");
             return strcmp(argv[i], "--help") == 0 ? 0 : 2;
         }
     }
@@ -159,11 +171,13 @@ int main(int argc, char **argv)
         return 1;
     }
     c.dir = dir;
+    g_new_bin = c.new_bin;
     n_sc = quick ? 2 : 4;
     n_sa = quick ? 1 : 3;
     n_es = quick ? 2 : 4;
-    printf("same_images: %s%s%s, 40x30 pixels, 6 spp, depth 8\n", c.new_bin,
-           c.old_bin ? " against " : "", c.old_bin ? c.old_bin : "");
+    printf("same_images: %s%s%s, 40x30 pixels, 6 spp, depth 8%s%s%s%s\n", c.new_bin,
+           c.old_bin ? " against " : "", c.old_bin ? c.old_bin : "", *g_args ? ", with " : "",
+           g_args, *g_new_args ? ", the new build with " : "", g_new_args);
     for (a = 0; a < n_sc; ++a)
         for (b = 0; b < n_sa; ++b)
             for (e = 0; e < n_es; ++e) {
