@@ -235,7 +235,9 @@ static int start_rank0(rs_dist *d, start_thread *s, double timeout_s, int *who)
                 *who = r;
     }
     for (r = 1; r < d->size; ++r) {
-        uint64_t go[2] = {(uint64_t)worst, (uint64_t)*who};
+        /* the second word's bit 32: a rank is dead, so no rank may call MPI_Finalize (with
+         * --enable-recovery its fence would wait for the dead one for ever) */
+        uint64_t go[2] = {(uint64_t)worst, (uint64_t)*who | (dead >= 0 ? (uint64_t)1 << 32 : 0)};
         rs_dist_send_small(go, 2, r, T_GO);
     }
     start_wait(s);
@@ -267,7 +269,9 @@ static int start_worker(rs_dist *d, start_thread *s, double timeout_s, int *who)
             heard = now;
             active = 1;
             if (tag == T_GO) {
-                *who = (int)v[1];
+                *who = (int)(v[1] & 0xffffffffu);
+                if (v[1] >> 32)
+                    d->any_dead = 1; /* rank 0 found a rank dead: no MPI_Finalize */
                 start_wait(s);
                 return (int)v[0];
             }
