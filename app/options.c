@@ -173,6 +173,8 @@ static void help_render_scene(void)
           "                      gaussian, blackman-harris or mitchell, W its full width in\n"
           "                      pixels (default blackman-harris:1.5, as Cycles; box:1 is\n"
           "                      the 1-pixel box of raystream before 0.9; docs/filters.md)\n"
+          "  --texture-filter F  image textures: trilinear (mip-mapped, the default) or\n"
+          "                      bilinear (level 0 only, as before 0.9; docs/textures.md)\n"
           "  --view NAME         view transform of 8-bit outputs (PNG, JPEG, TIFF): standard\n"
           "                      (clip and sRGB, the default), filmic (AgX-like: highlights\n"
           "                      desaturate instead of clipping) or pbr-neutral (Khronos PBR\n"
@@ -517,6 +519,18 @@ static int opt_filter(const char *name, const char *v, rs_cli_options *o)
     return RS_EXIT_OK;
 }
 
+static int opt_texture_filter(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (strcmp(v, "trilinear") == 0)
+        o->texture_filter = RS_TEXTURE_TRILINEAR;
+    else if (strcmp(v, "bilinear") == 0)
+        o->texture_filter = RS_TEXTURE_BILINEAR;
+    else
+        return usage_error("--texture-filter: '%s' is not trilinear or bilinear%s", v, "");
+    return RS_EXIT_OK;
+}
+
 static int opt_exposure(const char *name, const char *v, rs_cli_options *o)
 {
     char *end;
@@ -690,6 +704,7 @@ static const opt_row options[] = {
     ROW_CALL("--envmap", opt_envmap),
     ROW_CALL("--envmap-scale", opt_envmap_scale),
     ROW_CALL("--filter", opt_filter),
+    ROW_CALL("--texture-filter", opt_texture_filter),
     ROW_TEXT("--view", NULL, view, "a view's name"),
     ROW_CALL("--exposure", opt_exposure),
     ROW_NUM("--denoise", OPT_FLAG, denoise, 0, 0),

@@ -60,6 +60,8 @@ typedef struct rs_cli_options {
     const char *background;
     float background_rgb[3];
     rs_filter filter;      /* --filter NAME[:WIDTH] (default blackman-harris:1.5) */
+    uint32_t texture_filter; /* --texture-filter: rs_texture_filter (shading/texture.h),
+                                0 trilinear (the default) */
     const char *view;      /* --view NAME: the display outputs' view transform (core/view.h);
                               NULL: standard */
     float exposure;        /* --exposure EV: display outputs scaled by 2^EV first */

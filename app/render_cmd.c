@@ -45,6 +45,7 @@ void rs_run_settings(const rs_cli_options *o, render_run *r)
     st->sampling = o->sampling;
     st->sampler = o->sampler;
     st->filter = o->filter;
+    st->texture_filter = o->texture_filter;
     st->wave_paths = o->wave_paths;
     st->waves_in_flight = o->waves;
     r->threads = o->threads ? o->threads : rs_cpu_count();

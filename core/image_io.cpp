@@ -3,6 +3,8 @@
 // rs_status + message.
 #include "core/image_io.h"
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cerrno>
@@ -496,3 +498,28 @@ extern "C" rs_status rs_image_read_meta(const char *path, const char *key, char 
 }
 
 extern "C" const char *rs_image_library_version(void) { return OIIO_VERSION_STRING; }
+
+// One mip level from the one above (scenes/scene.c builds the pyramids): OpenImageIO's resize
+// with a box filter one destination pixel wide, so a 2:1 reduction is the exact mean of each 2x2
+// block (the image's mean is kept, and no texel goes negative as under lanczos3's lobes).
+extern "C" rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t h, float *out,
+                                         uint32_t w2, uint32_t h2)
+{
+    try {
+        if (w == 0 || h == 0 || w2 == 0 || h2 == 0 || w2 > w || h2 > h)
+            return rs_error_set(RS_ERR_ARG, "downsampling a %ux%u image to %ux%u", w, h, w2, h2);
+        OIIO::ImageSpec sspec((int)w, (int)h, 3, OIIO::TypeDesc::FLOAT);
+        OIIO::ImageSpec dspec((int)w2, (int)h2, 3, OIIO::TypeDesc::FLOAT);
+        // wraps the caller's memory: nothing is copied in or out but through these two buffers
+        OIIO::ImageBuf src(sspec, const_cast<float *>(rgb));
+        OIIO::ImageBuf dst(dspec, out);
+        if (!OIIO::ImageBufAlgo::resize(dst, src, "box", 1.0f, OIIO::ROI(), 1))
+            return rs_error_set(RS_ERR_IO, "downsampling a %ux%u image: %s", w, h,
+                                dst.geterror().c_str());
+        return RS_OK;
+    } catch (const std::exception &ex) {
+        return rs_error_set(RS_ERR_IO, "downsampling a %ux%u image: %s", w, h, ex.what());
+    } catch (...) {
+        return rs_error_set(RS_ERR_IO, "downsampling a %ux%u image: unknown error", w, h);
+    }
+}

@@ -92,6 +92,12 @@ rs_status rs_image_read_linear(const char *path, uint32_t *width, uint32_t *heig
  * An image without one gives RS_OK and *alpha NULL.  Free with rs_free. */
 rs_status rs_image_read_alpha(const char *path, uint32_t *width, uint32_t *height, float **alpha);
 
+/* A w2 x h2 copy of the w x h RGB float image rgb (rows from the top) into out (w2 * h2 * 3
+ * floats, the caller's), filtered by OpenImageIO's resize with a box one output pixel wide: a
+ * 2:1 reduction averages each 2x2 block.  w2 <= w, h2 <= h.  For texture mip levels. */
+rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t h, float *out, uint32_t w2,
+                              uint32_t h2);
+
 /* The linear value of an sRGB-encoded one in [0, 1]. */
 float rs_srgb_decode(float encoded);
 

@@ -250,6 +250,46 @@ static rs_status load_texture_ex(rs_scene *s, const struct aiScene *as,
                                  const char *mesh, const char *dir, int data, int strict,
                                  const alpha_req *alpha, uint32_t *id);
 
+/* glTF's KHR_texture_transform on the material's texture of `type` into tx->uv_m (tx->uv_xform
+ * set; left unset without one or for the identity, so that such textures look up exactly as
+ * before).  The spec maps glTF's UVs (v down from the image's top) by T(offset) R(rotation)
+ * S(scale), R turning (x, y) to (c x + s y, -s x + c y): what its example needs to take the
+ * lower-left quadrant.  Assimp 5.2's glTF2 importer (it reads the extension only where the
+ * file lists it in extensionsUsed) hands over scale as mScaling, -rotation as mRotation, and
+ * offset folded into mTranslation for its own centre of rotation and flipped v:
+ *     tx = sx/2 (1 - c + s) + ox,   ty = sy/2 (s + c - 1) + 1 - sy - oy
+ * which is undone here.  In the renderer's UVs (v = 1 - glTF's v):
+ *     u' = c sx u - s sy v + s sy + ox,   v' = s sx u + c sy v + 1 - c sy - oy. */
+static void uv_transform(const struct aiMaterial *am, enum aiTextureType type, rs_texture *tx)
+{
+    struct aiUVTransform tr;
+    unsigned int n = 5;
+    double sx, sy, rot, c, sn, ox, oy;
+    if (aiGetMaterialFloatArray(am, _AI_MATKEY_UVTRANSFORM_BASE, (unsigned int)type, 0,
+                                (ai_real *)&tr, &n) != aiReturn_SUCCESS ||
+        n != 5)
+        return;
+    sx = tr.mScaling.x;
+    sy = tr.mScaling.y;
+    rot = -(double)tr.mRotation;
+    if (!isfinite(sx) || !isfinite(sy) || !isfinite(rot) || !isfinite(tr.mTranslation.x) ||
+        !isfinite(tr.mTranslation.y))
+        return;
+    c = cos(rot);
+    sn = sin(rot);
+    ox = tr.mTranslation.x - 0.5 * sx * (1.0 - c + sn);
+    oy = 0.5 * sy * (sn + c - 1.0) + 1.0 - sy - tr.mTranslation.y;
+    if (sx == 1.0 && sy == 1.0 && rot == 0.0 && fabs(ox) < 1e-7 && fabs(oy) < 1e-7)
+        return;
+    tx->uv_xform = 1;
+    tx->uv_m[0] = (float)(c * sx);
+    tx->uv_m[1] = (float)(-sn * sy);
+    tx->uv_m[2] = (float)(sn * sy + ox);
+    tx->uv_m[3] = (float)(sn * sx);
+    tx->uv_m[4] = (float)(c * sy);
+    tx->uv_m[5] = (float)(1.0 - c * sy - oy);
+}
+
 static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struct aiMaterial *am,
                               enum aiTextureType type, const char *mesh, const char *dir,
                               int data, int strict, uint32_t *id)
@@ -380,6 +420,7 @@ made:
     memset(&tx, 0, sizeof tx);
     tx.type = RS_TEX_IMAGE;
     tx.image = image;
+    uv_transform(am, type, &tx);
     return rs_scene_add_texture(s, &tx, id);
 }
 

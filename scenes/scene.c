@@ -316,6 +316,7 @@ static rs_status add_image_owned(rs_scene *s, uint32_t w, uint32_t h, float *rgb
     s->images[s->n_images].width = w;
     s->images[s->n_images].height = h;
     s->images[s->n_images].rgb = rgb;
+    s->images[s->n_images].levels = 1;
     *id = s->n_images++;
     return RS_OK;
 }
@@ -573,6 +574,64 @@ static rs_status check_ranges(rs_scene *s)
     return RS_OK;
 }
 
+/* Image i's mip pyramid (docs/textures.md): the levels below level 0, each from the one above
+ * by core/image_io.h's rs_image_downsample (OpenImageIO's resize, a box one texel of the new
+ * level wide), max(1, floor(w / 2)) x max(1, floor(h / 2)) down to 1x1, stored after level 0 in
+ * one block so that a device copy stays one buffer.  An image that has them already is left. */
+static rs_status build_pyramid(rs_image *im)
+{
+    uint32_t levels = 1, w = im->width, h = im->height, k;
+    size_t total, off = 0;
+    float *rgb;
+    rs_status st;
+    if (im->levels > 1)
+        return RS_OK;
+    while (w > 1 || h > 1) {
+        w = w > 1 ? w / 2 : 1;
+        h = h > 1 ? h / 2 : 1;
+        ++levels;
+    }
+    im->levels = 1;
+    if (levels == 1)
+        return RS_OK;
+    total = rs_image_levels_floats(im->width, im->height, levels);
+    rgb = (float *)rs_alloc(total, sizeof *rgb);
+    if (!rgb)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for the mip levels of a %ux%u image",
+                            im->width, im->height);
+    memcpy(rgb, im->rgb, 3 * (size_t)im->width * im->height * sizeof *rgb);
+    w = im->width;
+    h = im->height;
+    for (k = 1; k < levels; ++k) {
+        uint32_t w2 = w > 1 ? w / 2 : 1, h2 = h > 1 ? h / 2 : 1;
+        size_t next = off + 3 * (size_t)w * h;
+        if ((st = rs_image_downsample(rgb + off, w, h, rgb + next, w2, h2)) != RS_OK) {
+            rs_free(rgb);
+            return st;
+        }
+        off = next;
+        w = w2;
+        h = h2;
+    }
+    rs_free(im->rgb);
+    im->rgb = rgb;
+    im->levels = levels;
+    return RS_OK;
+}
+
+/* Pyramids for every image an image texture uses (an image used only as the environment map
+ * keeps one level: shading/envmap.h samples its texels). */
+static rs_status build_pyramids(rs_scene *s)
+{
+    uint32_t i;
+    rs_status st;
+    for (i = 0; i < s->n_textures; ++i)
+        if (s->textures[i].type == RS_TEX_IMAGE && s->textures[i].image < s->n_images &&
+            (st = build_pyramid(&s->images[s->textures[i].image])) != RS_OK)
+            return st;
+    return RS_OK;
+}
+
 rs_status rs_scene_finalize(rs_scene *s)
 {
     uint32_t i, n = rs_scene_prim_count(s), nl = 0;
@@ -604,6 +663,8 @@ rs_status rs_scene_finalize(rs_scene *s)
     s->bad_part = RS_PART_NONE;
     {
         rs_status st = check_ranges(s);
+        if (st == RS_OK)
+            st = build_pyramids(s);
         if (st != RS_OK)
             return st;
     }

@@ -99,13 +99,38 @@ typedef struct rs_texture {
     uint32_t image; /* index into the scene's images (RS_TEX_IMAGE) */
     rs_vec3 a, b;
     float scale;
+    uint32_t uv_xform; /* RS_TEX_IMAGE: 1 when uv_m applies (glTF's KHR_texture_transform);
+                          0 (a zeroed texture): the surface's UVs as they are */
+    float uv_m[6];     /* (u, v) -> (m0 u + m1 v + m2, m3 u + m4 v + m5), in the renderer's UVs
+                          (v = 0 at the bottom row) */
 } rs_texture;
 
-/* A texture image in linear RGB (8-bit files are sRGB-decoded when loaded). */
+/* A texture image in linear RGB (8-bit files are sRGB-decoded when loaded), with its mip
+ * pyramid (docs/textures.md) after level 0 in the same block: level k + 1 is
+ * max(1, floor(w_k / 2)) x max(1, floor(h_k / 2)), down to 1x1, built by rs_scene_finalize for
+ * the images an image texture uses.  Level 0 is the image as loaded; whoever reads width *
+ * height texels (the environment map, the checkpoint's hash, export) reads exactly it. */
 typedef struct rs_image {
     uint32_t width, height;
-    float *rgb; /* width * height * 3, row-major from the top row */
+    float *rgb;      /* the levels one after another, each row-major from the top row */
+    uint32_t levels; /* levels in rgb; 0 or 1: level 0 only */
 } rs_image;
+
+/* The most mip levels an image has (a side of 65536 texels has 17). */
+#define RS_IMAGE_MAX_LEVELS 24u
+
+/* Floats of rgb that levels [0, levels) of a width x height image take (3 per texel). */
+RS_HD size_t rs_image_levels_floats(uint32_t width, uint32_t height, uint32_t levels)
+{
+    size_t n = 0;
+    uint32_t k;
+    for (k = 0; k < levels; ++k) {
+        n += 3 * (size_t)width * height;
+        width = width > 1 ? width / 2 : 1;
+        height = height > 1 ? height / 2 : 1;
+    }
+    return n;
+}
 
 /* A punctual light (glTF's KHR_lights_punctual): a delta light, which only light sampling
  * finds (the bsdf and uniform sampling modes never see it). */

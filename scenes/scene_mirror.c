@@ -64,8 +64,11 @@ static rs_status mirror_images(const rs_scene *s, const rs_mirror_ops *ops, rs_s
         return rs_error_set(RS_ERR_NOMEM, "out of memory mirroring the scene's images");
     for (i = 0; i < s->n_images && st == RS_OK; ++i) {
         images[i] = s->images[i];
+        /* every mip level: they follow level 0 in the one block */
         st = rs_mirror_copy(&out->made, ops, &p, s->images[i].rgb,
-                            3 * (size_t)s->images[i].width * s->images[i].height, sizeof(float));
+                            rs_image_levels_floats(s->images[i].width, s->images[i].height,
+                                                   s->images[i].levels ? s->images[i].levels : 1),
+                            sizeof(float));
         images[i].rgb = (float *)p;
     }
     if (st == RS_OK &&

@@ -1,5 +1,6 @@
 /* scheduler/engine.c — see render.h: the engine's set-up, its runs of plans and the time limit.
  * The stream engine's waves are render.c, the megakernel's calls passes.c. */
+#include <float.h>
 #include <string.h>
 
 #include "core/alloc.h"
@@ -58,6 +59,14 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
         it->filter = st->filter;
     else if (!rs_filter_make(RS_FILTER_BOX, 1.0f, &it->filter))
         return RS_ERR_ARG;
+    if (st->texture_filter == RS_TEXTURE_TRILINEAR) {
+        /* one pixel's angle at the focus plane, where du is laid (docs/textures.md) */
+        const rs_camera_desc *cd = &scene->camera;
+        float fd =
+            cd->focus_dist > 0.0f ? cd->focus_dist : rs_v3_length(rs_v3_sub(cd->from, cd->at));
+        float spread = fd > 0.0f ? rs_v3_length(it->camera.du) / fd : 0.0f;
+        it->tex_spread = spread > 0.0f && spread <= FLT_MAX ? spread : 0.0f;
+    }
     return RS_OK;
 }
 

@@ -33,6 +33,7 @@ RS_HD void rs_path_aov(const rs_render_consts *it, const rs_ray *r, const rs_hit
     const rs_scene *sc = it->scene;
     rs_vec3 x, ng, n_geo, wo;
     const rs_material *m;
+    float fw;
     if (h->prim == RS_NO_HIT) {
         rs_vec3 bg = rs_env_present(sc) ? rs_env_radiance(sc, r->d) : rs_scene_background(sc, r->d);
         *albedo = rs_v3(rs_fminf(bg.x, 1.0f), rs_fminf(bg.y, 1.0f), rs_fminf(bg.z, 1.0f));
@@ -55,11 +56,12 @@ RS_HD void rs_path_aov(const rs_render_consts *it, const rs_ray *r, const rs_hit
         *normal = n_geo;
         return;
     }
+    fw = rs_texture_footprint(it, m, x, ng); /* the lookups' footprint, as shading takes it */
     *normal = rs_shading_normal(sc, h->prim, h->u, h->v, n_geo, wo);
     if (m->type >= RS_MAT_CONDUCTOR && m->normal_tex != RS_NO_TEXTURE)
         *normal = rs_normal_mapped(sc, m, h->prim, h->u, h->v, x, *normal,
-                                   rs_v3_dot(ng, r->d) < 0.0f, wo);
-    *albedo = rs_surface_albedo(sc, m, h->prim, h->u, h->v, x, ng);
+                                   rs_v3_dot(ng, r->d) < 0.0f, wo, fw);
+    *albedo = rs_surface_albedo(sc, m, h->prim, h->u, h->v, x, ng, fw);
 }
 
 #ifdef __cplusplus

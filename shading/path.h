@@ -82,6 +82,9 @@ typedef struct rs_render_consts {
     uint32_t sampling;  /* rs_sampling */
     uint32_t sampler;   /* rs_sampler */
     rs_filter filter;   /* the pixel filter the camera samples are drawn from */
+    float tex_spread;   /* the camera's pixel spread angle (radians): |du| over the focus
+                           distance, for image textures' level of detail (rs_texture_footprint);
+                           0: bilinear textures on level 0 (--texture-filter bilinear) */
 } rs_render_consts;
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the
@@ -186,37 +189,105 @@ RS_HD void rs_surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, 
     }
 }
 
+/* UV length per world length at a hit on `prim` (n_out: its outward normal there): the square
+ * root of the UV area over the world area its parametrisation maps it to (rs_surface_uv's).
+ * Triangles: their UVs (or barycentrics) against their world area; quads: 1 / sqrt|u x v|;
+ * spheres: u = phi / 2pi, v = theta / pi cover 2 pi^2 r^2 sin(theta) du dv.  0 where the
+ * mapping is degenerate (no filtering). */
+RS_HD_COLD float rs_surface_uv_density(const rs_scene *sc, uint32_t prim, rs_vec3 n_out)
+{
+    if (prim < sc->n_spheres) {
+        float y = n_out.y / rs_v3_length(n_out);
+        float s = sqrtf(rs_fmaxf(1.0f - y * y, 1e-12f));
+        return 1.0f / (sc->spheres[prim].radius * RS_PI * sqrtf(2.0f * s));
+    }
+    if (prim - sc->n_spheres < sc->n_quads) {
+        const rs_quad *q = &sc->quads[prim - sc->n_spheres];
+        float a = rs_v3_length(rs_v3_cross(q->u, q->v));
+        return a > 0.0f ? 1.0f / sqrtf(a) : 0.0f;
+    }
+    {
+        float tmp[6];
+        const float *uv = rs_scene_tri_uv(sc, prim, tmp);
+        rs_tri tr = rs_scene_tri(sc, prim);
+        float a = rs_v3_length(rs_v3_cross(rs_v3_sub(tr.v1, tr.v0), rs_v3_sub(tr.v2, tr.v0)));
+        float det;
+        if (!uv)
+            uv = rs_default_tri_uv(tmp);
+        det = fabsf((uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]));
+        return a > 0.0f ? sqrtf(det / a) : 0.0f;
+    }
+}
+
+/* Whether material m looks up a texture at a hit (its albedo, or glTF's other maps). */
+RS_HD int rs_material_textured(const rs_material *m)
+{
+    return m->albedo_tex != RS_NO_TEXTURE ||
+           (m->type >= RS_MAT_CONDUCTOR &&
+            (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
+             m->normal_tex != RS_NO_TEXTURE));
+}
+
+/* The width in world units of what one pixel covers at surface point x (geometric normal ng)
+ * of a material with textures: pbrt-v4's camera approximation (Camera::Approximate_dp_dxy), a
+ * cone from the camera of the pixel's spread angle, at any vertex of the path: its width at
+ * x's distance from the camera, over |cos| between ng and the direction from the camera (the
+ * ray cone's footprint on the surface, Akenine-Moller et al. 2021).  0 without textures or
+ * with bilinear filtering.  Shading passes it to the lookups below. */
+RS_HD float rs_texture_footprint(const rs_render_consts *it, const rs_material *m, rs_vec3 x,
+                                 rs_vec3 ng)
+{
+    rs_vec3 d;
+    float dist, c;
+    if (!(it->tex_spread > 0.0f) || !rs_material_textured(m))
+        return 0.0f;
+    d = rs_v3_sub(x, it->camera.origin);
+    dist = rs_v3_length(d);
+    if (!(dist > 0.0f))
+        return 0.0f;
+    c = fabsf(rs_v3_dot(ng, d)) / (dist * rs_v3_length(ng));
+    return it->tex_spread * dist / rs_fmaxf(c, 1e-6f);
+}
+
+/* A lookup's footprint in UV units: the world footprint fw times the primitive's UV density. */
+RS_HD float rs_surface_uv_footprint(const rs_scene *sc, uint32_t prim, rs_vec3 ng, float fw)
+{
+    return fw > 0.0f ? fw * rs_surface_uv_density(sc, prim, ng) : 0.0f;
+}
+
+/* The material's albedo at a hit; fw: the world footprint (rs_texture_footprint). */
 RS_HD rs_vec3 rs_surface_albedo(const rs_scene *sc, const rs_material *m, uint32_t prim, float hu,
-                                float hv, rs_vec3 x, rs_vec3 ng)
+                                float hv, rs_vec3 x, rs_vec3 ng, float fw)
 {
     float u, v;
     if (m->albedo_tex == RS_NO_TEXTURE)
         return m->albedo;
     rs_surface_uv(sc, prim, hu, hv, ng, &u, &v);
-    return rs_texture_eval(&sc->textures[m->albedo_tex], sc->images, u, v, x);
+    return rs_texture_eval_lod(&sc->textures[m->albedo_tex], sc->images, u, v, x,
+                               rs_surface_uv_footprint(sc, prim, ng, fw));
 }
 
 /* The material at a hit with its textures other than the albedo applied (glTF's metallic-
  * roughness and emissive textures): m itself when it has none, else *local, filled. */
 RS_HD_COLD const rs_material *rs_surface_material(const rs_scene *sc, const rs_material *m,
                                                   uint32_t prim, float hu, float hv, rs_vec3 x,
-                                                  rs_vec3 ng, rs_material *local)
+                                                  rs_vec3 ng, float fw, rs_material *local)
 {
-    float u, v;
+    float u, v, uvw;
     if (m->mr_tex == RS_NO_TEXTURE && m->emission_tex == RS_NO_TEXTURE)
         return m;
     *local = *m;
     rs_surface_uv(sc, prim, hu, hv, ng, &u, &v);
+    uvw = rs_surface_uv_footprint(sc, prim, ng, fw);
     if (m->mr_tex != RS_NO_TEXTURE) {
-        rs_vec3 t = rs_texture_eval(&sc->textures[m->mr_tex], sc->images, u, v, x);
+        rs_vec3 t = rs_texture_eval_lod(&sc->textures[m->mr_tex], sc->images, u, v, x, uvw);
         float r = sqrtf(m->alpha) * rs_fminf(1.0f, rs_fmaxf(0.0f, t.y));
         local->alpha = rs_fmaxf(r * r, RS_GGX_DELTA_ALPHA);
         local->metallic = m->metallic * rs_fminf(1.0f, rs_fmaxf(0.0f, t.z));
     }
     if (m->emission_tex != RS_NO_TEXTURE)
-        local->emission =
-            rs_v3_mul(m->emission, rs_texture_eval(&sc->textures[m->emission_tex], sc->images, u,
-                                                   v, x));
+        local->emission = rs_v3_mul(m->emission, rs_texture_eval_lod(&sc->textures[m->emission_tex],
+                                                                     sc->images, u, v, x, uvw));
     return local;
 }
 
@@ -225,8 +296,8 @@ RS_HD_COLD const rs_material *rs_surface_material(const rs_scene *sc, const rs_m
  * gradient (dp/du, dp/dv), made orthonormal about the unbent normal.  n where there is no map,
  * no UVs or a degenerate UV mapping, or where the bent normal would face away from wo. */
 RS_HD_COLD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, uint32_t prim,
-                                    float hu, float hv, rs_vec3 x, rs_vec3 n, int front,
-                                    rs_vec3 wo)
+                                    float hu, float hv, rs_vec3 x, rs_vec3 n, int front, rs_vec3 wo,
+                                    float fw)
 {
     rs_tri tr;
     const float *uv;
@@ -256,7 +327,12 @@ RS_HD_COLD rs_vec3 rs_normal_mapped(const rs_scene *sc, const rs_material *m, ui
     B = rs_v3_scale(rs_v3_cross(nf, T), hand);
     u = (1.0f - hu - hv) * uv[0] + hu * uv[2] + hv * uv[4];
     v = (1.0f - hu - hv) * uv[1] + hu * uv[3] + hv * uv[5];
-    tex = rs_texture_eval(&sc->textures[m->normal_tex], sc->images, u, v, x);
+    /* the UV density from the world triangle and its UVs at hand (rs_surface_uv_density's) */
+    if (fw > 0.0f) {
+        float a = rs_v3_length(rs_v3_cross(e1, e2));
+        fw = a > 0.0f ? fw * sqrtf(fabsf(det) / a) : 0.0f;
+    }
+    tex = rs_texture_eval_lod(&sc->textures[m->normal_tex], sc->images, u, v, x, fw);
     tex = rs_v3((2.0f * tex.x - 1.0f) * m->normal_scale, (2.0f * tex.y - 1.0f) * m->normal_scale,
                 2.0f * tex.z - 1.0f);
     nm = rs_v3_add(rs_v3_add(rs_v3_scale(T, tex.x), rs_v3_scale(B, tex.y)), rs_v3_scale(nf, tex.z));
@@ -491,7 +567,7 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
     rs_vertex v;
     rs_material local;
     rs_rng_f4 rb;
-    float pdf = 0.0f;
+    float pdf = 0.0f, fw;
     int specular = 0;
     uint32_t out = 0;
 
@@ -526,9 +602,10 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
         rs_shade_emitter(it, &r, h->t, v.prim, v.m, v.ng, beta, ps);
         return 0; /* emitters reflect nothing */
     }
+    fw = rs_texture_footprint(it, v.m, v.x, v.ng); /* 0 without textures */
     if (v.m->type >= RS_MAT_CONDUCTOR) {
         if (v.m->mr_tex != RS_NO_TEXTURE || v.m->emission_tex != RS_NO_TEXTURE)
-            v.m = rs_surface_material(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, &local);
+            v.m = rs_surface_material(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, fw, &local);
         if (v.m->type == RS_MAT_PBR && !rs_v3_is_zero(v.m->emission)) {
             /* a glTF emissive surface: MIS-weighted against light sampling where that samples
              * it (constant emission), in full where it cannot (a textured one) */
@@ -548,8 +625,8 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
     v.wo = rs_v3_neg(r.d);
     v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
     if (v.m->type >= RS_MAT_CONDUCTOR && v.m->normal_tex != RS_NO_TEXTURE)
-        v.n = rs_normal_mapped(sc, v.m, v.prim, h->u, h->v, v.x, v.n, v.front, v.wo);
-    v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng);
+        v.n = rs_normal_mapped(sc, v.m, v.prim, h->u, h->v, v.x, v.n, v.front, v.wo, fw);
+    v.albedo = rs_surface_albedo(sc, v.m, v.prim, h->u, h->v, v.x, v.ng, fw);
     rb = pre ? pre[0] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_BSDF);
 
     if (rs_material_is_delta(v.m)) {

@@ -171,7 +171,9 @@ static void test_mirror_renders_alone(void **state)
     assert_int_equal(s->n_instances, 2u);
     assert_non_null(s->env_marg_cdf);
     for (i = 0; i < s->n_images; ++i) {
-        want += 3ull * s->images[i].width * s->images[i].height * sizeof(float);
+        want +=
+            rs_image_levels_floats(s->images[i].width, s->images[i].height, s->images[i].levels) *
+            sizeof(float); /* mip levels too */
         assert_ptr_not_equal(m.scene.images[i].rgb, s->images[i].rgb);
     }
     assert_int_equal(m.made.bytes, want);
