@@ -97,6 +97,8 @@ rs_status rs_image_read_alpha(const char *path, uint32_t *width, uint32_t *heigh
  * 2:1 reduction averages each 2x2 block.  w2 <= w, h2 <= h.  For texture mip levels. */
 rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t h, float *out, uint32_t w2,
                               uint32_t h2);
+/* 1 where rs_image_downsample works (OpenImageIO is built in), 0 in the PFM-only build. */
+int rs_image_can_downsample(void);
 
 /* The linear value of an sRGB-encoded one in [0, 1]. */
 float rs_srgb_decode(float encoded);

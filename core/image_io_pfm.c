@@ -110,3 +110,16 @@ rs_status rs_image_read_meta(const char *path, const char *key, char *value, siz
 }
 
 const char *rs_image_library_version(void) { return "none (PFM only)"; }
+
+/* No resampler without OpenImageIO: image textures keep one level (bilinear lookups), which
+ * scenes/scene.c learns from rs_image_can_downsample. */
+int rs_image_can_downsample(void) { return 0; }
+
+rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t h, float *out, uint32_t w2,
+                              uint32_t h2)
+{
+    (void)rgb;
+    (void)out;
+    return rs_error_set(RS_ERR_ARG, "downsampling a %ux%u image to %ux%u: this build has no "
+                                    "OpenImageIO", w, h, w2, h2);
+}

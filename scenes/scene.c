@@ -620,11 +620,14 @@ static rs_status build_pyramid(rs_image *im)
 }
 
 /* Pyramids for every image an image texture uses (an image used only as the environment map
- * keeps one level: shading/envmap.h samples its texels). */
+ * keeps one level: shading/envmap.h samples its texels).  A build without OpenImageIO has no
+ * resampler: its images keep one level, and their lookups stay bilinear. */
 static rs_status build_pyramids(rs_scene *s)
 {
     uint32_t i;
     rs_status st;
+    if (!rs_image_can_downsample())
+        return RS_OK;
     for (i = 0; i < s->n_textures; ++i)
         if (s->textures[i].type == RS_TEX_IMAGE && s->textures[i].image < s->n_images &&
             (st = build_pyramid(&s->images[s->textures[i].image])) != RS_OK)

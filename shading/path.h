@@ -260,11 +260,15 @@ RS_HD rs_vec3 rs_surface_albedo(const rs_scene *sc, const rs_material *m, uint32
                                 float hv, rs_vec3 x, rs_vec3 ng, float fw)
 {
     float u, v;
+    const rs_texture *t;
     if (m->albedo_tex == RS_NO_TEXTURE)
         return m->albedo;
     rs_surface_uv(sc, prim, hu, hv, ng, &u, &v);
-    return rs_texture_eval_lod(&sc->textures[m->albedo_tex], sc->images, u, v, x,
-                               rs_surface_uv_footprint(sc, prim, ng, fw));
+    t = &sc->textures[m->albedo_tex];
+    /* only an image has levels: a procedural texture skips the UV density */
+    return rs_texture_eval_lod(t, sc->images, u, v, x,
+                               t->type == RS_TEX_IMAGE ? rs_surface_uv_footprint(sc, prim, ng, fw)
+                                                       : 0.0f);
 }
 
 /* The material at a hit with its textures other than the albedo applied (glTF's metallic-
