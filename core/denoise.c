@@ -99,7 +99,8 @@ static int resolve(void *lib, const char *path, oidn_lib *o, char *why, size_t n
     return 1;
 }
 
-/* Opens `path` and resolves it; 1 and *o filled, or 0 with why[n]. */
+/* Opens `path` and resolves it: 1 and *o filled; 0 (not opened) or -1 (opened, but not OIDN
+ * 2.x) with why[n]. */
 static int try_open(const char *path, oidn_lib *o, char *why, size_t n, const char *hint)
 {
     void *lib;
@@ -111,7 +112,7 @@ static int try_open(const char *path, oidn_lib *o, char *why, size_t n, const ch
     }
     if (!resolve(lib, path, o, why, n)) {
         dlclose(lib);
-        return 0;
+        return -1;
     }
     return 1;
 }
@@ -141,7 +142,7 @@ static int load(char *why, size_t n)
                           " (reinstall: rm -r /opt/raystream/oidn; sh scripts/install-deps.sh)");
         } else {
             ok = try_open("libOpenImageDenoise.so.2", &o, why, n, "");
-            if (!ok)
+            if (ok == 0) /* not found (a found library's own problem is kept) */
                 say(why, n,
                     "Open Image Denoise 2.x not found (neither %s nor libOpenImageDenoise.so.2 on "
                     "the library path): run sh scripts/install-deps.sh as root, or set "
@@ -149,12 +150,12 @@ static int load(char *why, size_t n)
                     RS_DENOISE_DEFAULT_LIBRARY);
         }
     }
-    if (ok) {
+    if (ok == 1) {
         g_oidn = o;
         say(why, n, "%s", "");
     }
     pthread_mutex_unlock(&g_lock);
-    return ok;
+    return ok == 1;
 }
 
 int rs_denoise_available(char *why, size_t n) { return load(why, n); }
