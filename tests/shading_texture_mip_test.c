@@ -361,6 +361,78 @@ static const rs_texture *gltf_texture(const rs_scene *s, uint32_t k)
     return NULL;
 }
 
+/* The file's four quads (2 x 2, side by side at x = -3.3, -1.1, 1.1, 3.3 in the plane z = 0,
+ * glTF UVs (0, 1) at the lower-left corner: the renderer's (0, 0)) rendered head-on as white
+ * Lambertians carrying each material's texture, under a white sky with BSDF sampling: each pixel
+ * is the texture's colour at its UVs, averaged over the pixel. */
+#define TT_W 200u
+#define TT_H 50u
+
+static float *render_quads(rs_scene *s, float *corner_x, float *corner_y, float *du, float *dv)
+{
+    rs_render_settings st;
+    rs_render_consts it;
+    uint32_t i;
+    for (i = 0; i < s->n_materials; ++i) {
+        uint32_t tex = s->materials[i].albedo_tex;
+        s->materials[i] = rs_mat_lambertian(rs_v3_splat(1.0f));
+        s->materials[i].albedo_tex = tex;
+    }
+    s->background = rs_v3_splat(1.0f);
+    s->background_sky = 0;
+    s->camera.from = rs_v3(0, 0, 6);
+    s->camera.at = rs_v3(0, 0, 0);
+    s->camera.up = rs_v3(0, 1, 0);
+    s->camera.vfov_deg = 60.0f;
+    s->camera.aperture = 0.0f;
+    s->camera.focus_dist = 0.0f;
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    /* the focus plane is z = 0: pixel (a, b) (continuous) looks at corner + a du + b dv */
+    memset(&st, 0, sizeof st);
+    st.width = TT_W;
+    st.height = TT_H;
+    st.spp = 1;
+    st.max_depth = 2;
+    assert_int_equal(rs_render_constants(s, &st, &it), RS_OK);
+    *corner_x = it.camera.origin.x + it.camera.corner.x;
+    *corner_y = it.camera.origin.y + it.camera.corner.y;
+    *du = it.camera.du.x;
+    *dv = it.camera.dv.y;
+    {
+        rs_geom g = rs_scene_geom(s);
+        rs_bvh *bvh = NULL;
+        rs_device *dev = NULL;
+        rs_film *film = NULL;
+        rs_render_stats stats;
+        float *rgb = (float *)malloc((size_t)TT_W * TT_H * 3 * sizeof *rgb);
+        assert_non_null(rgb);
+        assert_int_equal(rs_bvh_build(&g, NULL, &bvh), RS_OK);
+        assert_int_equal(rs_cpu_device_create(1, "cpu", &dev), RS_OK);
+        assert_int_equal(rs_device_upload(dev, &g, bvh), RS_OK);
+        assert_int_equal(rs_film_create(TT_W, TT_H, &film), RS_OK);
+        st.spp = 16;
+        st.seed = 9;
+        st.sampling = RS_SAMPLING_BSDF;
+        st.sampler = RS_SAMPLER_SOBOL;
+        st.threads = 1;
+        assert_int_equal(rs_render_passes(s, dev, &st, NULL, film, &stats), RS_OK);
+        rs_film_resolve(film, rgb);
+        rs_device_destroy(dev);
+        rs_film_destroy(film);
+        rs_bvh_destroy(bvh);
+        return rgb;
+    }
+}
+
+/* The rendered pixel over point (x, y) of the plane z = 0. */
+static rs_vec3 pixel_at(const float *rgb, float cx, float cy, float du, float dv, float x, float y)
+{
+    uint32_t i = (uint32_t)((x - cx) / du), j = (uint32_t)((y - cy) / dv);
+    const float *p = &rgb[3 * ((size_t)j * TT_W + i)];
+    assert_true(i < TT_W && j < TT_H);
+    return rs_v3(p[0], p[1], p[2]);
+}
+
 static int is_red(rs_vec3 c) { return c.x > 0.99f && c.z < 0.01f; }
 static int is_blue(rs_vec3 c) { return c.z > 0.99f && c.x < 0.01f; }
 
@@ -418,6 +490,43 @@ static void test_khr_texture_transform(void **state)
             }
         /* v = 1/2 maps to u' = 1/4, the red texel's centre; v = 0 to u' = 1/2, the seam */
         assert_true(is_red(rs_texture_eval(t, s->images, 0.5f, 0.5f, p)));
+    }
+    {
+        /* rendered: the plain quad is red on its left half's centre and blue on its right's,
+         * the half-offset one the other way round; and every pixel well inside a quad is its
+         * texture at the pixel's centre (the transform applied by the renderer's lookups) */
+        static const float qx[4] = {-3.3f, -1.1f, 1.1f, 3.3f};
+        float cx, cy, du, dv, *rgb = render_quads(s, &cx, &cy, &du, &dv);
+        uint32_t k, i, j, checked = 0;
+        rs_vec3 c;
+        c = pixel_at(rgb, cx, cy, du, dv, qx[0] - 0.5f, 0.0f);
+        assert_true(c.x > 0.9f && c.z < 0.1f);
+        c = pixel_at(rgb, cx, cy, du, dv, qx[0] + 0.5f, 0.0f);
+        assert_true(c.z > 0.9f && c.x < 0.1f);
+        c = pixel_at(rgb, cx, cy, du, dv, qx[1] - 0.5f, 0.0f);
+        assert_true(c.z > 0.9f && c.x < 0.1f);
+        c = pixel_at(rgb, cx, cy, du, dv, qx[1] + 0.5f, 0.0f);
+        assert_true(c.x > 0.9f && c.z < 0.1f);
+        for (j = 0; j < TT_H; ++j)
+            for (i = 0; i < TT_W; ++i) {
+                float x = cx + (i + 0.5f) * du, y = cy + (j + 0.5f) * dv;
+                for (k = 0; k < 4; ++k) {
+                    float lx = x - qx[k], ly = y;
+                    rs_vec3 want;
+                    const float *px = &rgb[3 * ((size_t)j * TT_W + i)];
+                    if (!(fabsf(lx) < 0.9f && fabsf(ly) < 0.9f))
+                        continue;
+                    want = rs_texture_eval(gltf_texture(s, k), s->images, 0.5f * (lx + 1.0f),
+                                           0.5f * (ly + 1.0f), p);
+                    /* a pixel spans 1/20 of a quad: a ramp's value at its centre is its mean,
+                     * to the kinks of the wrap */
+                    assert_true(fabsf(px[0] - want.x) < 0.08f && fabsf(px[2] - want.z) < 0.08f);
+                    ++checked;
+                }
+            }
+        printf("%u pixels inside the quads as the transforms say\n", checked);
+        assert_true(checked > 400);
+        free(rgb);
     }
     rs_scene_destroy(s);
 }
