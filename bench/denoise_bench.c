@@ -1,8 +1,9 @@
 /* bench/denoise_bench.c — what denoising with Intel Open Image Denoise buys (core/denoise.h,
  * --denoise; docs/denoise.md): a low-spp render, denoised, against a converged reference.
  *
- * For each scene: a reference at --ref-spp (Sobol), the beauty at --spp (MIS; the Sobol sampler,
- * the CLI's default, then the independent one, noisier at equal spp) with the albedo and normal
+ * For each scene: a reference at --ref-spp (Sobol), the beauty at --spp (MIS and the CLI's
+ * default pixel filter; the Sobol sampler, the CLI's default, then the independent one, noisier
+ * at equal spp) with the albedo and normal
  * AOVs exactly as `--aov albedo,normal` makes them (shading/aov.c), then rs_denoise three ways:
  * beauty only; beauty, albedo and normal with cleanAux on (what --denoise does: our AOVs are
  * first-hit values averaged over up to 16 camera rays, so carry no path-tracing noise); and the
@@ -43,6 +44,7 @@
 #include "core/image_io.h"
 #include "machine.h"
 #include "shading/aov.h"
+#include "shading/filter.h"
 
 #define MAX_RUNS 9
 
@@ -62,6 +64,7 @@ static void settings_for(uint32_t size, uint32_t spp, rs_sampler sampler, int th
     st->seed = 1;
     st->sampling = RS_SAMPLING_MIS;
     st->sampler = sampler;
+    rs_filter_default(&st->filter); /* the CLI's pixel filter */
     st->threads = threads;
     rs_cores_init(cores, threads);
     st->cores = cores;
@@ -271,9 +274,16 @@ static int bench_scene(const char *spec, const opts *o)
         fprintf(stderr, "denoise_bench: out of memory\n");
         goto done;
     }
-    printf("scene builtin:%s, %ux%u, %u spp against a %u-spp reference (sobol, MIS, depth 50), "
-           "%d thread%s\n",
-           spec, o->size, o->size, o->spp, o->ref_spp, o->threads, o->threads == 1 ? "" : "s");
+    {
+        rs_filter f;
+        char fd[128];
+        rs_filter_default(&f);
+        rs_filter_describe(&f, fd, sizeof fd);
+        printf("scene builtin:%s, %ux%u, %u spp against a %u-spp reference (sobol, MIS, depth 50, "
+               "pixel filter %s), %d thread%s\n",
+               spec, o->size, o->size, o->spp, o->ref_spp, fd, o->threads,
+               o->threads == 1 ? "" : "s");
+    }
     if (!render(&s, o->size, o->ref_spp, RS_SAMPLER_SOBOL, o->threads, ref, &t_ref))
         goto done;
     rc = 0;
