@@ -262,24 +262,29 @@ static int mismatch_s(const char *path, const char *field, const char *in_file, 
     return RS_EXIT_USAGE;
 }
 
-uint32_t rs_checkpoint_filter_code(const rs_filter *f)
+uint32_t rs_checkpoint_filter_code(const rs_filter *f, int trilinear)
 {
+    uint32_t tex = trilinear ? 1u << 23 : 0u;
     if (f->kind == RS_FILTER_BOX && f->width == 1.0f)
-        return 0;
-    return f->kind << 24 | (uint32_t)lrintf(f->width * 1000.0f);
+        return tex;
+    return f->kind << 24 | tex | (uint32_t)lrintf(f->width * 1000.0f);
 }
 
-/* "mitchell:4" for a header's filter code. */
+/* "mitchell:4 with trilinear textures" for a header's filter code. */
 static void filter_code_name(uint32_t code, char *buf, size_t n)
 {
     rs_filter f;
+    uint32_t width = code & 0x7fffffu;
+    size_t len;
     memset(&f, 0, sizeof f);
-    f.kind = code ? code >> 24 : RS_FILTER_BOX;
-    f.width = code ? (float)(code & 0xffffffu) / 1000.0f : 1.0f;
+    f.kind = width ? code >> 24 : RS_FILTER_BOX;
+    f.width = width ? (float)width / 1000.0f : 1.0f;
     if (f.kind > RS_FILTER_MITCHELL)
         snprintf(buf, n, "an unknown filter (%08x)", code);
     else
         rs_filter_describe(&f, buf, n);
+    len = strlen(buf);
+    snprintf(buf + len, n - len, " (%s textures)", code & (1u << 23) ? "trilinear" : "bilinear");
 }
 
 /* The header against `want`.  Returns RS_EXIT_OK or the exit code after one line. */
@@ -312,10 +317,10 @@ static int check_header(const char *path, const unsigned char *h, const char *na
         return mismatch_s(path, "--sampler", rs_sampler_name((rs_sampler)u[6]),
                           rs_sampler_name((rs_sampler)want->sampler));
     if (get32(h + FIXED_HEADER + get32(h + 88) + 4) != want->filter) {
-        char a[48], b[48];
+        char a[80], b[80];
         filter_code_name(get32(h + FIXED_HEADER + get32(h + 88) + 4), a, sizeof a);
         filter_code_name(want->filter, b, sizeof b);
-        return mismatch_s(path, "--filter", a, b);
+        return mismatch_s(path, "--filter / --texture-filter", a, b);
     }
     if (u[7] != want->isect_sphere)
         return mismatch_s(path, "--isect-sphere", rs_isect_sphere_algo_name(u[7]),

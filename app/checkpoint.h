@@ -21,9 +21,10 @@
  *    48    40  width, height, spp, max depth, rr depth, sampling, sampler, sphere test,
  *              triangle test, box test (u32 each)
  *    88     4  scene name bytes n (< 4096), then the name as given on the command line
- *  92+n     4  ranges R (1..65536; 0 for an empty film), then the pixel filter (u32:
- *              0 for a box of 1 pixel, the only filter before raystream 0.9, whose files
- *              hold 0 here; else kind << 24 | the width in thousandths of a pixel)
+ *  92+n     4  ranges R (1..65536; 0 for an empty film), then the pixel and texture filters
+ *              (u32: kind << 24 | 1 << 23 for trilinear textures | the width in thousandths
+ *              of a pixel, kind and width 0 for a box of 1 pixel: files before raystream 0.9,
+ *              a box and bilinear textures, hold 0 here)
  *  100+n 16*R  the paths held: R ranges [lo, hi) (u64 each), sorted, disjoint, not touching,
  *              each starting at a whole sample (lo a multiple of P)
  *  hdr   48*P  the sums, 3 signed 128-bit integers a pixel in film units (2^-40; P = width *
@@ -74,9 +75,10 @@ typedef struct rs_checkpoint_key {
     const char *scene; /* the scene's name on the command line (messages only) */
 } rs_checkpoint_key;
 
-/* The pixel filter as the header holds it: 0 for box:1, else kind << 24 | width in
- * thousandths of a pixel. */
-uint32_t rs_checkpoint_filter_code(const rs_filter *f);
+/* The pixel filter and the texture filter as the header holds them: kind << 24 | trilinear << 23
+ * | width in thousandths of a pixel, kind and width 0 for box:1 (so 0 is box:1 with bilinear
+ * textures: every checkpoint before raystream 0.9). */
+uint32_t rs_checkpoint_filter_code(const rs_filter *f, int trilinear);
 
 /* FNV-1a 64 over every array and setting of a finalized scene that shading reads. */
 uint64_t rs_checkpoint_scene_hash(const rs_scene *s);

@@ -149,7 +149,8 @@ static void make_key(const rs_cli_options *o, render_run *r)
     k->rr_depth = r->st.rr_depth ? r->st.rr_depth : 3;
     k->sampling = (uint32_t)r->st.sampling;
     k->sampler = (uint32_t)r->st.sampler;
-    k->filter = rs_checkpoint_filter_code(&r->st.filter);
+    k->filter = rs_checkpoint_filter_code(&r->st.filter,
+                                          r->st.texture_filter == RS_TEXTURE_TRILINEAR);
     k->isect_sphere = o->isect_sphere;
     k->isect_tri = o->isect_tri;
     k->isect_aabb = o->isect_aabb;

@@ -323,7 +323,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
         "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
         "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
         "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter",
-        "raystream:lighting",   "raystream:denoised"};
+        "raystream:lighting",   "raystream:denoised", "raystream:texture_filter"};
     const char *values[RS_REPORT_META_N];
     size_t used = 0;
     int i;
@@ -357,6 +357,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     values[11] = rep->filter;
     values[12] = rep->lighting ? rep->lighting : "the scene's own";
     values[13] = rep->denoised ? rep->denoised : "no";
+    values[14] = rep->texture_filter ? rep->texture_filter : "trilinear";
     for (i = 0; i < RS_REPORT_META_N; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];

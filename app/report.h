@@ -30,6 +30,7 @@ typedef struct rs_report {
     rs_sampling sampling;
     rs_sampler sampler;
     char filter[40];       /* "blackman-harris:1.5" */
+    const char *texture_filter; /* "trilinear" or "bilinear" */
     const char *denoised;  /* --denoise: the OIDN device that ran it; NULL: not denoised */
     const char *lighting;  /* how the scene was lit when the file said nothing ("the default
                               sky: ..."), or NULL */
@@ -61,9 +62,10 @@ void rs_report_print_summary(const rs_report *rep);
 
 /* The .exr header's attributes (core/image_io.h): the scene, the spp every pixel has and the
  * spp asked for, seed, sampling, sampler, max depth, devices, integrator, version, adaptive,
- * the pixel filter, the lighting when the scene's file gave none, the denoiser;
+ * the pixel filter, the lighting when the scene's file gave none, the denoiser, the texture
+ * filter;
  * their strings in the struct itself. */
-enum { RS_REPORT_META_N = 14 };
+enum { RS_REPORT_META_N = 15 };
 typedef struct rs_report_meta {
     rs_image_meta meta[RS_REPORT_META_N];
     char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];

@@ -114,6 +114,10 @@ static void test_filter_in_checkpoint(void **state)
     static const char *const other[] = {"render", "builtin:cornell", "--width", "40", "--height",
                                         "30", "--spp", "4", "--filter", "gaussian", "--resume",
                                         "c.ckpt", "-q", "-o", "r.exr", NULL};
+    static const char *const other_tex[] = {"render", "builtin:cornell", "--width", "40",
+                                            "--height", "30", "--spp", "4", "--filter",
+                                            "mitchell", "--texture-filter", "bilinear",
+                                            "--resume", "c.ckpt", "-q", "-o", "r.exr", NULL};
     static const char *const same[] = {"render", "builtin:cornell", "--width", "40", "--height",
                                        "30", "--spp", "4", "--filter", "mitchell", "--resume",
                                        "c.ckpt", "-q", "-o", "r.exr", NULL};
@@ -121,8 +125,13 @@ static void test_filter_in_checkpoint(void **state)
     run_expect(f, half, 0, &p);
     proc_free(&p);
     run_expect(f, other, 2, &p);
-    EXPECT(&p, strstr(p.err.data, "--filter mitchell:4") && strstr(p.err.data, "gaussian:3"),
+    EXPECT(&p, strstr(p.err.data, "--filter") && strstr(p.err.data, "mitchell:4") &&
+                   strstr(p.err.data, "gaussian:3"),
            "the resume with another filter does not name both filters");
+    proc_free(&p);
+    run_expect(f, other_tex, 2, &p);
+    EXPECT(&p, strstr(p.err.data, "trilinear textures") && strstr(p.err.data, "bilinear textures"),
+           "the resume with another texture filter does not name both");
     proc_free(&p);
     run_expect(f, same, 0, &p);
     proc_free(&p);
