@@ -83,7 +83,8 @@ static void make_edges(rs_filter_kind kind, double width, double *e)
 
 int rs_filter_make(rs_filter_kind kind, float width, rs_filter *out)
 {
-    double h[RS_FILTER_BINS], e[RS_FILTER_BINS + 1], sum_abs = 0.0, run = 0.0;
+    double h[RS_FILTER_BINS], e[RS_FILTER_BINS + 1], v[RS_FILTER_BINS + 1], sum_abs = 0.0,
+           run = 0.0;
     int k;
     if ((unsigned)kind > RS_FILTER_MITCHELL) {
         rs_error_set(RS_ERR_ARG, "unknown filter %u", (unsigned)kind);
@@ -101,28 +102,33 @@ int rs_filter_make(rs_filter_kind kind, float width, rs_filter *out)
     out->weight = 1.0f;
     make_edges(kind, width, e);
     for (k = 0; k <= RS_FILTER_BINS; ++k) {
-        double v = rs_filter_eval(kind, width, e[k]);
+        v[k] = fabs(rs_filter_eval(kind, width, e[k]));
         if (k == 0 || k == RS_FILTER_BINS) /* the support's ends: f's limit from inside */
-            v = rs_filter_eval(kind, width, e[k] * (1.0 - 1e-12));
+            v[k] = fabs(rs_filter_eval(kind, width, e[k] * (1.0 - 1e-12)));
         out->edge[k] = (float)e[k];
-        out->value[k] = (float)fabs(v);
     }
+    if (kind == RS_FILTER_BOX)
+        for (k = 0; k <= RS_FILTER_BINS; ++k)
+            v[k] = 1.0;
+    for (k = 0; k < RS_FILTER_BINS; ++k) /* the bin's area under the linear |f| */
+        sum_abs += h[k] = 0.5 * (v[k] + v[k + 1]) * (e[k + 1] - e[k]);
     for (k = 0; k < RS_FILTER_BINS; ++k) {
-        /* the bin's area under the linear |f|, signed as f in its middle */
-        double area = 0.5 * ((double)out->value[k] + out->value[k + 1]) * (e[k + 1] - e[k]);
-        h[k] = rs_filter_eval(kind, width, 0.5 * (e[k] + e[k + 1])) < 0.0 ? -area : area;
-        sum_abs += fabs(h[k]);
-    }
-    for (k = 0; k < RS_FILTER_BINS; ++k) {
+        double ab = v[k] + v[k + 1], beta = ab > 0.0 ? 2.0 * (v[k + 1] - v[k]) / ab : 0.0;
+        double prob = h[k] / sum_abs;
         out->cdf[k] = (float)(run / sum_abs);
-        run += fabs(h[k]);
+        run += h[k];
+        out->alpha[k] = (float)(ab > 0.0 ? 2.0 * v[k] / ab : 1.0);
+        out->beta[k] = (float)beta;
+        out->inv_beta[k] = fabs(beta) >= 1e-3 ? (float)(1.0 / beta) : 0.0f;
+        out->inv_p[k] = prob > 0.0 ? (float)(1.0 / prob) : 0.0f;
+        out->pdf[k] = e[k + 1] > e[k] ? (float)(prob / (e[k + 1] - e[k])) : 0.0f;
     }
     out->cdf[RS_FILTER_BINS] = 1.0f;
     if (kind == RS_FILTER_MITCHELL) { /* int f exactly: f's pieces are cubics, 4000 midpoints */
         double exact = 0.0;
         for (k = 0; k < 4000; ++k)
             exact += rs_filter_eval(kind, width, -0.5 * width + (k + 0.5) * width / 4000);
-        out->weight = (float)(sum_abs / (exact * width / 4000));
+        out->weight = (float)(1.0 / (exact * width / 4000));
     }
     return 1;
 }

@@ -53,9 +53,13 @@ typedef struct rs_filter {
     float edge[RS_FILTER_BINS + 1]; /* the bins' edges in pixels, edge[0] = -width/2: equal
                                        bins, but for Mitchell, whose zero crossings are edges
                                        (so each bin lies under one sign of f) */
-    float value[RS_FILTER_BINS + 1]; /* |f| at each edge: the density is linear between */
-    float weight;                  /* Mitchell: the table's area over int f (its weights);
-                                      else 1 */
+    /* per bin k, the density over s in [0, 1] across it (|f| linear between its edges' values
+     * a and b, normalised): g(s) = alpha + beta s, alpha = 2a / (a + b), beta = 2(b - a) /
+     * (a + b); inv_beta = 1 / beta, 0 for a bin flat to 1e-3 (drawn uniformly); inv_p = 1 / the
+     * bin's probability (0 for none); pdf = the probability over the bin's width */
+    float alpha[RS_FILTER_BINS], beta[RS_FILTER_BINS], inv_beta[RS_FILTER_BINS];
+    float inv_p[RS_FILTER_BINS], pdf[RS_FILTER_BINS];
+    float weight;                  /* Mitchell: 1 / int f (its weights); else 1 */
 } rs_filter;
 
 /* Whether the filter leaves the uniform numbers as they are: box of width 1. */
@@ -79,23 +83,19 @@ RS_HD uint32_t rs_filter_bin(const rs_filter *f, float u)
 RS_HD float rs_filter_max0(float x) { return x > 0.0f ? x : 0.0f; }
 
 /* One axis: the offset in pixels from the pixel's centre drawn with u in [0, 1); *dens: the
- * table's |f| there (the drawn density times the table's area). */
+ * density it was drawn with (per pixel of offset). */
 RS_HD float rs_filter_draw(const rs_filter *f, float u, float *dens)
 {
-    uint32_t k;
-    float t, p, a, b, s, d;
-    k = rs_filter_bin(f, u);
-    p = f->cdf[k + 1] - f->cdf[k];
-    t = p > 0.0f ? (u - f->cdf[k]) / p : 0.5f;
+    uint32_t k = rs_filter_bin(f, u);
+    float t = (u - f->cdf[k]) * f->inv_p[k], s;
     t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
-    /* the density a + (b - a) s over the bin, s in [0, 1]: its cdf (a s + (b - a) s^2 / 2) /
-     * ((a + b) / 2) = t solved in the form that never cancels (a, b >= 0) */
-    a = f->value[k];
-    b = f->value[k + 1];
-    d = a + sqrtf(rs_filter_max0(a * a + t * (b - a) * (a + b)));
-    s = a + b == 0.0f ? t : d > 0.0f ? t * (a + b) / d : 0.0f; /* d = 0: a = 0 and t = 0 */
-    s = s > 1.0f ? 1.0f : s;
-    *dens = a + s * (b - a);
+    /* alpha s + beta s^2 / 2 = t; no division: a camera ray takes two of these */
+    s = f->inv_beta[k] != 0.0f
+            ? (sqrtf(rs_filter_max0(f->alpha[k] * f->alpha[k] + 2.0f * f->beta[k] * t)) -
+               f->alpha[k]) * f->inv_beta[k]
+            : t;
+    s = s < 0.0f ? 0.0f : s > 1.0f ? 1.0f : s;
+    *dens = (f->alpha[k] + f->beta[k] * s) * f->pdf[k];
     return f->edge[k] + s * (f->edge[k + 1] - f->edge[k]);
 }
 
