@@ -52,15 +52,6 @@ typedef struct oidn_lib {
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
 static oidn_lib g_oidn;
 
-static void say(char *why, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    if (!why || n == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(why, n, fmt, ap);
-    va_end(ap);
-}
 
 /* dlerror()'s text without a trailing newline, or "unknown reason". */
 static const char *dl_reason(void)
@@ -79,13 +70,13 @@ static int resolve(void *lib, const char *path, oidn_lib *o, char *why, size_t n
   if (!p) {                                                                                        \
     /* 2.0 renamed OIDN 1.x's oidnSetFilter1b/oidnSetDevice1i */                                   \
     if (dlsym(lib, "oidnSetFilter1b"))                                                             \
-      say(why, n,                                                                                  \
+      rs_say(why, n,                                                                                  \
           "%s is Open Image Denoise 1.x (it has oidnSetFilter1b, not %s); raystream needs "        \
           "2.x: run sh scripts/install-deps.sh, or set RS_OIDN_LIBRARY=PATH to a 2.x "             \
           "libOpenImageDenoise.so.2",                                                              \
           path, sym);                                                                              \
     else                                                                                           \
-      say(why, n,                                                                                  \
+      rs_say(why, n,                                                                                  \
           "%s lacks %s: not Open Image Denoise 2.x; run sh scripts/install-deps.sh, or set "       \
           "RS_OIDN_LIBRARY=PATH to libOpenImageDenoise.so.2",                                      \
           path, sym);                                                                              \
@@ -107,7 +98,7 @@ static int try_open(const char *path, oidn_lib *o, char *why, size_t n, const ch
     dlerror();
     lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) {
-        say(why, n, "Open Image Denoise not loaded: %s%s", dl_reason(), hint);
+        rs_say(why, n, "Open Image Denoise not loaded: %s%s", dl_reason(), hint);
         return 0;
     }
     if (!resolve(lib, path, o, why, n)) {
@@ -126,7 +117,7 @@ static int load(char *why, size_t n)
     pthread_mutex_lock(&g_lock);
     if (g_oidn.lib) {
         pthread_mutex_unlock(&g_lock);
-        say(why, n, "%s", "");
+        rs_say(why, n, "%s", "");
         return 1;
     }
     if (env && env[0]) {
@@ -143,7 +134,7 @@ static int load(char *why, size_t n)
         } else {
             ok = try_open("libOpenImageDenoise.so.2", &o, why, n, "");
             if (ok == 0) /* not found (a found library's own problem is kept) */
-                say(why, n,
+                rs_say(why, n,
                     "Open Image Denoise 2.x not found (neither %s nor libOpenImageDenoise.so.2 on "
                     "the library path): run sh scripts/install-deps.sh as root, or set "
                     "RS_OIDN_LIBRARY=PATH to libOpenImageDenoise.so.2",
@@ -152,7 +143,7 @@ static int load(char *why, size_t n)
     }
     if (ok == 1) {
         g_oidn = o;
-        say(why, n, "%s", "");
+        rs_say(why, n, "%s", "");
     }
     pthread_mutex_unlock(&g_lock);
     return ok == 1;
@@ -294,7 +285,7 @@ rs_status rs_denoise(const float *beauty, const float *albedo, const float *norm
     denoise_job j;
     int version = 0;
     rs_status st = RS_ERR_DEVICE_LOST;
-    say(device_used, n, "%s", "");
+    rs_say(device_used, n, "%s", "");
     if (!beauty || !out)
         return rs_error_set(RS_ERR_ARG, "denoise: no %s image", beauty ? "output" : "beauty");
     if (w == 0 || h == 0)
@@ -320,7 +311,7 @@ rs_status rs_denoise(const float *beauty, const float *albedo, const float *norm
         /* g_oidn is never written again once loaded (see the top of the file) */
         st = run_on(&g_oidn, RS_OIDN_DEVICE_TYPE_CUDA, &j, &version, gpu_msg, sizeof gpu_msg);
         if (st == RS_OK) {
-            say(device_used, n, "CUDA (OIDN %d.%d.%d)", version / 10000, version / 100 % 100,
+            rs_say(device_used, n, "CUDA (OIDN %d.%d.%d)", version / 10000, version / 100 % 100,
                 version % 100);
             return RS_OK;
         }
@@ -332,10 +323,10 @@ rs_status rs_denoise(const float *beauty, const float *albedo, const float *norm
         return rs_error_set(st, "denoise: %s", msg);
     }
     if (gpu_msg[0])
-        say(device_used, n, "CPU (OIDN %d.%d.%d; %s)", version / 10000, version / 100 % 100,
+        rs_say(device_used, n, "CPU (OIDN %d.%d.%d; %s)", version / 10000, version / 100 % 100,
             version % 100, gpu_msg);
     else
-        say(device_used, n, "CPU (OIDN %d.%d.%d)", version / 10000, version / 100 % 100,
+        rs_say(device_used, n, "CPU (OIDN %d.%d.%d)", version / 10000, version / 100 % 100,
             version % 100);
     return RS_OK;
 }

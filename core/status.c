@@ -40,3 +40,13 @@ const char *rs_status_name(rs_status s)
     }
     return "unknown error";
 }
+
+void rs_say(char *why, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    if (!why || n == 0)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(why, n, fmt, ap);
+    va_end(ap);
+}

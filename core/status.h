@@ -6,6 +6,8 @@
 #ifndef RS_CORE_STATUS_H
 #define RS_CORE_STATUS_H
 
+#include <stddef.h>
+
 typedef enum rs_status {
     RS_OK = 0,
     RS_ERR_ARG,         /* bad argument or bad input data */
@@ -31,6 +33,13 @@ const char *rs_error_message(void);
 /* Forgets this thread's message. */
 void rs_error_clear(void);
 const char *rs_status_name(rs_status s);
+/* A reason for the caller into why[n] (nothing when why is NULL or n is 0): the "0 with one line
+ * in why" convention of the parsers and loaders that do not record an error. */
+void rs_say(char *why, size_t n, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
 #ifdef __cplusplus
 }
 #endif

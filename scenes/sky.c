@@ -432,15 +432,6 @@ rs_status rs_sky_image(const rs_sky_params *p, uint32_t w, uint32_t h, float **r
 
 /* ---- parsing ---- */
 
-static void say(char *why, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    if (!why || n == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(why, n, fmt, ap);
-    va_end(ap);
-}
 
 typedef struct sky_key {
     const char *name;
@@ -461,7 +452,7 @@ int rs_sky_parse(const char *spec, rs_sky_params *out, char *why, size_t n)
     if (why && n)
         why[0] = '\0';
     if (!spec || !out) {
-        say(why, n, "sky: no specification");
+        rs_say(why, n, "sky: no specification");
         return 0;
     }
     rs_sky_defaults(&p);
@@ -470,7 +461,7 @@ int rs_sky_parse(const char *spec, rs_sky_params *out, char *why, size_t n)
         return 1;
     }
     if (spec[0] != ':') {
-        say(why, n, "sky: expected ':key=value,...' after 'sky', got '%.40s'", spec);
+        rs_say(why, n, "sky: expected ':key=value,...' after 'sky', got '%.40s'", spec);
         return 0;
     }
     s = spec + 1;
@@ -480,7 +471,7 @@ int rs_sky_parse(const char *spec, rs_sky_params *out, char *why, size_t n)
         char val[64], *vend;
         double v;
         if (len == 0) {
-            say(why, n,
+            rs_say(why, n,
                 "sky: empty item in '%.60s' (keys: elevation, azimuth, turbidity, "
                 "intensity, sun)",
                 spec);
@@ -488,7 +479,7 @@ int rs_sky_parse(const char *spec, rs_sky_params *out, char *why, size_t n)
         }
         eq = memchr(s, '=', len);
         if (!eq) {
-            say(why, n, "sky: '%.*s' is not key=value", (int)(len > 40 ? 40 : len), s);
+            rs_say(why, n, "sky: '%.*s' is not key=value", (int)(len > 40 ? 40 : len), s);
             return 0;
         }
         kl = (size_t)(eq - s);
@@ -497,26 +488,26 @@ int rs_sky_parse(const char *spec, rs_sky_params *out, char *why, size_t n)
             if (strlen(sky_keys[k].name) == kl && memcmp(sky_keys[k].name, s, kl) == 0)
                 break;
         if (k == sizeof sky_keys / sizeof *sky_keys) {
-            say(why, n,
+            rs_say(why, n,
                 "sky: unknown key '%.*s' (keys: elevation, azimuth, turbidity, intensity, "
                 "sun)",
                 (int)(kl > 40 ? 40 : kl), s);
             return 0;
         }
         if (vl == 0 || vl >= sizeof val) {
-            say(why, n, "sky: %s needs a value in %s", sky_keys[k].name, sky_keys[k].range);
+            rs_say(why, n, "sky: %s needs a value in %s", sky_keys[k].name, sky_keys[k].range);
             return 0;
         }
         memcpy(val, eq + 1, vl);
         val[vl] = '\0';
         v = strtod(val, &vend);
         if (vend == val || *vend != '\0' || !isfinite(v)) {
-            say(why, n, "sky: %s='%s' is not a number (%s)", sky_keys[k].name, val,
+            rs_say(why, n, "sky: %s='%s' is not a number (%s)", sky_keys[k].name, val,
                 sky_keys[k].range);
             return 0;
         }
         if (v < sky_keys[k].lo || v > sky_keys[k].hi || (k == 4 && v != 0.0 && v != 1.0)) {
-            say(why, n, "sky: %s=%s is out of range (%s)", sky_keys[k].name, val,
+            rs_say(why, n, "sky: %s=%s is out of range (%s)", sky_keys[k].name, val,
                 sky_keys[k].range);
             return 0;
         }

@@ -1172,13 +1172,6 @@ static long long json_number(const fixture *f, const char *name, const char *key
     return at ? strtoll(at + strlen(pat), NULL, 10) : -1;
 }
 
-/* Runs args (NULL-terminated) in the test folder; it must exit with `code`. */
-static void run_expect(const fixture *f, const char *const *args, int code, proc *p)
-{
-    run(p, f->dir, DEFAULT_TIMEOUT_S, args);
-    EXPECT(p, exited_with(p, code), "expected exit status %d", code);
-}
-
 /* The images `a` and `b` of the test folder are the same bit for bit (`p`: the run to show). */
 static void expect_same_image(const proc *p, const fixture *f, const char *a, const char *b)
 {
@@ -1201,17 +1194,6 @@ static void expect_same_image(const proc *p, const fixture *f, const char *a, co
 /* Scenes as users make them: bad glTF, instance cycles, absurd transforms, a camera the file
  * lacks, a missing environment map: exit 1 (2 for a misused option), one line naming the file,
  * no image.  `raystream export` of builtin:cornell renders builtin:cornell bit for bit. */
-static void write_in(const fixture *f, const char *name, const char *text)
-{
-    char path[512];
-    FILE *fp;
-    path_in(f, name, path, sizeof path);
-    fp = fopen(path, "w");
-    assert_non_null(fp);
-    fputs(text, fp);
-    fclose(fp);
-}
-
 static void test_user_scenes(void **state)
 {
     const fixture *f = (const fixture *)*state;

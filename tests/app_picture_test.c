@@ -32,11 +32,6 @@
 
 #include "cli_harness.h"
 
-static void run_expect(const fixture *f, const char *const *args, int code, proc *p)
-{
-    run(p, f->dir, DEFAULT_TIMEOUT_S, args);
-    EXPECT(p, exited_with(p, code), "expected exit status %d", code);
-}
 
 /* Renders builtin:cornell small with `filter` and the extra args (NULL-terminated, up to 6)
  * into `out`. */
@@ -191,17 +186,6 @@ static void test_background_and_gltf_default(void **state)
     rs_free(g.rgb);
 }
 
-static void write_text(const fixture *f, const char *name, const char *text)
-{
-    char path[256];
-    FILE *fp;
-    path_in(f, name, path, sizeof path);
-    fp = fopen(path, "w");
-    assert_non_null(fp);
-    fputs(text, fp);
-    fclose(fp);
-}
-
 static void test_sky_options_checked(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -236,7 +220,7 @@ static void test_sky_options_checked(void **state)
            "two backgrounds are not refused");
     proc_free(&p);
     snprintf(text, sizeof text, scene, "");
-    write_text(f, "sky.json", text);
+    write_in(f, "sky.json", text);
     run_expect(f, json_sky, 0, &p);
     im = read_image(&p, f, "sky.exr");
     EXPECT(&p, image_mean(&im) > 0.05 && first_bad_value(&im) < 0,
@@ -244,7 +228,7 @@ static void test_sky_options_checked(void **state)
     rs_free(im.rgb);
     proc_free(&p);
     snprintf(text, sizeof text, scene, ", \"haze\": 3");
-    write_text(f, "bad.json", text);
+    write_in(f, "bad.json", text);
     run_expect(f, json_bad, 1, &p);
     EXPECT(&p, strstr(p.err.data, "bad.json") && strstr(p.err.data, "background.sky") &&
                    strstr(p.err.data, "haze"),

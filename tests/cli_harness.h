@@ -383,6 +383,25 @@ static int group_setup(void **state)
     return 0;
 }
 
+/* Runs `args` in the test folder and expects exit status `code`. */
+static void run_expect(const fixture *f, const char *const *args, int code, proc *p)
+{
+    run(p, f->dir, DEFAULT_TIMEOUT_S, args);
+    EXPECT(p, exited_with(p, code), "expected exit status %d", code);
+}
+
+/* Writes `text` to file `name` in the test folder. */
+static void write_in(const fixture *f, const char *name, const char *text)
+{
+    char path[512];
+    FILE *fp;
+    path_in(f, name, path, sizeof path);
+    fp = fopen(path, "w");
+    assert_non_null(fp);
+    fputs(text, fp);
+    fclose(fp);
+}
+
 /* ---- reading images back --------------------------------------------------------------------- */
 
 typedef struct image {
