@@ -109,6 +109,20 @@ static int try_open(const char *path, oidn_lib *o, char *why, size_t n, const ch
 }
 
 /* Loads the library (see denoise.h for the order) unless it is loaded; 1, or 0 with why[n]. */
+/* AddressSanitizer builds (gcc's __SANITIZE_ADDRESS__, clang's __has_feature): OIDN's CPU
+ * device makes TBB dlopen libtbbbind with RTLD_DEEPBIND, and ASan's runtime aborts the process
+ * on that (google/sanitizers#611), so such a build reports OIDN unavailable instead. */
+#if defined(__SANITIZE_ADDRESS__)
+#  define RS_DENOISE_UNDER_ASAN 1
+#elif defined(__has_feature)
+#  if __has_feature(address_sanitizer)
+#    define RS_DENOISE_UNDER_ASAN 1
+#  endif
+#endif
+#ifndef RS_DENOISE_UNDER_ASAN
+#  define RS_DENOISE_UNDER_ASAN 0
+#endif
+
 static int load(char *why, size_t n)
 {
     const char *env = getenv("RS_OIDN_LIBRARY");
@@ -141,6 +155,15 @@ static int load(char *why, size_t n)
                     RS_DENOISE_DEFAULT_LIBRARY);
         }
     }
+#if RS_DENOISE_UNDER_ASAN
+    if (ok == 1) { /* loaded, but its first device would abort the process */
+        dlclose(o.lib);
+        ok = 0;
+        rs_say(why, n, "Open Image Denoise cannot run in this AddressSanitizer build (its TBB "
+                       "opens libtbbbind with RTLD_DEEPBIND, which the sanitizer's runtime "
+                       "refuses); use a build without -fsanitize=address");
+    }
+#endif
     if (ok == 1) {
         g_oidn = o;
         rs_say(why, n, "%s", "");
