@@ -491,6 +491,10 @@ static int opt_background(const char *name, const char *v, rs_cli_options *o)
         o->background_rgb[2] = n == 3 ? c[2] : c[0];
         return RS_EXIT_OK;
     }
+    if (strspn(v, "0123456789.,eE+-") == strlen(v)) /* numbers, but not a colour */
+        return usage_error("--background '%s' is not a colour (a grey 0.5 or R,G,B, each a "
+                           "radiance in [0, 1e12])%s",
+                           v, "");
     o->background_kind = RS_BG_FILE;
     o->background = o->envmap = v;
     return RS_EXIT_OK;

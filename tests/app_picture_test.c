@@ -193,6 +193,8 @@ static void test_sky_options_checked(void **state)
                                           "x.png", NULL};
     static const char *const bad_value[] = {"render", "--background", "sky:turbidity=20",
                                             "-o", "x.png", NULL};
+    static const char *const not_colour[] = {"render", "--background", "-1", "-o", "x.png",
+                                             NULL};
     static const char *const twice[] = {"render", "--background", "0.5", "--envmap", "a.exr",
                                         "-o", "x.png", NULL};
     static const char *const json_sky[] = {"render", "sky.json", "--spp", "2", "-q", "-o",
@@ -214,6 +216,10 @@ static void test_sky_options_checked(void **state)
     run_expect(f, bad_value, 2, &p);
     EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "turbidity") && strstr(p.err.data, "2..10"),
            "an out-of-range turbidity is not named with its range");
+    proc_free(&p);
+    run_expect(f, not_colour, 2, &p);
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "is not a colour"),
+           "a negative grey is not refused as a colour");
     proc_free(&p);
     run_expect(f, twice, 2, &p);
     EXPECT(&p, strstr(p.err.data, "background is given twice") != NULL,
