@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -501,17 +502,20 @@ extern "C" const char *rs_image_library_version(void) { return OIIO_VERSION_STRI
 
 extern "C" int rs_image_can_downsample(void) { return 1; }
 
-// OpenImageIO's own thread pool for a resize (0: its default), but one thread under
-// ThreadSanitizer: the pool synchronises in OpenImageIO's uninstrumented code, where TSan sees
-// only the threads' reads and writes and reports them as races.
+// OpenImageIO's own thread pool for a resize (0: its default), but no pool at all under
+// ThreadSanitizer (its global "threads" attribute 1, set once): the pool synchronises in
+// OpenImageIO's uninstrumented code, where TSan sees only the workers' reads and writes and
+// reports them as races.
 #if defined(__SANITIZE_THREAD__)
-static const int k_resize_threads = 1;
+#  define RS_UNDER_TSAN 1
 #elif defined(__has_feature)
 #  if __has_feature(thread_sanitizer)
-static const int k_resize_threads = 1;
-#  else
-static const int k_resize_threads = 0;
+#    define RS_UNDER_TSAN 1
 #  endif
+#endif
+#ifdef RS_UNDER_TSAN
+static const int k_resize_threads = 1;
+static std::once_flag g_tsan_threads;
 #else
 static const int k_resize_threads = 0;
 #endif
@@ -525,6 +529,9 @@ extern "C" rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t 
     try {
         if (w == 0 || h == 0 || w2 == 0 || h2 == 0 || w2 > w || h2 > h)
             return rs_error_set(RS_ERR_ARG, "downsampling a %ux%u image to %ux%u", w, h, w2, h2);
+#ifdef RS_UNDER_TSAN
+        std::call_once(g_tsan_threads, [] { OIIO::attribute("threads", 1); });
+#endif
         OIIO::ImageSpec sspec((int)w, (int)h, 3, OIIO::TypeDesc::FLOAT);
         OIIO::ImageSpec dspec((int)w2, (int)h2, 3, OIIO::TypeDesc::FLOAT);
         // wraps the caller's memory: nothing is copied in or out but through these two buffers
