@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -502,24 +501,6 @@ extern "C" const char *rs_image_library_version(void) { return OIIO_VERSION_STRI
 
 extern "C" int rs_image_can_downsample(void) { return 1; }
 
-// OpenImageIO's own thread pool for a resize (0: its default), but no pool at all under
-// ThreadSanitizer (its global "threads" attribute 1, set once): the pool synchronises in
-// OpenImageIO's uninstrumented code, where TSan sees only the workers' reads and writes and
-// reports them as races.
-#if defined(__SANITIZE_THREAD__)
-#  define RS_UNDER_TSAN 1
-#elif defined(__has_feature)
-#  if __has_feature(thread_sanitizer)
-#    define RS_UNDER_TSAN 1
-#  endif
-#endif
-#ifdef RS_UNDER_TSAN
-static const int k_resize_threads = 1;
-static std::once_flag g_tsan_threads;
-#else
-static const int k_resize_threads = 0;
-#endif
-
 // One mip level from the one above (scenes/scene.c builds the pyramids): OpenImageIO's resize
 // with a box filter one destination pixel wide, so a 2:1 reduction is the exact mean of each 2x2
 // block (the image's mean is kept, and no texel goes negative as under lanczos3's lobes).
@@ -529,15 +510,12 @@ extern "C" rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t 
     try {
         if (w == 0 || h == 0 || w2 == 0 || h2 == 0 || w2 > w || h2 > h)
             return rs_error_set(RS_ERR_ARG, "downsampling a %ux%u image to %ux%u", w, h, w2, h2);
-#ifdef RS_UNDER_TSAN
-        std::call_once(g_tsan_threads, [] { OIIO::attribute("threads", 1); });
-#endif
         OIIO::ImageSpec sspec((int)w, (int)h, 3, OIIO::TypeDesc::FLOAT);
         OIIO::ImageSpec dspec((int)w2, (int)h2, 3, OIIO::TypeDesc::FLOAT);
         // wraps the caller's memory: nothing is copied in or out but through these two buffers
         OIIO::ImageBuf src(sspec, const_cast<float *>(rgb));
         OIIO::ImageBuf dst(dspec, out);
-        if (!OIIO::ImageBufAlgo::resize(dst, src, "box", 1.0f, OIIO::ROI(), k_resize_threads))
+        if (!OIIO::ImageBufAlgo::resize(dst, src, "box", 1.0f, OIIO::ROI(), 0))
             return rs_error_set(RS_ERR_IO, "downsampling a %ux%u image: %s", w, h,
                                 dst.geterror().c_str());
         return RS_OK;

@@ -33,7 +33,8 @@ if [ "$which" = all ] || [ "$which" = thread ]; then
     # OpenMP is compiled out of this build (core/parallel.h says why): no suppressions needed.
     # app_mpi_test: the render thread against the messaging loop of every rank; Open MPI's own
     # locks and threads are suppressed by the binary itself (app/distributed.c)
-    TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
+    # OpenImageIO's thread pool synchronises where TSan cannot see (scripts/tsan.supp)
+    TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(pwd)/scripts/tsan.supp" \
         ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli|app_mpi|app_timeline"
 fi
 if [ "$which" = all ] || [ "$which" = fuzz ]; then
