@@ -186,27 +186,37 @@ static int used_gpu(const render_run *r)
 
 /* --denoise: r->denoised from r->rgb with OIDN, guided by the first-hit albedo and normal
  * (averaged over the render's spp camera samples, so taken as clean: cleanAux; bench/
- * denoise_bench measures both), on OIDN's CUDA device when the render used a GPU.  0 after a
+ * denoise_bench measures both), on OIDN's CUDA device when the render used a GPU.  Up to
+ * RS_AOV_EMISSION_SPP spp, what the camera sees emitted is kept out of the denoiser and added
+ * back, better estimated on its edges (rs_aov_emission, rs_denoise_split): beyond that the
+ * render's own samples resolve a light's outline, and the pass would cost more.  0 after a
  * message. */
 static int denoise(render_run *r)
 {
     size_t npix = (size_t)r->st.width * r->st.height;
+    int split = r->st.spp <= RS_AOV_EMISSION_SPP;
     float *albedo = (float *)rs_alloc(npix * 3, sizeof(float));
     float *normal = (float *)rs_alloc(npix * 3, sizeof(float));
+    float *direct = split ? (float *)rs_alloc(npix * 6, sizeof(float)) : NULL;
     rs_render_consts it;
     rs_bvh_view v = rs_bvh_view_of(r->bvh);
     int ok = 0;
     r->denoised = (float *)rs_alloc(npix * 3, sizeof(float));
-    if (!albedo || !normal || !r->denoised)
+    if (!albedo || !normal || !r->denoised || (split && !direct))
         rs_error_set(RS_ERR_NOMEM, "out of memory for --denoise (%ux%u)", r->st.width,
                      r->st.height);
     else if (rs_render_constants(r->scene, &r->st, &it) == RS_OK) {
         rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, albedo, normal, NULL);
-        ok = rs_denoise(r->rgb, albedo, normal, r->st.width, r->st.height, 1, used_gpu(r),
-                        r->denoised, r->denoise_device, sizeof r->denoise_device) == RS_OK;
+        if (split)
+            rs_aov_emission(&it, &v, &r->geom, r->film->count, r->st.spp, r->threads, direct,
+                            direct + npix * 3);
+        ok = rs_denoise_split(r->rgb, direct, split ? direct + npix * 3 : NULL, albedo, normal,
+                              r->st.width, r->st.height, 1, used_gpu(r), r->denoised,
+                              r->denoise_device, sizeof r->denoise_device) == RS_OK;
     }
     rs_free(albedo);
     rs_free(normal);
+    rs_free(direct);
     if (!ok) {
         rs_free(r->denoised);
         r->denoised = NULL;

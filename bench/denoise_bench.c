@@ -106,8 +106,10 @@ static int render(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sa
 
 /* The --aov albedo,normal layers of the spp render, as app/render_outputs.c makes them. */
 static int aovs(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
-                float *albedo, float *normal)
+                float *albedo, float *normal, float *direct, float *direct_fine, size_t *refined,
+                double *seconds)
 {
+    double t0;
     rs_render_settings st;
     rs_render_consts it;
     rs_cores cores;
@@ -117,7 +119,10 @@ static int aovs(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler samp
         fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
         return 0;
     }
+    t0 = rs_now_s();
     rs_aov_render(&it, &v, &s->g, spp, threads, albedo, normal, NULL);
+    *refined = rs_aov_emission(&it, &v, &s->g, NULL, spp, threads, direct, direct_fine);
+    *seconds = rs_now_s() - t0;
     return 1;
 }
 
@@ -186,12 +191,15 @@ static void dump(const opts *o, const char *spec, const char *what, const float 
 /* The rows for one noisy image against `ref`: noisy, then the three denoises.  Returns 1, 0
  * after a failed check (printed), -1 after an error (printed). */
 static int denoise_rows(const char *spec, const char *tag, const opts *o, const float *ref,
-                        const float *noisy, const float *albedo, const float *normal, float *out,
-                        float *again)
+                        const float *noisy, const float *albedo, const float *normal,
+                        const float *direct, const float *direct_fine, float *out, float *again)
 {
-    static const char *const labels[3] = {"beauty only", "+ albedo, normal, cleanAux on",
-                                          "+ albedo, normal, cleanAux off"};
-    static const char *const files[3] = {"beauty-only", "aux-clean", "aux-noisy"};
+    static const char *const labels[5] = {"beauty only", "+ albedo, normal, cleanAux on",
+                                          "+ albedo, normal, cleanAux off",
+                                          "cleanAux, direct kept out",
+                                          "cleanAux, direct out, refined"};
+    static const char *const files[5] = {"beauty-only", "aux-clean", "aux-noisy", "split",
+                                         "split-fine"};
     size_t n = (size_t)o->size * o->size * 3;
     double clean_ratio = 0;
     char used[512] = "", what[64];
@@ -201,15 +209,16 @@ static int denoise_rows(const char *spec, const char *tag, const opts *o, const 
            "RMSE lin", "ratio", "rel RMSE", "denoise s");
     printf("  %-31s %9.5f %6.2fx %9u %10.5f %6.2fx %9.4f %9s\n", "noisy", e0.clamped, 1.0, o->spp,
            e0.linear, 1.0, e0.rel, "-");
-    for (row = 0; row < 3; ++row) {
+    for (row = 0; row < 5; ++row) {
         const float *a = row == 0 ? NULL : albedo, *nm = row == 0 ? NULL : normal;
+        const float *d = row >= 3 ? direct : NULL, *df = row == 4 ? direct_fine : direct;
         double t[MAX_RUNS], ratio;
         errs e;
         for (r = 0; r < o->runs; ++r) {
             double t0 = rs_now_s();
             rs_error_clear();
-            if (rs_denoise(noisy, a, nm, o->size, o->size, row == 1, o->gpu, r ? again : out, used,
-                           sizeof used) != RS_OK) {
+            if (rs_denoise_split(noisy, d, df, a, nm, o->size, o->size, row != 2, o->gpu,
+                                 r ? again : out, used, sizeof used) != RS_OK) {
                 fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
                 return -1;
             }
@@ -230,7 +239,7 @@ static int denoise_rows(const char *spec, const char *tag, const opts *o, const 
         printf("  %-31s %9.5f %6.2fx %9.0f %10.5f %6.2fx %9.4f %9.3f\n", labels[row], e.clamped,
                ratio, o->spp * ratio * ratio, e.linear, e0.linear / e.linear, e.rel,
                rs_bench_median(t, o->runs));
-        if (row == 1)
+        if (row == 4)
             clean_ratio = ratio;
     }
     printf("  denoised on: %s\n", used);
@@ -256,7 +265,9 @@ static int bench_scene(const char *spec, const opts *o)
     scene_ctx s;
     size_t n = (size_t)o->size * o->size * 3, k;
     float *ref = NULL, *noisy = NULL, *albedo = NULL, *normal = NULL, *out = NULL, *again = NULL;
-    double t_ref = 0, t_noisy = 0;
+    float *direct = NULL, *direct_fine = NULL;
+    double t_ref = 0, t_noisy = 0, t_aov = 0;
+    size_t refined = 0;
     int rc = -1, loaded, j;
     char what[64];
     memset(&s, 0, sizeof s);
@@ -270,7 +281,9 @@ static int bench_scene(const char *spec, const opts *o)
     normal = (float *)rs_alloc(n, sizeof(float));
     out = (float *)rs_alloc(n, sizeof(float));
     again = (float *)rs_alloc(n, sizeof(float));
-    if (!ref || !noisy || !albedo || !normal || !out || !again) {
+    direct = (float *)rs_alloc(n, sizeof(float));
+    direct_fine = (float *)rs_alloc(n, sizeof(float));
+    if (!ref || !noisy || !albedo || !normal || !out || !again || !direct || !direct_fine) {
         fprintf(stderr, "denoise_bench: out of memory\n");
         goto done;
     }
@@ -297,7 +310,8 @@ static int bench_scene(const char *spec, const opts *o)
         double floor;
         rc = -1;
         if (!render(&s, o->size, o->spp, samplers[j], o->threads, noisy, &t_noisy) ||
-            !aovs(&s, o->size, o->spp, samplers[j], o->threads, albedo, normal))
+            !aovs(&s, o->size, o->spp, samplers[j], o->threads, albedo, normal, direct,
+                  direct_fine, &refined, &t_aov))
             goto done;
         /* validate the inputs */
         rc = 0;
@@ -330,7 +344,11 @@ static int bench_scene(const char *spec, const opts *o)
             printf("; the reference's own RMSE is about %.5f (this RMSE x sqrt(%u/%u))", floor,
                    o->spp, o->ref_spp);
         printf("\n");
-        rc = denoise_rows(spec, sampler_names[j], o, ref, noisy, albedo, normal, out, again);
+        printf("  AOVs and direct emission in %.2f s, %zu pixels (%.1f%%) refined with %u samples\n",
+               t_aov, refined, 100.0 * (double)refined / ((double)o->size * o->size),
+               RS_AOV_EMISSION_SPP);
+        rc = denoise_rows(spec, sampler_names[j], o, ref, noisy, albedo, normal, direct,
+                          direct_fine, out, again);
         if (rc <= 0)
             goto done;
     }
@@ -342,6 +360,8 @@ done:
     rs_free(normal);
     rs_free(out);
     rs_free(again);
+    rs_free(direct);
+    rs_free(direct_fine);
     rs_bvh_destroy(s.bvh);
     rs_scene_destroy(s.scene);
     return rc;

@@ -353,3 +353,32 @@ rs_status rs_denoise(const float *beauty, const float *albedo, const float *norm
             version % 100);
     return RS_OK;
 }
+
+rs_status rs_denoise_split(const float *beauty, const float *direct, const float *direct_fine,
+                           const float *albedo, const float *normal, uint32_t w, uint32_t h,
+                           int clean_aux, int use_gpu, float *out, char *device_used, size_t n)
+{
+    size_t i, len;
+    float *reflected;
+    rs_status st;
+    if (!direct || !direct_fine)
+        return rs_denoise(beauty, albedo, normal, w, h, clean_aux, use_gpu, out, device_used, n);
+    if (!beauty || !out || w == 0 || h == 0 || (uint64_t)w * h > SIZE_MAX / (3 * sizeof(float)))
+        return rs_denoise(beauty, albedo, normal, w, h, clean_aux, use_gpu, out, device_used, n);
+    len = (size_t)w * h * 3;
+    reflected = (float *)malloc(len * sizeof(float));
+    if (!reflected)
+        return rs_error_set(RS_ERR_NOMEM, "denoise: out of memory (%ux%u)", (unsigned)w,
+                            (unsigned)h);
+    for (i = 0; i < len; ++i) {
+        /* what arrived by reflection; a positive filter's rounding kept from going below 0 */
+        float r = beauty[i] - direct[i];
+        reflected[i] = beauty[i] >= 0.0f && r < 0.0f ? 0.0f : r;
+    }
+    st = rs_denoise(reflected, albedo, normal, w, h, clean_aux, use_gpu, out, device_used, n);
+    if (st == RS_OK)
+        for (i = 0; i < len; ++i)
+            out[i] += direct_fine[i];
+    free(reflected);
+    return st;
+}

@@ -53,6 +53,18 @@ int rs_denoise_available(char *why, size_t n);
 rs_status rs_denoise(const float *beauty, const float *albedo, const float *normal, uint32_t w,
                      uint32_t h, int clean_aux, int use_gpu, float *out, char *device_used,
                      size_t n);
+
+/* rs_denoise with what the camera sees emitted kept out of the denoiser: beauty - direct (the
+ * light that arrived by reflection) is denoised, and direct_fine added back to the result.
+ * direct: per pixel, the share of `beauty` that its camera rays' first hits emitted (an
+ * emitter, the background), from the render's own samples; direct_fine: the same, estimated
+ * better (shading/aov.h rs_aov_emission makes both).  A light seen at 16 samples a pixel has a
+ * noisy outline 15 times brighter than the wall beside it, which the denoiser cannot tell from
+ * noise it should smooth; this way it never sees it.  direct or direct_fine NULL: rs_denoise.
+ * Same arguments and results otherwise (`out` may be `beauty`). */
+rs_status rs_denoise_split(const float *beauty, const float *direct, const float *direct_fine,
+                           const float *albedo, const float *normal, uint32_t w, uint32_t h,
+                           int clean_aux, int use_gpu, float *out, char *device_used, size_t n);
 #ifdef __cplusplus
 }
 #endif

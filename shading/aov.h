@@ -64,6 +64,41 @@ RS_HD void rs_path_aov(const rs_render_consts *it, const rs_ray *r, const rs_hit
     *albedo = rs_surface_albedo(sc, m, h->prim, h->u, h->v, x, ng, fw);
 }
 
+/* What the first vertex of a camera path adds to its pixel (rs_path_shade_at's share at bounce
+ * 0, ps being rs_path_begin_at's state: its filter weight and sign included): the emission of
+ * an emitter or a glTF emissive surface it hits, the background's radiance when it misses, zero
+ * on anything else.  The path takes these unweighted by MIS (nothing could have sampled them
+ * from the camera), so a render with max_depth 1 is exactly this, averaged (tests/
+ * shading_aov_test.c). */
+RS_HD rs_vec3 rs_path_first_emission(const rs_render_consts *it, const rs_ray *r, const rs_hit *h,
+                                     const rs_path_state *ps)
+{
+    const rs_scene *sc = it->scene;
+    rs_vec3 le = rs_v3_splat(0.0f);
+    if (h->prim == RS_NO_HIT) {
+        le = rs_env_present(sc) ? rs_env_radiance(sc, r->d) : rs_scene_background(sc, r->d);
+    } else {
+        const rs_material *m = rs_scene_prim_material(sc, h->prim);
+        if (m->type == RS_MAT_DIFFUSE_LIGHT || m->type == RS_MAT_PBR) {
+            rs_surface_point sp = rs_surface_at(sc, h->prim, r, h->t, h->u, h->v);
+            rs_material local;
+            if (m->type == RS_MAT_DIFFUSE_LIGHT) {
+                le = rs_emitted(m, sp.ng, r->d);
+            } else {
+                if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE)
+                    m = rs_surface_material(sc, m, h->prim, h->u, h->v, sp.p, sp.ng,
+                                            rs_texture_footprint(it, m, sp.p, sp.ng), &local);
+                le = m->emission;
+            }
+        }
+    }
+    return rs_path_result(rs_v3_mul(ps->throughput, le), ps->flags);
+}
+
+/* Camera samples per pixel for rs_aov_emission's better estimate where the direct emission has
+ * an edge (an emitter's outline, the horizon against a sky). */
+#define RS_AOV_EMISSION_SPP 256u
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -73,6 +108,25 @@ extern "C" {
  * may be NULL when not asked for); row-major from the top-left. */
 void rs_aov_render(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
                    uint32_t spp, int threads, float *albedo, float *normal, float *depth);
+
+/* The direct emission of a render (rs_path_first_emission: what the camera sees emitted, the
+ * background included), per pixel, two ways (w*h*3 floats each, row-major from the top-left):
+ *   e_render: the mean over the very samples the render took: samples 0 .. count[p]-1 of pixel p
+ *     (count: the film's per-pixel counts; NULL: spp for every pixel).  Up to rounding, the share
+ *     of the beauty image its camera rays' first hits added, so beauty - e_render is the light
+ *     that arrived by reflection.
+ *   e_fine: the same integral estimated better: where the direct emission has an edge within
+ *     the filter's reach (a pixel's neighbourhood of radius ceil(width/2) + 1 holds samples that
+ *     differ by more than 5% of its brightest), from RS_AOV_EMISSION_SPP Sobol camera samples of
+ *     its own (fewer when edges cover much of the image: at most 64 a pixel on average; none
+ *     when the render took as many); elsewhere e_render (a flat emitter, an empty background,
+ *     geometry that emits nothing: the render's samples already agree).
+ * Only camera rays and their first hits (with the host BVH, on `threads` host threads), as
+ * rs_aov_render.  Returns how many pixels got the better estimate.  --denoise keeps both out of
+ * the denoiser: core/denoise.h rs_denoise_split. */
+size_t rs_aov_emission(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
+                       const uint32_t *count, uint32_t spp, int threads, float *e_render,
+                       float *e_fine);
 #ifdef __cplusplus
 }
 #endif

@@ -42,6 +42,7 @@ typedef struct rt_args {
     rs_adaptive adaptive;            /* threshold > 0: rs_render_adaptive (the stream integrator) */
     rs_adaptive_stats *adaptive_out; /* its statistics, where not NULL */
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
+    const rs_filter *filter;         /* the pixel filter; NULL: box, 1 pixel */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -73,6 +74,8 @@ static inline rs_render_settings rt_settings(const rt_args *a)
     st.sampler = a->sampler;
     st.threads = 1;
     st.wave_paths = a->wave_paths;
+    if (a->filter)
+        st.filter = *a->filter;
     return st;
 }
 
