@@ -2,6 +2,7 @@
 #include "scenes/gltf_check.h"
 
 #include <cjson/cJSON.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -223,15 +224,16 @@ static rs_status check_uris(const char *path, const char *dir, const cJSON *root
     return RS_OK;
 }
 
-rs_status rs_gltf_preflight(const char *path, int glb)
+/* The file's JSON, parsed (cJSON_Delete it). */
+static rs_status parse_json(const char *path, int glb, cJSON **out)
 {
     FILE *f;
     uint64_t size;
-    char *json = NULL, dir[4096];
-    const char *slash = strrchr(path, '/');
+    char *json = NULL;
     size_t n = 0;
     cJSON *root;
     rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
+    *out = NULL;
     if (st != RS_OK)
         return st;
     st = glb ? read_glb_json(path, f, size, &json, &n) : read_text(path, f, size, &json, &n);
@@ -245,6 +247,18 @@ rs_status rs_gltf_preflight(const char *path, int glb)
         return rs_error_set(RS_ERR_ARG, "%s: its JSON cannot be read (cut short, or not JSON)",
                             path);
     }
+    *out = root;
+    return RS_OK;
+}
+
+rs_status rs_gltf_preflight(const char *path, int glb)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    cJSON *root;
+    rs_status st = parse_json(path, glb, &root);
+    if (st != RS_OK)
+        return st;
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
     st = check_nodes(path, root);
     if (st == RS_OK)
@@ -253,4 +267,158 @@ rs_status rs_gltf_preflight(const char *path, int glb)
         st = check_uris(path, dir, root, "images");
     cJSON_Delete(root);
     return st;
+}
+
+/* ---- the material extensions ---- */
+
+/* One number of an extension: 0 (absent: the default stays), 1 (read into *out), -1 (outside
+ * [lo, hi], or (lo, hi] when lo_open, or not a number: an error naming it, set). */
+static int read_number(const char *path, int mat, const char *ext, const cJSON *obj,
+                       const char *key, float lo, float hi, int lo_open, float *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    double d;
+    char want[64];
+    if (!v)
+        return 0;
+    d = cJSON_IsNumber(v) ? v->valuedouble : NAN;
+    if ((d >= lo && d <= hi) && (!lo_open || d > lo)) {
+        *out = (float)d;
+        return 1;
+    }
+    if (hi < INFINITY)
+        snprintf(want, sizeof want, "a number from %g to %g", (double)lo, (double)hi);
+    else
+        snprintf(want, sizeof want, "a number %s %g", lo_open ? "above" : "of at least",
+                 (double)lo);
+    rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%s.%s: %s (want %s)", path, mat, ext,
+                 key, cJSON_IsNumber(v) ? "out of range" : "not a number", want);
+    return -1;
+}
+
+static int read_colour(const char *path, int mat, const char *ext, const cJSON *obj,
+                       const char *key, float *out)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    int i;
+    if (!v)
+        return 0;
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 3) {
+        rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%s.%s: not 3 numbers", path, mat,
+                     ext, key);
+        return -1;
+    }
+    for (i = 0; i < 3; ++i) {
+        const cJSON *c = cJSON_GetArrayItem(v, i);
+        if (!cJSON_IsNumber(c) || !(c->valuedouble >= 0.0 && c->valuedouble <= 1.0)) {
+            rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%s.%s[%d]: not a number in "
+                         "[0, 1]", path, mat, ext, key, i);
+            return -1;
+        }
+        out[i] = (float)c->valuedouble;
+    }
+    return 1;
+}
+
+static const cJSON *ext_of(const cJSON *mat, const char *name)
+{
+    const cJSON *e = cJSON_GetObjectItemCaseSensitive(mat, "extensions");
+    const cJSON *x = cJSON_IsObject(e) ? cJSON_GetObjectItemCaseSensitive(e, name) : NULL;
+    return cJSON_IsObject(x) ? x : NULL;
+}
+
+static rs_status read_material(const char *path, int i, const cJSON *mat, rs_gltf_mat_ext *m)
+{
+    const cJSON *x;
+    *m = rs_gltf_mat_ext_default();
+    if (!cJSON_IsObject(mat))
+        return RS_OK;
+    if ((x = ext_of(mat, "KHR_materials_emissive_strength")) &&
+        read_number(path, i, "KHR_materials_emissive_strength", x, "emissiveStrength", 0.0f,
+                    INFINITY, 0, &m->emissive_strength) < 0)
+        return RS_ERR_ARG;
+    if ((x = ext_of(mat, "KHR_materials_ior"))) {
+        /* 0 is allowed by the extension (a "no refraction" flag); taken as the default */
+        float ior = m->ior;
+        if (read_number(path, i, "KHR_materials_ior", x, "ior", 0.0f, 100.0f, 0, &ior) < 0)
+            return RS_ERR_ARG;
+        if (ior != 0.0f && ior < 1.0f)
+            return rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.KHR_materials_ior.ior:"
+                                " %g is below 1", path, i, (double)ior);
+        if (ior >= 1.0f)
+            m->ior = ior;
+    }
+    if ((x = ext_of(mat, "KHR_materials_specular")) &&
+        (read_number(path, i, "KHR_materials_specular", x, "specularFactor", 0.0f, 1.0f, 0,
+                     &m->specular) < 0 ||
+         read_colour(path, i, "KHR_materials_specular", x, "specularColorFactor",
+                     m->specular_color) < 0))
+        return RS_ERR_ARG;
+    if ((x = ext_of(mat, "KHR_materials_volume")) &&
+        (read_number(path, i, "KHR_materials_volume", x, "attenuationDistance", 0.0f, INFINITY, 1,
+                     &m->attenuation_distance) < 0 ||
+         read_colour(path, i, "KHR_materials_volume", x, "attenuationColor",
+                     m->attenuation_color) < 0))
+        return RS_ERR_ARG;
+    m->unlit = ext_of(mat, "KHR_materials_unlit") != NULL;
+    return RS_OK;
+}
+
+/* Appends `name` to list[n], ", "-separated (a name that does not fit is left off, with "...") */
+static void append_name(char *list, size_t n, const char *name)
+{
+    size_t used = strlen(list);
+    if (used + strlen(name) + 8 < n)
+        snprintf(list + used, n - used, "%s%s", used ? ", " : "", name);
+    else if (used + 6 < n && !strstr(list, "..."))
+        snprintf(list + used, n - used, ", ...");
+}
+
+rs_status rs_gltf_read_ext(const char *path, int glb, rs_gltf_ext *out)
+{
+    static const char *const known[] = {RS_GLTF_READ_EXTENSIONS};
+    const cJSON *mats, *used, *u;
+    cJSON *root;
+    rs_status st;
+    int i, n;
+    memset(out, 0, sizeof *out);
+    st = parse_json(path, glb, &root);
+    if (st != RS_OK)
+        return st;
+    used = cJSON_GetObjectItemCaseSensitive(root, "extensionsUsed");
+    if (cJSON_IsArray(used))
+        for (u = used->child; u; u = u->next) {
+            size_t k;
+            int ours = 0;
+            if (!cJSON_IsString(u))
+                continue;
+            for (k = 0; k < sizeof known / sizeof *known; ++k)
+                ours |= strcmp(u->valuestring, known[k]) == 0;
+            append_name(ours ? out->used : out->unread, ours ? sizeof out->used
+                                                             : sizeof out->unread,
+                        u->valuestring);
+        }
+    mats = cJSON_GetObjectItemCaseSensitive(root, "materials");
+    n = cJSON_IsArray(mats) ? cJSON_GetArraySize(mats) : 0;
+    if (n > 0) {
+        out->materials = (rs_gltf_mat_ext *)rs_alloc((size_t)n, sizeof *out->materials);
+        if (!out->materials)
+            st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
+        else
+            out->n_materials = (uint32_t)n;
+        i = 0;
+        for (u = mats->child; u && st == RS_OK; u = u->next, ++i)
+            st = read_material(path, i, u, &out->materials[i]);
+    }
+    cJSON_Delete(root);
+    if (st != RS_OK)
+        rs_gltf_ext_free(out);
+    return st;
+}
+
+void rs_gltf_ext_free(rs_gltf_ext *e)
+{
+    rs_free(e->materials);
+    e->materials = NULL;
+    e->n_materials = 0;
 }

@@ -433,14 +433,17 @@ static rs_vec3 clamp01(rs_vec3 c)
  * its texture, metallic and roughness and their texture, emission and its texture, the normal
  * map. */
 static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
-                                  const struct aiMaterial *am, const char *mesh, const char *dir,
-                                  int strict, uint32_t *id)
+                                  const struct aiMaterial *am, const rs_gltf_mat_ext *x,
+                                  const char *mesh, const char *dir, int strict, uint32_t *id)
 {
     struct aiColor4D base = {1, 1, 1, 1}, ke = {0, 0, 0, 1};
     ai_real metal = 1, rough = 1, scale = 1, trans = 0, strength = 1;
     unsigned int one = 1;
     rs_material m;
     uint32_t t;
+    rs_gltf_mat_ext none = rs_gltf_mat_ext_default();
+    if (!x)
+        x = &none;
     aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base);
     aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &ke);
     aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &one);
@@ -455,20 +458,43 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
          * is not read */
         ai_real ior = 1.5f;
         float r = fminf(fmaxf(rough, 0), 1);
+        int c;
         one = 1;
         aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &ior, &one);
+        if (x->ior != 1.5f)
+            ior = x->ior; /* our reading of KHR_materials_ior (checked) */
         m = rs_mat_rough_dielectric(isfinite(ior) && ior > 1e-3f && ior < 100 ? ior : 1.5f, r * r);
         m.albedo = clamp01(rs_v3(base.r, base.g, base.b));
+        if (isfinite(x->attenuation_distance)) {
+            /* KHR_materials_volume: what is left after attenuationDistance is attenuationColor
+             * (a channel of 0 taken as 1e-6, so that the coefficient stays finite) */
+            float sig[3];
+            for (c = 0; c < 3; ++c)
+                sig[c] = (float)(-log(fmax((double)x->attenuation_color[c], 1e-6)) /
+                                 x->attenuation_distance);
+            m.sigma_a = rs_v3(sig[0], sig[1], sig[2]);
+        }
         return rs_scene_add_material(s, &m, id);
     }
     m = rs_mat_pbr(clamp01(rs_v3(base.r, base.g, base.b)), fminf(fmaxf(metal, 0), 1),
                    fminf(fmaxf(rough, 0), 1));
     m.emission = rs_v3(fmaxf(ke.r, 0), fmaxf(ke.g, 0), fmaxf(ke.b, 0));
     one = 1;
-    if (aiGetMaterialFloatArray(am, AI_MATKEY_EMISSIVE_INTENSITY, &strength, &one) ==
-            aiReturn_SUCCESS &&
-        strength >= 0 && isfinite(strength))
+    if (x->emissive_strength != 1.0f)
+        m.emission = rs_v3_scale(m.emission, x->emissive_strength); /* ours (Assimp 5.2 drops it) */
+    else if (aiGetMaterialFloatArray(am, AI_MATKEY_EMISSIVE_INTENSITY, &strength, &one) ==
+                 aiReturn_SUCCESS &&
+             strength >= 0 && isfinite(strength))
         m.emission = rs_v3_scale(m.emission, strength); /* KHR_materials_emissive_strength */
+    {
+        /* the dielectric layer: F0 from KHR_materials_ior and KHR_materials_specular's colour
+         * (in double, so that the defaults give exactly rs_mat_pbr's 0.04f), its weight */
+        double f = ((double)x->ior - 1.0) / ((double)x->ior + 1.0);
+        m.specular = rs_v3((float)fmin(f * f * x->specular_color[0], 1.0),
+                           (float)fmin(f * f * x->specular_color[1], 1.0),
+                           (float)fmin(f * f * x->specular_color[2], 1.0));
+        m.spec_weight = x->specular;
+    }
     if (!isfinite(m.emission.x + m.emission.y + m.emission.z))
         return rs_error_set(RS_ERR_ARG, "%s: a material's emissive factor is not finite", mesh);
     if (load_texture(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_COLOR, strict, &t) !=
@@ -520,6 +546,16 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         return RS_ERR_ARG;
     if (m.emission_tex != RS_NO_TEXTURE && rs_v3_is_zero(m.emission))
         m.emission_tex = RS_NO_TEXTURE; /* a texture times a zero factor */
+    if (x->unlit) {
+        /* KHR_materials_unlit: the base colour (its texture's too), emitted; nothing reflected */
+        m.emission = m.albedo;
+        m.emission_tex = m.albedo_tex;
+        m.albedo = rs_v3_splat(0.0f);
+        m.albedo_tex = RS_NO_TEXTURE;
+        m.metallic = 0.0f;
+        m.spec_weight = 0.0f;
+        m.mr_tex = m.normal_tex = RS_NO_TEXTURE;
+    }
     one = 1;
     if (m.normal_tex != RS_NO_TEXTURE &&
         aiGetMaterialFloatArray(am, "$tex.scale", aiTextureType_NORMALS, 0, &scale, &one) ==
@@ -533,15 +569,15 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
  * emitter if it emits, Phong if it has a specular colour and shininess, Lambertian otherwise; a
  * diffuse texture file becomes an image texture. */
 static rs_status add_file_material(rs_scene *s, const struct aiScene *as,
-                                   const struct aiMaterial *am, const char *mesh, const char *dir,
-                                   int strict, uint32_t *id)
+                                   const struct aiMaterial *am, const rs_gltf_mat_ext *x,
+                                   const char *mesh, const char *dir, int strict, uint32_t *id)
 {
     struct aiColor4D kd = {0.7f, 0.7f, 0.7f, 1}, ks = {0, 0, 0, 1}, ke = {0, 0, 0, 1};
     ai_real shininess = 0, metal;
     unsigned int max = 1;
     rs_material m;
     if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &max) == aiReturn_SUCCESS)
-        return add_pbr_material(s, as, am, mesh, dir, strict, id);
+        return add_pbr_material(s, as, am, x, mesh, dir, strict, id);
     max = 1;
     aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &kd);
     aiGetMaterialColor(am, AI_MATKEY_COLOR_SPECULAR, &ks);
@@ -918,6 +954,27 @@ static rs_status import_file(const char *path, unsigned int flags, const struct 
     return RS_OK;
 }
 
+/* The extensions of `path` when it is a glTF file (none otherwise), with the one warning line
+ * naming those the file uses that raystream does not read. */
+static rs_status file_extensions(const char *path, rs_gltf_ext *e)
+{
+    rs_status st = RS_OK;
+    memset(e, 0, sizeof *e);
+    if (ext_is(path, "glb") || ext_is(path, "gltf"))
+        st = rs_gltf_read_ext(path, ext_is(path, "glb"), e);
+    if (st == RS_OK && e->unread[0])
+        fprintf(stderr, "raystream: warning: %s uses %s, which raystream does not read: rendered "
+                        "without %s\n",
+                path, e->unread, strchr(e->unread, ',') ? "them" : "it");
+    return st;
+}
+
+/* Material k's extensions (NULL: none, or not a glTF file). */
+static const rs_gltf_mat_ext *material_extensions(const rs_gltf_ext *e, uint32_t k)
+{
+    return k < e->n_materials ? &e->materials[k] : NULL;
+}
+
 rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o,
                             rs_mesh_info *info)
 {
@@ -964,12 +1021,17 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     xf = fit_translate(o, &xf, raw);
 
     if (o->material == RS_MESH_FILE_MATERIALS) {
+        rs_gltf_ext ext;
         mat_of = (uint32_t *)rs_alloc(as->mNumMaterials ? as->mNumMaterials : 1, sizeof *mat_of);
         if (!mat_of) {
             release_scene(as);
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
         }
         st = check_overrides(as, path, o);
+        if (st == RS_OK)
+            st = file_extensions(path, &ext);
+        else
+            memset(&ext, 0, sizeof ext);
         for (k = 0; k < as->mNumMaterials && st == RS_OK; ++k) {
             int ov = override_of(as->mMaterials[k], o), used = 0;
             for (mi = 0; mi < as->mNumMeshes && !used; ++mi)
@@ -981,10 +1043,11 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
                 mat_of[k] = o->override_ids[ov];
                 continue;
             }
-            st = add_file_material(s, as, as->mMaterials[k], path, dir, o->strict_textures,
-                                   &mat_of[k]);
+            st = add_file_material(s, as, as->mMaterials[k], material_extensions(&ext, k), path,
+                                   dir, o->strict_textures, &mat_of[k]);
             info->materials++;
         }
+        rs_gltf_ext_free(&ext);
         if (st == RS_OK && as->mNumMaterials == 0) {
             rs_material def = rs_mat_lambertian(rs_v3_splat(0.7f));
             st = rs_scene_add_material(s, &def, &mat_of[0]);
@@ -1032,6 +1095,7 @@ typedef struct gltf_ctx {
     const struct aiCamera *camera;
     rs_xform camera_xf;
     uint32_t lights;
+    rs_gltf_ext ext; /* the file's extensions (scenes/gltf_check.h) */
 } gltf_ctx;
 
 /* Assimp's row-major 4x4 (a1..a4 the first row) as an affine transform. */
@@ -1199,6 +1263,8 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
         if (!g.mat_of)
             st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
     }
+    if (st == RS_OK)
+        st = file_extensions(path, &g.ext);
     for (k = 0; k < g.as->mNumMaterials && st == RS_OK; ++k) {
         uint32_t mi;
         int used = 0;
@@ -1206,7 +1272,8 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
             used = g.as->mMeshes[mi]->mMaterialIndex == k;
         if (!used)
             continue;
-        st = add_file_material(g.s, g.as, g.as->mMaterials[k], path, dir, 1, &g.mat_of[k]);
+        st = add_file_material(g.s, g.as, g.as->mMaterials[k], material_extensions(&g.ext, k),
+                               path, dir, 1, &g.mat_of[k]);
         if (st == RS_OK) {
             g.info.materials++;
             emissive += !rs_v3_is_zero(g.s->materials[g.mat_of[k]].emission);
@@ -1276,12 +1343,14 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
     if (st == RS_OK && opts && opts->log) {
         char why[160];
         fprintf(opts->log,
-                "raystream: %s: %u triangles, %u materials, %u lights, camera %s%s%s%s%s\n", path,
-                g.info.triangles, g.info.materials, g.lights,
+                "raystream: %s: %u triangles, %u materials, %u lights, camera %s%s%s%s%s%s%s\n",
+                path, g.info.triangles, g.info.materials, g.lights,
                 g.camera ? "'" : "(framing the model)", g.camera ? g.camera->mName.data : "",
                 g.camera ? "'" : "", g.info.dropped ? "; " : "",
-                rs_mesh_dropped_text(&g.info, why, sizeof why));
+                rs_mesh_dropped_text(&g.info, why, sizeof why),
+                g.ext.used[0] ? "; extensions: " : "", g.ext.used);
     }
+    rs_gltf_ext_free(&g.ext);
     rs_free(g.mat_of);
     release_scene(g.as);
     if (st != RS_OK) {

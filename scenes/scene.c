@@ -923,6 +923,8 @@ rs_material rs_mat_pbr(rs_vec3 base, float metallic, float roughness)
     rs_material m = mat_base(RS_MAT_PBR, base);
     m.metallic = metallic;
     m.alpha = roughness * roughness < RS_GGX_DELTA_ALPHA ? RS_GGX_DELTA_ALPHA : roughness * roughness;
+    m.specular = rs_v3_splat(0.04f); /* glTF's default: ior 1.5 */
+    m.spec_weight = 1.0f;
     return m;
 }
 

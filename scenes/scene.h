@@ -57,7 +57,9 @@ typedef struct rs_material {
     uint32_t flags;      /* RS_MAT_* */
     rs_vec3 albedo;      /* reflectance in [0, 1] per channel (used when albedo_tex is none) */
     uint32_t albedo_tex; /* texture index for the albedo, or RS_NO_TEXTURE */
-    rs_vec3 specular;    /* Phong ks */
+    rs_vec3 specular;    /* Phong ks; pbr: its dielectric layer's Fresnel F0 colour, glTF's
+                            ((ior - 1) / (ior + 1))^2 times KHR_materials_specular's colour,
+                            held to 1 (0.04 by default) */
     rs_vec3 emission;    /* emitted radiance, for lights */
     float roughness;     /* Disney diffuse, in [0, 1] */
     float exponent;      /* Phong n >= 0 */
@@ -76,6 +78,10 @@ typedef struct rs_material {
     float normal_scale;  /* glTF's normalTexture.scale: x and y of the map are multiplied by it */
     uint32_t alpha_mask; /* 1 + index of an alpha cut-out (rs_scene_add_mask) that rays pass
                             through where it is 0; 0: opaque.  Triangles only */
+    float spec_weight;   /* pbr: KHR_materials_specular's specularFactor, the dielectric
+                            layer's strength (1 by default) */
+    rs_vec3 sigma_a;     /* transmitting materials: the absorption coefficient inside, per unit
+                            length (KHR_materials_volume: -ln(colour) / distance); 0: clear */
 } rs_material;
 
 /* Whether a surface of material m is a light that light sampling picks: an emitter, or a glTF

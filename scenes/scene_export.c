@@ -86,6 +86,9 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         }
         break;
     case RS_MAT_ROUGH_DIELECTRIC:
+        if (!rs_v3_is_zero(m->sigma_a))
+            return rs_error_set(RS_ERR_ARG, "material %u: a glTF volume's absorption has no place "
+                                            "in a scene file", i);
         fputs("\"rough_dielectric\", \"ior\": ", f);
         num(f, m->ior);
         fputs(", \"roughness\": ", f);
@@ -94,10 +97,13 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         break;
     case RS_MAT_PBR:
         if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
-            m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission) || m->alpha_mask)
+            m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission) || m->alpha_mask ||
+            m->spec_weight != 1.0f || m->specular.x != 0.04f || m->specular.y != 0.04f ||
+            m->specular.z != 0.04f)
             return rs_error_set(RS_ERR_ARG, "material %u: a pbr material's metallic-roughness, "
-                                            "emissive and normal textures and alpha cut-outs "
-                                            "have no place in a scene file", i);
+                                            "emissive and normal textures, alpha cut-outs and "
+                                            "glTF specular layer have no place in a scene file",
+                                i);
         fputs("\"pbr\", \"metallic\": ", f);
         num(f, m->metallic);
         fputs(", \"roughness\": ", f);

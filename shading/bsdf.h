@@ -77,11 +77,19 @@ RS_HD rs_vec3 rs_conductor_fresnel(const rs_material *m, rs_vec3 albedo, float c
                                         : rs_fresnel_conductor(c, m->eta, m->k);
 }
 
+/* The pbr material's dielectric layer's Fresnel at cos c: Schlick's from its F0 colour, times
+ * its weight (glTF's KHR_materials_specular: F0 = ((ior - 1) / (ior + 1))^2 specularColor held
+ * to 1, weight specularFactor; the base's diffuse gets 1 - the largest component). */
+RS_HD rs_vec3 rs_pbr_dielectric_fresnel(const rs_material *m, float c)
+{
+    return rs_v3_scale(rs_fresnel_schlick3(c, m->specular), m->spec_weight);
+}
+
 /* The probability that pbr sampling picks the specular lobe: its estimated share of the
  * reflected light at wo (Fresnel at cos_o for both layers). */
 RS_HD float rs_pbr_spec_prob(const rs_material *m, rs_vec3 base, float co)
 {
-    float fd = rs_fresnel_schlick3(co, rs_v3_splat(0.04f)).x;
+    float fd = rs_v3_max_comp(rs_pbr_dielectric_fresnel(m, co));
     float ws = (1.0f - m->metallic) * fd +
                m->metallic * rs_luminance(rs_fresnel_schlick3(co, base));
     float wd = (1.0f - m->metallic) * (1.0f - fd) * rs_luminance(base);
@@ -206,9 +214,10 @@ RS_HD_COLD rs_vec3 rs_bsdf_eval_ggx(const rs_material *m, rs_vec3 albedo, rs_vec
     if (m->type == RS_MAT_CONDUCTOR)
         return rs_v3_scale(rs_conductor_fresnel(m, albedo, wo_h), spec);
     {
-        float fd = rs_fresnel_schlick3(wo_h, rs_v3_splat(0.04f)).x;
+        rs_vec3 fr = rs_pbr_dielectric_fresnel(m, wo_h);
+        float fd = rs_v3_max_comp(fr);
         rs_vec3 diel =
-            rs_v3_add(rs_v3_splat(fd * spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
+            rs_v3_add(rs_v3_scale(fr, spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
         rs_vec3 metal = rs_v3_scale(rs_fresnel_schlick3(wo_h, albedo), spec);
         return rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
     }

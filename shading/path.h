@@ -606,6 +606,12 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
         rs_shade_emitter(it, &r, h->t, v.prim, v.m, v.ng, beta, ps);
         return 0; /* emitters reflect nothing */
     }
+    if (!rs_v3_is_zero(v.m->sigma_a) && rs_v3_dot(v.ng, r.d) > 0.0f) {
+        /* the segment ran inside an absorbing object (KHR_materials_volume): Beer-Lambert */
+        float len = h->t * rs_v3_length(r.d);
+        beta = rs_v3_mul(beta, rs_v3(expf(-v.m->sigma_a.x * len), expf(-v.m->sigma_a.y * len),
+                                     expf(-v.m->sigma_a.z * len)));
+    }
     fw = rs_texture_footprint(it, v.m, v.x, v.ng); /* 0 without textures */
     if (v.m->type >= RS_MAT_CONDUCTOR) {
         if (v.m->mr_tex != RS_NO_TEXTURE || v.m->emission_tex != RS_NO_TEXTURE)

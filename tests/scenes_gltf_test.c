@@ -14,6 +14,9 @@
  *     textured model glow uniformly white);
  *   - alpha cut-outs (MASK by the texture's alpha times the factor's, OPAQUE ignoring it) let
  *     an emitter behind show through, the same on every traversal;
+ *   - the material extensions read from the JSON (emissive strength, ior, specular, unlit,
+ *     volume), the census of used and unread extensions, bad values named; a slab of absorbing
+ *     glass in the image (Beer-Lambert, exactly);
  *   - bad files: a missing texture, a missing buffer, cut JSON: one line naming the file, no
  *     scene. */
 #include <setjmp.h>
@@ -32,6 +35,7 @@
 #include "core/image_io.h"
 #include "render_util.h"
 #include "scenes/gltf.h"
+#include "scenes/gltf_check.h"
 
 static char g_dir[64];
 
@@ -466,6 +470,171 @@ static void test_transmission(void **state)
     rs_scene_destroy(s);
 }
 
+/* One quad with one material whose "extensions" object is `ext`, the file listing `used`. */
+static rs_scene *load_ext(const char *name, const char *used, const char *pbr, const char *ext)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+        "\"extensionsUsed\":[%s],\"nodes\":[{\"mesh\":0}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{%s},\"emissiveFactor\":[0.5,0.25,1],"
+        "\"extensions\":{%s}}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+    char buf[8192], views[4] = "";
+    snprintf(buf, sizeof buf, k, used, pbr, ext, views);
+    write_text(name, buf);
+    return load(name, NULL);
+}
+
+/* The material extensions read from the file's JSON (scenes/gltf_check.h): emissive strength,
+ * ior and specular into the dielectric layer's F0 and weight, unlit, volume; the defaults give
+ * exactly rs_mat_pbr's 0.04 and 1; the census of what the file uses; bad values named. */
+static void test_material_extensions(void **state)
+{
+    rs_scene *s;
+    const rs_material *m;
+    rs_gltf_ext e;
+    char p[256];
+    double f0;
+    (void)state;
+    write_full_files();
+    /* none: the defaults, bit for bit */
+    s = load_ext("plain.gltf", "", "\"baseColorFactor\":[0.2,0.4,0.6,1]", "");
+    m = &s->materials[s->tri_mat[0]];
+    assert_true(m->specular.x == 0.04f && m->specular.y == 0.04f && m->specular.z == 0.04f);
+    assert_true(m->spec_weight == 1.0f);
+    expect_v3(m->emission, 0.5f, 0.25f, 1.0f, 0.0f);
+    rs_scene_destroy(s);
+    /* emissive strength (Assimp 5.2 drops it), ior 2 and a coloured specular at weight .6 */
+    s = load_ext("spec.gltf",
+                 "\"KHR_materials_emissive_strength\",\"KHR_materials_ior\","
+                 "\"KHR_materials_specular\"",
+                 "\"baseColorFactor\":[0.2,0.4,0.6,1],\"metallicFactor\":0",
+                 "\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4},"
+                 "\"KHR_materials_ior\":{\"ior\":2},"
+                 "\"KHR_materials_specular\":{\"specularFactor\":0.6,"
+                 "\"specularColorFactor\":[1,0.5,0.2]}");
+    m = &s->materials[s->tri_mat[0]];
+    assert_int_equal(m->type, RS_MAT_PBR);
+    expect_v3(m->emission, 2.0f, 1.0f, 4.0f, 0.0f);
+    f0 = (1.0 / 3.0) * (1.0 / 3.0);
+    expect_v3(m->specular, (float)f0, (float)(f0 * 0.5), (float)(f0 * 0.2), 1e-7f);
+    assert_true(m->spec_weight == 0.6f);
+    rs_scene_destroy(s);
+    /* unlit: the base colour emitted, nothing reflected */
+    s = load_ext("unlit.gltf", "\"KHR_materials_unlit\"", "\"baseColorFactor\":[0.2,0.4,0.6,1]",
+                 "\"KHR_materials_unlit\":{}");
+    m = &s->materials[s->tri_mat[0]];
+    expect_v3(m->emission, 0.2f, 0.4f, 0.6f, 1e-7f);
+    expect_v3(m->albedo, 0.0f, 0.0f, 0.0f, 0.0f);
+    assert_true(m->spec_weight == 0.0f && m->metallic == 0.0f);
+    rs_scene_destroy(s);
+    /* volume on a transmitting material: sigma_a = -ln(colour) / distance */
+    s = load_ext("volume.gltf",
+                 "\"KHR_materials_transmission\",\"KHR_materials_volume\",\"KHR_materials_ior\"",
+                 "\"metallicFactor\":0,\"roughnessFactor\":0",
+                 "\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+                 "\"KHR_materials_ior\":{\"ior\":1.25},"
+                 "\"KHR_materials_volume\":{\"thicknessFactor\":1,\"attenuationDistance\":2,"
+                 "\"attenuationColor\":[0.5,0.25,1]}");
+    m = &s->materials[s->tri_mat[0]];
+    assert_int_equal(m->type, RS_MAT_ROUGH_DIELECTRIC);
+    assert_true(m->ior == 1.25f);
+    expect_v3(m->sigma_a, (float)(log(2.0) / 2), (float)(log(4.0) / 2), 0.0f, 1e-7f);
+    rs_scene_destroy(s);
+    /* the census: what raystream reads, what it does not */
+    s = load_ext("census.gltf", "\"KHR_materials_clearcoat\",\"KHR_materials_ior\","
+                 "\"EXT_texture_webp\"", "", "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1}");
+    rs_scene_destroy(s);
+    path_of(p, sizeof p, "census.gltf");
+    assert_int_equal(rs_gltf_read_ext(p, 0, &e), RS_OK);
+    assert_string_equal(e.used, "KHR_materials_ior");
+    assert_string_equal(e.unread, "KHR_materials_clearcoat, EXT_texture_webp");
+    assert_int_equal(e.n_materials, 1);
+    rs_gltf_ext_free(&e);
+}
+
+static void expect_bad(const char *name, const char *text, const char *a, const char *b);
+
+/* Bad extension values: one line naming the file, the material and the field. */
+static void test_material_extensions_bad(void **state)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+        "\"nodes\":[{\"mesh\":0}],\"materials\":[{\"extensions\":{%s}}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+    static const char *const cases[][3] = {
+        {"\"KHR_materials_ior\":{\"ior\":0.5}", "KHR_materials_ior.ior", "below 1"},
+        {"\"KHR_materials_specular\":{\"specularColorFactor\":[2,0,0]}", "specularColorFactor[0]",
+         "[0, 1]"},
+        {"\"KHR_materials_volume\":{\"attenuationDistance\":0}", "attenuationDistance",
+         "above 0"},
+        {"\"KHR_materials_emissive_strength\":{\"emissiveStrength\":\"x\"}", "emissiveStrength",
+         "not a number"},
+    };
+    char buf[8192];
+    size_t i;
+    (void)state;
+    write_full_files();
+    for (i = 0; i < sizeof cases / sizeof *cases; ++i) {
+        char views[4] = "", ext[256];
+        snprintf(ext, sizeof ext, "%s", cases[i][0]);
+        snprintf(buf, sizeof buf, k, ext, views);
+        expect_bad("badext.gltf", buf, cases[i][1], cases[i][2]);
+    }
+}
+
+/* KHR_materials_volume in the image: a slab of clear glass (ior 1: no refraction, no
+ * reflection) 2 units thick, two quads facing out, in front of the white sky a glTF file
+ * without lights gets.  Each camera ray crosses it straight: the pixel is exp(-sigma_a 2) =
+ * the attenuation colour, exactly (no noise). */
+static void test_volume_renders(void **state)
+{
+    static const char *k =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],"
+        "\"extensionsUsed\":[\"KHR_materials_transmission\",\"KHR_materials_volume\","
+        "\"KHR_materials_ior\"],"
+        "\"nodes\":[{\"mesh\":0,\"scale\":[3,3,1],\"translation\":[0,0,1]},"
+        "{\"mesh\":0,\"scale\":[3,3,1],\"translation\":[0,0,-1],\"rotation\":[0,1,0,0]},"
+        "{\"camera\":0,\"translation\":[0,0,6]}],"
+        "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.3,\"aspectRatio\":1,"
+        "\"znear\":0.1}}],"
+        "\"materials\":[{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0},"
+        "\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+        "\"KHR_materials_ior\":{\"ior\":1},\"KHR_materials_volume\":{\"attenuationDistance\":2,"
+        "\"attenuationColor\":[0.5,0.25,0.8]}}}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
+    char buf[8192], views[4] = "";
+    rs_scene *s;
+    rt_args a = rt_defaults("slab", 16, 4);
+    float *rgb;
+    size_t i;
+    (void)state;
+    write_full_files();
+    snprintf(buf, sizeof buf, k, views);
+    write_text("slab.gltf", buf);
+    s = load("slab.gltf", NULL);
+    a.width = a.height = 16;
+    rgb = rt_render_scene(s, &a, NULL);
+    assert_non_null(rgb);
+    for (i = 0; i < 16 * 16; ++i) {
+        uint32_t x = (uint32_t)i % 16, y = (uint32_t)i / 16;
+        int c;
+        for (c = 0; c < 3; ++c) {
+            /* a ray at angle t to the axis crosses 2 / cos t: at most 1.03x (yfov 0.3) */
+            double want = c == 0 ? 0.5 : c == 1 ? 0.25 : 0.8, v = rgb[3 * i + c];
+            assert_true(v <= want + 1e-5 && v >= pow(want, 1.03) - 1e-5);
+            if ((x == 7 || x == 8) && (y == 7 || y == 8))
+                assert_true(fabs(v - want) < 2e-3 * want); /* the axis: 2 units exactly */
+        }
+    }
+    printf("slab of glass, attenuation colour (.5, .25, .8) over 2: centre (%.4f, %.4f, %.4f), "
+           "corner (%.4f, %.4f, %.4f)\n",
+           rgb[3 * (7 * 16 + 7)], rgb[3 * (7 * 16 + 7) + 1], rgb[3 * (7 * 16 + 7) + 2], rgb[0],
+           rgb[1], rgb[2]);
+    free(rgb);
+    rs_scene_destroy(s);
+}
+
 /* A .glb: the JSON chunk and a binary chunk holding the buffer and a PNG texture. */
 static void test_glb_embedded(void **state)
 {
@@ -726,6 +895,9 @@ int main(void)
         cmocka_unit_test(test_emissive_texture_renders),
         cmocka_unit_test(test_glb_embedded),
         cmocka_unit_test(test_transmission),
+        cmocka_unit_test(test_material_extensions),
+        cmocka_unit_test(test_material_extensions_bad),
+        cmocka_unit_test(test_volume_renders),
         cmocka_unit_test(test_alpha_cutout),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_hostile_files),

@@ -598,6 +598,15 @@ static void test_albedo_ggx(void **state)
     check_albedo("pbr white metal r .5", &m, 1.0, -1.0, -1.0, 905);
     m = rs_mat_pbr(rs_v3_splat(0.5f), 0.5f, 0.3f);
     check_albedo("pbr grey metallic .5 r .3", &m, 1.0, -1.0, -1.0, 906);
+    /* KHR_materials_specular: the strongest F0 (ior 3, 0.25) at full weight; and the layer
+     * switched off (weight 0): then exactly the Lambertian base, whose albedo at any cos_o is
+     * the base colour (0.8) */
+    m = rs_mat_pbr(rs_v3_splat(1.0f), 0.0f, 0.5f);
+    m.specular = rs_v3_splat(0.25f);
+    check_albedo("pbr white, F0 .25 r .5", &m, 1.15, -1.0, -1.0, 907);
+    m = rs_mat_pbr(rs_v3_splat(0.8f), 0.0f, 0.5f);
+    m.spec_weight = 0.0f;
+    check_albedo("pbr .8, specular weight 0", &m, 0.81, 0.8, -1.0, 908);
 }
 
 /* The rough dielectric, from outside and inside: reflection and transmission together keep at

@@ -1331,6 +1331,14 @@ static void test_bsdf_pbr(void **state)
     /* (seed 0x5EED00C3 gives p = 0.0068 here and for the same conductor_f0: one of the 1% of
      * seeds a correct sampler fails at alpha = 0.01; seeds ...D3 and ...E3 give 0.22 and 0.62) */
     fails += run_bsdf("pbr metal r .2, n1", metal, N1, 30.0, 0.0, 0x5EED00D3u);
+    {
+        /* KHR_materials_specular and _ior: a coloured F0 of ior 2 (1/9 x (1, .5, .2)), weight
+         * .6: the lobe pick follows the largest component */
+        rs_material spec = rs_mat_pbr(rs_v3(0.2f, 0.5f, 0.7f), 0.0f, 0.5f);
+        spec.specular = rs_v3(1.0f / 9.0f, 0.5f / 9.0f, 0.2f / 9.0f);
+        spec.spec_weight = 0.6f;
+        fails += run_bsdf("pbr specular layer r .5, n1", spec, N1, 60.0, 0.0, 0x5EED00C4u);
+    }
     assert_int_equal(fails, 0);
 }
 
