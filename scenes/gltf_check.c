@@ -360,6 +360,12 @@ static rs_status read_material(const char *path, int i, const cJSON *mat, rs_glt
          read_colour(path, i, "KHR_materials_volume", x, "attenuationColor",
                      m->attenuation_color) < 0))
         return RS_ERR_ARG;
+    if ((x = ext_of(mat, "KHR_materials_clearcoat")) &&
+        (read_number(path, i, "KHR_materials_clearcoat", x, "clearcoatFactor", 0.0f, 1.0f, 0,
+                     &m->clearcoat) < 0 ||
+         read_number(path, i, "KHR_materials_clearcoat", x, "clearcoatRoughnessFactor", 0.0f,
+                     1.0f, 0, &m->clearcoat_roughness) < 0))
+        return RS_ERR_ARG;
     m->unlit = ext_of(mat, "KHR_materials_unlit") != NULL;
     return RS_OK;
 }

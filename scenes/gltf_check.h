@@ -26,11 +26,11 @@ rs_status rs_gltf_preflight(const char *path, int glb);
 #define RS_GLTF_READ_EXTENSIONS                                                                   \
     "KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_transmission",                 \
         "KHR_materials_ior", "KHR_materials_emissive_strength", "KHR_materials_volume",           \
-        "KHR_materials_specular", "KHR_materials_unlit"
+        "KHR_materials_specular", "KHR_materials_unlit", "KHR_materials_clearcoat"
 
 /* What raystream takes from a material's extensions through the file's own JSON (Assimp 5.2
  * drops emissive strength, unlit and the specular colour; reading them all here keeps one
- * place).  Each field holds the extension's default where the material lacks it. */
+ * place; the extensions' textures are not read).  Each field holds the extension's default where the material lacks it. */
 typedef struct rs_gltf_mat_ext {
     float emissive_strength;    /* KHR_materials_emissive_strength: 1 */
     float ior;                  /* KHR_materials_ior: 1.5 */
@@ -39,6 +39,8 @@ typedef struct rs_gltf_mat_ext {
     float attenuation_distance; /* KHR_materials_volume: infinity (none) */
     float attenuation_color[3]; /* 1, 1, 1 */
     int unlit;                  /* KHR_materials_unlit */
+    float clearcoat;            /* KHR_materials_clearcoat clearcoatFactor: 0 */
+    float clearcoat_roughness;  /* clearcoatRoughnessFactor: 0 */
 } rs_gltf_mat_ext;
 
 typedef struct rs_gltf_ext {
@@ -66,6 +68,8 @@ static inline rs_gltf_mat_ext rs_gltf_mat_ext_default(void)
     m.attenuation_distance = INFINITY;
     m.attenuation_color[0] = m.attenuation_color[1] = m.attenuation_color[2] = 1.0f;
     m.unlit = 0;
+    m.clearcoat = 0.0f;
+    m.clearcoat_roughness = 0.0f;
     return m;
 }
 

@@ -495,6 +495,11 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
                            (float)fmin(f * f * x->specular_color[2], 1.0));
         m.spec_weight = x->specular;
     }
+    if (x->clearcoat > 0.0f) { /* KHR_materials_clearcoat (its textures and normal not read) */
+        float a = x->clearcoat_roughness * x->clearcoat_roughness;
+        m.coat = x->clearcoat;
+        m.coat_alpha = a < RS_GGX_DELTA_ALPHA ? RS_GGX_DELTA_ALPHA : a;
+    }
     if (!isfinite(m.emission.x + m.emission.y + m.emission.z))
         return rs_error_set(RS_ERR_ARG, "%s: a material's emissive factor is not finite", mesh);
     if (load_texture(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_COLOR, strict, &t) !=
@@ -554,6 +559,7 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         m.albedo_tex = RS_NO_TEXTURE;
         m.metallic = 0.0f;
         m.spec_weight = 0.0f;
+        m.coat = 0.0f;
         m.mr_tex = m.normal_tex = RS_NO_TEXTURE;
     }
     one = 1;

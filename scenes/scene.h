@@ -82,6 +82,9 @@ typedef struct rs_material {
                             layer's strength (1 by default) */
     rs_vec3 sigma_a;     /* transmitting materials: the absorption coefficient inside, per unit
                             length (KHR_materials_volume: -ln(colour) / distance); 0: clear */
+    float coat;          /* pbr: KHR_materials_clearcoat's clearcoatFactor, in [0, 1]; 0: none */
+    float coat_alpha;    /* pbr: the coat's GGX alpha (clearcoatRoughnessFactor^2, at least
+                            RS_GGX_DELTA_ALPHA) */
 } rs_material;
 
 /* Whether a surface of material m is a light that light sampling picks: an emitter, or a glTF

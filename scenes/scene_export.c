@@ -99,10 +99,11 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
             m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission) || m->alpha_mask ||
             m->spec_weight != 1.0f || m->specular.x != 0.04f || m->specular.y != 0.04f ||
-            m->specular.z != 0.04f)
+            m->specular.z != 0.04f || m->coat > 0.0f)
             return rs_error_set(RS_ERR_ARG, "material %u: a pbr material's metallic-roughness, "
                                             "emissive and normal textures, alpha cut-outs and "
-                                            "glTF specular layer have no place in a scene file",
+                                            "glTF specular and clearcoat layers have no place "
+                                            "in a scene file",
                                 i);
         fputs("\"pbr\", \"metallic\": ", f);
         num(f, m->metallic);

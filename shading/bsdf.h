@@ -35,7 +35,12 @@
  *                     GGX term D G2 / (4 cos_o cos_i), Fd Schlick's with F0 = 0.04, Fm Schlick's
  *                     with F0 = base, both at wo.h (the glTF 2.0 specification's BRDF)
  *                                                            sampled: visible normals or cosine,
- *                     picked by the lobes' estimated weights at wo (rs_pbr_spec_prob)
+ *                     picked by the lobes' estimated weights at wo (rs_pbr_spec_prob).
+ *                     KHR_materials_specular: Fd from F0 = ((ior-1)/(ior+1))^2 specularColor,
+ *                     weighted; KHR_materials_clearcoat: the specification's fresnel_coat,
+ *                     (1 - c Fc) f_base + c Fc D G2 / (4 cos_o cos_i) with the coat's alpha, Fc
+ *                     Schlick's with F0 = 0.04 at n.wo, c the coat factor; sampled: the coat's
+ *                     visible normals with probability c Fc, else the base as above
  * A conductor or rough dielectric with alpha below RS_GGX_DELTA_ALPHA is perfectly smooth: a
  * mirror weighted by its Fresnel, or glass with the exact Fresnel (delta).
  *
@@ -83,6 +88,14 @@ RS_HD rs_vec3 rs_conductor_fresnel(const rs_material *m, rs_vec3 albedo, float c
 RS_HD rs_vec3 rs_pbr_dielectric_fresnel(const rs_material *m, float c)
 {
     return rs_v3_scale(rs_fresnel_schlick3(c, m->specular), m->spec_weight);
+}
+
+/* glTF's clearcoat: its weight c Fc at wo (c the coat factor, Fc Schlick's with the coat's
+ * F0 = 0.04, ior 1.5, at n.wo, as KHR_materials_clearcoat's fresnel_coat takes it). */
+RS_HD float rs_pbr_coat_weight(const rs_material *m, float co)
+{
+    float c = 1.0f - rs_fminf(rs_fmaxf(co, 0.0f), 1.0f), c2 = c * c;
+    return m->coat * (0.04f + 0.96f * c2 * c2 * c);
 }
 
 /* The probability that pbr sampling picks the specular lobe: its estimated share of the
@@ -219,7 +232,13 @@ RS_HD_COLD rs_vec3 rs_bsdf_eval_ggx(const rs_material *m, rs_vec3 albedo, rs_vec
         rs_vec3 diel =
             rs_v3_add(rs_v3_scale(fr, spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
         rs_vec3 metal = rs_v3_scale(rs_fresnel_schlick3(wo_h, albedo), spec);
-        return rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
+        rs_vec3 f = rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
+        if (m->coat > 0.0f) {
+            float wc = rs_pbr_coat_weight(m, co), pc, hc;
+            float coat = rs_ggx_reflect(m->coat_alpha, n, wo, wi, co, ci, &pc, &hc);
+            f = rs_v3_add(rs_v3_scale(f, 1.0f - wc), rs_v3_splat(wc * coat));
+        }
+        return f;
     }
 }
 
@@ -262,6 +281,11 @@ RS_HD_COLD float rs_bsdf_pdf_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n
     if (m->type == RS_MAT_PBR) {
         float ps = rs_pbr_spec_prob(m, albedo, co);
         pdf = ps * pdf + (1.0f - ps) * rs_pdf_cosine_hemisphere(ci);
+        if (m->coat > 0.0f) {
+            float q = rs_pbr_coat_weight(m, co), pc, hc;
+            rs_ggx_reflect(m->coat_alpha, n, wo, wi, co, ci, &pc, &hc);
+            pdf = q * pc + (1.0f - q) * pdf;
+        }
     }
     return pdf;
 }
@@ -339,7 +363,14 @@ RS_HD_COLD int rs_bsdf_sample_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 
         if (out->transmit ? !(c < 0.0f) : !(c > 0.0f))
             return 0; /* the microfacet sent it to the wrong side of the surface */
     } else {
-        if (m->type == RS_MAT_CONDUCTOR || u3 < rs_pbr_spec_prob(m, albedo, rs_v3_dot(n, wo)))
+        float q = m->type == RS_MAT_PBR && m->coat > 0.0f
+                      ? rs_pbr_coat_weight(m, rs_v3_dot(n, wo)) : 0.0f;
+        int coat = u3 < q; /* the clearcoat's visible normals, with probability q */
+        if (!coat && q > 0.0f)
+            u3 = (u3 - q) / (1.0f - q); /* the base's own pick, from what is left */
+        if (coat)
+            out->wi = rs_ggx_sample_reflect(m->coat_alpha, &frame, wo, u1, u2, &h);
+        else if (m->type == RS_MAT_CONDUCTOR || u3 < rs_pbr_spec_prob(m, albedo, rs_v3_dot(n, wo)))
             out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
         else
             out->wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(u1, u2));

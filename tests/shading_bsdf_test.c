@@ -607,6 +607,19 @@ static void test_albedo_ggx(void **state)
     m = rs_mat_pbr(rs_v3_splat(0.8f), 0.0f, 0.5f);
     m.spec_weight = 0.0f;
     check_albedo("pbr .8, specular weight 0", &m, 0.81, 0.8, -1.0, 908);
+    /* KHR_materials_clearcoat over a black base: the coat alone, c Fc(n.wo) times the GGX
+     * term's albedo (<= 1): at most c (grazing); over a white base it can only take away from
+     * what the base had (1 - c Fc) plus what the coat adds (c Fc rho_coat <= c Fc) */
+    m = rs_mat_pbr(rs_v3_splat(0.0f), 0.0f, 1.0f);
+    m.spec_weight = 0.0f;
+    m.coat = 1.0f;
+    m.coat_alpha = 0.09f;
+    worst = check_albedo("pbr black, coat 1 r .3", &m, 1.0, -1.0, -1.0, 909);
+    assert_true(worst > 0.5); /* grazing: Fc near 1 */
+    m = rs_mat_pbr(rs_v3_splat(1.0f), 0.0f, 0.5f);
+    m.coat = 1.0f;
+    m.coat_alpha = 0.09f;
+    check_albedo("pbr white, coat 1 r .3", &m, 1.15, -1.0, -1.0, 910);
 }
 
 /* The rough dielectric, from outside and inside: reflection and transmission together keep at

@@ -1339,6 +1339,16 @@ static void test_bsdf_pbr(void **state)
         spec.spec_weight = 0.6f;
         fails += run_bsdf("pbr specular layer r .5, n1", spec, N1, 60.0, 0.0, 0x5EED00C4u);
     }
+    {
+        /* KHR_materials_clearcoat: a sharp coat (alpha .01) on a rough base, and a rough one */
+        rs_material coated = rs_mat_pbr(rs_v3(0.7f, 0.2f, 0.1f), 0.3f, 0.7f);
+        coated.coat = 1.0f;
+        coated.coat_alpha = 0.1f * 0.1f;
+        fails += run_bsdf("pbr clearcoat .1 on r .7, n1", coated, N1, 45.0, 0.0, 0x5EED00C5u);
+        coated.coat = 0.5f;
+        coated.coat_alpha = 0.4f * 0.4f;
+        fails += run_bsdf("pbr clearcoat .5 r .4, n2", coated, N2, 70.0, 0.0, 0x5EED00C6u);
+    }
     assert_int_equal(fails, 0);
 }
 
