@@ -366,6 +366,11 @@ static rs_status read_material(const char *path, int i, const cJSON *mat, rs_glt
          read_number(path, i, "KHR_materials_clearcoat", x, "clearcoatRoughnessFactor", 0.0f,
                      1.0f, 0, &m->clearcoat_roughness) < 0))
         return RS_ERR_ARG;
+    if ((x = ext_of(mat, "KHR_materials_sheen")) &&
+        (read_colour(path, i, "KHR_materials_sheen", x, "sheenColorFactor", m->sheen_color) < 0 ||
+         read_number(path, i, "KHR_materials_sheen", x, "sheenRoughnessFactor", 0.0f, 1.0f, 0,
+                     &m->sheen_roughness) < 0))
+        return RS_ERR_ARG;
     m->unlit = ext_of(mat, "KHR_materials_unlit") != NULL;
     return RS_OK;
 }

@@ -26,7 +26,8 @@ rs_status rs_gltf_preflight(const char *path, int glb);
 #define RS_GLTF_READ_EXTENSIONS                                                                   \
     "KHR_lights_punctual", "KHR_texture_transform", "KHR_materials_transmission",                 \
         "KHR_materials_ior", "KHR_materials_emissive_strength", "KHR_materials_volume",           \
-        "KHR_materials_specular", "KHR_materials_unlit", "KHR_materials_clearcoat"
+        "KHR_materials_specular", "KHR_materials_unlit", "KHR_materials_clearcoat", \
+        "KHR_materials_sheen"
 
 /* What raystream takes from a material's extensions through the file's own JSON (Assimp 5.2
  * drops emissive strength, unlit and the specular colour; reading them all here keeps one
@@ -41,6 +42,8 @@ typedef struct rs_gltf_mat_ext {
     int unlit;                  /* KHR_materials_unlit */
     float clearcoat;            /* KHR_materials_clearcoat clearcoatFactor: 0 */
     float clearcoat_roughness;  /* clearcoatRoughnessFactor: 0 */
+    float sheen_color[3];       /* KHR_materials_sheen sheenColorFactor: 0, 0, 0 */
+    float sheen_roughness;      /* sheenRoughnessFactor: 0 */
 } rs_gltf_mat_ext;
 
 typedef struct rs_gltf_ext {
@@ -70,6 +73,8 @@ static inline rs_gltf_mat_ext rs_gltf_mat_ext_default(void)
     m.unlit = 0;
     m.clearcoat = 0.0f;
     m.clearcoat_roughness = 0.0f;
+    m.sheen_color[0] = m.sheen_color[1] = m.sheen_color[2] = 0.0f;
+    m.sheen_roughness = 0.0f;
     return m;
 }
 

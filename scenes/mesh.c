@@ -495,6 +495,9 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
                            (float)fmin(f * f * x->specular_color[2], 1.0));
         m.spec_weight = x->specular;
     }
+    /* KHR_materials_sheen (its textures not read) */
+    m.sheen = rs_v3(x->sheen_color[0], x->sheen_color[1], x->sheen_color[2]);
+    m.sheen_rough = x->sheen_roughness;
     if (x->clearcoat > 0.0f) { /* KHR_materials_clearcoat (its textures and normal not read) */
         float a = x->clearcoat_roughness * x->clearcoat_roughness;
         m.coat = x->clearcoat;
@@ -560,6 +563,7 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         m.metallic = 0.0f;
         m.spec_weight = 0.0f;
         m.coat = 0.0f;
+        m.sheen = rs_v3_splat(0.0f);
         m.mr_tex = m.normal_tex = RS_NO_TEXTURE;
     }
     one = 1;

@@ -85,6 +85,8 @@ typedef struct rs_material {
     float coat;          /* pbr: KHR_materials_clearcoat's clearcoatFactor, in [0, 1]; 0: none */
     float coat_alpha;    /* pbr: the coat's GGX alpha (clearcoatRoughnessFactor^2, at least
                             RS_GGX_DELTA_ALPHA) */
+    rs_vec3 sheen;       /* pbr: KHR_materials_sheen's sheenColorFactor; 0: none */
+    float sheen_rough;   /* pbr: its sheenRoughnessFactor, in [0, 1] */
 } rs_material;
 
 /* Whether a surface of material m is a light that light sampling picks: an emitter, or a glTF

@@ -99,10 +99,11 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
             m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission) || m->alpha_mask ||
             m->spec_weight != 1.0f || m->specular.x != 0.04f || m->specular.y != 0.04f ||
-            m->specular.z != 0.04f || m->coat > 0.0f)
+            m->specular.z != 0.04f || m->coat > 0.0f || !rs_v3_is_zero(m->sheen))
             return rs_error_set(RS_ERR_ARG, "material %u: a pbr material's metallic-roughness, "
                                             "emissive and normal textures, alpha cut-outs and "
-                                            "glTF specular and clearcoat layers have no place "
+                                            "glTF specular, clearcoat and sheen layers have "
+                                            "no place "
                                             "in a scene file",
                                 i);
         fputs("\"pbr\", \"metallic\": ", f);

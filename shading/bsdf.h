@@ -40,7 +40,12 @@
  *                     weighted; KHR_materials_clearcoat: the specification's fresnel_coat,
  *                     (1 - c Fc) f_base + c Fc D G2 / (4 cos_o cos_i) with the coat's alpha, Fc
  *                     Schlick's with F0 = 0.04 at n.wo, c the coat factor; sampled: the coat's
- *                     visible normals with probability c Fc, else the base as above
+ *                     visible normals with probability c Fc, else the base as above;
+ *                     KHR_materials_sheen under the coat: f_sheen + s f_base, f_sheen the
+ *                     Charlie sheen (Conty & Kulla 2017: D = (2 + 1/a) sin(h)^(1/a) / 2pi,
+ *                     their visibility, colour sheenColor), s = min(1 - max(sheenColor)
+ *                     E(cos_o), 1 - max(sheenColor) E(cos_i)), E its albedo (sheen_table.h);
+ *                     sampled: cosine with probability max(sheenColor) E(cos_o), else the base
  * A conductor or rough dielectric with alpha below RS_GGX_DELTA_ALPHA is perfectly smooth: a
  * mirror weighted by its Fresnel, or glass with the exact Fresnel (delta).
  *
@@ -52,6 +57,7 @@
 #include "core/sampling.h"
 #include "scenes/scene.h"
 #include "shading/microfacet.h"
+#include "shading/sheen_table.h"
 
 typedef struct rs_scatter {
     rs_vec3 wi;     /* sampled direction */
@@ -96,6 +102,52 @@ RS_HD float rs_pbr_coat_weight(const rs_material *m, float co)
 {
     float c = 1.0f - rs_fminf(rs_fmaxf(co, 0.0f), 1.0f), c2 = c * c;
     return m->coat * (0.04f + 0.96f * c2 * c2 * c);
+}
+
+/* glTF's sheen (KHR_materials_sheen, its "Charlie" distribution and visibility; Conty and Kulla
+ * 2017): the exponent's fit l(x) and the visibility's lambda, at roughness a (>= 0.07). */
+RS_HD float rs_sheen_l(float x, float a)
+{
+    float t = (1.0f - a) * (1.0f - a);
+    float A = 21.5473f + (25.3245f - 21.5473f) * t, B = 3.82987f + (3.32435f - 3.82987f) * t;
+    float C = 0.19823f + (0.16801f - 0.19823f) * t, D = -1.97760f + (-1.27393f + 1.97760f) * t;
+    float E = -4.32054f + (-4.85967f + 4.32054f) * t;
+    return A / (1.0f + B * powf(x, C)) + D * x + E;
+}
+
+RS_HD float rs_sheen_lambda(float c, float a)
+{
+    c = rs_fminf(fabsf(c), 1.0f); /* a cosine rounded above 1 would take powf of x < 0 */
+    return c < 0.5f ? expf(rs_sheen_l(c, a)) : expf(2.0f * rs_sheen_l(0.5f, a) - rs_sheen_l(1.0f - c, a));
+}
+
+/* The sheen BRDF (colour 1): D V with cos_o, cos_i > 0 and ch = n.h, a = max(rough, 0.07). */
+RS_HD float rs_sheen_brdf(float rough, float co, float ci, float ch)
+{
+    float a = rs_fmaxf(rough, 0.07f), s2h = rs_fmaxf(0.0f, 1.0f - ch * ch);
+    float d = (2.0f + 1.0f / a) * powf(s2h, 0.5f / a) * (0.5f * RS_INV_PI);
+    return d / ((1.0f + rs_sheen_lambda(co, a) + rs_sheen_lambda(ci, a)) * 4.0f * co * ci);
+}
+
+/* The sheen BRDF's directional albedo at cos c, roughness `rough`: the table, bilinear. */
+RS_HD float rs_sheen_albedo(float rough, float c)
+{
+    float x = rs_fminf(rs_fmaxf(c, 0.0f), 1.0f) * (RS_SHEEN_TABLE_N - 1);
+    float y = rs_fminf(rs_fmaxf(rough, 0.0f), 1.0f) * (RS_SHEEN_TABLE_N - 1);
+    int i = (int)x, j = (int)y;
+    float fx, fy;
+    i = i > RS_SHEEN_TABLE_N - 2 ? RS_SHEEN_TABLE_N - 2 : i;
+    j = j > RS_SHEEN_TABLE_N - 2 ? RS_SHEEN_TABLE_N - 2 : j;
+    fx = x - (float)i;
+    fy = y - (float)j;
+    return (1.0f - fy) * ((1.0f - fx) * rs_sheen_table_at(j, i) + fx * rs_sheen_table_at(j, i + 1)) +
+           fy * ((1.0f - fx) * rs_sheen_table_at(j + 1, i) + fx * rs_sheen_table_at(j + 1, i + 1));
+}
+
+/* The probability that pbr sampling draws the sheen's (cosine) lobe at cos_o co. */
+RS_HD float rs_pbr_sheen_prob(const rs_material *m, float co)
+{
+    return rs_fminf(rs_v3_max_comp(m->sheen) * rs_sheen_albedo(m->sheen_rough, co), 1.0f);
 }
 
 /* The probability that pbr sampling picks the specular lobe: its estimated share of the
@@ -233,6 +285,14 @@ RS_HD_COLD rs_vec3 rs_bsdf_eval_ggx(const rs_material *m, rs_vec3 albedo, rs_vec
             rs_v3_add(rs_v3_scale(fr, spec), rs_v3_scale(albedo, (1.0f - fd) * RS_INV_PI));
         rs_vec3 metal = rs_v3_scale(rs_fresnel_schlick3(wo_h, albedo), spec);
         rs_vec3 f = rs_v3_add(rs_v3_scale(diel, 1.0f - m->metallic), rs_v3_scale(metal, m->metallic));
+        if (!rs_v3_is_zero(m->sheen)) {
+            /* the sheen over the base, the base scaled by what the sheen does not take */
+            float mx = rs_v3_max_comp(m->sheen), ch = rs_v3_dot(n, rs_v3_normalize(rs_v3_add(wo, wi)));
+            float sc = rs_fminf(1.0f - mx * rs_sheen_albedo(m->sheen_rough, co),
+                                1.0f - mx * rs_sheen_albedo(m->sheen_rough, ci));
+            f = rs_v3_add(rs_v3_scale(f, sc),
+                          rs_v3_scale(m->sheen, rs_sheen_brdf(m->sheen_rough, co, ci, ch)));
+        }
         if (m->coat > 0.0f) {
             float wc = rs_pbr_coat_weight(m, co), pc, hc;
             float coat = rs_ggx_reflect(m->coat_alpha, n, wo, wi, co, ci, &pc, &hc);
@@ -281,6 +341,10 @@ RS_HD_COLD float rs_bsdf_pdf_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 n
     if (m->type == RS_MAT_PBR) {
         float ps = rs_pbr_spec_prob(m, albedo, co);
         pdf = ps * pdf + (1.0f - ps) * rs_pdf_cosine_hemisphere(ci);
+        if (!rs_v3_is_zero(m->sheen)) {
+            float qs = rs_pbr_sheen_prob(m, co);
+            pdf = qs * rs_pdf_cosine_hemisphere(ci) + (1.0f - qs) * pdf;
+        }
         if (m->coat > 0.0f) {
             float q = rs_pbr_coat_weight(m, co), pc, hc;
             rs_ggx_reflect(m->coat_alpha, n, wo, wi, co, ci, &pc, &hc);
@@ -365,11 +429,20 @@ RS_HD_COLD int rs_bsdf_sample_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 
     } else {
         float q = m->type == RS_MAT_PBR && m->coat > 0.0f
                       ? rs_pbr_coat_weight(m, rs_v3_dot(n, wo)) : 0.0f;
-        int coat = u3 < q; /* the clearcoat's visible normals, with probability q */
+        float qs;
+        int coat = u3 < q, sheen = 0; /* the clearcoat's visible normals, with probability q */
         if (!coat && q > 0.0f)
-            u3 = (u3 - q) / (1.0f - q); /* the base's own pick, from what is left */
+            u3 = (u3 - q) / (1.0f - q); /* the rest's own pick, from what is left */
+        if (!coat && m->type == RS_MAT_PBR && !rs_v3_is_zero(m->sheen)) {
+            qs = rs_pbr_sheen_prob(m, rs_v3_dot(n, wo)); /* the sheen: cosine, probability qs */
+            sheen = u3 < qs;
+            if (!sheen)
+                u3 = (u3 - qs) / (1.0f - qs);
+        }
         if (coat)
             out->wi = rs_ggx_sample_reflect(m->coat_alpha, &frame, wo, u1, u2, &h);
+        else if (sheen)
+            out->wi = rs_onb_to_world(&frame, rs_sample_cosine_hemisphere(u1, u2));
         else if (m->type == RS_MAT_CONDUCTOR || u3 < rs_pbr_spec_prob(m, albedo, rs_v3_dot(n, wo)))
             out->wi = rs_ggx_sample_reflect(m->alpha, &frame, wo, u1, u2, &h);
         else

@@ -501,7 +501,7 @@ static void test_material_extensions(void **state)
     s = load_ext("plain.gltf", "", "\"baseColorFactor\":[0.2,0.4,0.6,1]", "");
     m = &s->materials[s->tri_mat[0]];
     assert_true(m->specular.x == 0.04f && m->specular.y == 0.04f && m->specular.z == 0.04f);
-    assert_true(m->spec_weight == 1.0f && m->coat == 0.0f);
+    assert_true(m->spec_weight == 1.0f && m->coat == 0.0f && rs_v3_is_zero(m->sheen));
     expect_v3(m->emission, 0.5f, 0.25f, 1.0f, 0.0f);
     rs_scene_destroy(s);
     /* emissive strength (Assimp 5.2 drops it), ior 2 and a coloured specular at weight .6 */
@@ -542,18 +542,21 @@ static void test_material_extensions(void **state)
     expect_v3(m->sigma_a, (float)(log(2.0) / 2), (float)(log(4.0) / 2), 0.0f, 1e-7f);
     rs_scene_destroy(s);
     /* the census: what raystream reads, what it does not */
-    s = load_ext("census.gltf", "\"KHR_materials_sheen\",\"KHR_materials_clearcoat\","
-                 "\"EXT_texture_webp\"", "",
-                 "\"KHR_materials_sheen\":{\"sheenColorFactor\":[1,1,1]},"
+    s = load_ext("census.gltf", "\"KHR_materials_iridescence\",\"KHR_materials_clearcoat\","
+                 "\"KHR_materials_sheen\",\"EXT_texture_webp\"", "",
+                 "\"KHR_materials_sheen\":{\"sheenColorFactor\":[1,0.5,0.25],"
+                 "\"sheenRoughnessFactor\":0.3},"
                  "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":0.8,"
                  "\"clearcoatRoughnessFactor\":0.5}");
     m = &s->materials[s->tri_mat[0]];
     assert_true(m->coat == 0.8f && m->coat_alpha == 0.25f);
+    expect_v3(m->sheen, 1.0f, 0.5f, 0.25f, 0.0f);
+    assert_true(m->sheen_rough == 0.3f);
     rs_scene_destroy(s);
     path_of(p, sizeof p, "census.gltf");
     assert_int_equal(rs_gltf_read_ext(p, 0, &e), RS_OK);
-    assert_string_equal(e.used, "KHR_materials_clearcoat");
-    assert_string_equal(e.unread, "KHR_materials_sheen, EXT_texture_webp");
+    assert_string_equal(e.used, "KHR_materials_clearcoat, KHR_materials_sheen");
+    assert_string_equal(e.unread, "KHR_materials_iridescence, EXT_texture_webp");
     assert_int_equal(e.n_materials, 1);
     rs_gltf_ext_free(&e);
 }

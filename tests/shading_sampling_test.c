@@ -1349,6 +1349,17 @@ static void test_bsdf_pbr(void **state)
         coated.coat_alpha = 0.4f * 0.4f;
         fails += run_bsdf("pbr clearcoat .5 r .4, n2", coated, N2, 70.0, 0.0, 0x5EED00C6u);
     }
+    {
+        /* KHR_materials_sheen: a sharp (r .1) and a soft (r .6) sheen, the second under a coat */
+        rs_material velvet = rs_mat_pbr(rs_v3(0.3f, 0.1f, 0.4f), 0.0f, 0.8f);
+        velvet.sheen = rs_v3(1.0f, 0.6f, 0.8f);
+        velvet.sheen_rough = 0.1f;
+        fails += run_bsdf("pbr sheen r .1, n1", velvet, N1, 70.0, 0.0, 0x5EED00C7u);
+        velvet.sheen_rough = 0.6f;
+        velvet.coat = 0.7f;
+        velvet.coat_alpha = 0.05f;
+        fails += run_bsdf("pbr sheen r .6 coated, n2", velvet, N2, 30.0, 0.0, 0x5EED00C8u);
+    }
     assert_int_equal(fails, 0);
 }
 
