@@ -1,5 +1,6 @@
 /* scenes/scene.c — see scene.h. */
 #include "scenes/scene.h"
+#include "scenes/light_bvh.h"
 #include "scenes/scene_env.h"
 
 #include <math.h>
@@ -86,6 +87,8 @@ void rs_scene_destroy(rs_scene *s)
     rs_free(s->lights);
     rs_free(s->light_cdf);
     rs_free(s->prim_light);
+    rs_free(s->light_nodes);
+    rs_free(s->light_trail);
     rs_free(s->env_marg_cdf);
     rs_free(s->env_cond_cdf);
     rs_free(s->punctuals);
@@ -830,6 +833,11 @@ rs_status rs_scene_finalize(rs_scene *s)
     s->area_mass = s->n_lights > s->n_area_lights
                        ? s->env_pick + (1.0f - s->env_pick) * s->light_cdf[s->n_area_lights]
                        : 1.0f;
+    {
+        rs_status st = rs_scene_build_light_bvh(s); /* --light-sampler bvh (scenes/light_bvh.h) */
+        if (st != RS_OK)
+            return st;
+    }
     s->finalized = 1;
     return RS_OK;
 }

@@ -176,6 +176,23 @@ typedef struct rs_light {
     float pick_pdf; /* power / total power: probability that sampling picks this light */
 } rs_light;
 
+/* A node of the light BVH (scenes/light_bvh.c builds it, shading/light_bvh.h samples it; the
+ * bounds and importance of Conty and Kulla 2018, as pbrt-v4's BVHLightSampler has them, without
+ * the receiver's normal).  Nodes are depth-first: an interior node's first child follows it,
+ * its second is at `child`; a leaf holds one light (`child` its index in the scene's lights). */
+typedef struct rs_light_node {
+    float lo[3], hi[3]; /* the lights' bounds (a moving sphere's over the shutter) */
+    float w[3];         /* the axis of the cone holding their normals (emission directions) */
+    float cos_o;        /* cos of that cone's half-angle (-1: every direction) */
+    float cos_e;        /* cos of the angle beyond cos_o over which they still emit (pi/2: 0) */
+    float phi;          /* their power (rs_light.power summed) */
+    uint32_t child;     /* interior: the second child's index; leaf: the light's index */
+    uint32_t flags;     /* RS_LIGHT_NODE_* */
+} rs_light_node;
+
+#define RS_LIGHT_NODE_LEAF      1u
+#define RS_LIGHT_NODE_TWO_SIDED 2u /* a leaf's emitter emits on both sides of its normal */
+
 typedef struct rs_camera_desc {
     rs_vec3 from, at, up;
     float vfov_deg;      /* vertical field of view, degrees */
@@ -238,6 +255,13 @@ typedef struct rs_scene {
     float *light_cdf; /* n_lights + 1 entries, cdf[0] = 0, cdf[n] = 1 */
     uint32_t n_lights;
     uint32_t n_area_lights; /* lights[0, n_area_lights) are emitters, the rest punctual */
+    rs_light_node *light_nodes; /* the light BVH over the emitters, point and spot lights (not
+                                   directional ones, not the map); NULL when there are none */
+    uint32_t n_light_nodes;
+    uint64_t *light_trail;      /* per light: its path from the BVH's root (bit k: the second
+                                   child at depth k) under a leading 1 bit; 0: not in the BVH */
+    float light_bvh_mass;       /* the BVH's lights' share of the lights' power (the rest:
+                                   directional lights, picked by power) */
     float area_mass;        /* the probability that light sampling picks the map or an emitter
                                (1 without punctual lights) */
     int32_t *prim_light; /* per global primitive: index into lights, or -1 */
@@ -609,6 +633,8 @@ static inline size_t rs_scene_env_cond_len(const rs_scene *s)
     X(textures, (size_t)(s)->n_textures)                                                           \
     X(lights, (size_t)(s)->n_lights)                                                               \
     X(light_cdf, (s)->n_lights ? (size_t)(s)->n_lights + 1 : 0)                                    \
+    X(light_nodes, (size_t)(s)->n_light_nodes)                                                     \
+    X(light_trail, (s)->light_nodes ? (size_t)(s)->n_lights : 0)                                   \
     X(prim_light, (size_t)(s)->n_spheres + (s)->n_quads + (s)->n_tris)                           \
     X(punctuals, (size_t)(s)->n_punctuals)                                                         \
     X(env_marg_cdf, rs_scene_env_marg_len(s))                                                      \
