@@ -151,7 +151,8 @@ static void test_mirror_renders_alone(void **state)
     assert_false(SHARED(spheres) || SHARED(sphere_mat) || SHARED(sphere_motion) || SHARED(quads) ||
                  SHARED(quad_mat) || SHARED(tris) || SHARED(tri_mat) || SHARED(tri_uv) ||
                  SHARED(tri_normal) || SHARED(materials) || SHARED(textures) || SHARED(images) ||
-                 SHARED(lights) || SHARED(light_cdf) || SHARED(prim_light) ||
+                 SHARED(lights) || SHARED(light_cdf) || SHARED(light_nodes) ||
+                 SHARED(light_trail) || SHARED(prim_light) ||
                  SHARED(env_marg_cdf) || SHARED(env_cond_cdf) || SHARED(inst_tris) ||
                  SHARED(inst_tri_mat) || SHARED(inst_tri_uv) || SHARED(inst_tri_normal) ||
                  SHARED(instances) || SHARED(masks) || SHARED(mask_bits) ||
@@ -162,6 +163,8 @@ static void test_mirror_renders_alone(void **state)
            s->n_materials * sizeof(rs_material) + s->n_textures * sizeof(rs_texture) +
            s->n_images * sizeof(rs_image) + s->n_lights * sizeof(rs_light) +
            (s->n_lights + 1) * sizeof(float) +
+           s->n_light_nodes * sizeof(rs_light_node) + /* the light BVH */
+           (s->light_nodes ? s->n_lights * sizeof(uint64_t) : 0) +
            (s->n_spheres + s->n_quads + s->n_tris) * sizeof(int32_t) +
            (4 + 1 + 4 * (8 + 1)) * sizeof(float) + /* the 8 x 4 map's two CDFs */
            s->n_inst_tris * (sizeof(rs_tri) + sizeof(uint32_t) + 15 * sizeof(float)) +
