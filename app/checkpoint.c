@@ -274,7 +274,7 @@ uint32_t rs_checkpoint_filter_code(const rs_filter *f, int trilinear)
 static void filter_code_name(uint32_t code, char *buf, size_t n)
 {
     rs_filter f;
-    uint32_t width = code & 0x7fffffu;
+    uint32_t width = code & 0x3fffffu;
     size_t len;
     memset(&f, 0, sizeof f);
     f.kind = width ? code >> 24 : RS_FILTER_BOX;
@@ -284,7 +284,9 @@ static void filter_code_name(uint32_t code, char *buf, size_t n)
     else
         rs_filter_describe(&f, buf, n);
     len = strlen(buf);
-    snprintf(buf + len, n - len, " (%s textures)", code & (1u << 23) ? "trilinear" : "bilinear");
+    snprintf(buf + len, n - len, " (%s textures, light sampler %s)",
+             code & (1u << 23) ? "trilinear" : "bilinear",
+             code & RS_CHECKPOINT_LIGHT_BVH ? "bvh" : "power");
 }
 
 /* The header against `want`.  Returns RS_EXIT_OK or the exit code after one line. */
@@ -320,7 +322,7 @@ static int check_header(const char *path, const unsigned char *h, const char *na
         char a[80], b[80];
         filter_code_name(get32(h + FIXED_HEADER + get32(h + 88) + 4), a, sizeof a);
         filter_code_name(want->filter, b, sizeof b);
-        return mismatch_s(path, "--filter / --texture-filter", a, b);
+        return mismatch_s(path, "--filter / --texture-filter / --light-sampler", a, b);
     }
     if (u[7] != want->isect_sphere)
         return mismatch_s(path, "--isect-sphere", rs_isect_sphere_algo_name(u[7]),

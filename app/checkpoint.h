@@ -76,9 +76,12 @@ typedef struct rs_checkpoint_key {
 } rs_checkpoint_key;
 
 /* The pixel filter and the texture filter as the header holds them: kind << 24 | trilinear << 23
- * | width in thousandths of a pixel, kind and width 0 for box:1 (so 0 is box:1 with bilinear
- * textures: every checkpoint before raystream 0.9). */
+ * | width in thousandths of a pixel (at most 16000: 14 bits), kind and width 0 for box:1 (so 0
+ * is box:1 with bilinear textures: every checkpoint before raystream 0.9).  The same word
+ * carries RS_CHECKPOINT_LIGHT_BVH for --light-sampler bvh (a render with it is a different
+ * image). */
 uint32_t rs_checkpoint_filter_code(const rs_filter *f, int trilinear);
+#define RS_CHECKPOINT_LIGHT_BVH (1u << 22)
 
 /* FNV-1a 64 over every array and setting of a finalized scene that shading reads. */
 uint64_t rs_checkpoint_scene_hash(const rs_scene *s);

@@ -174,7 +174,10 @@ static void help_render_scene(void)
           "                      pixels (default blackman-harris:1.5, as Cycles; box:1 is\n"
           "                      the 1-pixel box of raystream before 0.9; docs/filters.md)\n"
           "  --texture-filter F  image textures: trilinear (mip-mapped, the default) or\n"
-          "                      bilinear (level 0 only, as before 0.9; docs/textures.md)\n"
+          "                      bilinear (level 0 only, as before 0.9; docs/textures.md)\n"          "  --light-sampler S   how next-event estimation picks a light (MIS): power (in\n"
+          "                      proportion to power, the default) or bvh (a light BVH by\n"
+          "                      each light's estimated contribution at the point: many\n"
+          "                      lights; docs/sampling.md)\n"
           "  --view NAME         view transform of 8-bit outputs (PNG, JPEG, TIFF): standard\n"
           "                      (clip and sRGB, the default), filmic (AgX-like: highlights\n"
           "                      desaturate instead of clipping) or pbr-neutral (Khronos PBR\n"
@@ -536,6 +539,18 @@ static int opt_texture_filter(const char *name, const char *v, rs_cli_options *o
     return RS_EXIT_OK;
 }
 
+static int opt_light_sampler(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (strcmp(v, "power") == 0)
+        o->light_sampler = RS_LIGHT_SAMPLER_POWER;
+    else if (strcmp(v, "bvh") == 0)
+        o->light_sampler = RS_LIGHT_SAMPLER_BVH;
+    else
+        return usage_error("--light-sampler: '%s' is not power or bvh%s", v, "");
+    return RS_EXIT_OK;
+}
+
 static int opt_exposure(const char *name, const char *v, rs_cli_options *o)
 {
     char *end;
@@ -710,6 +725,7 @@ static const opt_row options[] = {
     ROW_CALL("--envmap-scale", opt_envmap_scale),
     ROW_CALL("--filter", opt_filter),
     ROW_CALL("--texture-filter", opt_texture_filter),
+    ROW_CALL("--light-sampler", opt_light_sampler),
     ROW_TEXT("--view", NULL, view, "a view's name"),
     ROW_CALL("--exposure", opt_exposure),
     ROW_NUM("--denoise", OPT_FLAG, denoise, 0, 0),

@@ -46,6 +46,7 @@ void rs_run_settings(const rs_cli_options *o, render_run *r)
     st->sampler = o->sampler;
     st->filter = o->filter;
     st->texture_filter = o->texture_filter;
+    st->light_sampler = o->light_sampler;
     st->wave_paths = o->wave_paths;
     st->waves_in_flight = o->waves;
     r->threads = o->threads ? o->threads : rs_cpu_count();
@@ -150,7 +151,8 @@ static void make_key(const rs_cli_options *o, render_run *r)
     k->sampling = (uint32_t)r->st.sampling;
     k->sampler = (uint32_t)r->st.sampler;
     k->filter = rs_checkpoint_filter_code(&r->st.filter,
-                                          r->st.texture_filter == RS_TEXTURE_TRILINEAR);
+                                          r->st.texture_filter == RS_TEXTURE_TRILINEAR) |
+                (r->st.light_sampler == RS_LIGHT_SAMPLER_BVH ? RS_CHECKPOINT_LIGHT_BVH : 0u);
     k->isect_sphere = o->isect_sphere;
     k->isect_tri = o->isect_tri;
     k->isect_aabb = o->isect_aabb;

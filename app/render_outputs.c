@@ -65,6 +65,7 @@ static void make_report(const rs_cli_options *o, const render_run *r, rs_report 
     rs_filter_describe(&r->st.filter, rep->filter, sizeof rep->filter);
     rep->lighting = r->lighting[0] ? r->lighting : NULL;
     rep->texture_filter = r->st.texture_filter == RS_TEXTURE_TRILINEAR ? "trilinear" : "bilinear";
+    rep->light_sampler = r->st.light_sampler == RS_LIGHT_SAMPLER_BVH ? "bvh" : "power";
     rep->denoised = r->denoised ? r->denoise_device : NULL;
     rep->adaptive = o->adaptive > 0 ? o->adaptive : 0.0;
     rep->time_limit_s = o->time_limit_s;

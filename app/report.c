@@ -226,12 +226,14 @@ static void summary_render(const rs_report *rep)
                  "shared triangles)",
                  rep->instances, rep->inst_prims, rep->blas_nodes, rep->inst_tris);
     fprintf(stderr,
-            "%s %s at %ux%u, %s (%s sampling, %s sampler, %s filter, max depth %u, seed %llu) "
+            "%s %s at %ux%u, %s (%s sampling%s, %s sampler, %s filter, max depth %u, seed %llu) "
             "in %.2f s: "
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
             "BVH (%s, SAH cost %.1f): %u nodes over %u primitives%s, built in %.2f ms. ",
             rep->interrupted ? "Partial render (interrupted):" : "Rendered", rep->scene, rep->width,
-            rep->height, spp, rs_sampling_name(rep->sampling), rs_sampler_name(rep->sampler),
+            rep->height, spp, rs_sampling_name(rep->sampling),
+            rep->light_sampler && strcmp(rep->light_sampler, "bvh") == 0 ? " with a light BVH" : "",
+            rs_sampler_name(rep->sampler),
             rep->filter, rep->max_depth, (unsigned long long)rep->seed, s->seconds, sps, rps, rays,
             (unsigned long long)s->rays_closest, (unsigned long long)s->rays_shadow,
             rep->bvh_builder, rep->bvh_sah, rep->bvh_nodes, rep->bvh_prims, inst, rep->bvh_ms);
@@ -323,7 +325,8 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
         "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
         "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
         "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter",
-        "raystream:lighting",   "raystream:denoised", "raystream:texture_filter"};
+        "raystream:lighting",   "raystream:denoised", "raystream:texture_filter",
+        "raystream:light_sampler"};
     const char *values[RS_REPORT_META_N];
     size_t used = 0;
     int i;
@@ -358,6 +361,7 @@ void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
     values[12] = rep->lighting ? rep->lighting : "the scene's own";
     values[13] = rep->denoised ? rep->denoised : "no";
     values[14] = rep->texture_filter ? rep->texture_filter : "trilinear";
+    values[15] = rep->light_sampler ? rep->light_sampler : "power";
     for (i = 0; i < RS_REPORT_META_N; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];

@@ -31,6 +31,7 @@ typedef struct rs_report {
     rs_sampler sampler;
     char filter[40];       /* "blackman-harris:1.5" */
     const char *texture_filter; /* "trilinear" or "bilinear" */
+    const char *light_sampler;  /* "power" or "bvh" */
     const char *denoised;  /* --denoise: the OIDN device that ran it; NULL: not denoised */
     const char *lighting;  /* how the scene was lit when the file said nothing ("the default
                               sky: ..."), or NULL */
@@ -65,7 +66,7 @@ void rs_report_print_summary(const rs_report *rep);
  * the pixel filter, the lighting when the scene's file gave none, the denoiser, the texture
  * filter;
  * their strings in the struct itself. */
-enum { RS_REPORT_META_N = 15 };
+enum { RS_REPORT_META_N = 16 };
 typedef struct rs_report_meta {
     rs_image_meta meta[RS_REPORT_META_N];
     char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];

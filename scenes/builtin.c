@@ -403,6 +403,63 @@ static rs_status build_furnace(rs_scene *s)
     return RS_OK;
 }
 
+/* Many lights (issue 29's light-sampler benchmark): a 24 x 24 floor and a back wall lit only
+ * by a 14 x 14 grid of small emissive quads facing down at heights 0.6 to 1.4, each of its own
+ * colour and strength (4 to 40, a few of them bright), and 24 small emissive spheres: 220
+ * lights, most of them far from any one point, so that picking them by power wastes most
+ * shadow rays. */
+/* A number in [0, 1) from the scene's own generator (one statement each: a fixed order). */
+static float many_rnd(uint64_t *r)
+{
+    *r = *r * 6364136223846793005ull + 1442695040888963407ull;
+    return (float)((*r >> 40) * (1.0 / 16777216.0));
+}
+
+static rs_status build_many_lights(rs_scene *s)
+{
+    rs_material floor_m = lambertian(0.6f, 0.6f, 0.6f), wall_m = lambertian(0.4f, 0.5f, 0.6f);
+    uint32_t floor_id, wall_id, i, j;
+    uint64_t r = 0x9e3779b97f4a7c15ull;
+    RS_TRY(rs_scene_add_material(s, &floor_m, &floor_id));
+    RS_TRY(rs_scene_add_material(s, &wall_m, &wall_id));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(-12, 0, -12), rs_v3(0, 0, 24), rs_v3(24, 0, 0), floor_id));
+    RS_TRY(rs_scene_add_quad(s, rs_v3(-12, 0, -12), rs_v3(24, 0, 0), rs_v3(0, 6, 0), wall_id));
+    for (j = 0; j < 14; ++j)
+        for (i = 0; i < 14; ++i) {
+            float x = -11.0f + 22.0f * ((float)i + 0.2f + 0.6f * many_rnd(&r)) / 14.0f;
+            float z = -11.0f + 22.0f * ((float)j + 0.2f + 0.6f * many_rnd(&r)) / 14.0f;
+            float y = 0.6f + 0.8f * many_rnd(&r), k = many_rnd(&r), cr, cg, cb;
+            rs_material m;
+            uint32_t id;
+            k = 4.0f + 36.0f * k * many_rnd(&r);
+            cr = 0.4f + 0.6f * many_rnd(&r);
+            cg = 0.4f + 0.6f * many_rnd(&r);
+            cb = 0.4f + 0.6f * many_rnd(&r);
+            m = rs_mat_light(rs_v3(k * cr, k * cg, k * cb), 0);
+            RS_TRY(rs_scene_add_material(s, &m, &id));
+            /* u x v points down: the quad emits toward the floor */
+            RS_TRY(rs_scene_add_quad(s, rs_v3(x, y, z), rs_v3(0.3f, 0, 0), rs_v3(0, 0, 0.3f), id));
+        }
+    for (i = 0; i < 24; ++i) {
+        float k = 2.0f + 10.0f * many_rnd(&r), cx, cy, cz;
+        rs_material m = rs_mat_light(rs_v3(k, 0.8f * k, 0.5f * k), 0);
+        uint32_t id;
+        cx = -11.0f + 22.0f * many_rnd(&r);
+        cy = 0.15f + 0.3f * many_rnd(&r);
+        cz = -11.0f + 22.0f * many_rnd(&r);
+        RS_TRY(rs_scene_add_material(s, &m, &id));
+        RS_TRY(rs_scene_add_sphere(s, rs_v3(cx, cy, cz), 0.1f, id));
+    }
+    s->camera.from = rs_v3(0, 9, 16);
+    s->camera.at = rs_v3(0, 0, -1);
+    s->camera.up = rs_v3(0, 1, 0);
+    s->camera.vfov_deg = 50.0f;
+    s->background = rs_v3(0, 0, 0);
+    s->width = 400;
+    s->height = 300;
+    return RS_OK;
+}
+
 typedef struct builtin {
     const char *name;
     const char *description;
@@ -428,6 +485,8 @@ static const builtin g_builtins[] = {
      build_cornell_bunny_teapot},
     {"furnace", "white furnace: an albedo-0.5 diffuse sphere under a white sky (renders 0.5)",
      build_furnace, NULL},
+    {"many-lights", "a floor under 220 small lights of many colours (the light sampler's test)",
+     build_many_lights, NULL},
     {"gpucheck", "every material, texture, light and primitive the GPU shades (the GPU check's)",
      rs_builtin_build_gpucheck, NULL},
 };

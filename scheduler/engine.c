@@ -55,6 +55,7 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     it->rr_depth = st->rr_depth ? st->rr_depth : 3;
     it->sampling = (uint32_t)st->sampling;
     it->sampler = (uint32_t)st->sampler;
+    it->light_sampler = st->light_sampler;
     if (st->filter.width > 0.0f)
         it->filter = st->filter;
     else if (!rs_filter_make(RS_FILTER_BOX, 1.0f, &it->filter))

@@ -16,6 +16,7 @@
 #include "core/sampling.h"
 #include "scenes/scene.h"
 #include "shading/envmap.h"
+#include "shading/light_bvh.h"
 #include "shading/spawn.h"
 
 typedef struct rs_light_sample {
@@ -36,6 +37,8 @@ typedef struct rs_light_sample {
 #define RS_LIGHTS_ALL   0 /* every light (MIS's next-event estimation) */
 #define RS_LIGHTS_AREA  1 /* the map and the emitters (the mixture's light half) */
 #define RS_LIGHTS_DELTA 2 /* the punctual lights (the mixture's next-event estimation) */
+#define RS_LIGHTS_BVH   3 /* every light, the bounded ones picked by the light BVH at the point
+                             (--light-sampler bvh: rs_light_sample_bvh) */
 
 /* Whether the map or an emitter can be sampled (the mixture's light half has something). */
 RS_HD int rs_scene_has_area_lights(const rs_scene *s)
@@ -152,6 +155,9 @@ RS_HD_COLD int rs_light_sample_delta(const rs_scene *s, rs_vec3 x, float u_pick,
                               s->lights[l].pick_pdf / ((1.0f - s->env_pick) * (1.0f - a)), out);
 }
 
+RS_HD int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
+                              rs_vec3 x, float time, float u1, float u2, rs_light_sample *out);
+
 /* Samples a light of `subset` (RS_LIGHTS_*) as seen from x at `time` on a surface with unit
  * normal n_x (zero: none; a uniform sky is sampled about it, shading/envmap.h); the pdf is relative
  * to the subset (the pick probability divided by the subset's).  Returns 0 (and no sample) if
@@ -160,11 +166,8 @@ RS_HD_COLD int rs_light_sample_delta(const rs_scene *s, rs_vec3 x, float u_pick,
 RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3 n_x,
                                float time, float u_pick, float u1, float u2, rs_light_sample *out)
 {
-    uint32_t l, prim, n = s->n_lights;
-    const rs_light *lt;
-    rs_surface_point sp;
-    rs_vec3 p, n_l, to;
-    float d2, cos_l, env_pick = s->env_pick, inv_mass = 1.0f;
+    uint32_t l, n = s->n_lights;
+    float env_pick = s->env_pick, inv_mass = 1.0f;
     if (!rs_scene_has_lights(s))
         return 0;
     out->env = 0;
@@ -197,10 +200,22 @@ RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3
     if (n < s->n_lights) /* the emitters' part of the CDF */
         u_pick *= s->light_cdf[n];
     l = rs_light_pick_n(s, u_pick, n);
-    lt = &s->lights[l];
-    prim = lt->prim;
+    return rs_light_sample_one(s, l, s->lights[l].pick_pdf, inv_mass, x, time, u1, u2, out);
+}
+
+/* A point on light l, picked with probability `pick` (times inv_mass: relative to a subset),
+ * as seen from x at `time`: out's direction, distance, radiance and pdf (pick included).  0
+ * when the sample is degenerate. */
+RS_HD int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
+                              rs_vec3 x, float time, float u1, float u2, rs_light_sample *out)
+{
+    const rs_light *lt = &s->lights[l];
+    uint32_t prim = lt->prim;
+    rs_surface_point sp;
+    rs_vec3 p, n_l, to;
+    float d2, cos_l;
     if (prim & RS_LIGHT_PUNCTUAL)
-        return rs_punctual_sample(&s->punctuals[prim & ~RS_LIGHT_PUNCTUAL], x, lt->pick_pdf, out);
+        return rs_punctual_sample(&s->punctuals[prim & ~RS_LIGHT_PUNCTUAL], x, pick, out);
     if (prim < s->n_spheres) {
         rs_geom g = rs_scene_geom(s);
         rs_vec3 c = rs_geom_sphere_center(&g, prim, time), axis = rs_v3_sub(c, x);
@@ -222,7 +237,7 @@ RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3
             out->point = sp.p;
             out->err = sp.err;
             out->n = sp.ng;
-            out->pdf = lt->pick_pdf * rs_pdf_uniform_cone(omc);
+            out->pdf = pick * rs_pdf_uniform_cone(omc);
             out->le = rs_emitted(rs_scene_prim_material(s, prim), sp.ng, w);
             if (inv_mass != 1.0f)
                 out->pdf *= inv_mass;
@@ -251,11 +266,75 @@ RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3
     out->point = p;
     out->err = sp.err;
     out->n = n_l;
-    out->pdf = lt->pick_pdf * d2 / (lt->area * cos_l);
+    out->pdf = pick * d2 / (lt->area * cos_l);
     if (inv_mass != 1.0f)
         out->pdf *= inv_mass;
     out->le = rs_emitted(rs_scene_prim_material(s, prim), n_l, out->wi);
     return 1;
+}
+
+/* The probability that rs_light_sample_bvh picks light l for a vertex whose light pick was
+ * taken at `at` (the vertex's offset origin; what MIS needs when a BSDF sample hits l). */
+RS_HD float rs_light_pick_bvh(const rs_scene *s, uint32_t l, rs_vec3 at)
+{
+    if (s->light_trail && s->light_trail[l])
+        return (1.0f - s->env_pick) * s->light_bvh_mass * rs_light_bvh_pmf(s, at, l);
+    return s->lights[l].pick_pdf; /* a directional light: by power (never hit by a ray) */
+}
+
+/* RS_LIGHTS_BVH: the map with its pick probability as ever, else a bounded light picked by the
+ * light BVH at `at` (with the BVH's share of the lights' power), else a directional light by
+ * power among the directional ones; x, n_x, time, u1, u2 as rs_light_sample_from. */
+RS_HD_COLD int rs_light_sample_bvh(const rs_scene *s, rs_vec3 x, rs_vec3 n_x, rs_vec3 at,
+                                   float time, float u_pick, float u1, float u2,
+                                   rs_light_sample *out)
+{
+    float env_pick = s->env_pick, m = s->light_bvh_mass, pick;
+    uint32_t l = 0, i;
+    if (!rs_scene_has_lights(s))
+        return 0;
+    out->env = 0;
+    out->delta = 0;
+    if (env_pick > 0.0f) {
+        if (u_pick < env_pick) {
+            if (!rs_env_sample_at(s, n_x, u1, u2, &out->wi, &out->pdf, &out->le))
+                return 0;
+            out->pdf *= env_pick;
+            out->point = x;
+            out->dist = FLT_MAX;
+            out->env = 1;
+            return 1;
+        }
+        u_pick = (u_pick - env_pick) / (1.0f - env_pick);
+    }
+    if (s->n_lights == 0)
+        return 0;
+    if (u_pick < m && s->light_nodes) {
+        float pmf;
+        if (!rs_light_bvh_pick(s, at, rs_fminf(u_pick / m, 0x1.fffffep-1f), &l, &pmf))
+            return 0;
+        pick = (1.0f - env_pick) * m * pmf;
+    } else {
+        /* the directional lights, by their power (1 - m of it) */
+        float total = 0.0f, acc = 0.0f, u;
+        int found = 0;
+        for (i = s->n_area_lights; i < s->n_lights; ++i)
+            if (!s->light_trail || !s->light_trail[i])
+                total += s->lights[i].power;
+        u = (m < 1.0f ? (u_pick - m) / (1.0f - m) : 0.0f) * total;
+        for (i = s->n_area_lights; i < s->n_lights && !found; ++i)
+            if (!s->light_trail || !s->light_trail[i]) {
+                acc += s->lights[i].power;
+                if (u < acc || i + 1 == s->n_lights) {
+                    l = i;
+                    found = 1;
+                }
+            }
+        if (!found || !(total > 0.0f))
+            return 0;
+        pick = s->lights[l].pick_pdf;
+    }
+    return rs_light_sample_one(s, l, pick, 1.0f, x, time, u1, u2, out);
 }
 
 /* The same seen from no surface. */
@@ -272,10 +351,11 @@ RS_HD int rs_light_sample_at(const rs_scene *s, rs_vec3 x, float time, float u_p
     return rs_light_sample_in(s, RS_LIGHTS_ALL, x, time, u_pick, u1, u2, out);
 }
 
-/* The pdf rs_light_sample_at gives to direction w (unit) from x that reaches light `light` at
- * distance t where its normal is ng: what MIS needs when BSDF sampling hits an emitter. */
-RS_HD float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float time, rs_vec3 w,
-                             float t, rs_vec3 ng)
+/* The pdf that a sampler picking light `light` with probability `pick` gives to direction w
+ * (unit) from x that reaches the light at distance t where its normal is ng: what MIS needs
+ * when BSDF sampling hits an emitter. */
+RS_HD float rs_light_pdf_hit_pick(const rs_scene *s, uint32_t light, float pick, rs_vec3 x,
+                                  float time, rs_vec3 w, float t, rs_vec3 ng)
 {
     const rs_light *lt = &s->lights[light];
     float cos_l;
@@ -284,12 +364,19 @@ RS_HD float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float
         rs_vec3 axis = rs_v3_sub(rs_geom_sphere_center(&g, lt->prim, time), x);
         float r = s->spheres[lt->prim].radius, dc2 = rs_v3_dot(axis, axis);
         if (dc2 > r * r * 1.0001f)
-            return lt->pick_pdf * rs_pdf_uniform_cone(rs_cone_one_minus_cos(r, dc2));
+            return pick * rs_pdf_uniform_cone(rs_cone_one_minus_cos(r, dc2));
     }
     cos_l = fabsf(rs_v3_dot(ng, w));
     if (!(cos_l > 1e-7f))
         return 0.0f;
-    return lt->pick_pdf * t * t / (lt->area * cos_l);
+    return pick * t * t / (lt->area * cos_l);
+}
+
+/* The same with the light's pick probability by power (rs_light_sample_at's). */
+RS_HD float rs_light_pdf_hit(const rs_scene *s, uint32_t light, rs_vec3 x, float time, rs_vec3 w,
+                             float t, rs_vec3 ng)
+{
+    return rs_light_pdf_hit_pick(s, light, s->lights[light].pick_pdf, x, time, w, t, ng);
 }
 
 /* The pdf of direction w (unit) from x summed over every light that the line x + t w meets,

@@ -55,6 +55,13 @@ typedef enum rs_sampler {
                                    (core/zsobol.h): blue-noise error across pixels */
 } rs_sampler;
 
+/* How next-event estimation picks a light (--light-sampler; MIS only, the other modes pick by
+ * power). */
+typedef enum rs_light_sampler {
+    RS_LIGHT_SAMPLER_POWER = 0, /* in proportion to each light's power, anywhere */
+    RS_LIGHT_SAMPLER_BVH = 1    /* by the light BVH's importance at the point (light_bvh.h) */
+} rs_light_sampler;
+
 /* Path flags. */
 #define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
 #define RS_PATH_NEGATIVE 2u /* the camera sample fell under a negative lobe of the pixel filter
@@ -85,6 +92,7 @@ typedef struct rs_render_consts {
     float tex_spread;   /* the camera's pixel spread angle (radians): |du| over the focus
                            distance, for image textures' level of detail (rs_texture_footprint);
                            0: bilinear textures on level 0 (--texture-filter bilinear) */
+    uint32_t light_sampler; /* rs_light_sampler: how MIS's next-event estimation picks a light */
 } rs_render_consts;
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the
@@ -400,6 +408,15 @@ typedef struct rs_vertex {
     rs_vec3 origin; /* where rays leaving the reflecting side start (rs_spawn_origin) */
 } rs_vertex;
 
+/* The probability that MIS's next-event estimation picks light l at the vertex whose offset
+ * origin is `at` (the ray's that found the light): by power, or by the light BVH. */
+RS_HD float rs_path_light_pick(const rs_render_consts *it, uint32_t l, rs_vec3 at)
+{
+    if (it->light_sampler == RS_LIGHT_SAMPLER_BVH)
+        return rs_light_pick_bvh(it->scene, l, at);
+    return it->scene->lights[l].pick_pdf;
+}
+
 /* An emitter hit: its radiance, MIS-weighted against the light sampling that could also have
  * found it when the path came by BSDF sampling (not after a delta bounce or from the camera,
  * where none could). */
@@ -412,7 +429,9 @@ RS_HD void rs_shade_emitter(const rs_render_consts *it, const rs_ray *r, float t
     int32_t l = rs_scene_prim_light(sc, prim);
     if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
         w = rs_power_heuristic(ps->bsdf_pdf,
-                               rs_light_pdf_hit(sc, (uint32_t)l, r->o, r->time, r->d, t, ng));
+                               rs_light_pdf_hit_pick(sc, (uint32_t)l,
+                                                     rs_path_light_pick(it, (uint32_t)l, r->o),
+                                                     r->o, r->time, r->d, t, ng));
     ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, le), w));
 }
 
@@ -461,7 +480,11 @@ RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, c
     int through;
     /* the light seen from the surface point itself (its distance, direction and pdf); only the
      * shadow ray starts at the offset origin */
-    if (!rs_light_sample_from(sc, subset, v->x, v->n, r->time, rl.v[0], rl.v[1], rl.v[2], &ls))
+    if (subset == RS_LIGHTS_BVH
+            ? !rs_light_sample_bvh(sc, v->x, v->n, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2],
+                                   &ls)
+            : !rs_light_sample_from(sc, subset, v->x, v->n, r->time, rl.v[0], rl.v[1], rl.v[2],
+                                    &ls))
         return 0;
     c = rs_v3_dot(v->n, ls.wi);
     through = !(rs_v3_dot(v->n_geo, ls.wi) > 0.0f); /* beyond a transmitting surface */
@@ -622,8 +645,10 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
             float w = 1.0f;
             int32_t l = rs_scene_prim_light(sc, v.prim);
             if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
-                w = rs_power_heuristic(ps->bsdf_pdf, rs_light_pdf_hit(sc, (uint32_t)l, r.o, r.time,
-                                                                      r.d, h->t, v.ng));
+                w = rs_power_heuristic(
+                    ps->bsdf_pdf, rs_light_pdf_hit_pick(sc, (uint32_t)l,
+                                                        rs_path_light_pick(it, (uint32_t)l, r.o),
+                                                        r.o, r.time, r.d, h->t, v.ng));
             ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, v.m->emission), w));
         }
     }
@@ -647,7 +672,9 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
         rs_rng_f4 rl = pre ? pre[1] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
         v.origin = rs_spawn_origin(v.x, v.err, v.n_geo);
         if (it->sampling == RS_SAMPLING_MIS && rs_scene_has_lights(sc))
-            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_ALL);
+            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow,
+                                      it->light_sampler == RS_LIGHT_SAMPLER_BVH ? RS_LIGHTS_BVH
+                                                                                : RS_LIGHTS_ALL);
         else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > sc->n_area_lights)
             /* the mixture cannot draw a delta light's direction: next-event estimation does,
              * with the same numbers (the mixture's light half uses them only when it picks the
