@@ -22,6 +22,9 @@ typedef struct br_config {
     rs_par_strategy strategy;
     uint32_t bvh_width; /* 2, 4, 8, or 0: the widest this CPU runs */
     int with_gpu;       /* stream: a CUDA device beside the CPU device; megakernel: on CUDA */
+    rs_sampler sampler; /* zeroed: independent */
+    uint32_t light_sampler; /* rs_light_sampler; zeroed: by power */
+    uint64_t seed;      /* 0: 1 */
 } br_config;
 
 /* A benchmark's scene: a built-in one by name, or "cornell-mesh:FILE" (FILE under the models
@@ -82,8 +85,10 @@ static inline int br_render(const char *prog, const rs_scene *scene, const rs_ge
     st.height = c->height;
     st.spp = c->spp;
     st.max_depth = 50;
-    st.seed = 1;
+    st.seed = c->seed ? c->seed : 1;
     st.sampling = c->sampling;
+    st.sampler = c->sampler;
+    st.light_sampler = c->light_sampler;
     st.threads = c->threads;
     st.strategy = c->strategy;
     rs_cores_init(&cores, c->threads);

@@ -43,6 +43,7 @@ typedef struct rt_args {
     rs_adaptive_stats *adaptive_out; /* its statistics, where not NULL */
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
     const rs_filter *filter;         /* the pixel filter; NULL: box, 1 pixel */
+    uint32_t light_sampler;          /* rs_light_sampler; zeroed: by power */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -76,6 +77,7 @@ static inline rs_render_settings rt_settings(const rt_args *a)
     st.wave_paths = a->wave_paths;
     if (a->filter)
         st.filter = *a->filter;
+    st.light_sampler = a->light_sampler;
     return st;
 }
 
