@@ -11,7 +11,9 @@
  * bound never says 0 for a light that can reach the point, so every such light keeps a pick
  * probability above 0 (tests/shading_light_bvh_test.c).  Traversal goes down by the two
  * children's importances; rs_light_bvh_pmf retraces one light's path (rs_scene.light_trail) with
- * the same arithmetic, so a pick's probability and the pmf agree bit for bit.
+ * the same arithmetic, so a pick's probability and the pmf agree bit for bit.  A tree of one
+ * light picks it with probability 1 wherever x is (where it cannot reach x, its sample carries
+ * nothing, as with the power sampler): the one-light scene costs no importance at all.
  *
  * Leaving the normal out keeps the pick a function of the point alone, so the MIS weight of a
  * light that a BSDF sample hit can be computed at the next vertex from the ray's origin. */
@@ -77,26 +79,23 @@ RS_HD int rs_light_bvh_pick(const rs_scene *s, rs_vec3 x, float u, uint32_t *lig
     float p = 1.0f;
     if (!s->light_nodes)
         return 0;
-    if (!(s->light_nodes[0].flags & RS_LIGHT_NODE_LEAF) || rs_light_node_importance(s->light_nodes, x) > 0.0f) {
-        while (!(s->light_nodes[n].flags & RS_LIGHT_NODE_LEAF)) {
-            float p0 = rs_light_bvh_first(s, n, x);
-            if (p0 < 0.0f)
-                return 0;
-            if (u < p0) {
-                u = rs_fminf(u / p0, 0x1.fffffep-1f);
-                p *= p0;
-                n = n + 1;
-            } else {
-                u = rs_fminf((u - p0) / (1.0f - p0), 0x1.fffffep-1f);
-                p *= 1.0f - p0;
-                n = s->light_nodes[n].child;
-            }
+    while (!(s->light_nodes[n].flags & RS_LIGHT_NODE_LEAF)) {
+        float p0 = rs_light_bvh_first(s, n, x);
+        if (p0 < 0.0f)
+            return 0;
+        if (u < p0) {
+            u = rs_fminf(u / p0, 0x1.fffffep-1f);
+            p *= p0;
+            n = n + 1;
+        } else {
+            u = rs_fminf((u - p0) / (1.0f - p0), 0x1.fffffep-1f);
+            p *= 1.0f - p0;
+            n = s->light_nodes[n].child;
         }
-        *light = s->light_nodes[n].child;
-        *pmf = p;
-        return p > 0.0f;
     }
-    return 0;
+    *light = s->light_nodes[n].child;
+    *pmf = p;
+    return p > 0.0f;
 }
 
 /* The probability that rs_light_bvh_pick picks light l for point x (0 for a light outside the
@@ -108,8 +107,6 @@ RS_HD float rs_light_bvh_pmf(const rs_scene *s, rs_vec3 x, uint32_t l)
     float p = 1.0f;
     if (!s->light_nodes || !(trail = s->light_trail[l]))
         return 0.0f;
-    if (s->light_nodes[0].flags & RS_LIGHT_NODE_LEAF)
-        return rs_light_node_importance(s->light_nodes, x) > 0.0f ? 1.0f : 0.0f;
     while (!(s->light_nodes[n].flags & RS_LIGHT_NODE_LEAF)) {
         float p0 = rs_light_bvh_first(s, n, x);
         if (p0 < 0.0f)
