@@ -146,4 +146,30 @@ out:
     return ok;
 }
 
+/* Runs fn(name, ctx) for each name of the comma-separated `list` (empty names skipped): 1 when
+ * every call returned 1, 0 when one returned 0 (a failed check: the others still run), -1 at
+ * the first that returned -1 (an error). */
+static inline int br_each_name(const char *list, int (*fn)(const char *name, const void *ctx),
+                               const void *ctx)
+{
+    char name[128];
+    const char *p, *end;
+    int ok = 1;
+    for (p = list; *p; p = *end ? end + 1 : end) {
+        int r;
+        end = strchr(p, ',');
+        if (!end)
+            end = p + strlen(p);
+        snprintf(name, sizeof name, "%.*s", (int)(end - p), p);
+        if (!name[0])
+            continue;
+        r = fn(name, ctx);
+        if (r < 0)
+            return -1;
+        if (r == 0)
+            ok = 0;
+    }
+    return ok;
+}
+
 #endif

@@ -367,13 +367,17 @@ done:
     return rc;
 }
 
+static int scene_cb(const char *name, const void *ctx)
+{
+    return bench_scene(name, (const opts *)ctx);
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     const char *scenes = "cornell,cornell-bunny-teapot";
-    char why[512], name[128];
-    const char *p, *end;
-    int i, ok = 1;
+    char why[512];
+    int i;
     memset(&o, 0, sizeof o);
     o.size = 256;
     o.spp = 16;
@@ -432,19 +436,5 @@ int main(int argc, char **argv)
     printf("denoiser: Open Image Denoise, RT filter, hdr; %s device requested; %d run%s per row "
            "(median)\n\n",
            o.gpu ? "CUDA" : "CPU", o.runs, o.runs == 1 ? "" : "s");
-    for (p = scenes; *p; p = *end ? end + 1 : end) {
-        int r;
-        end = strchr(p, ',');
-        if (!end)
-            end = p + strlen(p);
-        snprintf(name, sizeof name, "%.*s", (int)(end - p), p);
-        if (!name[0])
-            continue;
-        r = bench_scene(name, &o);
-        if (r < 0)
-            return 1;
-        if (r == 0)
-            ok = 0;
-    }
-    return ok ? 0 : 1;
+    return br_each_name(scenes, scene_cb, &o) == 1 ? 0 : 1;
 }

@@ -181,13 +181,16 @@ done:
     return rc;
 }
 
+static int scene_cb(const char *name, const void *ctx)
+{
+    return bench_scene(name, (const opts *)ctx);
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     const char *scenes = "many-lights,cornell";
-    char name[128];
-    const char *p, *end;
-    int i, ok = 1;
+    int i;
     static const uint32_t full[] = {4, 8, 16, 32, 64}, quick[] = {4, 16};
     memset(&o, 0, sizeof o);
     o.size = 200;
@@ -234,19 +237,5 @@ int main(int argc, char **argv)
         return 2;
     }
     rs_bench_print_machine(stdout);
-    for (p = scenes; *p; p = *end ? end + 1 : end) {
-        int r;
-        end = strchr(p, ',');
-        if (!end)
-            end = p + strlen(p);
-        snprintf(name, sizeof name, "%.*s", (int)(end - p), p);
-        if (!name[0])
-            continue;
-        r = bench_scene(name, &o);
-        if (r < 0)
-            return 1;
-        if (r == 0)
-            ok = 0;
-    }
-    return ok ? 0 : 1;
+    return br_each_name(scenes, scene_cb, &o) == 1 ? 0 : 1;
 }

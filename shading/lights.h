@@ -155,6 +155,20 @@ RS_HD_COLD int rs_light_sample_delta(const rs_scene *s, rs_vec3 x, float u_pick,
                               s->lights[l].pick_pdf / ((1.0f - s->env_pick) * (1.0f - a)), out);
 }
 
+/* A direction toward the environment map from x (surface normal n_x, zero: none), picked with
+ * probability env_pick. */
+RS_HD int rs_light_sample_env(const rs_scene *s, rs_vec3 x, rs_vec3 n_x, float env_pick, float u1,
+                              float u2, rs_light_sample *out)
+{
+    if (!rs_env_sample_at(s, n_x, u1, u2, &out->wi, &out->pdf, &out->le))
+        return 0;
+    out->pdf *= env_pick;
+    out->point = x;
+    out->dist = FLT_MAX;
+    out->env = 1;
+    return 1;
+}
+
 RS_HD int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
                               rs_vec3 x, float time, float u1, float u2, rs_light_sample *out);
 
@@ -183,15 +197,8 @@ RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3
         n = s->n_area_lights;
     }
     if (env_pick > 0.0f) {
-        if (u_pick < env_pick) {
-            if (!rs_env_sample_at(s, n_x, u1, u2, &out->wi, &out->pdf, &out->le))
-                return 0;
-            out->pdf *= env_pick;
-            out->point = x;
-            out->dist = FLT_MAX;
-            out->env = 1;
-            return 1;
-        }
+        if (u_pick < env_pick)
+            return rs_light_sample_env(s, x, n_x, env_pick, u1, u2, out);
         /* the rest of [0, 1) picks an emitter as before */
         u_pick = (u_pick - env_pick) / (1.0f - env_pick);
     }
@@ -296,15 +303,8 @@ RS_HD_COLD int rs_light_sample_bvh(const rs_scene *s, rs_vec3 x, rs_vec3 n_x, rs
     out->env = 0;
     out->delta = 0;
     if (env_pick > 0.0f) {
-        if (u_pick < env_pick) {
-            if (!rs_env_sample_at(s, n_x, u1, u2, &out->wi, &out->pdf, &out->le))
-                return 0;
-            out->pdf *= env_pick;
-            out->point = x;
-            out->dist = FLT_MAX;
-            out->env = 1;
-            return 1;
-        }
+        if (u_pick < env_pick)
+            return rs_light_sample_env(s, x, n_x, env_pick, u1, u2, out);
         u_pick = (u_pick - env_pick) / (1.0f - env_pick);
     }
     if (s->n_lights == 0)
