@@ -64,6 +64,7 @@ static void make_report(const rs_cli_options *o, const render_run *r, rs_report 
     rep->sampler = r->st.sampler;
     rs_filter_describe(&r->st.filter, rep->filter, sizeof rep->filter);
     rep->lighting = r->lighting[0] ? r->lighting : NULL;
+    rep->extensions = r->gltf_extensions[0] ? r->gltf_extensions : NULL;
     rep->texture_filter = r->st.texture_filter == RS_TEXTURE_TRILINEAR ? "trilinear" : "bilinear";
     rep->light_sampler = r->st.light_sampler == RS_LIGHT_SAMPLER_BVH ? "bvh" : "power";
     rep->denoised = r->denoised ? r->denoise_device : NULL;

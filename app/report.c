@@ -237,6 +237,8 @@ static void summary_render(const rs_report *rep)
             rep->filter, rep->max_depth, (unsigned long long)rep->seed, s->seconds, sps, rps, rays,
             (unsigned long long)s->rays_closest, (unsigned long long)s->rays_shadow,
             rep->bvh_builder, rep->bvh_sah, rep->bvh_nodes, rep->bvh_prims, inst, rep->bvh_ms);
+    if (rep->extensions)
+        fprintf(stderr, "glTF extensions read: %s. ", rep->extensions);
     if (rep->lighting)
         fprintf(stderr, "Lit by %s. ", rep->lighting);
     if (rep->denoised)

@@ -32,6 +32,7 @@ typedef struct rs_report {
     char filter[40];       /* "blackman-harris:1.5" */
     const char *texture_filter; /* "trilinear" or "bilinear" */
     const char *light_sampler;  /* "power" or "bvh" */
+    const char *extensions;     /* a glTF file's extensions that were read, or NULL */
     const char *denoised;  /* --denoise: the OIDN device that ran it; NULL: not denoised */
     const char *lighting;  /* how the scene was lit when the file said nothing ("the default
                               sky: ..."), or NULL */

@@ -68,6 +68,8 @@ static int load_scene(const rs_cli_options *o, render_run *r)
         rs_gltf_opts go;
         go.camera = o->camera;
         go.log = o->quiet ? NULL : stderr;
+        go.extensions = r->gltf_extensions;
+        go.extensions_n = sizeof r->gltf_extensions;
         if (rs_scene_load_gltf(o->scene, &go, &r->scene) != RS_OK)
             return rs_app_fail(RS_EXIT_RUNTIME, NULL);
     } else if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK) {

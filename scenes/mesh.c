@@ -1360,6 +1360,8 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
                 rs_mesh_dropped_text(&g.info, why, sizeof why),
                 g.ext.used[0] ? "; extensions: " : "", g.ext.used);
     }
+    if (st == RS_OK && opts && opts->extensions && opts->extensions_n)
+        snprintf(opts->extensions, opts->extensions_n, "%s", g.ext.used);
     rs_gltf_ext_free(&g.ext);
     rs_free(g.mat_of);
     release_scene(g.as);

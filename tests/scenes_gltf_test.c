@@ -161,6 +161,7 @@ static rs_scene *load(const char *name, const char *camera)
     rs_gltf_opts o;
     rs_scene *s = NULL;
     path_of(p, sizeof p, name);
+    memset(&o, 0, sizeof o);
     o.camera = camera;
     o.log = NULL;
     if (rs_scene_load_gltf(p, &o, &s) != RS_OK)
@@ -239,7 +240,7 @@ static void test_hierarchy_camera_lights(void **state)
     {
         /* a name the file lacks: the cameras it has */
         char p2[256];
-        rs_gltf_opts o = {"front", NULL};
+        rs_gltf_opts o = {"front", NULL, NULL, 0};
         rs_scene *t = (rs_scene *)0x1;
         path_of(p2, sizeof p2, "full.gltf");
         rs_error_clear();
