@@ -109,18 +109,19 @@ static int try_open(const char *path, oidn_lib *o, char *why, size_t n, const ch
 }
 
 /* Loads the library (see denoise.h for the order) unless it is loaded; 1, or 0 with why[n]. */
-/* AddressSanitizer builds (gcc's __SANITIZE_ADDRESS__, clang's __has_feature): OIDN's CPU
- * device makes TBB dlopen libtbbbind with RTLD_DEEPBIND, and ASan's runtime aborts the process
- * on that (google/sanitizers#611), so such a build reports OIDN unavailable instead. */
-#if defined(__SANITIZE_ADDRESS__)
-#  define RS_DENOISE_UNDER_ASAN 1
+/* AddressSanitizer and ThreadSanitizer builds (gcc's __SANITIZE_ADDRESS__ and
+ * __SANITIZE_THREAD__, clang's __has_feature): OIDN's CPU device makes TBB dlopen libtbbbind with
+ * RTLD_DEEPBIND, and both runtimes abort the process on that (google/sanitizers#611), so such a
+ * build reports OIDN unavailable instead. */
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#  define RS_DENOISE_UNDER_SANITIZER 1
 #elif defined(__has_feature)
-#  if __has_feature(address_sanitizer)
-#    define RS_DENOISE_UNDER_ASAN 1
+#  if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#    define RS_DENOISE_UNDER_SANITIZER 1
 #  endif
 #endif
-#ifndef RS_DENOISE_UNDER_ASAN
-#  define RS_DENOISE_UNDER_ASAN 0
+#ifndef RS_DENOISE_UNDER_SANITIZER
+#  define RS_DENOISE_UNDER_SANITIZER 0
 #endif
 
 static int load(char *why, size_t n)
@@ -155,13 +156,13 @@ static int load(char *why, size_t n)
                     RS_DENOISE_DEFAULT_LIBRARY);
         }
     }
-#if RS_DENOISE_UNDER_ASAN
+#if RS_DENOISE_UNDER_SANITIZER
     if (ok == 1) { /* loaded, but its first device would abort the process */
         dlclose(o.lib);
         ok = 0;
-        rs_say(why, n, "Open Image Denoise cannot run in this AddressSanitizer build (its TBB "
-                       "opens libtbbbind with RTLD_DEEPBIND, which the sanitizer's runtime "
-                       "refuses); use a build without -fsanitize=address");
+        rs_say(why, n, "Open Image Denoise cannot run in this sanitizer build (its TBB opens "
+                       "libtbbbind with RTLD_DEEPBIND, which the sanitizer's runtime refuses); "
+                       "use a build without -fsanitize=address or thread");
     }
 #endif
     if (ok == 1) {
