@@ -188,6 +188,41 @@ if [ "$ext" = pfm ]; then
     done
 fi
 
+# ---- 5b. issue 29's code on the GPU: the light BVH and glTF's layered materials ---------------
+# builtin:many-lights with --light-sampler bvh, and scripts/make-gltf-samples.py's spheres (every
+# material extension; needs python3), on the CPU, the GPU and the GPU megakernel: the same image
+scenes="builtin:many-lights --light-sampler bvh"
+if command -v python3 >/dev/null 2>&1 &&
+    python3 scripts/make-gltf-samples.py "$out/gltf" >/dev/null 2>&1; then
+    scenes="$scenes|$out/gltf/extensions.gltf --background 1"
+else
+    say "python3 missing: the glTF extension spheres are not rendered on the GPU"
+fi
+k=0
+echo "$scenes" | tr '|' '\n' >"$out/scenes29.txt"
+while read -r spec; do
+    k=$((k + 1))
+    for args in "--devices cpu" "--devices gpu" "--integrator megakernel --devices gpu"; do
+        name=s29-$k-$(echo "$args" | sed 's/--devices //; s/--integrator //; s/ /-/g')
+        rc=0
+        # shellcheck disable=SC2086
+        build-gpu/raystream render $spec --width 192 --height 144 --spp 16 $args \
+            -o "$out/$name.$ext" >"$out/$name.txt" 2>&1 || rc=$?
+        [ $rc = 0 ] || failed "render $spec $args: exit $rc (see $out/$name.txt)"
+    done
+    if [ "$ext" = pfm ]; then
+        for b in gpu megakernel-gpu; do
+            if cmp -s "$out/s29-$k-cpu.pfm" "$out/s29-$k-$b.pfm"; then
+                say "render $spec on $b: the CPU image, byte for byte"
+            else
+                failed "render $spec on $b: not the CPU image"
+            fi
+        done
+    else
+        say "render $spec: rendered on cpu, gpu and the GPU megakernel (EXR: not compared here)"
+    fi
+done <"$out/scenes29.txt"
+
 # ---- benchmarks, on request -------------------------------------------------------------------
 if [ -n "$bench" ]; then
     build-gpu/bench/scheduler_bench $quick --csv "$out/scheduler_bench.csv" >"$out/scheduler_bench.txt" 2>&1 || failed "scheduler_bench"
