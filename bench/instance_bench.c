@@ -130,6 +130,7 @@ int main(int argc, char **argv)
     char dir[] = "/tmp/rs_instance_bench_XXXXXX", mesh[128], scene[128];
     sample smp[2][MAX_RUNS];
     float *rgb[2];
+    BR_SKIP_NO_SCENE_FILES(argv[0]);
     memset(&c, 0, sizeof c);
     c.width = 320;
     c.height = 240;

@@ -9,11 +9,32 @@
 #include <string.h>
 
 #include "core/clock.h"
+#include "core/image_io.h"
 #include "core/parallel.h"
 #include "gpu/gpu_device.h"
 
 #ifndef RS_BUILD_FLAGS
 #  define RS_BUILD_FLAGS "?"
+#endif
+
+/* The float image format this build writes: .exr, or .pfm in the PFM-only build (no
+ * OpenImageIO: RS_DEPS=OPTIONAL, a bare GPU machine's). */
+static inline const char *br_float_ext(void)
+{
+    return strncmp(rs_image_library_version(), "none", 4) == 0 ? "pfm" : "exr";
+}
+
+/* A benchmark that renders scene files it writes: in a build that reads none (RS_DEPS=OPTIONAL
+ * without cJSON; bench/CMakeLists.txt defines RS_NO_SCENE_FILES) it says so and exits 77, which
+ * CTest and bench/run-all count as skipped. */
+#ifdef RS_NO_SCENE_FILES
+#  define BR_SKIP_NO_SCENE_FILES(prog)                                                         \
+      do {                                                                                     \
+          printf("%s: skipped: this build has no cJSON and reads no scene files\n", (prog));  \
+          return 77;                                                                           \
+      } while (0)
+#else
+#  define BR_SKIP_NO_SCENE_FILES(prog) (void)(prog)
 #endif
 
 static inline int rs_bench_cmp_double(const void *a, const void *b)

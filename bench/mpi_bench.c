@@ -147,7 +147,7 @@ static int render_once(int ranks, const char *scene, uint32_t w, uint32_t h, uin
     snprintf(hs, sizeof hs, "%u", h);
     snprintf(ss, sizeof ss, "%u", spp);
     snprintf(ns, sizeof ns, "%d", ranks);
-    snprintf(img, sizeof img, "%s/img-%d.exr", tmp_dir, ranks);
+    snprintf(img, sizeof img, "%s/img-%d.%s", tmp_dir, ranks, br_float_ext());
     snprintf(json, sizeof json, "%s/stats-%d.json", tmp_dir, ranks);
     if (ranks > 0) {
         argv[k++] = (char *)"mpirun";

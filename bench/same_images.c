@@ -22,6 +22,7 @@
 
 #include "core/alloc.h"
 #include "core/image_io.h"
+#include "machine.h"
 
 #ifndef RS_BINARY_DIR
 #  define RS_BINARY_DIR "."
@@ -93,8 +94,8 @@ static void check(ctx *c, const char *label, const char *args, image *ref)
 {
     char out[1024], old_out[1024];
     image im = {0, 0, NULL}, old = {0, 0, NULL};
-    snprintf(out, sizeof out, "%s/new.exr", c->dir);
-    snprintf(old_out, sizeof old_out, "%s/old.exr", c->dir);
+    snprintf(out, sizeof out, "%s/new.%s", c->dir, br_float_ext());
+    snprintf(old_out, sizeof old_out, "%s/old.%s", c->dir, br_float_ext());
     c->renders++;
     if (!render(c->new_bin, args, out) || !load(out, &im)) {
         c->bad++;
@@ -122,7 +123,7 @@ static void check_resume(ctx *c, const char *base, const char *label, image *ref
     char args[1400], ckpt[1024], out[1024], what[1200];
     image im = {0, 0, NULL};
     snprintf(ckpt, sizeof ckpt, "%s/part.ckpt", c->dir);
-    snprintf(out, sizeof out, "%s/part.exr", c->dir);
+    snprintf(out, sizeof out, "%s/part.%s", c->dir, br_float_ext());
     snprintf(args, sizeof args, "%s --spp 3 --checkpoint %s", base, ckpt);
     unlink(ckpt);
     if (!render(c->new_bin, args, out)) {

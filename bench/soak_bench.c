@@ -539,6 +539,7 @@ int main(int argc, char **argv)
     const char *tmp = getenv("TMPDIR");
     tally ty;
     int i, ok;
+    BR_SKIP_NO_SCENE_FILES(argv[0]);
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--quick") == 0) {
             seconds = 3.0;

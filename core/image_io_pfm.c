@@ -3,6 +3,7 @@
  * only (.pfm, linear RGB, written bottom row first as the format says), with the same
  * temporary-file-and-rename write as the OpenImageIO shim.  Every other extension is an error
  * that says why. */
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -99,6 +100,84 @@ rs_status rs_image_write_meta(const char *path, uint32_t w, uint32_t h, const fl
     (void)meta; /* a .pfm has no header for them */
     (void)n_meta;
     return rs_image_write(path, w, h, rgb);
+}
+
+/* Extra layers need an .exr, which needs OpenImageIO; without layers a .pfm as rs_image_write. */
+rs_status rs_image_write_layers(const char *path, uint32_t w, uint32_t h, const float *rgb,
+                                const rs_image_layer *layers, size_t n_layers,
+                                const rs_image_meta *meta, size_t n_meta)
+{
+    (void)layers;
+    if (n_layers > 0)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: extra layers (AOVs) need an .exr file, and this build has no "
+                            "OpenImageIO",
+                            path);
+    return rs_image_write_meta(path, w, h, rgb, meta, n_meta);
+}
+
+/* A .pfm is a float format: the view leaves its pixels linear, as in the OpenImageIO build, and
+ * the format has no header to record the view in. */
+rs_status rs_image_write_view(const char *path, uint32_t w, uint32_t h, const float *rgb,
+                              const rs_image_layer *layers, size_t n_layers,
+                              const rs_image_meta *meta, size_t n_meta, const rs_view *view)
+{
+    (void)view;
+    return rs_image_write_layers(path, w, h, rgb, layers, n_layers, meta, n_meta);
+}
+
+int rs_image_is_display_format(const char *path)
+{
+    static const char *const exts[] = {"png", "jpg", "jpeg", "tif", "tiff", "bmp", "tga"};
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    char e[8];
+    size_t i, n;
+    if (!dot || (slash && dot < slash) || (n = strlen(dot + 1)) >= sizeof e)
+        return 0;
+    for (i = 0; i <= n; ++i)
+        e[i] = (char)tolower((unsigned char)dot[1 + i]);
+    for (i = 0; i < sizeof exts / sizeof exts[0]; ++i)
+        if (strcmp(e, exts[i]) == 0)
+            return 1;
+    return 0;
+}
+
+/* A .pfm holds R, G and B. */
+rs_status rs_image_read_channel(const char *path, const char *channel, uint32_t *w, uint32_t *h,
+                                float **data)
+{
+    static const char names[] = "RGB";
+    const char *c = strlen(channel) == 1 ? strchr(names, channel[0]) : NULL;
+    float *rgb = NULL;
+    size_t i, n;
+    rs_status st;
+    *data = NULL;
+    if (!c || !*c)
+        return rs_error_set(RS_ERR_ARG, "%s: no channel %s (this build has no OpenImageIO: .pfm "
+                                        "files hold R, G and B only)",
+                            path, channel);
+    st = rs_image_read(path, w, h, &rgb);
+    if (st != RS_OK)
+        return st;
+    n = (size_t)*w * *h;
+    if (!(*data = (float *)rs_alloc(n, sizeof(float)))) {
+        rs_free(rgb);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory reading channel %s", path, channel);
+    }
+    for (i = 0; i < n; ++i)
+        (*data)[i] = rgb[3 * i + (size_t)(c - names)];
+    rs_free(rgb);
+    return RS_OK;
+}
+
+/* A .pfm has no alpha: opaque (RS_OK, *alpha NULL) once the file reads as one. */
+rs_status rs_image_read_alpha(const char *path, uint32_t *w, uint32_t *h, float **alpha)
+{
+    float *rgb = NULL;
+    rs_status st = rs_image_read(path, w, h, &rgb);
+    *alpha = NULL;
+    rs_free(rgb);
+    return st;
 }
 
 rs_status rs_image_read_meta(const char *path, const char *key, char *value, size_t n)
