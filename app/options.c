@@ -236,6 +236,10 @@ static void help_render_devices(void)
           "                      megakernel (the thesis's per-pixel loop, on one device: the\n"
           "                      cpu, or a gpu (CUDA, one thread per pixel); auto picks the\n"
           "                      gpu where there is one; same image)\n"
+          "  --shade-on WHERE    stream integrator: device (default): a GPU runs its paths\n"
+          "                      whole, shading included (its own wavefront; --devices auto\n"
+          "                      then takes the GPU alone); host: the devices only trace and\n"
+          "                      the host shades every ray (the thesis's design); same image\n"
           "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
           "                      tasks (the thesis's three OpenMP strategies)\n",
           stdout);
@@ -571,6 +575,15 @@ static int opt_integrator(const char *name, const char *v, rs_cli_options *o)
     return RS_EXIT_OK;
 }
 
+static int opt_shade_on(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (strcmp(v, "device") != 0 && strcmp(v, "host") != 0)
+        return usage_error("--shade-on: '%s'%s (use device or host)", v, "");
+    o->shade_host = v[0] == 'h';
+    return RS_EXIT_OK;
+}
+
 static int opt_cpu_strategy(const char *name, const char *v, rs_cli_options *o)
 {
     (void)name;
@@ -735,6 +748,7 @@ static const opt_row options[] = {
     ROW_CALL("--devices", opt_devices),
     ROW_NUM("--require-gpu", OPT_FLAG, require_gpu, 0, 0),
     ROW_CALL("--integrator", opt_integrator),
+    ROW_CALL("--shade-on", opt_shade_on),
     ROW_CALL("--cpu-strategy", opt_cpu_strategy),
     ROW_NUM("--stats", OPT_FLAG, stats, 0, 0),
     ROW_TEXT("--stats-json", NULL, stats_json, "a file name"),

@@ -82,6 +82,9 @@ typedef struct rs_cli_options {
     int require_gpu;       /* --require-gpu: a gpu that cannot be used is an error, not the
                               CPU fallback (app/devices.h) */
     int megakernel;           /* --integrator megakernel: the per-pixel loop on one device */
+    int shade_host;           /* --shade-on host: devices only trace, the host shades every ray
+                                 (the thesis's design); default: a device that can runs its
+                                 paths whole (a GPU's wavefront) */
     rs_par_strategy strategy; /* --cpu-strategy */
     int no_bvh;               /* --no-bvh: every ray tests every primitive */
     int flatten_instances;    /* --flatten-instances: instances copied, one-level BVH */

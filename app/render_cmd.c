@@ -269,12 +269,20 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
     int n = make_devices(o, r);
     if (n < 0)
         return RS_EXIT_RUNTIME;
+    /* one device that runs paths whole (a GPU, or its fallback): the stream integrator's stages
+     * run there, shading included, unless --shade-on host keeps the shading on the host */
+    if (!o->megakernel && !o->shade_host && n == 1 && r->devs[0]->ops->render_paths) {
+        r->mk = r->devs[0];
+        r->devs[0] = NULL;
+        r->n_devs = 0;
+        r->wavefront = 1;
+    }
     /* about 200 spans per wave and device; the log never grows past this */
     if (o->timeline && rs_timeline_create(1u << 20, &r->timeline) != RS_OK)
         return rs_app_fail(RS_EXIT_RUNTIME, "starting the timeline");
     r->st.timeline = r->timeline;
-    r->st.timeline_lane = (uint16_t)(o->megakernel ? 1 : n);
-    if (!o->megakernel) {
+    r->st.timeline_lane = (uint16_t)(o->megakernel || r->wavefront ? 1 : n);
+    if (!o->megakernel && !r->wavefront) {
         rs_sched_config cfg;
         memset(&cfg, 0, sizeof cfg);
         cfg.chunk_size = o->chunk_size;
@@ -289,7 +297,8 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
     }
     /* under mpirun the job's coordinator keeps the time (app/distributed.h) */
     r->st.time_limit_s = r->dist ? 0.0 : o->time_limit_s;
-    if (rs_engine_create(r->scene, &r->st, r->sched, r->mk, &r->engine) != RS_OK)
+    if (r->wavefront ? rs_engine_create_paths(r->scene, &r->st, r->mk, &r->engine) != RS_OK
+                     : rs_engine_create(r->scene, &r->st, r->sched, r->mk, &r->engine) != RS_OK)
         return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
     return RS_EXIT_OK;
 }

@@ -30,7 +30,8 @@ static void report_devices(const render_run *r, rs_report *rep)
         d->threads = r->mk->threads;
         d->alive = 1;
         rep->n_dev = 1;
-        rep->megakernel = 1;
+        rep->megakernel = !r->wavefront;
+        rep->wavefront = r->wavefront;
         rep->mk_gpu = rs_device_owns_memory(r->mk);
         return;
     }

@@ -32,7 +32,8 @@ typedef struct render_run {
     double bvh_ms;
     rs_device *devs[RS_MAX_DEVICES]; /* the stream engine's devices */
     int n_devs;
-    rs_device *mk; /* the megakernel's one device */
+    rs_device *mk; /* the megakernel's one device, or the one that runs its paths whole */
+    int wavefront; /* mk runs the stream integrator's paths whole (rs_engine_create_paths) */
     rs_sched *sched;
     rs_engine *engine; /* set up once; every plan of the render runs on it */
     rs_film *film;

@@ -264,7 +264,10 @@ static void summary_devices(const rs_report *rep)
                 rays_total ? 100.0 * (double)d->ds.rays / (double)rays_total : 0.0,
                 d->alive ? "" : " and then failed", i + 1 == rep->n_dev ? ". " : "");
     }
-    if (rep->megakernel && rep->mk_gpu)
+    if (rep->wavefront)
+        fprintf(stderr, "Integrator: stream, paths run whole on %s (its own wavefront). ",
+                rep->dev[0].name);
+    else if (rep->megakernel && rep->mk_gpu)
         fprintf(stderr, "Integrator: megakernel on %s. ", rep->dev[0].name);
     else if (rep->megakernel)
         fprintf(stderr, "Integrator: megakernel on %s (%s, %d thread%s). ", rep->dev[0].name,

@@ -24,6 +24,7 @@ typedef struct rs_report {
     /* what was asked: the options' strings (they outlive the report) */
     const char *scene, *image, *resume, *checkpoint; /* resume, checkpoint: NULL where none */
     int quiet, megakernel, mk_gpu;                   /* mk_gpu: the megakernel ran on a GPU */
+    int wavefront; /* the stream integrator's paths ran whole on dev[0] (its wavefront) */
     const char *strategy;                            /* the megakernel's host thread split */
     uint32_t width, height, spp, spp_min, max_depth; /* spp asked; spp_min every pixel has */
     uint64_t seed;

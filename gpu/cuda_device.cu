@@ -305,7 +305,7 @@ static void cuda_destroy(rs_device *d)
 
 static const rs_device_ops cuda_ops = {cuda_upload,        cuda_trace,     cuda_destroy,
                                        cuda_host_alloc,    cuda_host_free, rs_cuda_upload_scene,
-                                       rs_cuda_render_pass};
+                                       rs_cuda_render_pass, rs_cuda_render_paths};
 
 extern "C" int rs_gpu_compiled(void) { return 1; }
 
@@ -371,20 +371,33 @@ extern "C" int rs_gpu_count(const char **why)
     return p.n;
 }
 
+/* Every kernel of the device, for their attributes: the trace kernel, the megakernel, the
+ * wavefront's five. */
+#define RS_CUDA_KERNELS 7
+static void kernel_entries(const void **fn)
+{
+    int k;
+    fn[0] = (const void *)rs_trace_kernel;
+    fn[1] = rs_cuda_megakernel_entry();
+    for (k = 0; k < 5; ++k)
+        fn[2 + k] = rs_cuda_wf_entry(k);
+}
+
 /* Raises device `index`'s stack limit (per thread; the device current) to the most local memory
  * a kernel of ours uses, as cudaFuncGetAttributes reports it (also what fails first when the
  * build has no code for this GPU's architecture).  The limit is never lowered. */
 static rs_status size_stack(int index)
 {
-    static const char *const names[2] = {"rs_trace_kernel", "rs_megakernel_kernel"};
-    const void *fn[2];
+    static const char *const names[RS_CUDA_KERNELS] = {
+        "rs_trace_kernel",    "rs_megakernel_kernel", "rs_wf_raygen_kernel", "rs_wf_trace_kernel",
+        "rs_wf_shade_kernel", "rs_wf_resolve_kernel", "rs_wf_film_kernel"};
+    const void *fn[RS_CUDA_KERNELS];
     cudaFuncAttributes a;
-    size_t need = 0, have = 0, local[2];
+    size_t need = 0, have = 0, local[RS_CUDA_KERNELS];
     cudaError_t e;
-    int k;
-    fn[0] = (const void *)rs_trace_kernel;
-    fn[1] = rs_cuda_megakernel_entry();
-    for (k = 0; k < 2; ++k) {
+    int k, most = 0;
+    kernel_entries(fn);
+    for (k = 0; k < RS_CUDA_KERNELS; ++k) {
         if ((e = cudaFuncGetAttributes(&a, fn[k])) != cudaSuccess) {
             cudaDeviceProp prop;
             int major = 0, minor = 0;
@@ -396,7 +409,10 @@ static rs_status size_stack(int index)
                                 index, names[k], cudaGetErrorString(e), major, minor);
         }
         local[k] = a.localSizeBytes;
-        need = local[k] > need ? local[k] : need;
+        if (local[k] > need) {
+            need = local[k];
+            most = k;
+        }
     }
     CUDA_TRY(cudaDeviceGetLimit(&have, cudaLimitStackSize));
     if (have >= need)
@@ -405,9 +421,8 @@ static rs_status size_stack(int index)
         return rs_error_set(RS_ERR_CUDA,
                             "gpu:%d: cannot raise the CUDA stack from %zu to %zu bytes per thread, "
                             "the kernels' local memory (cudaFuncGetAttributes localSizeBytes: "
-                            "%s %zu, %s %zu): cudaDeviceSetLimit(cudaLimitStackSize) failed: %s",
-                            index, have, need, names[0], local[0], names[1], local[1],
-                            cudaGetErrorString(e));
+                            "%s %zu): cudaDeviceSetLimit(cudaLimitStackSize) failed: %s",
+                            index, have, need, names[most], local[most], cudaGetErrorString(e));
     CUDA_TRY(cudaDeviceGetLimit(&have, cudaLimitStackSize));
     if (have < need)
         return rs_error_set(RS_ERR_CUDA,
@@ -419,7 +434,9 @@ static rs_status size_stack(int index)
 
 extern "C" int rs_gpu_describe(int index, char *buf, size_t n)
 {
-    static const char *const names[2] = {"trace", "megakernel"};
+    static const char *const names[RS_CUDA_KERNELS] = {
+        "trace", "megakernel", "wf-raygen", "wf-trace", "wf-shade", "wf-resolve", "wf-film"};
+    const void *fn[RS_CUDA_KERNELS];
     const char *why = "";
     int count = rs_gpu_count(&why), drv = 0, rt = 0, k;
     char dv[16], rv[16];
@@ -442,10 +459,10 @@ extern "C" int rs_gpu_describe(int index, char *buf, size_t n)
     used = (size_t)snprintf(buf, n, "gpu:%d %s (sm_%d%d, %d SMs), driver for CUDA %s, runtime %s;",
                             index, prop.name, prop.major, prop.minor, prop.multiProcessorCount, dv,
                             rv);
-    for (k = 0; k < 2 && used < n; ++k) {
+    kernel_entries(fn);
+    for (k = 0; k < RS_CUDA_KERNELS && used < n; ++k) {
         cudaFuncAttributes a;
-        const void *fn = k ? rs_cuda_megakernel_entry() : (const void *)rs_trace_kernel;
-        if (cudaFuncGetAttributes(&a, fn) != cudaSuccess)
+        if (cudaFuncGetAttributes(&a, fn[k]) != cudaSuccess)
             used += (size_t)snprintf(buf + used, n - used, " %s: no attributes;", names[k]);
         else
             used += (size_t)snprintf(buf + used, n - used,

@@ -62,6 +62,7 @@ void rs_cuda_scene_release(rs_cuda_impl *c)
 {
     rs_cuda_mk *mk = &c->mk;
     int k;
+    rs_cuda_wf_release(c); /* the wavefront reads the scene copy */
     for (k = 0; k < 2; ++k) {
         rs_cuda_mk_slot *sl = &mk->slot[k];
         if (sl->done)

@@ -39,6 +39,7 @@
 #include "core/alloc.h"
 #include "core/cores.h"
 #include "gpu/megakernel_path.h"
+#include "gpu/wavefront.h"
 #include "scheduler/device_copy.h"
 #include "scheduler/sched.h"
 #include "shading/path_counts.h"
@@ -56,7 +57,18 @@ typedef struct fallback_impl {
     rs_render_consts it;   /* the render's constants, it.scene = scene.scene */
     rs_vec3 *radiance;     /* it.npix: one pass */
     int pass_ready;
+    /* render_paths: the wavefront's buffers (RS_WF_FALLBACK_WAVE paths, made at the first call)
+     * and its film (it.npix pixels) */
+    rs_paths paths;
+    rs_ray_soa queue[2], shadow;
+    rs_hit_soa wf_hits;
+    uint8_t *occ;
+    uint32_t wf_cap;
+    rs_wf_film film;
 } fallback_impl;
+
+/* The fallback's waves: smaller than the GPU's (host caches), the same stages. */
+#define RS_WF_FALLBACK_WAVE (1u << 16)
 
 static void free_staging(fallback_impl *f)
 {
@@ -95,8 +107,26 @@ static rs_status ensure_staging(fallback_impl *f, uint32_t n)
     return RS_OK;
 }
 
+static void release_wavefront(fallback_impl *f)
+{
+    rs_paths_free(&f->paths);
+    rs_ray_soa_free(&f->queue[0]);
+    rs_ray_soa_free(&f->queue[1]);
+    rs_ray_soa_free(&f->shadow);
+    rs_hit_soa_free(&f->wf_hits);
+    rs_free(f->occ);
+    f->occ = NULL;
+    f->wf_cap = 0;
+    rs_free(f->film.sum);
+    rs_free(f->film.count);
+    rs_free(f->film.sum_l2);
+    rs_free(f->film.nonfinite);
+    memset(&f->film, 0, sizeof f->film);
+}
+
 static void release_pass(fallback_impl *f)
 {
+    release_wavefront(f);
     rs_device_scene_release(&f->scene, &rs_device_copy_host_ops);
     rs_free(f->radiance);
     f->radiance = NULL;
@@ -249,6 +279,139 @@ static rs_status fallback_render_pass(rs_device *d, const rs_pass_job *job, uint
     return RS_OK;
 }
 
+/* The wavefront's buffers and film, made at the first render_paths (the film's variance words
+ * when the host film first keeps them). */
+static rs_status wavefront_ready(rs_device *d, fallback_impl *f, int l2)
+{
+    size_t npix = f->it.npix;
+    rs_status st;
+    if (!f->wf_cap) {
+        uint32_t cap = RS_WF_FALLBACK_WAVE;
+        if ((st = rs_paths_init(&f->paths, cap)) != RS_OK ||
+            (st = rs_ray_soa_init(&f->queue[0], cap)) != RS_OK ||
+            (st = rs_ray_soa_init(&f->queue[1], cap)) != RS_OK ||
+            (st = rs_ray_soa_init(&f->shadow, cap)) != RS_OK ||
+            (st = rs_hit_soa_init(&f->wf_hits, cap)) != RS_OK)
+            goto fail;
+        f->occ = (uint8_t *)rs_alloc_aligned(cap, 1);
+        f->film.sum = (rs_wf_u64 *)rs_calloc(6 * npix, sizeof *f->film.sum);
+        f->film.count = (unsigned int *)rs_calloc(npix, sizeof *f->film.count);
+        f->film.nonfinite = (rs_wf_u64 *)rs_calloc(1, sizeof *f->film.nonfinite);
+        if (!f->occ || !f->film.sum || !f->film.count || !f->film.nonfinite)
+            goto nomem;
+        f->wf_cap = cap;
+    }
+    if (l2 && !f->film.sum_l2 &&
+        !(f->film.sum_l2 = (rs_wf_u64 *)rs_calloc(3 * npix, sizeof *f->film.sum_l2)))
+        goto nomem;
+    return RS_OK;
+nomem:
+    st = rs_error_set(RS_ERR_NOMEM, "device %s: out of memory for the wavefront", d->name);
+fail:
+    release_wavefront(f);
+    return st;
+}
+
+/* One wave of the wavefront on host threads: the CUDA kernels' bodies (gpu/wavefront.h) as
+ * loops, the queues appended with atomics as there. */
+static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_counts *counts)
+{
+    const rs_render_consts *it = &f->it;
+    const rs_path_tracer *tr = &f->scene.tracer;
+    uint32_t alive = w->count, cur = 0;
+    long i;
+    (void)threads; /* read only by the OpenMP clauses */
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+    for (i = 0; i < (long)w->count; ++i)
+        rs_wf_raygen(it, w, (uint32_t)i, &f->paths, &f->queue[0]);
+    for (w->bounce = 0; alive > 0; w->bounce++) {
+        rs_trace_batch tb;
+        uint32_t n_next = 0, n_shadow = 0;
+        memset(&tb, 0, sizeof tb);
+        tb.kind = RS_TRACE_CLOSEST;
+        tb.count = alive;
+        tb.rays = f->queue[cur];
+        tb.hits = f->wf_hits;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1)
+        for (i = 0; i < (long)alive; ++i)
+            rs_trace_one(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
+        counts->closest += alive;
+        if (w->bounce > counts->max_bounce)
+            counts->max_bounce = w->bounce;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1)
+        for (i = 0; i < (long)alive; ++i) {
+            rs_ray nr, sr;
+            uint32_t p, made = rs_wf_shade(it, w, (uint32_t)i, &f->queue[cur], &f->wf_hits, &f->paths,
+                                           &nr, &sr, &p);
+            if (made & RS_SHADE_SHADOW)
+                rs_ray_soa_set(&f->shadow, RS_WF_ADD32(&n_shadow, 1u), &sr, p);
+            if (made & RS_SHADE_NEXT)
+                rs_ray_soa_set(&f->queue[cur ^ 1], RS_WF_ADD32(&n_next, 1u), &nr, p);
+        }
+        if (n_shadow) {
+            tb.kind = RS_TRACE_OCCLUDED;
+            tb.count = n_shadow;
+            tb.rays = f->shadow;
+            tb.occluded = f->occ;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1)
+            for (i = 0; i < (long)n_shadow; ++i)
+                rs_trace_one(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+            for (i = 0; i < (long)n_shadow; ++i)
+                rs_wf_resolve((uint32_t)i, &f->shadow, f->occ, &f->paths);
+            counts->shadow += n_shadow;
+        }
+        cur ^= 1;
+        alive = n_next;
+    }
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+    for (i = 0; i < (long)w->count; ++i)
+        rs_wf_film_path(w, (uint32_t)i, &f->paths, &f->film);
+}
+
+static rs_status fallback_render_paths(rs_device *d, const rs_paths_job *job, uint64_t p0,
+                                       uint64_t p1, uint64_t *done, rs_path_counts *counts)
+{
+    fallback_impl *f = (fallback_impl *)d->impl;
+    rs_wf_wave w;
+    rs_film view;
+    rs_status st;
+    uint64_t g;
+    int threads;
+    *done = 0;
+    if (!f->pass_ready)
+        return rs_error_set(RS_ERR_ARG, "device %s: render_paths before upload_scene", d->name);
+    if (job->film->width * job->film->height != f->it.npix)
+        return rs_error_set(RS_ERR_ARG, "device %s: the film is not the upload_scene's image size",
+                            d->name);
+    if ((st = wavefront_ready(d, f, job->film->sum_l2 != NULL)) != RS_OK)
+        return st;
+    memset(&w, 0, sizeof w);
+    w.pixel_of = job->pixel_of; /* host memory is the fallback's own */
+    w.n_active = job->n_active;
+    threads = rs_cores_acquire(f->cores, d->threads);
+    for (g = p0; g < p1; g += w.count) {
+        if (job->cancelled && job->cancelled(job->user))
+            break;
+        w.start = g;
+        w.count = p1 - g < f->wf_cap ? (uint32_t)(p1 - g) : f->wf_cap;
+        run_wave(f, threads, &w, counts);
+        *done += w.count;
+    }
+    rs_cores_release(f->cores, threads);
+    /* the finished waves onto the host's film, the device's cleared for the next call */
+    view = rs_wf_film_view(&f->film, job->film->width, job->film->height);
+    if (!job->film->sum_l2)
+        view.sum_l2 = NULL;
+    st = rs_film_merge(job->film, &view);
+    memset(f->film.sum, 0, 6 * (size_t)f->it.npix * sizeof *f->film.sum);
+    memset(f->film.count, 0, (size_t)f->it.npix * sizeof *f->film.count);
+    if (f->film.sum_l2)
+        memset(f->film.sum_l2, 0, 3 * (size_t)f->it.npix * sizeof *f->film.sum_l2);
+    *f->film.nonfinite = 0;
+    return st;
+}
+
 static void fallback_destroy(rs_device *d)
 {
     fallback_impl *f = (fallback_impl *)d->impl;
@@ -267,7 +430,8 @@ static const rs_device_ops fallback_ops = {fallback_upload,
                                            NULL, /* host_alloc: malloc */
                                            NULL,
                                            fallback_upload_scene,
-                                           fallback_render_pass};
+                                           fallback_render_pass,
+                                           fallback_render_paths};
 
 rs_status rs_gpu_fallback_create(int threads, int gpu_index, rs_cores *cores, rs_device **out)
 {

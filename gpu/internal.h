@@ -19,6 +19,7 @@
 
 #include "gpu/cuda_check.h"
 #include "gpu/gpu_device.h"
+#include "gpu/wavefront.h"
 #include "scheduler/device_copy.h"
 
 #define RS_CUDA_STAGES 2
@@ -32,6 +33,12 @@
  * registers, the trace kernel 118, no spills, stack frames of 976 and 736 bytes unchanged). */
 #define RS_CUDA_TRACE_BLOCK_MAX 256
 #define RS_CUDA_MK_BLOCK_MAX    256
+/* The wavefront's kernels (gpu/cuda_wavefront.cu): at most 256 threads a block, registers left
+ * to ptxas (no minimum of blocks per SM). */
+#define RS_CUDA_WF_BLOCK_MAX 256
+/* Paths per wave of the wavefront (two in flight): enough to fill an H200 (132 SMs x 2048
+ * threads) several times over at every segment but the last few. */
+#define RS_CUDA_WF_WAVE (1u << 21)
 
 /* One of the two staging sets a chunk's pieces alternate between.  While one piece's rays are
  * copied in, traced and copied out on one stream, the host packs the next piece into the other
@@ -72,6 +79,35 @@ typedef struct rs_cuda_mk {
     int ready;
 } rs_cuda_mk;
 
+/* One wave of the wavefront in flight, on one stream: its path state, its two queues (current
+ * and next), the shadow queue, hits and occlusion, all cut from one device block; d_counts[0]
+ * the next rays appended, [1] the shadow rays, [2] the current queue's entries; h_counts pinned
+ * (the first two copied back per segment, [4] the wave's size copied in). */
+typedef struct rs_cuda_wf_slot {
+    void *block;
+    rs_paths paths;
+    rs_ray_soa queue[2], shadow;
+    rs_hit_soa hits;
+    uint8_t *occ;
+    unsigned int *d_counts, *h_counts;
+    cudaEvent_t done;
+    cudaStream_t stream; /* the device's stage k stream */
+    rs_wf_wave w;
+    uint32_t cur, upper;
+    int active, pending;
+} rs_cuda_wf_slot;
+
+typedef struct rs_cuda_wf {
+    rs_cuda_wf_slot slot[2];
+    uint32_t cap;  /* paths per wave */
+    int block[5];  /* threads per block of each kernel (rs_cuda_wf_entry order) */
+    rs_wf_film film;
+    rs_wf_u64 *h_sum, *h_sum_l2; /* the film copied back */
+    unsigned int *h_count;
+    uint32_t *pixel_of, pixel_cap; /* the plan's pixels on the device */
+    uint64_t plan_id;
+} rs_cuda_wf;
+
 typedef struct rs_cuda_impl {
     int ordinal;
     int block; /* the trace kernel's threads per block, from the occupancy API */
@@ -80,6 +116,7 @@ typedef struct rs_cuda_impl {
     rs_cuda_stage st[RS_CUDA_STAGES];
     uint32_t cap; /* entries per staging set */
     rs_cuda_mk mk;
+    rs_cuda_wf wf; /* render_paths: over mk's scene copy */
 } rs_cuda_impl;
 
 /* cudaMalloc + cudaMemcpy (pageable, on the legacy stream: whoever copies through these ends
@@ -93,6 +130,12 @@ rs_status rs_cuda_upload_scene(rs_device *d, const rs_scene *scene, const rs_ren
 rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                               rs_path_counts *counts);
 void rs_cuda_scene_release(rs_cuda_impl *c);
+/* gpu/cuda_wavefront.cu: render_paths (scheduler/device.h), the release of what it made, and its
+ * kernels' entry points (0 raygen, 1 trace, 2 shade, 3 resolve, 4 film; NULL past them). */
+rs_status rs_cuda_render_paths(rs_device *d, const rs_paths_job *job, uint64_t p0, uint64_t p1,
+                               uint64_t *done, rs_path_counts *counts);
+void rs_cuda_wf_release(rs_cuda_impl *c);
+const void *rs_cuda_wf_entry(int k);
 /* The megakernel's entry point, for cudaFuncGetAttributes (gpu/cuda_device.cu sizes the stack
  * from it and the trace kernel). */
 const void *rs_cuda_megakernel_entry(void);

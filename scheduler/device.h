@@ -47,6 +47,21 @@ typedef struct rs_pass_job {
     void *user;
 } rs_pass_job;
 
+/* One call of render_paths: what a device needs to run paths whole (the wavefront). */
+typedef struct rs_paths_job {
+    const rs_render_consts *it; /* the render's constants; it->scene is the host scene */
+    /* The plan's pixels (shading/integrator.h's rs_path_map): path g is pixel
+     * pixel_of[g mod n_active] (NULL: g mod n_active itself), sample g div n_active.  Host
+     * memory; `plan_id` changes whenever the plan does, so a device may keep a copy. */
+    const uint32_t *pixel_of;
+    uint32_t n_active;
+    uint64_t plan_id;
+    rs_film *film; /* the paths' samples are added to it (exact sums: in any order) */
+    /* Polled between waves; non-zero: stop, and put only the waves finished on the film. */
+    int (*cancelled)(void *user);
+    void *user;
+} rs_paths_job;
+
 typedef struct rs_device_ops {
     /* Makes the scene geometry and BVH available to the device (a copy for a GPU; the host
      * arrays are only borrowed by host devices and must outlive the device). */
@@ -73,6 +88,14 @@ typedef struct rs_device_ops {
      * Stops early, with RS_OK, when job->cancelled says so. */
     rs_status (*render_pass)(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                              rs_path_counts *counts);
+    /* Optional (NULL: the device only traces for the host's stages).  After upload_scene: paths
+     * [p0, p1) of job's plan run whole where the device is (the wavefront: camera rays, both
+     * traversals, shading, shadow rays, compaction and the film, each a stage over the device's
+     * own path state; per wave only counts cross to the host), in waves of consecutive paths,
+     * then added to job->film.  *done: the paths on the film, p1 - p0 unless job->cancelled
+     * stopped it (a prefix: the finished waves); the rays traced are added to *counts. */
+    rs_status (*render_paths)(rs_device *d, const rs_paths_job *job, uint64_t p0, uint64_t p1,
+                              uint64_t *done, rs_path_counts *counts);
 } rs_device_ops;
 
 typedef struct rs_device_stats {

@@ -71,8 +71,27 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     return RS_OK;
 }
 
+static rs_status engine_make(const rs_scene *scene, const rs_render_settings *settings,
+                             rs_sched *sched, rs_device *mk, int paths, rs_engine **out);
+
 rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *settings,
                            rs_sched *sched, rs_device *mk, rs_engine **out)
+{
+    return engine_make(scene, settings, sched, mk, 0, out);
+}
+
+rs_status rs_engine_create_paths(const rs_scene *scene, const rs_render_settings *settings,
+                                 rs_device *d, rs_engine **out)
+{
+    *out = NULL;
+    if (!d || !d->ops->render_paths || !d->ops->upload_scene)
+        return rs_error_set(RS_ERR_ARG, "device %s cannot run paths whole (no wavefront)",
+                            d ? d->name : "(none)");
+    return engine_make(scene, settings, NULL, d, 1, out);
+}
+
+static rs_status engine_make(const rs_scene *scene, const rs_render_settings *settings,
+                             rs_sched *sched, rs_device *mk, int paths, rs_engine **out)
 {
     rs_engine *e;
     rs_status st;
@@ -83,7 +102,7 @@ rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *sett
     if (settings->waves_in_flight > RS_RENDER_MAX_WAVES)
         return rs_error_set(RS_ERR_ARG, "%u waves in flight: at most %u", settings->waves_in_flight,
                             RS_RENDER_MAX_WAVES);
-    if (mk && !mk->ops->render_pass)
+    if (mk && !paths && !mk->ops->render_pass)
         return rs_error_set(RS_ERR_ARG, "device %s cannot run the megakernel", mk->name);
     e = (rs_engine *)rs_calloc(1, sizeof *e);
     if (!e)
@@ -92,6 +111,7 @@ rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *sett
     e->st = *settings;
     e->sched = sched;
     e->mk = mk;
+    e->paths = paths;
     e->t_start = rs_now_s();
     if ((st = rs_render_constants(scene, settings, &e->it)) == RS_OK)
         st = mk ? rs_passes_setup(e) : rs_stream_setup(e);
@@ -138,7 +158,7 @@ static rs_status check_plan(const rs_engine *e, const rs_work_plan *p, const rs_
         return rs_error_set(RS_ERR_ARG, "a plan up to path %llu of a render of %llu",
                             (unsigned long long)p->todo.r[p->todo.n - 1][1],
                             (unsigned long long)(n * e->st.spp));
-    if (!e->mk)
+    if (!e->mk || e->paths)
         return RS_OK;
     if (p->pixels)
         return rs_error_set(RS_ERR_ARG, "the megakernel renders whole images only: adaptive "
@@ -181,7 +201,8 @@ rs_status rs_engine_run(rs_engine *e, const rs_work_plan *plan, const rs_render_
         c.end_path = plan->todo.r[0][1];
     }
     stats->paths_total = rs_path_ranges_total(&plan->todo);
-    st = e->mk ? rs_passes_run(&c) : rs_stream_run(&c);
+    e->plan_id++;
+    st = e->paths ? rs_paths_run(&c) : e->mk ? rs_passes_run(&c) : rs_stream_run(&c);
     stats->seconds = rs_now_s() - t0;
     if (stats->paths_done)
         e->any_done = 1;

@@ -27,7 +27,9 @@ struct rs_engine {
     rs_render_settings st; /* the automatic choices made */
     rs_render_consts it;   /* the render's constants, what a device receives */
     rs_sched *sched;       /* the stream engine's devices, or NULL */
-    rs_device *mk;         /* the megakernel's device, or NULL */
+    rs_device *mk;         /* the megakernel's device, or the wavefront's (paths), or NULL */
+    int paths;             /* mk runs whole paths (render_paths): the device's wavefront */
+    uint64_t plan_id;      /* counts the runs: rs_paths_job.plan_id */
     rs_slot slots[RS_RENDER_MAX_WAVES];
     uint32_t n_slots;
     double t_start;        /* rs_now_s at creation: the time limit's clock */
@@ -69,6 +71,8 @@ rs_status rs_run_on_film(rs_run *c, uint64_t lo, uint64_t hi);
 rs_status rs_stream_setup(rs_engine *e);
 rs_status rs_stream_run(rs_run *c);
 void rs_stream_release(rs_engine *e);
+/* A device's wavefront (wavefront.c): whole paths in calls of render_paths. */
+rs_status rs_paths_run(rs_run *c);
 /* The megakernel: upload_scene (creation) and the run. */
 rs_status rs_passes_setup(rs_engine *e);
 rs_status rs_passes_run(rs_run *c);

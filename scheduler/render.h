@@ -133,6 +133,11 @@ typedef struct rs_engine rs_engine;
  * device's upload_scene, and starts the time limit's clock.  Used from one thread. */
 rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *settings,
                            rs_sched *sched, rs_device *mk, rs_engine **out);
+/* An engine whose device `d` (already uploaded, with render_paths) runs the paths whole: the
+ * stream engine's stages as the device's own wavefront (gpu/wavefront.h), no ray crossing to the
+ * host; any plan, the stream engine's image bit for bit.  The device gets upload_scene here. */
+rs_status rs_engine_create_paths(const rs_scene *scene, const rs_render_settings *settings,
+                                 rs_device *d, rs_engine **out);
 /* Renders the plan's paths onto `film` (the render's size): each pixel's samples are added in
  * sample order after what the film holds.  `hooks` may be NULL; *stats is this run's.  The
  * megakernel takes plans over every pixel, in whole samples (RS_ERR_ARG otherwise). */

@@ -44,6 +44,8 @@ typedef struct rt_args {
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
     const rs_filter *filter;         /* the pixel filter; NULL: box, 1 pixel */
     uint32_t light_sampler;          /* rs_light_sampler; zeroed: by power */
+    int wavefront; /* with fallback_only: the device runs the paths whole (render_paths, its
+                      wavefront: rs_engine_create_paths) instead of tracing for the host */
 } rt_args;
 
 static inline rt_args rt_defaults(const char *scene, uint32_t size, uint32_t spp)
@@ -175,6 +177,25 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
         /* devs[0] runs it: the CPU device, or with fallback_only the GPU megakernel's passes
          * (on host threads / on CUDA with real_gpu) */
         if (rs_render_passes(scene, devs[0], &st, NULL, film, &stats) != RS_OK)
+            goto out;
+    } else if (a->wavefront) {
+        rs_engine *e = NULL;
+        rs_status rst = rs_engine_create_paths(scene, &st, devs[0], &e);
+        if (rst == RS_OK && a->adaptive.threshold > 0) {
+            rs_adaptive_stats as;
+            rst = rs_render_adaptive(e, &a->adaptive, NULL, film, &stats, &as);
+            if (a->adaptive_out)
+                *a->adaptive_out = as;
+        } else if (rst == RS_OK) {
+            rs_work_plan plan;
+            memset(&plan, 0, sizeof plan);
+            rst = rs_path_ranges_add(&plan.todo, 0, (uint64_t)a->width * a->height * a->spp)
+                      ? rs_engine_run(e, &plan, NULL, film, &stats)
+                      : RS_ERR_NOMEM;
+            rs_work_plan_free(&plan);
+        }
+        rs_engine_destroy(e);
+        if (rst != RS_OK)
             goto out;
     } else if (a->adaptive.threshold > 0) {
         rs_adaptive_stats as;
