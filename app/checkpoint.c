@@ -496,13 +496,11 @@ static int read_film(reader *r, rs_film *film, unsigned char *q, rs_adaptive_sta
 static int take_ranges(const reader *r, const rs_film *film, rs_path_ranges *held)
 {
     const int rc = RS_EXIT_RUNTIME;
-    size_t npix = (size_t)film->width * film->height;
     uint32_t k;
     for (k = 0; k < r->n_ranges; ++k) {
         const unsigned char *q = r->h + FIXED_HEADER + r->name_len + 8 + 16 * (size_t)k;
-        if (get64(q) % npix != 0) /* every range starts at a whole sample */
-            return refuse(rc, r->path,
-                          "corrupt header (a range of paths starts within a sample)%s%s", "", "");
+        /* a range may start and end anywhere (a GPU's wavefront beside the CPU leaves gaps
+         * within samples); counts_agree checks the film against the ranges */
         if (!rs_path_ranges_add(held, get64(q), get64(q + 8)))
             return refuse(rc, r->path, "out of memory for its list of paths%s%s", "", "");
     }

@@ -267,27 +267,37 @@ static int make_devices(const rs_cli_options *o, render_run *r)
 int rs_run_start_devices(const rs_cli_options *o, render_run *r)
 {
     int n = make_devices(o, r);
+    rs_device *sched_devs[RS_MAX_DEVICES];
+    int i, n_sched = 0;
     if (n < 0)
         return RS_EXIT_RUNTIME;
-    /* one device that runs paths whole (a GPU, or its fallback): the stream integrator's stages
-     * run there, shading included, unless --shade-on host keeps the shading on the host */
-    if (!o->megakernel && !o->shade_host && n == 1 && r->devs[0]->ops->render_paths) {
-        r->mk = r->devs[0];
-        r->devs[0] = NULL;
-        r->n_devs = 0;
-        r->wavefront = 1;
+    /* devices that run paths whole (a GPU, or its fallback) run the stream integrator's stages
+     * themselves, shading included, beside the others (the CPU: the stream engine), unless
+     * --shade-on host keeps all shading on the host */
+    for (i = 0; !o->megakernel && i < n; ++i) {
+        if (!o->shade_host && r->devs[i]->ops->render_paths &&
+            r->n_pdev < RS_ENGINE_MAX_PATH_DEVICES)
+            r->pdev[r->n_pdev++] = r->devs[i];
+        else
+            sched_devs[n_sched++] = r->devs[i];
+    }
+    if (r->n_pdev && n_sched && r->threads > 1) {
+        /* each GPU's host thread waits on it with a core of its own */
+        int left = r->threads - r->n_pdev > 0 ? r->threads - r->n_pdev : 1;
+        rs_cores_init(&r->cores, left);
+        r->st.threads = left;
     }
     /* about 200 spans per wave and device; the log never grows past this */
     if (o->timeline && rs_timeline_create(1u << 20, &r->timeline) != RS_OK)
         return rs_app_fail(RS_EXIT_RUNTIME, "starting the timeline");
     r->st.timeline = r->timeline;
-    r->st.timeline_lane = (uint16_t)(o->megakernel || r->wavefront ? 1 : n);
-    if (!o->megakernel && !r->wavefront) {
+    r->st.timeline_lane = (uint16_t)(o->megakernel ? 1 : n);
+    if (!o->megakernel && n_sched) {
         rs_sched_config cfg;
         memset(&cfg, 0, sizeof cfg);
         cfg.chunk_size = o->chunk_size;
         cfg.timeline = r->timeline;
-        if (rs_sched_create(r->devs, n, &cfg, &r->sched) != RS_OK)
+        if (rs_sched_create(sched_devs, n_sched, &cfg, &r->sched) != RS_OK)
             return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
     }
     r->rgb = (float *)rs_alloc((size_t)r->st.width * r->st.height * 3, sizeof *r->rgb);
@@ -297,8 +307,9 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
     }
     /* under mpirun the job's coordinator keeps the time (app/distributed.h) */
     r->st.time_limit_s = r->dist ? 0.0 : o->time_limit_s;
-    if (r->wavefront ? rs_engine_create_paths(r->scene, &r->st, r->mk, &r->engine) != RS_OK
-                     : rs_engine_create(r->scene, &r->st, r->sched, r->mk, &r->engine) != RS_OK)
+    if (r->n_pdev ? rs_engine_create_paths(r->scene, &r->st, r->sched, r->pdev, r->n_pdev,
+                                           &r->engine) != RS_OK
+                  : rs_engine_create(r->scene, &r->st, r->sched, r->mk, &r->engine) != RS_OK)
         return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
     return RS_EXIT_OK;
 }

@@ -30,19 +30,28 @@ static void report_devices(const render_run *r, rs_report *rep)
         d->threads = r->mk->threads;
         d->alive = 1;
         rep->n_dev = 1;
-        rep->megakernel = !r->wavefront;
-        rep->wavefront = r->wavefront;
+        rep->megakernel = 1;
         rep->mk_gpu = rs_device_owns_memory(r->mk);
         return;
     }
-    for (i = 0; i < r->n_devs; ++i) {
-        rs_report_device *d = &rep->dev[i];
+    for (i = 0; r->sched && i < rs_sched_device_count(r->sched); ++i) {
+        rs_report_device *d = &rep->dev[rep->n_dev++];
+        rs_device *dev = rs_sched_device(r->sched, i);
         rs_sched_device_stats(r->sched, i, &d->ds, &d->alive);
-        snprintf(d->name, sizeof d->name, "%s", r->devs[i]->name);
-        d->threads = r->devs[i]->threads;
+        snprintf(d->name, sizeof d->name, "%s", dev->name);
+        d->threads = dev->threads;
         rep->dev_rays += d->ds.rays;
     }
-    rep->n_dev = r->n_devs;
+    for (i = 0; i < r->n_pdev; ++i) { /* the stream integrator's paths run whole there */
+        rs_report_device *d = &rep->dev[rep->n_dev++];
+        d->ds = r->pdev[i]->stats;
+        d->alive = d->ds.failures == 0;
+        snprintf(d->name, sizeof d->name, "%s", r->pdev[i]->name);
+        d->threads = r->pdev[i]->threads;
+        d->paths = 1;
+        rep->dev_rays += d->ds.rays;
+        rep->wavefront = 1;
+    }
 }
 
 /* The report of the render, once the film is final. */

@@ -32,8 +32,11 @@ typedef struct render_run {
     double bvh_ms;
     rs_device *devs[RS_MAX_DEVICES]; /* the stream engine's devices */
     int n_devs;
-    rs_device *mk; /* the megakernel's one device, or the one that runs its paths whole */
-    int wavefront; /* mk runs the stream integrator's paths whole (rs_engine_create_paths) */
+    rs_device *mk; /* the megakernel's one device */
+    /* those of devs that run the stream integrator's paths whole (a GPU's wavefront:
+     * rs_engine_create_paths); the others are the scheduler's */
+    rs_device *pdev[RS_ENGINE_MAX_PATH_DEVICES];
+    int n_pdev;
     rs_sched *sched;
     rs_engine *engine; /* set up once; every plan of the render runs on it */
     rs_film *film;

@@ -29,6 +29,8 @@ void rs_report_device_label(const rs_report *rep, int i, char *buf, size_t n)
 {
     if (rep->megakernel) /* one device traced everything, one path at a time */
         snprintf(buf, n, "%s (megakernel)", rep->dev[i].name);
+    else if (rep->dev[i].paths) /* its own wavefront: paths whole, shading included */
+        snprintf(buf, n, "%s (wavefront)", rep->dev[i].name);
     else
         snprintf(buf, n, "%s", rep->dev[i].name);
 }
@@ -264,9 +266,13 @@ static void summary_devices(const rs_report *rep)
                 rays_total ? 100.0 * (double)d->ds.rays / (double)rays_total : 0.0,
                 d->alive ? "" : " and then failed", i + 1 == rep->n_dev ? ". " : "");
     }
-    if (rep->wavefront)
+    if (rep->wavefront && rep->n_dev == 1)
         fprintf(stderr, "Integrator: stream, paths run whole on %s (its own wavefront). ",
                 rep->dev[0].name);
+    else if (rep->wavefront)
+        fprintf(stderr, "Integrator: stream, the GPU running its paths whole (its own wavefront) "
+                        "beside the host's stages (%.2f s). ",
+                rep->stats.host_s);
     else if (rep->megakernel && rep->mk_gpu)
         fprintf(stderr, "Integrator: megakernel on %s. ", rep->dev[0].name);
     else if (rep->megakernel)

@@ -17,6 +17,7 @@
 typedef struct rs_report_device {
     char name[48]; /* the device's own name */
     int threads, alive;
+    int paths; /* it ran the stream integrator's paths whole (a GPU's wavefront) */
     rs_device_stats ds;
 } rs_report_device;
 
@@ -24,7 +25,7 @@ typedef struct rs_report {
     /* what was asked: the options' strings (they outlive the report) */
     const char *scene, *image, *resume, *checkpoint; /* resume, checkpoint: NULL where none */
     int quiet, megakernel, mk_gpu;                   /* mk_gpu: the megakernel ran on a GPU */
-    int wavefront; /* the stream integrator's paths ran whole on dev[0] (its wavefront) */
+    int wavefront; /* some devices ran the stream integrator's paths whole (dev[i].paths) */
     const char *strategy;                            /* the megakernel's host thread split */
     uint32_t width, height, spp, spp_min, max_depth; /* spp asked; spp_min every pixel has */
     uint64_t seed;

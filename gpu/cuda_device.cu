@@ -373,7 +373,7 @@ extern "C" int rs_gpu_count(const char **why)
 
 /* Every kernel of the device, for their attributes: the trace kernel, the megakernel, the
  * wavefront's five. */
-#define RS_CUDA_KERNELS 7
+#define RS_CUDA_KERNELS 8
 static void kernel_entries(const void **fn)
 {
     int k;
@@ -381,6 +381,7 @@ static void kernel_entries(const void **fn)
     fn[1] = rs_cuda_megakernel_entry();
     for (k = 0; k < 5; ++k)
         fn[2 + k] = rs_cuda_wf_entry(k);
+    fn[7] = rs_cuda_megakernel_b2_entry();
 }
 
 /* Raises device `index`'s stack limit (per thread; the device current) to the most local memory
@@ -390,7 +391,7 @@ static rs_status size_stack(int index)
 {
     static const char *const names[RS_CUDA_KERNELS] = {
         "rs_trace_kernel",    "rs_megakernel_kernel", "rs_wf_raygen_kernel", "rs_wf_trace_kernel",
-        "rs_wf_shade_kernel", "rs_wf_resolve_kernel", "rs_wf_film_kernel"};
+        "rs_wf_shade_kernel", "rs_wf_resolve_kernel", "rs_wf_film_kernel", "rs_megakernel_kernel_b2"};
     const void *fn[RS_CUDA_KERNELS];
     cudaFuncAttributes a;
     size_t need = 0, have = 0, local[RS_CUDA_KERNELS];
@@ -435,7 +436,8 @@ static rs_status size_stack(int index)
 extern "C" int rs_gpu_describe(int index, char *buf, size_t n)
 {
     static const char *const names[RS_CUDA_KERNELS] = {
-        "trace", "megakernel", "wf-raygen", "wf-trace", "wf-shade", "wf-resolve", "wf-film"};
+        "trace", "megakernel", "wf-raygen", "wf-trace", "wf-shade", "wf-resolve", "wf-film",
+        "megakernel-b2"};
     const void *fn[RS_CUDA_KERNELS];
     const char *why = "";
     int count = rs_gpu_count(&why), drv = 0, rt = 0, k;

@@ -21,17 +21,21 @@
 #include "gpu/internal.h"
 #include "gpu/megakernel_path.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/parallel.h"
 
 #define RS_WARP 32
 
-__global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
-    rs_megakernel_kernel(rs_render_consts it, rs_path_tracer tr, uint32_t sample, rs_vec3 *radiance,
-                         rs_cuda_mk_counts *counts)
+/* Samples [sample, sample + nsamp) of every pixel, one thread each: thread t is pixel t mod npix
+ * of sample sample + t div npix, its radiance at radiance[t]. */
+__device__ __forceinline__ static void megakernel_body(const rs_render_consts &it,
+                                                       const rs_path_tracer &tr, uint32_t sample,
+                                                       uint32_t nsamp, rs_vec3 *radiance,
+                                                       rs_cuda_mk_counts *counts)
 {
-    uint32_t pixel = blockIdx.x * blockDim.x + threadIdx.x;
+    uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
     rs_path_counts n;
     unsigned long long closest, shadow;
     unsigned int max_bounce;
@@ -39,8 +43,8 @@ __global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
     n.closest = n.shadow = 0;
     n.max_bounce = 0;
     /* no early return: every lane of the warp takes part in the shuffles below */
-    if (pixel < it.npix)
-        radiance[pixel] = rs_gpu_path_radiance(&it, &tr, pixel, sample, &n);
+    if (t < it.npix * nsamp)
+        radiance[t] = rs_gpu_path_radiance(&it, &tr, t % it.npix, sample + t / it.npix, &n);
     closest = n.closest;
     shadow = n.shadow;
     max_bounce = n.max_bounce;
@@ -56,7 +60,32 @@ __global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
     }
 }
 
+__global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 1)
+    rs_megakernel_kernel(rs_render_consts it, rs_path_tracer tr, uint32_t sample, uint32_t nsamp,
+                         rs_vec3 *radiance, rs_cuda_mk_counts *counts)
+{
+    megakernel_body(it, tr, sample, nsamp, radiance, counts);
+}
+
+/* The same with at least two blocks per SM asked of ptxas (at most 128 registers): chosen with
+ * RS_MEGAKERNEL_BOUNDS=2 in the environment, so that a GPU run can time both (bench/gpu_bench.py
+ * --rows megakernel-b2) before one becomes the default. */
+__global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 2)
+    rs_megakernel_kernel_b2(rs_render_consts it, rs_path_tracer tr, uint32_t sample,
+                            uint32_t nsamp, rs_vec3 *radiance, rs_cuda_mk_counts *counts)
+{
+    megakernel_body(it, tr, sample, nsamp, radiance, counts);
+}
+
 const void *rs_cuda_megakernel_entry(void) { return (const void *)rs_megakernel_kernel; }
+const void *rs_cuda_megakernel_b2_entry(void) { return (const void *)rs_megakernel_kernel_b2; }
+
+/* The kernel this process runs: RS_MEGAKERNEL_BOUNDS=2 picks the two-blocks-per-SM build. */
+static const void *megakernel_fn(void)
+{
+    const char *v = getenv("RS_MEGAKERNEL_BOUNDS");
+    return v && strcmp(v, "2") == 0 ? rs_cuda_megakernel_b2_entry() : rs_cuda_megakernel_entry();
+}
 
 void rs_cuda_scene_release(rs_cuda_impl *c)
 {
@@ -84,11 +113,12 @@ void rs_cuda_scene_release(rs_cuda_impl *c)
 static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_render_consts *it)
 {
     rs_cuda_mk *mk = &c->mk;
-    size_t image = (size_t)it->npix * sizeof(rs_vec3);
+    /* RS_GPU_LAUNCH_SAMPLES samples of every pixel per launch */
+    size_t image = (size_t)it->npix * RS_GPU_LAUNCH_SAMPLES * sizeof(rs_vec3);
     int min_grid = 0, block = 0, k;
     rs_status st;
     /* at most RS_CUDA_MK_BLOCK_MAX (the kernel's __launch_bounds__, which the API reads) */
-    CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_megakernel_kernel, 0, 0));
+    CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, megakernel_fn(), 0, 0));
     /* whole warps only: the counters' shuffles need every lane */
     block -= block % RS_WARP;
     mk->block = block >= RS_WARP ? block : RS_WARP;
@@ -128,25 +158,32 @@ rs_status rs_cuda_upload_scene(rs_device *d, const rs_scene *scene, const rs_ren
     return RS_OK;
 }
 
-/* Queues sample s into slot sl on `stream`: counters zeroed, kernel, both copies, event. */
-static rs_status launch_sample(rs_cuda_mk *mk, rs_cuda_mk_slot *sl, uint32_t s, cudaStream_t stream)
+/* Queues samples [s, s + ns) into slot sl on `stream`: counters zeroed, one kernel over
+ * ns x npix threads, both copies, event. */
+static rs_status launch_sample(rs_cuda_mk *mk, rs_cuda_mk_slot *sl, uint32_t s, uint32_t ns,
+                               cudaStream_t stream)
 {
-    uint32_t npix = mk->it.npix, grid = (npix + mk->block - 1) / mk->block;
-    void *args[5];
+    uint32_t npix = mk->it.npix;
+    uint64_t threads = (uint64_t)npix * ns, grid = (threads + mk->block - 1) / mk->block;
+    void *args[6];
+    if (threads > UINT32_MAX)
+        return rs_error_set(RS_ERR_ARG, "%u samples of %u pixels in one launch", ns, npix);
     args[0] = &mk->it;
     args[1] = &mk->copy.tracer;
     args[2] = &s;
-    args[3] = &sl->d_rad;
-    args[4] = &sl->d_cnt;
+    args[3] = &ns;
+    args[4] = &sl->d_rad;
+    args[5] = &sl->d_cnt;
     CUDA_TRY(cudaMemsetAsync(sl->d_cnt, 0, sizeof *sl->d_cnt, stream));
-    CUDA_TRY(cudaLaunchKernel((const void *)rs_megakernel_kernel, dim3(grid), dim3(mk->block), args,
-                              0, stream));
-    CUDA_TRY(cudaMemcpyAsync(sl->h_rad, sl->d_rad, (size_t)npix * sizeof(rs_vec3),
+    CUDA_TRY(cudaLaunchKernel(megakernel_fn(), dim3((unsigned)grid), dim3(mk->block), args, 0,
+                              stream));
+    CUDA_TRY(cudaMemcpyAsync(sl->h_rad, sl->d_rad, (size_t)threads * sizeof(rs_vec3),
                              cudaMemcpyDeviceToHost, stream));
     CUDA_TRY(
         cudaMemcpyAsync(sl->h_cnt, sl->d_cnt, sizeof *sl->h_cnt, cudaMemcpyDeviceToHost, stream));
     CUDA_TRY(cudaEventRecord(sl->done, stream));
     sl->sample = s;
+    sl->nsamp = ns;
     sl->pending = 1;
     return RS_OK;
 }
@@ -160,18 +197,21 @@ static rs_status finish_sample(rs_device *d, rs_cuda_mk_slot *sl, const rs_pass_
     if (!sl->pending)
         return RS_OK;
     sl->pending = 0;
+    uint32_t j;
     CUDA_TRY(cudaEventSynchronize(sl->done));
     if (!add)
         return RS_OK;
-    /* the host is otherwise idle while the GPU runs the next sample: every core adds */
-    rs_film_add_image(job->film, sl->h_rad, rs_cpu_count());
+    /* the host is otherwise idle while the GPU runs the next samples: every core adds, each
+     * pixel's samples in sample order */
+    for (j = 0; j < sl->nsamp; ++j)
+        rs_film_add_image(job->film, sl->h_rad + (size_t)j * npix, rs_cpu_count());
     counts->closest += sl->h_cnt->closest;
     counts->shadow += sl->h_cnt->shadow;
     if (sl->h_cnt->max_bounce > counts->max_bounce)
         counts->max_bounce = sl->h_cnt->max_bounce;
-    d->stats.bytes_from_device += (uint64_t)npix * sizeof(rs_vec3) + sizeof *sl->h_cnt;
+    d->stats.bytes_from_device += (uint64_t)npix * sl->nsamp * sizeof(rs_vec3) + sizeof *sl->h_cnt;
     if (job->progress)
-        job->progress(job->user, npix);
+        job->progress(job->user, (uint64_t)npix * sl->nsamp);
     return RS_OK;
 }
 
@@ -182,7 +222,7 @@ rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0,
     rs_cuda_mk *mk = &c->mk;
     cudaStream_t stream = c->st[0].stream;
     rs_status st = RS_OK;
-    uint32_t s;
+    uint32_t s, ns, i;
     int k;
     if (!mk->ready)
         return rs_error_set(RS_ERR_ARG, "device %s: render_pass before upload_scene", d->name);
@@ -190,12 +230,13 @@ rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0,
         return rs_error_set(RS_ERR_ARG, "device %s: the film is not the upload_scene's image size",
                             d->name);
     CUDA_TRY(cudaSetDevice(c->ordinal));
-    for (s = s0; s - s0 < n && st == RS_OK; ++s) {
-        rs_cuda_mk_slot *cur = &mk->slot[s & 1], *prev = &mk->slot[(s & 1) ^ 1];
+    for (s = s0, i = 0; s - s0 < n && st == RS_OK; s += ns, ++i) {
+        rs_cuda_mk_slot *cur = &mk->slot[i & 1], *prev = &mk->slot[(i & 1) ^ 1];
+        ns = n - (s - s0) < RS_GPU_LAUNCH_SAMPLES ? n - (s - s0) : RS_GPU_LAUNCH_SAMPLES;
         if (job->cancelled && job->cancelled(job->user))
             break;
         /* cur was finished (or never used) before: its film add is done */
-        if ((st = launch_sample(mk, cur, s, stream)) == RS_OK)
+        if ((st = launch_sample(mk, cur, s, ns, stream)) == RS_OK)
             st = finish_sample(d, prev, job, counts, 1);
     }
     /* the last sample launched (both slots, oldest first, after a failure) */

@@ -39,7 +39,10 @@ int rs_gpu_describe(int index, char *buf, size_t n);
 rs_status rs_gpu_device_create(int index, rs_device **out);
 /* Samples per render_pass call the CUDA device asks for: few, so that cancel and progress are
  * seen often, enough that the film add of one sample overlaps the kernel of the next. */
-#define RS_GPU_PASS_SAMPLES 4u
+#define RS_GPU_PASS_SAMPLES 16u
+/* Samples of every pixel one launch of the CUDA megakernel runs (one thread each): a million
+ * paths and more in flight at 512x512, the film add of one launch overlapping the next. */
+#define RS_GPU_LAUNCH_SAMPLES 4u
 /* Pieces smaller than this are not worth a CUDA stream switch. */
 #define RS_GPU_MIN_PIECE 32768u
 /* The piece size the CUDA device (and its fallback) cut a trace chunk of n rays into: a quarter

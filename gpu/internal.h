@@ -67,7 +67,7 @@ typedef struct rs_cuda_mk_slot {
     rs_vec3 *d_rad, *h_rad;
     rs_cuda_mk_counts *d_cnt, *h_cnt;
     cudaEvent_t done;
-    uint32_t sample;
+    uint32_t sample, nsamp; /* samples [sample, sample + nsamp) */
     int pending;
 } rs_cuda_mk_slot;
 
@@ -139,5 +139,6 @@ const void *rs_cuda_wf_entry(int k);
 /* The megakernel's entry point, for cudaFuncGetAttributes (gpu/cuda_device.cu sizes the stack
  * from it and the trace kernel). */
 const void *rs_cuda_megakernel_entry(void);
+const void *rs_cuda_megakernel_b2_entry(void); /* the two-blocks-per-SM build of it */
 
 #endif

@@ -72,37 +72,46 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
 }
 
 static rs_status engine_make(const rs_scene *scene, const rs_render_settings *settings,
-                             rs_sched *sched, rs_device *mk, int paths, rs_engine **out);
+                             rs_sched *sched, rs_device *mk, rs_device *const *pdev, int n_pdev,
+                             rs_engine **out);
 
 rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *settings,
                            rs_sched *sched, rs_device *mk, rs_engine **out)
 {
-    return engine_make(scene, settings, sched, mk, 0, out);
-}
-
-rs_status rs_engine_create_paths(const rs_scene *scene, const rs_render_settings *settings,
-                                 rs_device *d, rs_engine **out)
-{
-    *out = NULL;
-    if (!d || !d->ops->render_paths || !d->ops->upload_scene)
-        return rs_error_set(RS_ERR_ARG, "device %s cannot run paths whole (no wavefront)",
-                            d ? d->name : "(none)");
-    return engine_make(scene, settings, NULL, d, 1, out);
-}
-
-static rs_status engine_make(const rs_scene *scene, const rs_render_settings *settings,
-                             rs_sched *sched, rs_device *mk, int paths, rs_engine **out)
-{
-    rs_engine *e;
-    rs_status st;
     *out = NULL;
     if (!sched == !mk)
         return rs_error_set(RS_ERR_ARG, "an engine traces through a scheduler or a megakernel "
                                         "device, one of them");
+    return engine_make(scene, settings, sched, mk, NULL, 0, out);
+}
+
+rs_status rs_engine_create_paths(const rs_scene *scene, const rs_render_settings *settings,
+                                 rs_sched *sched, rs_device *const *devs, int n, rs_engine **out)
+{
+    int k;
+    *out = NULL;
+    if (n < 1 || n > RS_ENGINE_MAX_PATH_DEVICES)
+        return rs_error_set(RS_ERR_ARG, "%d devices that run paths whole: 1 to %d", n,
+                            RS_ENGINE_MAX_PATH_DEVICES);
+    for (k = 0; k < n; ++k)
+        if (!devs[k] || !devs[k]->ops->render_paths || !devs[k]->ops->upload_scene)
+            return rs_error_set(RS_ERR_ARG, "device %s cannot run paths whole (no wavefront)",
+                                devs[k] ? devs[k]->name : "(none)");
+    return engine_make(scene, settings, sched, NULL, devs, n, out);
+}
+
+static rs_status engine_make(const rs_scene *scene, const rs_render_settings *settings,
+                             rs_sched *sched, rs_device *mk, rs_device *const *pdev, int n_pdev,
+                             rs_engine **out)
+{
+    rs_engine *e;
+    rs_status st;
+    int k;
+    *out = NULL;
     if (settings->waves_in_flight > RS_RENDER_MAX_WAVES)
         return rs_error_set(RS_ERR_ARG, "%u waves in flight: at most %u", settings->waves_in_flight,
                             RS_RENDER_MAX_WAVES);
-    if (mk && !paths && !mk->ops->render_pass)
+    if (mk && !mk->ops->render_pass)
         return rs_error_set(RS_ERR_ARG, "device %s cannot run the megakernel", mk->name);
     e = (rs_engine *)rs_calloc(1, sizeof *e);
     if (!e)
@@ -111,10 +120,12 @@ static rs_status engine_make(const rs_scene *scene, const rs_render_settings *se
     e->st = *settings;
     e->sched = sched;
     e->mk = mk;
-    e->paths = paths;
+    for (k = 0; k < n_pdev; ++k)
+        e->pdev[k] = pdev[k];
+    e->n_pdev = n_pdev;
     e->t_start = rs_now_s();
     if ((st = rs_render_constants(scene, settings, &e->it)) == RS_OK)
-        st = mk ? rs_passes_setup(e) : rs_stream_setup(e);
+        st = mk ? rs_passes_setup(e) : n_pdev ? rs_paths_setup(e) : rs_stream_setup(e);
     if (st != RS_OK) {
         rs_engine_destroy(e);
         return st;
@@ -125,10 +136,13 @@ static rs_status engine_make(const rs_scene *scene, const rs_render_settings *se
 
 void rs_engine_destroy(rs_engine *e)
 {
+    int k;
     if (!e)
         return;
     if (e->sched)
         rs_stream_release(e);
+    for (k = 0; k < e->n_pdev; ++k)
+        rs_film_destroy(e->pfilm[k]);
     rs_path_ranges_free(&e->done);
     rs_free(e);
 }
@@ -158,7 +172,7 @@ static rs_status check_plan(const rs_engine *e, const rs_work_plan *p, const rs_
         return rs_error_set(RS_ERR_ARG, "a plan up to path %llu of a render of %llu",
                             (unsigned long long)p->todo.r[p->todo.n - 1][1],
                             (unsigned long long)(n * e->st.spp));
-    if (!e->mk || e->paths)
+    if (!e->mk)
         return RS_OK;
     if (p->pixels)
         return rs_error_set(RS_ERR_ARG, "the megakernel renders whole images only: adaptive "
@@ -196,13 +210,14 @@ rs_status rs_engine_run(rs_engine *e, const rs_work_plan *plan, const rs_render_
     c.film = film;
     e->done.n = 0;
     c.n_ranges = plan->todo.n;
+    c.cut = UINT64_MAX;
     if (c.n_ranges) {
         c.next_path = plan->todo.r[0][0];
         c.end_path = plan->todo.r[0][1];
     }
     stats->paths_total = rs_path_ranges_total(&plan->todo);
     e->plan_id++;
-    st = e->paths ? rs_paths_run(&c) : e->mk ? rs_passes_run(&c) : rs_stream_run(&c);
+    st = e->n_pdev ? rs_paths_run(&c) : e->mk ? rs_passes_run(&c) : rs_stream_run(&c);
     stats->seconds = rs_now_s() - t0;
     if (stats->paths_done)
         e->any_done = 1;
@@ -221,27 +236,49 @@ uint64_t rs_run_time_cut(rs_run *c, uint64_t next)
     uint64_t n = c->map.n_active, end;
     if (!(e->st.time_limit_s > 0) || rs_now_s() - e->t_start < e->st.time_limit_s)
         return UINT64_MAX;
+    uint32_t k;
     end = (next + n - 1) / n * n;
     if (!e->any_done && c->plan->todo.n) { /* the render's first pass is always finished */
         uint64_t first = (c->plan->todo.r[0][0] / n + 1) * n;
         if (end < first)
             end = first;
     }
+    /* The paths between the plan's ranges are on the film already (a checkpoint's, which has
+     * gaps where devices finished ranges out of order): where such paths lie past `end`, the
+     * passes they are in are finished too, so that every pixel ends with the same samples.
+     * Scanning the later ranges in order: one that starts past `end` after a gap moves `end` to
+     * the end of its start's pass, which may take in the next. */
+    for (k = c->range + 1; k < c->n_ranges; ++k) {
+        uint64_t lo = c->plan->todo.r[k][0];
+        if (lo > end && lo > c->plan->todo.r[k - 1][1])
+            end = (lo + n - 1) / n * n;
+    }
     if (end < c->end_path || c->range + 1 < c->n_ranges) {
+        int dropped = end < c->end_path;
         if (end < c->end_path)
             c->end_path = end > c->next_path ? end : c->next_path;
-        c->n_ranges = c->range + 1;
-        c->stats->time_limited = 1;
+        /* later ranges: those that start before `end` stay, the last cut there (rs_run_more) */
+        for (k = c->range + 1; k < c->n_ranges && c->plan->todo.r[k][0] < end; ++k)
+            dropped |= c->plan->todo.r[k][1] > end;
+        dropped |= k < c->n_ranges;
+        c->n_ranges = k;
+        c->cut = end;
+        if (dropped)
+            c->stats->time_limited = 1;
     }
     return end;
 }
 
 int rs_run_more(rs_run *c)
 {
+    if (c->n_redo)
+        return 1;
     while (c->next_path >= c->end_path && c->range + 1 < c->n_ranges) {
         c->range++;
         c->next_path = c->plan->todo.r[c->range][0];
         c->end_path = c->plan->todo.r[c->range][1];
+        if (c->end_path > c->cut) /* the time limit's cut (rs_run_time_cut) */
+            c->end_path = c->cut > c->next_path ? c->cut : c->next_path;
     }
     return c->next_path < c->end_path;
 }

@@ -4,6 +4,8 @@
 #ifndef RS_SCHEDULER_ENGINE_IMPL_H
 #define RS_SCHEDULER_ENGINE_IMPL_H
 
+#include <pthread.h>
+
 #include "scheduler/render.h"
 #include "streams/wave.h"
 
@@ -27,8 +29,13 @@ struct rs_engine {
     rs_render_settings st; /* the automatic choices made */
     rs_render_consts it;   /* the render's constants, what a device receives */
     rs_sched *sched;       /* the stream engine's devices, or NULL */
-    rs_device *mk;         /* the megakernel's device, or the wavefront's (paths), or NULL */
-    int paths;             /* mk runs whole paths (render_paths): the device's wavefront */
+    rs_device *mk;         /* the megakernel's device, or NULL */
+    /* Devices that run paths whole (render_paths: a GPU's wavefront), beside the stream
+     * engine's own devices (sched, which may then be NULL), each with a film of its own when
+     * others render beside it (merged into the run's film after each call). */
+    rs_device *pdev[RS_ENGINE_MAX_PATH_DEVICES];
+    rs_film *pfilm[RS_ENGINE_MAX_PATH_DEVICES];
+    int n_pdev;
     uint64_t plan_id;      /* counts the runs: rs_paths_job.plan_id */
     rs_slot slots[RS_RENDER_MAX_WAVES];
     uint32_t n_slots;
@@ -52,7 +59,30 @@ typedef struct rs_run {
     uint64_t next_path; /* the first path of that range no wave has started */
     uint64_t end_path;  /* its end, or the end of the pass under way once the time is up */
     uint64_t ended;     /* paths ended in waves not yet on the film */
+    uint64_t cut;       /* once the time limit has cut the run: no path at or past this one */
+    /* With path devices beside the stream engine (wavefront.c), their threads and the render
+     * thread share the run: the ranges dealt, the film, the stats and the hooks, under `lock`
+     * (NULL: one thread, no lock).  Each participant's rate (paths/s, 0 until measured: the
+     * stream engine's is rate[n_pdev]) sizes what it takes next. */
+    pthread_mutex_t *lock;
+    double rate[RS_ENGINE_MAX_PATH_DEVICES + 1];
+    uint64_t redo[RS_ENGINE_MAX_PATH_DEVICES][2]; /* ranges a failed device gave back */
+    uint32_t n_redo;
+    double t0;           /* rs_now_s at the run's start (the stream engine's rate) */
+    uint64_t host_paths; /* paths the stream engine put on the film in this run */
 } rs_run;
+
+/* rs_run's lock, where it has one. */
+static inline void rs_run_lock(rs_run *c)
+{
+    if (c->lock)
+        pthread_mutex_lock(c->lock);
+}
+static inline void rs_run_unlock(rs_run *c)
+{
+    if (c->lock)
+        pthread_mutex_unlock(c->lock);
+}
 
 /* Whether hooks->cancel is set. */
 int rs_run_cancelled(const rs_run *c);
@@ -71,7 +101,15 @@ rs_status rs_run_on_film(rs_run *c, uint64_t lo, uint64_t hi);
 rs_status rs_stream_setup(rs_engine *e);
 rs_status rs_stream_run(rs_run *c);
 void rs_stream_release(rs_engine *e);
-/* A device's wavefront (wavefront.c): whole paths in calls of render_paths. */
+/* Paths [*lo, *lo + *n) for participant `who` (a path device's index, or n_pdev for the stream
+ * engine) to run next, at most `most`: a range a failed device gave back first, else the next of
+ * the plan, sized by the participants' rates so that near the end each takes a share it finishes
+ * about when the others finish theirs (guided self-scheduling).  0 when nothing is left (or the
+ * run is cancelled).  Takes the run's lock. */
+int rs_run_take(rs_run *c, int who, uint64_t most, uint64_t *lo, uint64_t *n);
+/* The path devices (wavefront.c): their upload_scene (creation) and the run, with the stream
+ * engine's waves on the render thread beside them when the engine has a scheduler. */
+rs_status rs_paths_setup(rs_engine *e);
 rs_status rs_paths_run(rs_run *c);
 /* The megakernel: upload_scene (creation) and the run. */
 rs_status rs_passes_setup(rs_engine *e);

@@ -8,11 +8,23 @@
 #include "core/cores.h"
 #include "scheduler/engine_impl.h"
 
-static void report(const rs_run *c)
+static void report(rs_run *c)
 {
     const rs_render_hooks *h = c->hooks;
+    rs_run_lock(c);
     if (h && h->progress)
         h->progress(h->user, c->stats->paths_done + c->ended, c->stats->paths_total);
+    rs_run_unlock(c);
+}
+
+/* rs_run_more under the run's lock (path devices may be taking ranges beside the waves). */
+static int more(rs_run *c)
+{
+    int m;
+    rs_run_lock(c);
+    m = rs_run_more(c);
+    rs_run_unlock(c);
+    return m;
 }
 
 /* Hands the slot's rays to the scheduler: extension rays (closest hit) or shadow rays. */
@@ -121,17 +133,27 @@ static void flush_range(void *ctx, uint32_t begin, uint32_t end)
 static int stage_film(rs_run *c, rs_slot *sl, rs_status *status)
 {
     flush_ctx f;
+    const rs_render_hooks *h = c->hooks;
     f.sl = sl;
     f.film = c->film;
     f.map = &c->map;
     f.npix = c->map.n_active;
+    rs_run_lock(c); /* path devices merge their films into the same one */
     rs_parallel_range(RS_PAR_FOR_DYNAMIC, c->ex.threads, 0, sl->count < f.npix ? sl->count : f.npix,
                       4096, flush_range, &f);
     c->stats->paths_done += sl->count;
     c->ended -= sl->count;
     c->stats->waves++;
-    report(c);
+    if (c->lock) { /* the stream engine's rate, for the share it takes next (wavefront.c) */
+        double s = rs_now_s() - c->t0;
+        c->host_paths += sl->count;
+        if (s > 0)
+            c->rate[c->e->n_pdev] = (double)c->host_paths / s;
+    }
+    if (h && h->progress)
+        h->progress(h->user, c->stats->paths_done + c->ended, c->stats->paths_total);
     *status = rs_run_on_film(c, sl->start, sl->start + sl->count);
+    rs_run_unlock(c);
     return 0;
 }
 
@@ -183,14 +205,17 @@ static rs_status run_stage(rs_run *c, rs_slot *sl)
     return status;
 }
 
-/* Starts the next wave: paths [next_path, next_path + wave_paths), cut at end_path. */
-static rs_status slot_start(rs_run *c, rs_slot *sl, uint64_t wave)
+/* Starts the next wave: at most wave_paths paths from where the plan stands (rs_run_take: the
+ * next ones, or with path devices beside it a share by its rate).  An idle slot stays idle when
+ * nothing is left. */
+static rs_status slot_start(rs_run *c, rs_slot *sl, uint64_t *wave)
 {
-    uint64_t left = c->end_path - c->next_path, per = c->e->st.wave_paths;
-    sl->wave = wave;
-    sl->start = c->next_path;
-    sl->count = (uint32_t)(left < per ? left : per);
-    c->next_path += sl->count;
+    uint64_t lo, n;
+    if (!rs_run_take(c, c->e->n_pdev, c->e->st.wave_paths, &lo, &n))
+        return RS_OK;
+    sl->wave = (*wave)++;
+    sl->start = lo;
+    sl->count = (uint32_t)n;
     sl->alive = sl->count;
     sl->bounce = 0;
     sl->cur = 0;
@@ -241,12 +266,10 @@ rs_status rs_stream_run(rs_run *c)
         busy = 0;
         for (k = 0; k < e->n_slots && status == RS_OK; ++k) {
             rs_slot *sl = &e->slots[k];
-            if (sl->stage == SLOT_IDLE && rs_run_more(c)) {
+            if (sl->stage == SLOT_IDLE && more(c)) {
                 if (rs_run_cancelled(c))
                     break;
-                (void)rs_run_time_cut(c, c->next_path);
-                if (rs_run_more(c))
-                    status = slot_start(c, sl, next_wave++);
+                status = slot_start(c, sl, &next_wave);
             } else if (sl->stage != SLOT_IDLE && stages[sl->stage].yields &&
                        sl->stage != RS_STAGE_FILM) {
                 if (rs_run_cancelled(c))
@@ -255,7 +278,7 @@ rs_status rs_stream_run(rs_run *c)
             }
             if (status == RS_OK)
                 status = flush_in_order(c, &next_flush);
-            busy |= sl->stage != SLOT_IDLE || rs_run_more(c);
+            busy |= sl->stage != SLOT_IDLE || more(c);
         }
         if (status == RS_OK && rs_run_cancelled(c))
             status = rs_error_set(RS_ERR_CANCELLED, "render interrupted");

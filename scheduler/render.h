@@ -91,6 +91,8 @@ typedef struct rs_render_settings {
  * traces beside the stages: larger waves keep it busy (docs/performance.md). */
 #define RS_RENDER_HOST_WAVE_FREE 131072u
 #define RS_RENDER_MAX_WAVES      4u
+/* Devices of an engine that run paths whole (rs_engine_create_paths). */
+#define RS_ENGINE_MAX_PATH_DEVICES 8
 
 typedef struct rs_render_stats {
     double seconds;                 /* wall time of the run */
@@ -133,11 +135,15 @@ typedef struct rs_engine rs_engine;
  * device's upload_scene, and starts the time limit's clock.  Used from one thread. */
 rs_status rs_engine_create(const rs_scene *scene, const rs_render_settings *settings,
                            rs_sched *sched, rs_device *mk, rs_engine **out);
-/* An engine whose device `d` (already uploaded, with render_paths) runs the paths whole: the
- * stream engine's stages as the device's own wavefront (gpu/wavefront.h), no ray crossing to the
- * host; any plan, the stream engine's image bit for bit.  The device gets upload_scene here. */
+/* An engine whose devices devs[0..n) (already uploaded, each with render_paths: a GPU) run
+ * their paths whole: the stream engine's stages as each device's own wavefront
+ * (gpu/wavefront.h), no ray crossing to the host.  With `sched` (NULL: none) the stream engine
+ * runs beside them on the render thread, over the scheduler's devices (the CPU), shading on the
+ * host as ever.  The plan's paths are dealt in ranges to whoever is free, sized by each one's
+ * measured rate, and every device's samples go onto the one film with exact sums: any plan, any
+ * split, the CPU stream engine's image bit for bit.  Each device gets upload_scene here. */
 rs_status rs_engine_create_paths(const rs_scene *scene, const rs_render_settings *settings,
-                                 rs_device *d, rs_engine **out);
+                                 rs_sched *sched, rs_device *const *devs, int n, rs_engine **out);
 /* Renders the plan's paths onto `film` (the render's size): each pixel's samples are added in
  * sample order after what the film holds.  `hooks` may be NULL; *stats is this run's.  The
  * megakernel takes plans over every pixel, in whole samples (RS_ERR_ARG otherwise). */

@@ -514,6 +514,73 @@ static void test_gpucheck_megakernel_vs_cpu(void **state)
     }
 }
 
+/* The CUDA wavefront (gpu/cuda_wavefront.cu: the paths run whole on the GPU, shading included)
+ * against the CPU stream engine: `a` rendered both ways gives one image, bit for bit.  Expected
+ * where the shading's arithmetic rounds alike on both (--fmad=false); the film's sums are exact
+ * integers, so the order of the GPU's atomic adds does not matter. */
+static void wavefront_same(const char *what, rt_args a)
+{
+    float *cpu, *img;
+    char label[160];
+    cpu = rt_render(&a, NULL);
+    assert_non_null(cpu);
+    a.fallback_only = a.real_gpu = a.wavefront = 1;
+    img = rt_render(&a, NULL);
+    assert_non_null(img);
+    assert_true(gc_image_sane(img, a.width, a.height));
+    snprintf(label, sizeof label, "%s: cpu stream vs cuda wavefront", what);
+    assert_int_equal(gc_diff_pixels(label, cpu, img, a.width, a.height), 0);
+    free(img);
+    a.fallback_only = 0;
+    a.with_fallback = 1; /* with real_gpu and wavefront: the CPU's stream engine beside it */
+    img = rt_render(&a, NULL);
+    assert_non_null(img);
+    snprintf(label, sizeof label, "%s: cpu stream vs cpu + cuda wavefront", what);
+    assert_int_equal(gc_diff_pixels(label, cpu, img, a.width, a.height), 0);
+    free(cpu);
+    free(img);
+}
+
+/* builtin:gpucheck in every sampling mode and sampler, builtin:many-lights with the light BVH,
+ * adaptive sampling (plans over some pixels, the device's copy of them). */
+static void test_gpucheck_wavefront_bit_exact(void **state)
+{
+    int c;
+    rt_args a;
+    rs_adaptive_stats as;
+    (void)state;
+    for (c = 0; c < GC_N_CASES; ++c) {
+        char what[96];
+        snprintf(what, sizeof what, "gpucheck %s", gc_cases[c].name);
+        wavefront_same(what, gc_args(&gc_cases[c]));
+    }
+    a = rt_defaults("many-lights", 64, 8);
+    a.threads = 4;
+    a.sampler = RS_SAMPLER_SOBOL;
+    a.light_sampler = RS_LIGHT_SAMPLER_BVH;
+    wavefront_same("many-lights, light BVH", a);
+    a = rt_defaults("cornell", 64, 64);
+    a.threads = 4;
+    a.sampler = RS_SAMPLER_SOBOL;
+    a.adaptive.threshold = 0.05;
+    a.adaptive.min_spp = 4;
+    a.adaptive_out = &as;
+    wavefront_same("cornell, adaptive", a);
+}
+
+/* A render of 2.6 million paths: two waves of RS_CUDA_WF_WAVE in flight at once, the second
+ * partial (left out of scripts/gpu-check.sh's memcheck run, where it would take minutes). */
+static void test_wavefront_two_waves(void **state)
+{
+    rt_args a = gc_args(&gc_cases[0]);
+    (void)state;
+    a.width = 256;
+    a.height = 256;
+    a.spp = 40;
+    a.threads = 8;
+    wavefront_same("gpucheck 256x256x40 (two waves)", a);
+}
+
 /* gpu_trace_test [PATTERN]: only the tests whose names match PATTERN (cmocka's wildcards), as
  * scripts/gpu-check.sh runs the gpucheck ones under compute-sanitizer. */
 int main(int argc, char **argv)
@@ -529,6 +596,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_megakernel_cpu_vs_gpu),
         cmocka_unit_test(test_gpucheck_stream_bit_exact),
         cmocka_unit_test(test_gpucheck_megakernel_vs_cpu),
+        cmocka_unit_test(test_gpucheck_wavefront_bit_exact),
+        cmocka_unit_test(test_wavefront_two_waves),
     };
     if (rs_gpu_count(&why) == 0) {
         printf("SKIP: no CUDA device: %s\n", why);

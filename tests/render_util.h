@@ -44,7 +44,8 @@ typedef struct rt_args {
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
     const rs_filter *filter;         /* the pixel filter; NULL: box, 1 pixel */
     uint32_t light_sampler;          /* rs_light_sampler; zeroed: by power */
-    int wavefront; /* with fallback_only: the device runs the paths whole (render_paths, its
+    int wavefront; /* the GPU device (fallback_only: alone; with_fallback: beside the CPU device,
+                      which runs the stream engine) runs its paths whole (render_paths, its
                       wavefront: rs_engine_create_paths) instead of tracing for the host */
 } rt_args;
 
@@ -165,7 +166,8 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
             goto out;
     memset(&cfg, 0, sizeof cfg);
     cfg.chunk_size = a->chunk_size;
-    if (rs_sched_create(devs, n, &cfg, &sched) != RS_OK ||
+    /* with the wavefront beside it, the scheduler has the CPU device alone */
+    if (rs_sched_create(devs, a->wavefront && n == 2 ? 1 : n, &cfg, &sched) != RS_OK ||
         rs_film_create(a->width, a->height, &film) != RS_OK)
         goto out;
     st = rt_settings(a);
@@ -180,7 +182,8 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
             goto out;
     } else if (a->wavefront) {
         rs_engine *e = NULL;
-        rs_status rst = rs_engine_create_paths(scene, &st, devs[0], &e);
+        rs_status rst = n == 2 ? rs_engine_create_paths(scene, &st, sched, &devs[1], 1, &e)
+                               : rs_engine_create_paths(scene, &st, NULL, &devs[0], 1, &e);
         if (rst == RS_OK && a->adaptive.threshold > 0) {
             rs_adaptive_stats as;
             rst = rs_render_adaptive(e, &a->adaptive, NULL, film, &stats, &as);
