@@ -69,6 +69,9 @@ typedef struct fallback_impl {
 
 /* The fallback's waves: smaller than the GPU's (host caches), the same stages. */
 #define RS_WF_FALLBACK_WAVE (1u << 16)
+/* Fewer items than this run on the calling thread: a wave's last segments hold a few paths, and
+ * a parallel region for each would cost more than the work (OpenMP's spinning threads). */
+#define RS_WF_FALLBACK_PAR_MIN 4096
 
 static void free_staging(fallback_impl *f)
 {
@@ -321,7 +324,7 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
     uint32_t alive = w->count, cur = 0;
     long i;
     (void)threads; /* read only by the OpenMP clauses */
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && w->count >= RS_WF_FALLBACK_PAR_MIN)
     for (i = 0; i < (long)w->count; ++i)
         rs_wf_raygen(it, w, (uint32_t)i, &f->paths, &f->queue[0]);
     for (w->bounce = 0; alive > 0; w->bounce++) {
@@ -332,13 +335,13 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
         tb.count = alive;
         tb.rays = f->queue[cur];
         tb.hits = f->wf_hits;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && alive >= RS_WF_FALLBACK_PAR_MIN)
         for (i = 0; i < (long)alive; ++i)
             rs_trace_one(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
         counts->closest += alive;
         if (w->bounce > counts->max_bounce)
             counts->max_bounce = w->bounce;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && alive >= RS_WF_FALLBACK_PAR_MIN)
         for (i = 0; i < (long)alive; ++i) {
             rs_ray nr, sr;
             uint32_t p, made = rs_wf_shade(it, w, (uint32_t)i, &f->queue[cur], &f->wf_hits, &f->paths,
@@ -353,10 +356,10 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
             tb.count = n_shadow;
             tb.rays = f->shadow;
             tb.occluded = f->occ;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && n_shadow >= RS_WF_FALLBACK_PAR_MIN)
             for (i = 0; i < (long)n_shadow; ++i)
                 rs_trace_one(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && n_shadow >= RS_WF_FALLBACK_PAR_MIN)
             for (i = 0; i < (long)n_shadow; ++i)
                 rs_wf_resolve((uint32_t)i, &f->shadow, f->occ, &f->paths);
             counts->shadow += n_shadow;
@@ -364,7 +367,7 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
         cur ^= 1;
         alive = n_next;
     }
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && w->count >= RS_WF_FALLBACK_PAR_MIN)
     for (i = 0; i < (long)w->count; ++i)
         rs_wf_film_path(w, (uint32_t)i, &f->paths, &f->film);
 }
