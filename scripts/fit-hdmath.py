@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """scripts/fit-hdmath.py — where the constants of core/hdmath.h come from.
 
-Prints, as C, the minimax polynomials of core/hdmath.h and the bits of 2/pi its large-argument
-sine and cosine reduce with.  Needs mpmath (pip install mpmath); runs in a few seconds:
+Prints, as C, the minimax polynomials of core/hdmath.h, its split constants, the bits of 2/pi its
+large-argument sine and cosine reduce with, and how near a float comes to a multiple of pi/2.
+Needs mpmath (pip install mpmath); runs in under a minute:
 
     python3 scripts/fit-hdmath.py
 
@@ -23,7 +24,6 @@ import struct
 import mpmath as mp
 
 mp.mp.dps = 50
-FIT = __import__("os").environ.get("FIT", "1") == "1"
 
 
 def to_float(x):
@@ -179,3 +179,19 @@ split("PIF", mp.pi, [24], 2)
 print("/* ln 2 for the double log and exp: 32 bits and a double */")
 split("LN2D", mp.log(2), [32], 2, fmt="d")
 print("#define RS_HDM_PIO2_2M94 %.17e /* pi/2 * 2^-94, double */" % float(mp.pi / 2 * mp.mpf(2) ** -94))
+
+# The nearest approach of a float to a multiple of pi/2 (k pi/2 for k < 2^15, that is |x| below
+# about 51000): how many bits the reductions must keep of x - k pi/2.  Only the float nearest
+# each k pi/2 can be nearest.
+mp.mp.dps = 40
+best = None
+for k in range(1, 1 << 15):
+    v = k * mp.pi / 2
+    e = int(mp.floor(mp.log(v, 2)))
+    ulp = mp.mpf(2) ** (e - 23)
+    d = abs(mp.nint(v / ulp) * ulp - v)
+    if best is None or d < best[0]:
+        best = (d, k)
+    if k == 10:
+        print("/* below 16: nearest approach 2^%.1f (k = %d) */" % (float(mp.log(best[0], 2)), best[1]))
+print("/* below 51000: nearest approach 2^%.1f (k = %d) */" % (float(mp.log(best[0], 2)), best[1]))
