@@ -87,10 +87,55 @@
 #define RS_HDM_PIO2F_1 7.549790126e-08f
 #define RS_HDM_PIF_0   3.141592503e+00f
 #define RS_HDM_PIF_1   1.509958025e-07f
-/* ln 2 = LN2D_0 (32 bits) + LN2D_1 for the double log and exp; pi/2 2^-94 */
-#define RS_HDM_LN2D_0    6.93147180369123816e-01
-#define RS_HDM_LN2D_1    1.90821492927058770e-10
+/* pi/2 2^-94 (double) */
 #define RS_HDM_PIO2_2M94 7.93049479854887923e-29
+/* rs_powf's and rs_logf's double log2 and exp2 (tables as glibc's powf has them):
+ * log2 x = k + log2 c_i + log2(1 + r), r = z / c_i - 1 in [-0.0151, 0.0235], z = x 2^-k in
+ * [OFF, 2 OFF) by its bits, i = z's subinterval of 32 (c = 1 in the one holding 1);
+ * log2(1 + r) = r L(r), relative error 2^-42.0.
+ * 2^t = 2^(j/32) 2^e 2^r, |r| <= 1/64: 2^r = 1 + r X(r), relative error 2^-52.7. */
+#define RS_HDM_LOG2_OFF 0x3f330000u
+/* clang-format off */
+#define RS_HDM_LOG2_INVC {0x1.6a13cd1537290p+0, 0x1.623fa77016240p+0, 0x1.5ac056b015ac0p+0, \
+    0x1.5390948f40febp+0, 0x1.4cab88725af6ep+0, 0x1.460cbc7f5cf9ap+0, 0x1.3fb013fb013fbp+0, \
+    0x1.3991c2c187f63p+0, 0x1.33ae45b57bcb2p+0, 0x1.2e025c04b8097p+0, 0x1.288b01288b013p+0, \
+    0x1.23456789abcdfp+0, 0x1.1e2ef3b3fb874p+0, 0x1.19453808ca29cp+0, 0x1.1485f0e0acd3bp+0, \
+    0x1.0fef010fef011p+0, 0x1.0b7e6ec259dc8p+0, 0x1.073260a47f7c6p+0, 0x1.03091b51f5e1ap+0, \
+    0x1.0000000000000p+0, 0x1.ecc07b301ecc0p-1, 0x1.de5d6e3f8868ap-1, 0x1.d0cb58f6ec074p-1, \
+    0x1.c3f8f01c3f8f0p-1, 0x1.b7d6c3dda338bp-1, 0x1.ac5701ac5701bp-1, 0x1.a16d3f97a4b02p-1, \
+    0x1.970e4f80cb872p-1, 0x1.8d3018d3018d3p-1, 0x1.83c977ab2beddp-1, 0x1.7ad2208e0ecc3p-1, \
+    0x1.724287f46debcp-1}
+#define RS_HDM_LOG2_LOGC {-0x1.0014332be0032p-1, -0x1.dfdd89d586e2cp-2, -0x1.c043859e2fdb2p-2, \
+    -0x1.a152f142981b5p-2, -0x1.8304d90c11fd1p-2, -0x1.6552b49986277p-2, -0x1.48365e695d797p-2, \
+    -0x1.2baa0c34be1ebp-2, -0x1.0fa848044b352p-2, -0x1.e857d3d361368p-3, -0x1.b2602497d534ap-3, \
+    -0x1.7d60496cfbb4cp-3, -0x1.494f863b8df32p-3, -0x1.162593186da70p-3, -0x1.c7b528b70f1bcp-4, \
+    -0x1.64ce26c067157p-4, -0x1.0387efbca86a7p-4, -0x1.47aa07357703cp-5, -0x1.16a21e20a0a29p-6, \
+    0x0.0p+0, 0x1.c4dfab90aab6ap-5, 0x1.918a16e46335ep-4, 0x1.1dcd197552b7dp-3, \
+    0x1.70742d4ef0280p-3, 0x1.c0db6cdd94defp-3, 0x1.0790adbb03009p-2, 0x1.2db10fc4d9aaep-2, \
+    0x1.52dbdfc4c96b5p-2, 0x1.771d2ba7efb3cp-2, 0x1.9a802391e2330p-2, 0x1.bd0f2e9e79032p-2, \
+    0x1.ded3fd442364cp-2}
+#define RS_HDM_EXP2_TAB {0x1.0000000000000p+0, 0x1.059b0d3158574p+0, 0x1.0b5586cf9890fp+0, \
+    0x1.11301d0125b51p+0, 0x1.172b83c7d517bp+0, 0x1.1d4873168b9aap+0, 0x1.2387a6e756238p+0, \
+    0x1.29e9df51fdee1p+0, 0x1.306fe0a31b715p+0, 0x1.371a7373aa9cbp+0, 0x1.3dea64c123422p+0, \
+    0x1.44e086061892dp+0, 0x1.4bfdad5362a27p+0, 0x1.5342b569d4f82p+0, 0x1.5ab07dd485429p+0, \
+    0x1.6247eb03a5585p+0, 0x1.6a09e667f3bcdp+0, 0x1.71f75e8ec5f74p+0, 0x1.7a11473eb0187p+0, \
+    0x1.82589994cce13p+0, 0x1.8ace5422aa0dbp+0, 0x1.93737b0cdc5e5p+0, 0x1.9c49182a3f090p+0, \
+    0x1.a5503b23e255dp+0, 0x1.ae89f995ad3adp+0, 0x1.b7f76f2fb5e47p+0, 0x1.c199bdd85529cp+0, \
+    0x1.cb720dcef9069p+0, 0x1.d5818dcfba487p+0, 0x1.dfc97337b9b5fp+0, 0x1.ea4afa2a490dap+0, \
+    0x1.f50765b6e4540p+0}
+/* clang-format on */
+#define RS_HDM_LOG2_L0 0x1.71547652b846ap+0
+#define RS_HDM_LOG2_L1 -0x1.71547651dfe41p-1
+#define RS_HDM_LOG2_L2 0x1.ec709d71b6df8p-2
+#define RS_HDM_LOG2_L3 -0x1.7154dfd5f4dcap-2
+#define RS_HDM_LOG2_L4 0x1.27868a4412163p-2
+#define RS_HDM_LOG2_L5 -0x1.e22a81da9801ep-3
+#define RS_HDM_EXP2_X0 0x1.62e42fefa39eep-1
+#define RS_HDM_EXP2_X1 0x1.ebfbdff81326cp-3
+#define RS_HDM_EXP2_X2 0x1.c6b08d709fe60p-5
+#define RS_HDM_EXP2_X3 0x1.3b2b1bd9998e2p-7
+#define RS_HDM_EXP2_X4 0x1.5d878e9057566p-10
+#define RS_HDM_LN2_D   0x1.62e42fefa39efp-1 /* ln 2, double */
 /* 2/pi in 32-bit words: word i >= 1 holds the bits 32 (i - 1) + 1 .. 32 i after the binary
  * point, word 0 the 32 zero bits before it; enough for a 96-bit window at any float's exponent */
 /* clang-format off */
@@ -99,9 +144,16 @@
      0xdb629599u, 0x3c439041u, 0xfe5163abu, 0xdebbc561u}
 /* clang-format on */
 
+/* The tables, the host's and (under nvcc) the device's copy: rs_hdm_*_at picks. */
 static const uint32_t rs_hdm_two_over_pi[9] = RS_HDM_TWO_OVER_PI_WORDS;
+static const double rs_hdm_log2_invc[32] = RS_HDM_LOG2_INVC;
+static const double rs_hdm_log2_logc[32] = RS_HDM_LOG2_LOGC;
+static const double rs_hdm_exp2_tab[32] = RS_HDM_EXP2_TAB;
 #if defined(__CUDACC__)
 RS_CONST_TABLE uint32_t rs_hdm_two_over_pi_dev[9] = RS_HDM_TWO_OVER_PI_WORDS;
+RS_CONST_TABLE double rs_hdm_log2_invc_dev[32] = RS_HDM_LOG2_INVC;
+RS_CONST_TABLE double rs_hdm_log2_logc_dev[32] = RS_HDM_LOG2_LOGC;
+RS_CONST_TABLE double rs_hdm_exp2_tab_dev[32] = RS_HDM_EXP2_TAB;
 #endif
 
 /* ---- bits ------------------------------------------------------------------------------------ */
@@ -156,14 +208,11 @@ RS_HD double rs_hdm_u2d(uint64_t u)
 /* 2^n as a float, n in [-126, 127] (exact) */
 RS_HD float rs_hdm_pow2(int n) { return rs_hdm_u2f((uint32_t)(n + 127) << 23); }
 
-RS_HD uint32_t rs_hdm_two_over_pi_word(int i)
-{
 #if defined(__CUDA_ARCH__)
-    return rs_hdm_two_over_pi_dev[i];
+#  define RS_HDM_TABLE(name, i) name##_dev[i]
 #else
-    return rs_hdm_two_over_pi[i];
+#  define RS_HDM_TABLE(name, i) name[i]
 #endif
-}
 
 /* ---- sine and cosine ------------------------------------------------------------------------ */
 
@@ -198,8 +247,8 @@ RS_HD_COLD int rs_hdm_reduce_big(float ax, float *hi, float *lo)
     uint64_t m = (u & 0x7fffffu) | 0x800000u;
     int g = e + 30; /* the window's first bit, 2^-(e - 1), in the table */
     int w = g >> 5, s = g & 31;
-    uint64_t t0 = rs_hdm_two_over_pi_word(w), t1 = rs_hdm_two_over_pi_word(w + 1);
-    uint64_t t2 = rs_hdm_two_over_pi_word(w + 2), t3 = rs_hdm_two_over_pi_word(w + 3);
+    uint64_t t0 = RS_HDM_TABLE(rs_hdm_two_over_pi, w), t1 = RS_HDM_TABLE(rs_hdm_two_over_pi, w + 1);
+    uint64_t t2 = RS_HDM_TABLE(rs_hdm_two_over_pi, w + 2), t3 = RS_HDM_TABLE(rs_hdm_two_over_pi, w + 3);
     uint64_t w2 = (((t0 << 32) | t1) >> (32 - s)) & 0xffffffffu;
     uint64_t w1 = (((t1 << 32) | t2) >> (32 - s)) & 0xffffffffu;
     uint64_t w0 = (((t2 << 32) | t3) >> (32 - s)) & 0xffffffffu;
@@ -223,62 +272,51 @@ RS_HD_COLD int rs_hdm_reduce_big(float ax, float *hi, float *lo)
 RS_HD int rs_hdm_reduce(float ax, float *hi, float *lo)
 {
     if (ax < 16.0f) {
-        float k = (float)(int)(ax * 0.636619772f + 0.5f);
+        int ki = (int)(ax * 0.636619772f + 0.5f);
+        float k = (float)ki;
         float a = ax - k * RS_HDM_PIO2_0, k1 = k * RS_HDM_PIO2_1, k2 = k * RS_HDM_PIO2_2;
         float b = a - k1, r = b - k2;
         *hi = r;
         *lo = ((a - b) - k1) + ((b - r) - k2);
-        return (int)k & 3;
+        return ki & 3;
     }
     return rs_hdm_reduce_big(ax, hi, lo);
 }
 
-/* sin x and cos x at once (one reduction); NaN for infinite or NaN x. */
+/* sin x and cos x at once (one reduction); NaN for infinite or NaN x.  The quadrant picks and
+ * negates the two polynomials' results by bit operations, not branches: q is as random as the
+ * sampled angle, and mispredicted branches cost more than both polynomials. */
 RS_HD void rs_sincosf(float x, float *s, float *c)
 {
-    uint32_t u = rs_hdm_f2u(x), sign = u & 0x80000000u;
-    float ax = rs_hdm_u2f(u ^ sign), hi, lo, ps, pc, so, co;
+    uint32_t u = rs_hdm_f2u(x), sign = u & 0x80000000u, ps, pc, odd;
+    float ax = rs_hdm_u2f(u ^ sign), hi, lo;
     int q;
     if (!(ax < RS_HDM_INF)) {
         *s = *c = x - x;
         return;
     }
     q = rs_hdm_reduce(ax, &hi, &lo);
-    ps = rs_hdm_sin_poly(hi, lo);
-    pc = rs_hdm_cos_poly(hi, lo);
-    so = (q & 1) ? pc : ps;
-    co = (q & 1) ? ps : pc;
-    if (q & 2)
-        so = -so;
-    if ((q + 1) & 2)
-        co = -co;
-    *s = rs_hdm_u2f(rs_hdm_f2u(so) ^ sign);
-    *c = co;
+    ps = rs_hdm_f2u(rs_hdm_sin_poly(hi, lo));
+    pc = rs_hdm_f2u(rs_hdm_cos_poly(hi, lo));
+    odd = 0u - (uint32_t)(q & 1); /* quadrants 1 and 3: sin x = +-cos r, cos x = -+sin r */
+    *s = rs_hdm_u2f(((ps & ~odd) | (pc & odd)) ^ ((uint32_t)(q & 2) << 30) ^ sign);
+    *c = rs_hdm_u2f(((pc & ~odd) | (ps & odd)) ^ ((uint32_t)((q + 1) & 2) << 30));
 }
 
+/* rs_sincosf's sine and cosine (the same bits: the compiler drops the half not used but for
+ * the shared reduction and selection). */
 RS_HD float rs_sinf(float x)
 {
-    uint32_t u = rs_hdm_f2u(x), sign = u & 0x80000000u;
-    float ax = rs_hdm_u2f(u ^ sign), hi, lo, v;
-    int q;
-    if (!(ax < RS_HDM_INF))
-        return x - x;
-    q = rs_hdm_reduce(ax, &hi, &lo);
-    v = (q & 1) ? rs_hdm_cos_poly(hi, lo) : rs_hdm_sin_poly(hi, lo);
-    if (q & 2)
-        v = -v;
-    return rs_hdm_u2f(rs_hdm_f2u(v) ^ sign);
+    float s, c;
+    rs_sincosf(x, &s, &c);
+    return s;
 }
 
 RS_HD float rs_cosf(float x)
 {
-    float ax = rs_hdm_u2f(rs_hdm_f2u(x) & 0x7fffffffu), hi, lo, v;
-    int q;
-    if (!(ax < RS_HDM_INF))
-        return x - x;
-    q = rs_hdm_reduce(ax, &hi, &lo);
-    v = (q & 1) ? rs_hdm_sin_poly(hi, lo) : rs_hdm_cos_poly(hi, lo);
-    return ((q + 1) & 2) ? -v : v;
+    float s, c;
+    rs_sincosf(x, &s, &c);
+    return c;
 }
 
 /* tan x = sin / cos of the reduced argument (cos / -sin in odd quadrants: both polynomials are
@@ -329,48 +367,44 @@ RS_HD float rs_expf(float x)
 
 /* ---- logarithm and power (in double: 0.5 ulp and a hair after the final rounding) ------------ */
 
-/* ln x for a double x > 0 that came from a float (normal in double): x = 2^e f, f in
- * [sqrt 1/2, sqrt 2), ln f = 2 atanh(t), t = (f - 1) / (f + 1), |t| <= 0.1716: the series to
- * t^19 (the first term left out is under 2^-50 relative). */
-RS_HD double rs_hdm_log_d(double x)
+/* log2 x as a double for a float x > 0, finite (relative error about 2^-42, and exact at 1):
+ * the constants' comment above.  A subnormal x is scaled by 2^23 first (exactly). */
+RS_HD double rs_hdm_log2_d(float x)
 {
-    uint64_t u = rs_hdm_d2u(x);
-    int e = (int)((u >> 52) & 0x7ffu) - 1023;
-    double f = rs_hdm_u2d((u & 0x000fffffffffffffull) | 0x3ff0000000000000ull), t, t2, s;
-    if (f > 1.4142135623730951) {
-        f *= 0.5;
-        e += 1;
-    }
-    t = (f - 1.0) / (f + 1.0);
-    t2 = t * t;
-    /* clang-format off */
-    s = 2.0 + t2 * (2.0 / 3 + t2 * (2.0 / 5 + t2 * (2.0 / 7 + t2 * (2.0 / 9 + t2 * (2.0 / 11 +
-        t2 * (2.0 / 13 + t2 * (2.0 / 15 + t2 * (2.0 / 17 + t2 * (2.0 / 19)))))))));
-    /* clang-format on */
-    return (double)e * RS_HDM_LN2D_0 + ((double)e * RS_HDM_LN2D_1 + t * s);
+    uint32_t ix = rs_hdm_f2u(x), tmp;
+    int i, k;
+    double z, r, r2, p;
+    if (ix < 0x00800000u)
+        ix = rs_hdm_f2u(x * 8388608.0f) - (23u << 23);
+    tmp = ix - RS_HDM_LOG2_OFF;
+    i = (int)((tmp >> 18) & 31u);
+    k = (int)(tmp >> 23) - (int)((tmp >> 31) << 9); /* tmp >> 23 as a signed 32-bit value */
+    z = (double)rs_hdm_u2f(ix - (tmp & 0xff800000u));
+    r = z * RS_HDM_TABLE(rs_hdm_log2_invc, i) - 1.0;
+    r2 = r * r;
+    /* Estrin's scheme (shorter chains than Horner's: this sits on the Phong lobe's path) */
+    p = (RS_HDM_LOG2_L0 + r * RS_HDM_LOG2_L1) + r2 * (RS_HDM_LOG2_L2 + r * RS_HDM_LOG2_L3) +
+        (r2 * r2) * (RS_HDM_LOG2_L4 + r * RS_HDM_LOG2_L5);
+    return (double)k + (RS_HDM_TABLE(rs_hdm_log2_logc, i) + r * p);
 }
 
-/* e^z as a double for any double z, exact to ~2^-50 relative where a float result is not 0 or
- * inf (z in [-104, 89]): 2^k e^r, |r| <= ln 2 / 2, Taylor to r^11 (r^12/12! < 2^-47). */
-RS_HD double rs_hdm_exp_d(double z)
+/* 2^t as a double for a double t, not NaN (relative error about 2^-52): 0 at or below -160,
+ * inf at or above 129, where a float would be 0 or inf anyway. */
+RS_HD double rs_hdm_exp2_d(double t)
 {
-    double k, r, p;
-    int ki;
-    if (!(z == z))
-        return z + z;
-    if (z > 89.0)
+    int kb;
+    double r, r2, p;
+    if (t >= 129.0)
         return (double)RS_HDM_INF;
-    if (z < -104.0)
+    if (t <= -160.0)
         return 0.0;
-    ki = (int)(z * 1.4426950408889634 + (z < 0.0 ? -0.5 : 0.5));
-    k = (double)ki;
-    r = (z - k * RS_HDM_LN2D_0) - k * RS_HDM_LN2D_1;
-    /* clang-format off */
-    p = 1.0 + r * (1.0 + r * (1.0 / 2 + r * (1.0 / 6 + r * (1.0 / 24 + r * (1.0 / 120 +
-        r * (1.0 / 720 + r * (1.0 / 5040 + r * (1.0 / 40320 + r * (1.0 / 362880 +
-        r * (1.0 / 3628800 + r * (1.0 / 39916800)))))))))));
-    /* clang-format on */
-    return p * rs_hdm_u2d((uint64_t)(ki + 1023) << 52);
+    kb = (int)(t * 32.0 + 5120.5); /* round(32 t) + 5120: positive, so (int) floors */
+    r = t - (double)(kb - 5120) * (1.0 / 32); /* exact (Sterbenz) */
+    r2 = r * r;
+    p = (RS_HDM_EXP2_X0 + r * RS_HDM_EXP2_X1) + r2 * (RS_HDM_EXP2_X2 + r * RS_HDM_EXP2_X3) +
+        (r2 * r2) * RS_HDM_EXP2_X4;
+    return RS_HDM_TABLE(rs_hdm_exp2_tab, kb & 31) *
+           rs_hdm_u2d((uint64_t)((kb >> 5) - 160 + 1023) << 52) * (1.0 + r * p);
 }
 
 /* ln x: -inf at +-0, NaN below 0, inf at inf. */
@@ -384,7 +418,7 @@ RS_HD float rs_logf(float x)
         return -RS_HDM_INF;
     if (x == RS_HDM_INF)
         return x;
-    return (float)rs_hdm_log_d((double)x);
+    return (float)(rs_hdm_log2_d(x) * RS_HDM_LN2_D);
 }
 
 /* 0: y is not an integer; 1: an odd one; 2: an even one (infinities are even); y != 0, not NaN */
@@ -401,9 +435,9 @@ RS_HD int rs_hdm_int_kind(float y)
     return (((u & 0x7fffffu) | 0x800000u) >> (23 - e)) & 1u ? 1 : 2;
 }
 
-/* x^y as C99's powf: 1 for y = +-0 or x = 1 (even with a NaN), +0 or +inf for x = +0, NaN for
- * x < 0 and y not an integer, the sign of x for odd integer y.  |x|^y = e^(y ln|x|) in double. */
-RS_HD float rs_powf(float x, float y)
+/* rs_powf's cases off the common one (x in (0, inf), y finite): C99's zeros, infinities and
+ * NaNs, and negative x. */
+RS_HD_COLD float rs_hdm_pow_special(float x, float y)
 {
     uint32_t ux = rs_hdm_f2u(x), rsign = 0;
     float ax = rs_hdm_u2f(ux & 0x7fffffffu), v;
@@ -425,8 +459,20 @@ RS_HD float rs_powf(float x, float y)
     else if (ax == RS_HDM_INF)
         v = y < 0.0f ? 0.0f : RS_HDM_INF;
     else
-        v = (float)rs_hdm_exp_d((double)y * rs_hdm_log_d((double)ax));
+        v = (float)rs_hdm_exp2_d((double)y * rs_hdm_log2_d(ax));
     return rs_hdm_u2f(rs_hdm_f2u(v) | rsign);
+}
+
+/* x^y as C99's powf: 1 for y = +-0 or x = 1 (even with a NaN), +0 or +inf for x = +0, NaN for
+ * x < 0 and y not an integer, the sign of x for odd integer y.  x^y = 2^(y log2 x) in double
+ * for x in (0, inf) and finite y (the common case, one test: x = 1 and y = 0 give 2^0 = 1 there
+ * too), rs_hdm_pow_special for the rest. */
+RS_HD float rs_powf(float x, float y)
+{
+    uint32_t ux = rs_hdm_f2u(x), uy = rs_hdm_f2u(y);
+    if (ux - 1u < 0x7f7fffffu && (uy & 0x7fffffffu) < 0x7f800000u)
+        return (float)rs_hdm_exp2_d((double)y * rs_hdm_log2_d(x));
+    return rs_hdm_pow_special(x, y);
 }
 
 /* ---- inverse trigonometric functions -------------------------------------------------------- */

@@ -195,3 +195,50 @@ for k in range(1, 1 << 15):
     if k == 10:
         print("/* below 16: nearest approach 2^%.1f (k = %d) */" % (float(mp.log(best[0], 2)), best[1]))
 print("/* below 51000: nearest approach 2^%.1f (k = %d) */" % (float(mp.log(best[0], 2)), best[1]))
+
+# rs_powf's and rs_logf's double-precision log2 and exp2 (table-driven, as glibc's powf):
+#   log2 x = k + log2 c_i + log2(1 + r), r = z / c_i - 1, z = x 2^-k in [OFF, 2 OFF) (as bits),
+#   the 32 subintervals of z by its bits; c_i near each one's middle (c = 1 for the one holding 1,
+#   so that log2 x is exact relative to itself near 1); log2(1 + r) = r L(r)
+#   2^t = 2^(j/32) 2^(k) 2^r, |r| <= 1/64: 2^r = 1 + r X(r)
+mp.mp.dps = 50
+OFF = 0x3F330000
+
+
+def bits_to_float(b):
+    return struct.unpack("f", struct.pack("I", b))[0]
+
+
+invc, logc, rmin, rmax = [], [], 0, 0
+for i in range(32):
+    lo = mp.mpf(bits_to_float(OFF + (i << 18)))
+    hi = mp.mpf(bits_to_float(OFF + ((i + 1) << 18)))
+    if lo <= 1 < hi:
+        ic = mp.mpf(1)
+    else:
+        ic = mp.mpf(float(2 / (lo + hi)))  # 1/c rounded to double
+    invc.append(float(ic))
+    lc = -mp.log(mp.mpf(float(ic)), 2)
+    logc.append(float(lc))
+    rmin = min(rmin, lo * mp.mpf(float(ic)) - 1)
+    rmax = max(rmax, hi * mp.mpf(float(ic)) - 1)
+print("/* log2: r in [%.6f, %.6f] */" % (float(rmin), float(rmax)))
+print("#define RS_HDM_LOG2_INVC {" + ", ".join(v.hex() for v in invc) + "}")
+print("#define RS_HDM_LOG2_LOGC {" + ", ".join(v.hex() for v in logc) + "}")
+for deg in (6,):
+    c = remez(lambda r: mp.log(1 + r, 2) / r, lambda r: r / mp.log(1 + r, 2), rmin, rmax, deg - 1)
+    cd = [float(x) for x in c]
+    e = max_rel_err(lambda r: mp.log(1 + r, 2),
+                    lambda r: r * sum(mp.mpf(cj) * r**j for j, cj in enumerate(cd)), rmin, rmax, 4000)
+    print("/* log2(1 + r) = r L(r), degree %d: relative error 2^%.1f */" % (deg, float(mp.log(e, 2))))
+    print("#define RS_HDM_LOG2_POLY {" + ", ".join(v.hex() for v in cd) + "}")
+print("#define RS_HDM_EXP2_TAB {" + ", ".join(float(mp.mpf(2) ** (mp.mpf(j) / 32)).hex() for j in range(32)) + "}")
+h = mp.mpf(1) / 64 * mp.mpf("1.0001")
+for deg in (5,):
+    # weighted by 1 / 2^r, not r / 2^r: the relative error of X, |r| times that of 2^r
+    c = remez(lambda r: (mp.mpf(2) ** r - 1) / r, lambda r: 1 / mp.mpf(2) ** r, -h, h, deg - 1)
+    cd = [float(x) for x in c]
+    e = max_rel_err(lambda r: mp.mpf(2) ** r,
+                    lambda r: 1 + r * sum(mp.mpf(cj) * r**j for j, cj in enumerate(cd)), -h, h, 4000)
+    print("/* 2^r = 1 + r X(r), degree %d: relative error 2^%.1f */" % (deg, float(mp.log(e, 2))))
+    print("#define RS_HDM_EXP2_POLY {" + ", ".join(v.hex() for v in cd) + "}")
