@@ -14,8 +14,7 @@
 #     1. nvidia-smi must list a GPU and `raystream --version` must see a usable CUDA device (else
 #        its reason: no driver, a driver older than the CUDA runtime with both versions, ...);
 #     2. gpu_trace_test must run (exit 77, "no CUDA device", fails here) and pass: the CUDA trace
-#        kernel and the stream integrator on builtin:gpucheck bit for bit against the CPU, the
-#        megakernel within its bounds;
+#        kernel, the stream integrator and the megakernel bit for bit against the CPU;
 #     3. compute-sanitizer --tool memcheck over gpu_trace_test's gpucheck tests (both kernels,
 #        pinned DMA batches), where compute-sanitizer exists and supports the device (a refusal,
 #        as under gVisor, is reported, not failed; a memory error fails);
