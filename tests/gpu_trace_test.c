@@ -6,7 +6,8 @@
  * the mesh importer are missing) and builtin:gpucheck (every device function of the megakernel).
  * Runs only where a CUDA device exists; elsewhere it prints why and exits 77 (CTest: skipped).
  * Hits, and so the stream integrator's images, agree with the CPU's bit for bit (--fmad=false),
- * and so do the megakernel's images (test_gpucheck_megakernel_vs_cpu says why: core/hdmath.h).
+ * and so do the megakernel's images (test_gpucheck_megakernel_vs_cpu says why: core/hdmath.h,
+ * whose functions test_hdmath_device_bits compares one by one).
  * scripts/gpu-check.sh runs it on a lent GPU machine. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -25,7 +26,9 @@
 #include "scenes/builtin.h"
 #include "scheduler/sched.h"
 #include "gpucheck_util.h"
+#include "hdmath_eval.h"
 #include "render_util.h"
+#include "test_rand.h"
 
 static void trace_with(rs_device *d, const rs_geom *g, const rs_bvh *bvh, rs_trace_batch *b,
                        uint32_t chunk)
@@ -513,6 +516,62 @@ static void test_gpucheck_megakernel_vs_cpu(void **state)
     }
 }
 
+/* core/hdmath.h's functions on the GPU give the host's bits, for 2^22 arguments each: every
+ * 1021st float bit pattern (zeros, denormals, huge values, infinities and NaNs among them) and
+ * random ones in the shading's ranges (angles within 10 radians, exp's arguments over its whole
+ * range, cosines in [-1, 1], pow's bases in [0, 2] with exponents in [-50, 150] or any float).
+ * The megakernel tests below check the same through whole images; this one names the function
+ * and the argument. */
+static void test_hdmath_device_bits(void **state)
+{
+    static const char *names[HDM_EVAL_N] = {"sin", "cos",  "sincos (sin)", "sincos (cos)", "tan",
+                                            "exp", "log",  "pow",          "acos",         "atan2"};
+    const size_t n = (size_t)1 << 22;
+    float *x = (float *)malloc(n * sizeof(float)), *y = (float *)malloc(n * sizeof(float));
+    float *dev = (float *)malloc(n * sizeof(float));
+    char msg[256];
+    int f, failed = 0;
+    (void)state;
+    assert_true(x && y && dev);
+    for (f = 0; f < HDM_EVAL_N; ++f) {
+        uint64_t s = 38 + (uint64_t)f;
+        size_t i, differ = 0;
+        for (i = 0; i < n; ++i) {
+            uint64_t r = splitmix64(&s), r2 = splitmix64(&s);
+            double u = (double)(r >> 11) * 0x1.0p-53, v = (double)(r2 >> 11) * 0x1.0p-53;
+            uint32_t b = (uint32_t)(i * 1021u + (r & 1023u));
+            if (i % 2 == 0)
+                memcpy(&x[i], &b, sizeof b);
+            else
+                x[i] = (float)(f <= 4   ? 20.0 * u - 10.0
+                               : f == 5 ? 200.0 * u - 110.0
+                               : f == 8 ? 2.0 * u - 1.0
+                               : f == 9 ? 2.0 * u - 1.0
+                                        : 2.0 * u);
+            if (i % 3 == 0)
+                memcpy(&y[i], &r2, sizeof y[i]);
+            else
+                y[i] = (float)(f == 9 ? 2.0 * v - 1.0 : 200.0 * v - 50.0);
+        }
+        if (hdm_eval_on_gpu(f, x, y, dev, n, msg, sizeof msg) != 0)
+            fail_msg("hdm_eval_on_gpu: %s", msg);
+        for (i = 0; i < n; ++i) {
+            float h = hdm_eval(f, x[i], y[i]);
+            if (memcmp(&h, &dev[i], sizeof h) != 0 && !(isnan(h) && isnan(dev[i])) &&
+                differ++ < 3)
+                print_message("%s(%a, %a): host %a, GPU %a\n", names[f], (double)x[i],
+                              (double)y[i], (double)h, (double)dev[i]);
+        }
+        print_message("hdmath on the GPU: %s: %zu of %zu arguments differ in any bit\n", names[f],
+                      differ, n);
+        failed |= differ != 0;
+    }
+    free(x);
+    free(y);
+    free(dev);
+    assert_false(failed);
+}
+
 /* gpu_trace_test [PATTERN]: only the tests whose names match PATTERN (cmocka's wildcards), as
  * scripts/gpu-check.sh runs the gpucheck ones under compute-sanitizer. */
 int main(int argc, char **argv)
@@ -521,6 +580,7 @@ int main(int argc, char **argv)
     char line[512];
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_gpu_kernel_limits),
+        cmocka_unit_test(test_hdmath_device_bits),
         cmocka_unit_test(test_gpu_matches_cpu),
         cmocka_unit_test(test_gpu_motion_matches_cpu),
         cmocka_unit_test(test_gpu_lbvh),
