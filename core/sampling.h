@@ -13,6 +13,7 @@
 #ifndef RS_CORE_SAMPLING_H
 #define RS_CORE_SAMPLING_H
 
+#include "core/hdmath.h"
 #include "core/vec3.h"
 
 #define RS_PI     3.14159265358979323846f
@@ -45,9 +46,9 @@ RS_HD rs_vec3 rs_onb_to_world(const rs_onb *f, rs_vec3 l)
 RS_HD rs_vec3 rs_sample_uniform_hemisphere(float u1, float u2)
 {
     float z = u1;
-    float r = sqrtf(rs_fmaxf(0.0f, 1.0f - z * z));
-    float phi = 2.0f * RS_PI * u2;
-    return rs_v3(r * cosf(phi), r * sinf(phi), z);
+    float r = sqrtf(rs_fmaxf(0.0f, 1.0f - z * z)), s, c;
+    rs_sincosf(2.0f * RS_PI * u2, &s, &c);
+    return rs_v3(r * c, r * s, z);
 }
 
 RS_HD float rs_pdf_uniform_hemisphere(float cos_theta)
@@ -57,9 +58,9 @@ RS_HD float rs_pdf_uniform_hemisphere(float cos_theta)
 
 RS_HD rs_vec3 rs_sample_cosine_hemisphere(float u1, float u2)
 {
-    float r = sqrtf(u1);
-    float phi = 2.0f * RS_PI * u2;
-    return rs_v3(r * cosf(phi), r * sinf(phi), sqrtf(rs_fmaxf(0.0f, 1.0f - u1)));
+    float r = sqrtf(u1), s, c;
+    rs_sincosf(2.0f * RS_PI * u2, &s, &c);
+    return rs_v3(r * c, r * s, sqrtf(rs_fmaxf(0.0f, 1.0f - u1)));
 }
 
 RS_HD float rs_pdf_cosine_hemisphere(float cos_theta)
@@ -70,9 +71,9 @@ RS_HD float rs_pdf_cosine_hemisphere(float cos_theta)
 /* Direction from cos(theta) and phi = 2 pi u2 around the z axis. */
 RS_HD rs_vec3 rs_dir_from_z(float z, float u2)
 {
-    float r = sqrtf(rs_fmaxf(0.0f, 1.0f - z * z));
-    float phi = 2.0f * RS_PI * u2;
-    return rs_v3(r * cosf(phi), r * sinf(phi), z);
+    float r = sqrtf(rs_fmaxf(0.0f, 1.0f - z * z)), s, c;
+    rs_sincosf(2.0f * RS_PI * u2, &s, &c);
+    return rs_v3(r * c, r * s, z);
 }
 
 RS_HD rs_vec3 rs_sample_uniform_sphere(float u1, float u2)
@@ -85,12 +86,12 @@ RS_HD float rs_pdf_uniform_sphere(void) { return 0.25f * RS_INV_PI; }
 /* cos^n lobe around z, normalised over the hemisphere: p = (n + 1) / (2 pi) cos^n(theta). */
 RS_HD rs_vec3 rs_sample_power_cosine(float n, float u1, float u2)
 {
-    return rs_dir_from_z(powf(u1, 1.0f / (n + 1.0f)), u2);
+    return rs_dir_from_z(rs_powf(u1, 1.0f / (n + 1.0f)), u2);
 }
 
 RS_HD float rs_pdf_power_cosine(float n, float cos_theta)
 {
-    return cos_theta > 0.0f ? (n + 1.0f) * 0.5f * RS_INV_PI * powf(cos_theta, n) : 0.0f;
+    return cos_theta > 0.0f ? (n + 1.0f) * 0.5f * RS_INV_PI * rs_powf(cos_theta, n) : 0.0f;
 }
 
 /* Uniform over the cone of directions within angle theta_max of z, given omc = 1 - cos(theta_max).
@@ -99,9 +100,9 @@ RS_HD float rs_pdf_power_cosine(float n, float cos_theta)
 RS_HD rs_vec3 rs_sample_uniform_cone(float omc, float u1, float u2)
 {
     float s = u1 * omc;
-    float r = sqrtf(rs_fmaxf(0.0f, s * (2.0f - s)));
-    float phi = 2.0f * RS_PI * u2;
-    return rs_v3(r * cosf(phi), r * sinf(phi), 1.0f - s);
+    float r = sqrtf(rs_fmaxf(0.0f, s * (2.0f - s))), sp, cp;
+    rs_sincosf(2.0f * RS_PI * u2, &sp, &cp);
+    return rs_v3(r * cp, r * sp, 1.0f - s);
 }
 
 RS_HD float rs_pdf_uniform_cone(float omc) { return 1.0f / (2.0f * RS_PI * omc); }

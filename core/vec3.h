@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include "core/hd.h"
+#include "core/hdmath.h"
 
 /* fmaxf and fminf, inline.  The host's libm functions are calls (gcc may not turn them into
  * maxss / minss, whose NaN rule differs), 5% of the shade stage's instructions with the call
@@ -77,8 +78,8 @@ RS_HD int rs_v3_is_zero(rs_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z ==
 /* Rotation about the y axis by `deg` degrees (right-handed, as RTIOW's rotate_y). */
 RS_HD rs_vec3 rs_v3_rotate_y(rs_vec3 p, float deg)
 {
-    float r = deg * 0.017453292519943295f;
-    float c = cosf(r), s = sinf(r);
+    float c, s;
+    rs_sincosf(deg * 0.017453292519943295f, &s, &c);
     return rs_v3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);
 }
 

@@ -21,7 +21,8 @@
 #        its reason: no driver, a driver older than the CUDA runtime with both versions, ...);
 #     2. gpu_trace_test must run (exit 77, "no CUDA device", fails here) and pass: the CUDA trace
 #        kernel, the stream integrator with the host shading, the CUDA wavefront (paths whole on
-#        the GPU, alone and beside the CPU) and the megakernel, each bit for bit against the CPU;
+#        the GPU, alone and beside the CPU) and the megakernel, each bit for bit against the CPU,
+#        and core/hdmath.h's functions on the GPU against the host's, argument by argument;
 #     3. the CLI on the GPU: builtin:gpucheck with --devices cpu, gpu (the wavefront), gpu
 #        --shade-on host, cpu,gpu, and the GPU megakernel, each GPU render with --require-gpu
 #        (a GPU it cannot use stops it with exit 1 and the reason; as second guards a "CPU

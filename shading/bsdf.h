@@ -112,20 +112,21 @@ RS_HD float rs_sheen_l(float x, float a)
     float A = 21.5473f + (25.3245f - 21.5473f) * t, B = 3.82987f + (3.32435f - 3.82987f) * t;
     float C = 0.19823f + (0.16801f - 0.19823f) * t, D = -1.97760f + (-1.27393f + 1.97760f) * t;
     float E = -4.32054f + (-4.85967f + 4.32054f) * t;
-    return A / (1.0f + B * powf(x, C)) + D * x + E;
+    return A / (1.0f + B * rs_powf(x, C)) + D * x + E;
 }
 
 RS_HD float rs_sheen_lambda(float c, float a)
 {
-    c = rs_fminf(fabsf(c), 1.0f); /* a cosine rounded above 1 would take powf of x < 0 */
-    return c < 0.5f ? expf(rs_sheen_l(c, a)) : expf(2.0f * rs_sheen_l(0.5f, a) - rs_sheen_l(1.0f - c, a));
+    c = rs_fminf(fabsf(c), 1.0f); /* a cosine rounded above 1 would take rs_powf of x < 0 */
+    return c < 0.5f ? rs_expf(rs_sheen_l(c, a))
+                    : rs_expf(2.0f * rs_sheen_l(0.5f, a) - rs_sheen_l(1.0f - c, a));
 }
 
 /* The sheen BRDF (colour 1): D V with cos_o, cos_i > 0 and ch = n.h, a = max(rough, 0.07). */
 RS_HD float rs_sheen_brdf(float rough, float co, float ci, float ch)
 {
     float a = rs_fmaxf(rough, 0.07f), s2h = rs_fmaxf(0.0f, 1.0f - ch * ch);
-    float d = (2.0f + 1.0f / a) * powf(s2h, 0.5f / a) * (0.5f * RS_INV_PI);
+    float d = (2.0f + 1.0f / a) * rs_powf(s2h, 0.5f / a) * (0.5f * RS_INV_PI);
     return d / ((1.0f + rs_sheen_lambda(co, a) + rs_sheen_lambda(ci, a)) * 4.0f * co * ci);
 }
 
@@ -259,7 +260,7 @@ RS_HD_HOT rs_vec3 rs_bsdf_eval_side(const rs_material *m, rs_vec3 albedo, rs_vec
     case RS_MAT_PHONG: {
         float ca = rs_v3_dot(rs_reflect(wo, n), wi);
         float lobe =
-            ca > 0.0f ? (m->exponent + 2.0f) * 0.5f * RS_INV_PI * powf(ca, m->exponent) : 0.0f;
+            ca > 0.0f ? (m->exponent + 2.0f) * 0.5f * RS_INV_PI * rs_powf(ca, m->exponent) : 0.0f;
         return rs_v3_add(rs_v3_scale(albedo, RS_INV_PI), rs_v3_scale(m->specular, lobe));
     }
     default: return rs_v3_splat(0.0f);

@@ -25,7 +25,7 @@ RS_HD rs_camera rs_camera_make(rs_vec3 from, rs_vec3 at, rs_vec3 up, float vfov_
     rs_camera c;
     float theta = vfov_deg * (RS_PI / 180.0f);
     float fd = focus_dist > 0.0f ? focus_dist : rs_v3_length(rs_v3_sub(from, at));
-    float vh = 2.0f * tanf(0.5f * theta) * fd;
+    float vh = 2.0f * rs_tanf(0.5f * theta) * fd;
     float vw = vh * ((float)width / (float)height);
     rs_vec3 w = rs_v3_normalize(rs_v3_sub(from, at));
     rs_vec3 u = rs_v3_normalize(rs_v3_cross(up, w));
@@ -52,9 +52,9 @@ RS_HD rs_ray rs_camera_ray(const rs_camera *c, uint32_t px, uint32_t py, float j
     rs_vec3 lens = rs_v3_splat(0.0f);
     if (c->lens_radius > 0.0f) {
         /* uniform point on the unit disk by polar mapping */
-        float rr = sqrtf(l1), phi = 2.0f * RS_PI * l2;
-        lens = rs_v3_add(rs_v3_scale(c->lens_u, rr * cosf(phi)),
-                         rs_v3_scale(c->lens_v, rr * sinf(phi)));
+        float rr = sqrtf(l1), s, co;
+        rs_sincosf(2.0f * RS_PI * l2, &s, &co);
+        lens = rs_v3_add(rs_v3_scale(c->lens_u, rr * co), rs_v3_scale(c->lens_v, rr * s));
     }
     /* the direction from camera-relative points: the origin's size never rounds it */
     r.o = rs_v3_add(c->origin, lens);

@@ -44,7 +44,7 @@ RS_HD rs_vec3 rs_env_rot_inv(const float *r, rs_vec3 d)
 RS_HD void rs_env_texel_of(const rs_image *im, rs_vec3 m, uint32_t *i, uint32_t *j, float *sin_t)
 {
     float y = rs_fminf(1.0f, rs_fmaxf(-1.0f, m.y));
-    float u = 0.5f + atan2f(m.x, -m.z) * (0.5f * RS_INV_PI), v = acosf(y) * RS_INV_PI;
+    float u = 0.5f + rs_atan2f(m.x, -m.z) * (0.5f * RS_INV_PI), v = rs_acosf(y) * RS_INV_PI;
     float fi = u * (float)im->width, fj = v * (float)im->height;
     *i = fi >= (float)im->width ? im->width - 1 : fi > 0.0f ? (uint32_t)fi : 0u;
     *j = fj >= (float)im->height ? im->height - 1 : fj > 0.0f ? (uint32_t)fj : 0u;
@@ -116,7 +116,7 @@ RS_HD_COLD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi,
     const rs_image *im;
     const float *row;
     uint32_t i, j;
-    float du, dv, u, v, theta, phi, st, span;
+    float du, dv, u, v, theta, phi, st, ct, sp, cp, span;
     rs_vec3 m;
     if (s->env_uniform) {
         /* a uniform map or a constant background: uniform over the sphere (the rotation
@@ -144,11 +144,12 @@ RS_HD_COLD int rs_env_sample(const rs_scene *s, float u1, float u2, rs_vec3 *wi,
     v = ((float)j + dv) / (float)im->height;
     theta = v * RS_PI;
     phi = (u - 0.5f) * 2.0f * RS_PI;
-    st = sinf(theta);
+    rs_sincosf(theta, &st, &ct);
     if (!(st > 0.0f))
         return 0;
+    rs_sincosf(phi, &sp, &cp);
     /* the inverse of rs_env_texel_of's mapping: m.x = sin sin(phi), m.z = -sin cos(phi) */
-    m = rs_v3(st * sinf(phi), cosf(theta), -st * cosf(phi));
+    m = rs_v3(st * sp, ct, -st * cp);
     *wi = rs_env_rot_inv(s->env_rot, m);
     *pdf = rs_env_texel_pdf(s, i, j) / (2.0f * RS_PI * RS_PI * st);
     {

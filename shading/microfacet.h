@@ -63,8 +63,10 @@ RS_HD rs_vec3 rs_ggx_sample_visible(float alpha, rs_vec3 wo, float u1, float u2)
     rs_vec3 t1 = lensq > 0.0f ? rs_v3_scale(rs_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq))
                               : rs_v3(1.0f, 0.0f, 0.0f);
     rs_vec3 t2 = rs_v3_cross(vh, t1), nh;
-    float r = sqrtf(u1), phi = 2.0f * RS_PI * u2;
-    float p1 = r * cosf(phi), p2 = r * sinf(phi), s = 0.5f * (1.0f + vh.z);
+    float r = sqrtf(u1), sp, cp, p1, p2, s = 0.5f * (1.0f + vh.z);
+    rs_sincosf(2.0f * RS_PI * u2, &sp, &cp);
+    p1 = r * cp;
+    p2 = r * sp;
     p2 = (1.0f - s) * sqrtf(rs_fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
     nh = rs_v3_add(rs_v3_add(rs_v3_scale(t1, p1), rs_v3_scale(t2, p2)),
                    rs_v3_scale(vh, sqrtf(rs_fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));

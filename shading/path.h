@@ -177,8 +177,8 @@ RS_HD void rs_surface_uv(const rs_scene *sc, uint32_t prim, float hu, float hv, 
                          float *u, float *v)
 {
     if (prim < sc->n_spheres) {
-        float theta = acosf(rs_fminf(1.0f, rs_fmaxf(-1.0f, -n_out.y)));
-        float phi = atan2f(-n_out.z, n_out.x) + RS_PI;
+        float theta = rs_acosf(rs_fminf(1.0f, rs_fmaxf(-1.0f, -n_out.y)));
+        float phi = rs_atan2f(-n_out.z, n_out.x) + RS_PI;
         *u = phi * (0.5f * RS_INV_PI);
         *v = theta * RS_INV_PI;
         return;
@@ -632,8 +632,8 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
     if (!rs_v3_is_zero(v.m->sigma_a) && rs_v3_dot(v.ng, r.d) > 0.0f) {
         /* the segment ran inside an absorbing object (KHR_materials_volume): Beer-Lambert */
         float len = h->t * rs_v3_length(r.d);
-        beta = rs_v3_mul(beta, rs_v3(expf(-v.m->sigma_a.x * len), expf(-v.m->sigma_a.y * len),
-                                     expf(-v.m->sigma_a.z * len)));
+        beta = rs_v3_mul(beta, rs_v3(rs_expf(-v.m->sigma_a.x * len), rs_expf(-v.m->sigma_a.y * len),
+                                     rs_expf(-v.m->sigma_a.z * len)));
     }
     fw = rs_texture_footprint(it, v.m, v.x, v.ng); /* 0 without textures */
     if (v.m->type >= RS_MAT_CONDUCTOR) {
