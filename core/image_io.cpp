@@ -19,6 +19,7 @@
 
 #include "core/alloc.h"
 #include "core/file.h"
+#include "core/pfm.h"
 
 namespace
 {
@@ -148,6 +149,8 @@ extern "C" rs_status rs_image_check_output(const char *path)
                                 "%s: unsupported output format '.%s' (use .png, .exr, .hdr, .jpg "
                                 "or .tif)",
                                 path, e.c_str());
+        if (e == "pfm") // our own writer (core/pfm.h): OpenImageIO 2.4 cannot write one
+            return rs_pfm_check_output(path);
         auto out = OIIO::ImageOutput::create(path);
         if (!out)
             return rs_error_set(RS_ERR_ARG, "%s: OpenImageIO cannot write '.%s' files", path,
@@ -210,6 +213,8 @@ extern "C" rs_status rs_image_write_view(const char *path, uint32_t w, uint32_t 
         if (n_layers > 0 && e != "exr")
             return rs_error_set(RS_ERR_ARG, "%s: only an .exr file holds extra layers (AOVs)",
                                 path);
+        if (e == "pfm") // linear floats, no header for metadata or the view
+            return rs_pfm_write(path, w, h, rgb);
         auto out = OIIO::ImageOutput::create(path);
         if (!out)
             return rs_error_set(RS_ERR_ARG, "%s: OpenImageIO cannot write this format", path);
