@@ -32,6 +32,16 @@ __global__ void __launch_bounds__(RS_CUDA_TRACE_BLOCK_MAX, 1)
         rs_trace_one(&b, &g, &batch, i);
 }
 
+/* The same for geometry without instances (g.n_instances == 0): 64 registers, not 118, and no
+ * spills (4 blocks of 256 a multiprocessor). */
+__global__ void __launch_bounds__(RS_CUDA_TRACE_BLOCK_MAX, 4)
+    rs_trace_flat_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch)
+{
+    uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < batch.count)
+        rs_trace_one_flat(&b, &g, &batch, i);
+}
+
 /* ---- the mirror ops: device memory for device_copy ---------------------------------------- */
 
 static rs_status copy_to_device(void *dst, const void *src, size_t bytes)
@@ -211,8 +221,15 @@ static rs_status launch_piece(rs_device *d, rs_cuda_impl *c, rs_cuda_stage *s,
     args[0] = &c->geom.bvh;
     args[1] = &c->geom.geom;
     args[2] = &db;
-    CUDA_TRY(cudaLaunchKernel((const void *)rs_trace_kernel, dim3((n + c->block - 1) / c->block),
-                              dim3(c->block), args, 0, s->stream));
+    if (c->geom.geom.n_instances == 0) {
+        CUDA_TRY(cudaLaunchKernel((const void *)rs_trace_flat_kernel,
+                                  dim3((n + c->block_flat - 1) / c->block_flat),
+                                  dim3(c->block_flat), args, 0, s->stream));
+    } else {
+        CUDA_TRY(cudaLaunchKernel((const void *)rs_trace_kernel,
+                                  dim3((n + c->block - 1) / c->block), dim3(c->block), args, 0,
+                                  s->stream));
+    }
     if (batch->kind == RS_TRACE_CLOSEST) {
         const rs_hit_soa *dst = direct ? &batch->hits : &s->h_hits;
 #define RS_COPY_OUT(type, name)                                                                    \
@@ -372,16 +389,17 @@ extern "C" int rs_gpu_count(const char **why)
 }
 
 /* Every kernel of the device, for their attributes: the trace kernel, the megakernel, the
- * wavefront's five. */
-#define RS_CUDA_KERNELS 8
+ * wavefront's, the megakernel's bounds variant, the flat trace kernel. */
+#define RS_CUDA_KERNELS (4 + RS_CUDA_WF_ENTRIES)
 static void kernel_entries(const void **fn)
 {
     int k;
     fn[0] = (const void *)rs_trace_kernel;
     fn[1] = rs_cuda_megakernel_entry();
-    for (k = 0; k < 5; ++k)
+    for (k = 0; k < RS_CUDA_WF_ENTRIES; ++k)
         fn[2 + k] = rs_cuda_wf_entry(k);
-    fn[7] = rs_cuda_megakernel_b2_entry();
+    fn[2 + RS_CUDA_WF_ENTRIES] = rs_cuda_megakernel_b2_entry();
+    fn[3 + RS_CUDA_WF_ENTRIES] = (const void *)rs_trace_flat_kernel;
 }
 
 /* Raises device `index`'s stack limit (per thread; the device current) to the most local memory
@@ -391,7 +409,8 @@ static rs_status size_stack(int index)
 {
     static const char *const names[RS_CUDA_KERNELS] = {
         "rs_trace_kernel",    "rs_megakernel_kernel", "rs_wf_raygen_kernel", "rs_wf_trace_kernel",
-        "rs_wf_shade_kernel", "rs_wf_resolve_kernel", "rs_wf_film_kernel", "rs_megakernel_kernel_b2"};
+        "rs_wf_shade_kernel", "rs_wf_resolve_kernel", "rs_wf_film_kernel",
+        "rs_wf_trace_flat_kernel", "rs_megakernel_kernel_b2", "rs_trace_flat_kernel"};
     const void *fn[RS_CUDA_KERNELS];
     cudaFuncAttributes a;
     size_t need = 0, have = 0, local[RS_CUDA_KERNELS];
@@ -511,6 +530,8 @@ extern "C" rs_status rs_gpu_device_create(int index, rs_device **out)
     }
     c->ordinal = index;
     c->block = block > 0 ? block : 128;
+    CUDA_TRY(cudaOccupancyMaxPotentialBlockSize(&min_grid, &block, rs_trace_flat_kernel, 0, 0));
+    c->block_flat = block > 0 ? block : 128;
     d->ops = &cuda_ops;
     d->impl = c;
     d->flags = RS_DEVICE_OWN_MEMORY;

@@ -46,6 +46,16 @@ __global__ void __launch_bounds__(RS_CUDA_WF_BLOCK_MAX)
         rs_trace_one(&b, &g, &batch, i);
 }
 
+/* The same for geometry without instances (rs_trace_one_flat: no bottom levels' code). */
+__global__ void __launch_bounds__(RS_CUDA_WF_BLOCK_MAX)
+    rs_wf_trace_flat_kernel(rs_bvh_view b, rs_geom g, rs_trace_batch batch,
+                            const unsigned int *count)
+{
+    uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i < *count)
+        rs_trace_one_flat(&b, &g, &batch, i);
+}
+
 /* Index in the queue behind *counter for this lane, when `want`: one atomic per warp. */
 __device__ static uint32_t rs_wf_append(unsigned int *counter, int want)
 {
@@ -105,6 +115,7 @@ const void *rs_cuda_wf_entry(int k)
     case 2: return (const void *)rs_wf_shade_kernel;
     case 3: return (const void *)rs_wf_resolve_kernel;
     case 4: return (const void *)rs_wf_film_kernel;
+    case 5: return (const void *)rs_wf_trace_flat_kernel;
     }
     return NULL;
 }
@@ -192,6 +203,16 @@ static int block_of(const void *fn)
     return block >= RS_WARP ? block : RS_WARP;
 }
 
+/* Threads of `fn` resident on the whole device at once, in blocks of `block` (0 if unknown). */
+static uint32_t resident_of(int ordinal, const void *fn, int block)
+{
+    int per_sm = 0, sms = 0;
+    if (cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, fn, block, 0) != cudaSuccess ||
+        cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, ordinal) != cudaSuccess)
+        return 0;
+    return (uint32_t)per_sm * (uint32_t)sms * (uint32_t)block;
+}
+
 /* Everything render_paths needs, made at its first call (the film's variance words when the
  * host film first keeps them); on failure the caller releases what was made. */
 static rs_status wf_make(rs_cuda_impl *c, int l2)
@@ -200,9 +221,20 @@ static rs_status wf_make(rs_cuda_impl *c, int l2)
     size_t npix = c->mk.it.npix;
     int k;
     if (!wf->cap) {
-        uint32_t cap = wave_capacity();
-        for (k = 0; k < 5; ++k)
+        uint32_t cap, most = 0;
+        for (k = 0; k < RS_CUDA_WF_ENTRIES; ++k)
             wf->block[k] = block_of(rs_cuda_wf_entry(k));
+        /* a whole number of the busiest kernels' resident threads: no partial last wave of
+         * threads at a wave's first bounce (the trace kernels' count is twice the shade
+         * kernel's on an H200: 135,168 and 67,584) */
+        for (k = 0; k < 3; ++k) {
+            static const int busy[3] = {1, 2, 5}; /* trace, shade, flat trace */
+            uint32_t r = resident_of(c->ordinal, rs_cuda_wf_entry(busy[k]), wf->block[busy[k]]);
+            most = r > most ? r : most;
+        }
+        cap = wave_capacity();
+        if (most > 0 && cap >= most)
+            cap -= cap % most;
         for (k = 0; k < 2; ++k) {
             rs_cuda_wf_slot *s = &wf->slot[k];
             size_t bytes = slot_layout(NULL, cap, s);
@@ -255,6 +287,9 @@ static rs_status wf_pixels(rs_cuda_impl *c, const rs_paths_job *job)
 
 /* ---- the waves ---------------------------------------------------------------------------- */
 
+/* The trace kernel for the scene: the flat one where it has no instances. */
+static int trace_kernel(const rs_path_tracer *tr) { return tr->geom.n_instances == 0 ? 5 : 1; }
+
 static rs_status launch(const void *fn, uint32_t n, int block, void **args, cudaStream_t stream)
 {
     if (n == 0)
@@ -284,7 +319,8 @@ static rs_status wf_segment(rs_cuda_impl *c, rs_cuda_wf_slot *s, uint32_t upper)
     targs[1] = (void *)&tr->geom;
     targs[2] = &tb;
     targs[3] = &alive;
-    if ((st = launch(rs_cuda_wf_entry(1), upper, wf->block[1], targs, s->stream)) != RS_OK)
+    if ((st = launch(rs_cuda_wf_entry(trace_kernel(tr)), upper, wf->block[trace_kernel(tr)], targs,
+                     s->stream)) != RS_OK)
         return st;
     CUDA_TRY(cudaMemsetAsync(counts, 0, 2 * sizeof(unsigned int), s->stream));
     sargs[0] = &c->mk.it;
@@ -361,7 +397,8 @@ static rs_status wf_advance(rs_cuda_impl *c, rs_cuda_wf_slot *s, rs_path_counts 
         targs[1] = (void *)&tr->geom;
         targs[2] = &tb;
         targs[3] = &cnt;
-        if ((st = launch(rs_cuda_wf_entry(1), n_shadow, wf->block[1], targs, s->stream)) != RS_OK)
+        if ((st = launch(rs_cuda_wf_entry(trace_kernel(tr)), n_shadow,
+                         wf->block[trace_kernel(tr)], targs, s->stream)) != RS_OK)
             return st;
         rargs[0] = &s->shadow;
         rargs[1] = &s->occ;

@@ -73,6 +73,17 @@ typedef struct fallback_impl {
  * a parallel region for each would cost more than the work (OpenMP's spinning threads). */
 #define RS_WF_FALLBACK_PAR_MIN 4096
 
+/* One ray, as the CUDA device traces it: by the flat kernel's body where the geometry has no
+ * instances (so the host tests run the code that kernel runs). */
+static inline void trace_ray(const rs_bvh_view *b, const rs_geom *g, const rs_trace_batch *tb,
+                             uint32_t i)
+{
+    if (g->n_instances == 0)
+        rs_trace_one_flat(b, g, tb, i);
+    else
+        rs_trace_one(b, g, tb, i);
+}
+
 static void free_staging(fallback_impl *f)
 {
     rs_ray_soa_free(&f->rays);
@@ -170,7 +181,7 @@ static void trace_piece(rs_device *d, fallback_impl *f, const rs_trace_batch *ba
     (void)threads; /* read only by the OpenMP clause */
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && n >= 512u)
     for (i = 0; i < (long)n; ++i)
-        rs_trace_one(&f->geom.bvh, &f->geom.geom, &db, (uint32_t)i);
+        trace_ray(&f->geom.bvh, &f->geom.geom, &db, (uint32_t)i);
     rs_cores_release(f->cores, threads);
     d->stats.bytes_from_device += rs_trace_stage_out(batch, begin, n, &f->hits, f->occluded);
 }
@@ -337,7 +348,7 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
         tb.hits = f->wf_hits;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && alive >= RS_WF_FALLBACK_PAR_MIN)
         for (i = 0; i < (long)alive; ++i)
-            rs_trace_one(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
+            trace_ray(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
         counts->closest += alive;
         if (w->bounce > counts->max_bounce)
             counts->max_bounce = w->bounce;
@@ -358,7 +369,7 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
             tb.occluded = f->occ;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && n_shadow >= RS_WF_FALLBACK_PAR_MIN)
             for (i = 0; i < (long)n_shadow; ++i)
-                rs_trace_one(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
+                trace_ray(&tr->bvh, &tr->geom, &tb, (uint32_t)i);
 #pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && n_shadow >= RS_WF_FALLBACK_PAR_MIN)
             for (i = 0; i < (long)n_shadow; ++i)
                 rs_wf_resolve((uint32_t)i, &f->shadow, f->occ, &f->paths);

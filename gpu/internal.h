@@ -36,6 +36,9 @@
 /* The wavefront's kernels (gpu/cuda_wavefront.cu): at most 256 threads a block, registers left
  * to ptxas (no minimum of blocks per SM). */
 #define RS_CUDA_WF_BLOCK_MAX 256
+/* The wavefront's kernels: 0 raygen, 1 trace, 2 shade, 3 resolve, 4 film, 5 the trace kernel
+ * for geometry without instances (accel/trace.h rs_trace_one_flat). */
+#define RS_CUDA_WF_ENTRIES 6
 /* Paths per wave of the wavefront (two in flight): enough to fill an H200 (132 SMs x 2048
  * threads) several times over at every segment but the last few. */
 #define RS_CUDA_WF_WAVE (1u << 21)
@@ -100,7 +103,7 @@ typedef struct rs_cuda_wf_slot {
 typedef struct rs_cuda_wf {
     rs_cuda_wf_slot slot[2];
     uint32_t cap;  /* paths per wave */
-    int block[5];  /* threads per block of each kernel (rs_cuda_wf_entry order) */
+    int block[RS_CUDA_WF_ENTRIES]; /* threads per block of each kernel (rs_cuda_wf_entry order) */
     rs_wf_film film;
     rs_wf_u64 *h_sum, *h_sum_l2; /* the film copied back */
     unsigned int *h_count;
@@ -110,7 +113,8 @@ typedef struct rs_cuda_wf {
 
 typedef struct rs_cuda_impl {
     int ordinal;
-    int block; /* the trace kernel's threads per block, from the occupancy API */
+    int block;      /* the trace kernel's threads per block, from the occupancy API */
+    int block_flat; /* the same for its instance-free twin (rs_trace_flat_kernel) */
     rs_device_geom geom;
     int uploaded;
     rs_cuda_stage st[RS_CUDA_STAGES];

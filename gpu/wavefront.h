@@ -8,7 +8,8 @@
  * the wave's rs_paths slot g - start.  Per segment:
  *
  *   raygen (once)   rs_wf_raygen: the camera ray of slot i into queue[0][i]
- *   trace-closest   rs_trace_one over the current queue (accel/trace.h, the trace kernel's body)
+ *   trace-closest   rs_trace_one over the current queue (accel/trace.h, the trace kernel's body;
+ *                   rs_trace_one_flat where the scene has no instances)
  *   shade           rs_wf_shade: shading/path.h's rs_path_shade_at, the very code the CPU stream
  *                   engine's shade stage and every megakernel run; the caller appends the next
  *                   ray to the other queue and the shadow ray to the shadow queue (an atomic

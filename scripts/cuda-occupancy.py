@@ -445,7 +445,8 @@ def geometry(kernels, root, width=512, height=512, spps=(1, 64)):
     by = dict((k.name, k) for k in kernels)
     defs = c_defines(source_files(root, "scheduler", ".h") + source_files(root, "gpu", ".h"))
     const = dict((n, c_value(defs.get(n, ""), defs)) for n in (
-        "RS_RENDER_DEFAULT_WAVE", "RS_SCHED_FIRST_GPU", "RS_SCHED_MAX_CHUNK", "RS_GPU_MIN_PIECE"))
+        "RS_RENDER_DEFAULT_WAVE", "RS_SCHED_FIRST_GPU", "RS_SCHED_MAX_CHUNK", "RS_GPU_MIN_PIECE",
+        "RS_GPU_LAUNCH_SAMPLES", "RS_CUDA_WF_WAVE"))
     npix, million = width * height, 1 << 20
     rows = [("kernel", "spp", "launch", "paths", "launches", "block", "grid", "wave", "waves",
              ">=1M", "whole")]
@@ -462,9 +463,27 @@ def geometry(kernels, root, width=512, height=512, spps=(1, 64)):
                      "yes" if per_wave and grid % per_wave == 0 else "no"))
 
     mk, tr = by.get("rs_megakernel_kernel"), by.get("rs_trace_kernel")
-    if mk and mk.bound:
+    if mk and mk.bound and const["RS_GPU_LAUNCH_SAMPLES"]:
         for spp in spps:
-            row(mk, spp, "a sample", npix, spp)
+            per = min(spp, const["RS_GPU_LAUNCH_SAMPLES"])
+            row(mk, spp, f"{per} sample{'s' if per > 1 else ''}", npix * per, ceil_div(spp, per))
+    busy = [by[n] for n in ("rs_wf_trace_kernel", "rs_wf_shade_kernel", "rs_wf_trace_flat_kernel")
+            if n in by and by[n].bound]
+    if const["RS_CUDA_WF_WAVE"] and busy:
+        # gpu/cuda_wavefront.cu wf_make: a wave is a whole number of the busiest kernel's
+        # resident threads
+        def resident(k):
+            b = block_for(k.regs, k.smem, k.barriers, k.bound[0])
+            b -= b % WARP
+            return blocks_per_sm(k.regs, k.smem, k.barriers, b)[0] * SMS * b
+        most = max(resident(k) for k in busy)
+        cap = const["RS_CUDA_WF_WAVE"]
+        cap -= cap % most if cap >= most else 0
+        for name in ("rs_wf_trace_flat_kernel", "rs_wf_shade_kernel"):
+            k = by.get(name)
+            for spp in spps if k and k.bound else ():
+                wave = min(cap, npix * spp)
+                row(k, spp, "a wave, bounce 1", wave, ceil_div(npix * spp, wave))
     waves = []
     if tr and tr.bound and None not in const.values():
         for spp in spps:
@@ -487,9 +506,12 @@ def geometry(kernels, root, width=512, height=512, spps=(1, 64)):
         f" x {SMS});",
         "   >=1M: a million paths or more per launch; whole: no partial last wave.  Megakernel: "
         "every pixel",
-        "   once per launch, a launch per sample, grid = ceil(pixels / block) (gpu/cuda_megakernel"
-        ".cu",
-        "   launch_sample).  Trace kernel: the stream engine's waves in flight (scheduler/render.c",
+        f"   {const['RS_GPU_LAUNCH_SAMPLES'] or '?'} times per launch, grid = ceil(pixels x "
+        "samples / block) (gpu/cuda_megakernel.cu).",
+        f"   Wavefront: waves of up to {const['RS_CUDA_WF_WAVE'] or 0:,} paths, cut to a whole "
+        "number of the busiest",
+        "   kernel's resident threads (gpu/cuda_wavefront.cu; later bounces: the paths still alive).  Trace kernel (--shade-on host): the stream engine's waves in "
+        "flight (scheduler/render.c",
         f"   resolve_settings: {'; '.join(waves)} paths) are traced in chunks",
         "   (scheduler/sched.c), each cut into rs_gpu_piece_size pieces (gpu/gpu_device.h), a "
         "launch each",
