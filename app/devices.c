@@ -121,10 +121,11 @@ static void plan_devices(const rs_cli_options *o, int threads, device_plan *p)
     if (o->megakernel) {
         plan_megakernel(o, p);
     } else if (o->devices_auto && !o->shade_host && p->n_auto_gpus > 0) {
-        /* a GPU runs its paths whole (its wavefront), far ahead of the host: it alone */
-        p->n = 1;
-        p->specs[0].is_gpu = 1;
-        p->specs[0].index = p->auto_gpus[0];
+        /* a GPU runs its paths whole (its wavefront), far ahead of the host: the GPUs alone */
+        for (p->n = 0; p->n < p->n_auto_gpus && p->n < RS_MAX_DEVICES; ++p->n) {
+            p->specs[p->n].is_gpu = 1;
+            p->specs[p->n].index = p->auto_gpus[p->n];
+        }
     } else if (o->devices_auto) {
         p->n = 1;
         for (i = 0; i < p->n_auto_gpus && p->n < RS_MAX_DEVICES; ++i) {

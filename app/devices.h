@@ -7,8 +7,9 @@
 #include "scheduler/fault.h"
 
 /* Creates the devices the options name into devs[].  --integrator stream: every device of
- * --devices (auto: the CPU and every CUDA device, or under an MPI launcher with several ranks on
- * this machine the CPU and this rank's share of the CUDA devices, rs_devices_auto_gpus); the
+ * --devices (auto: every usable CUDA device, else the CPU, or with --shade-on host both; under an
+ * MPI launcher with several ranks on this machine, this rank's share of the CUDA devices,
+ * rs_devices_auto_gpus); the
  * cores are shared out without oversubscription: each GPU fallback takes one thread when a cpu
  * device is beside it (every core when it is alone), and a cpu device without an explicit
  * thread count gets the rest.  --integrator megakernel: its one device: cpu[:N] the CPU device,

@@ -207,7 +207,8 @@ static void help_render_scene(void)
 static void help_render_devices(void)
 {
     fputs("  --threads N         CPU threads (default: every core)\n"
-          "  --devices LIST      auto (default: the CPU and every CUDA device), or comma-\n"
+          "  --devices LIST      auto (default: every usable CUDA device, else the CPU; with\n"
+          "                      --shade-on host the CPU and every CUDA device), or comma-\n"
           "                      separated cpu, cpu:THREADS, gpu, gpu:INDEX.  A gpu that\n"
           "                      cannot be used runs on the CPU fallback (one warning).\n"
           "                      Under mpirun, auto deals a machine's GPUs out to its ranks\n"

@@ -75,7 +75,7 @@ typedef struct rs_cli_options {
     uint32_t isect_aabb;   /* --isect-aabb: rs_isect_aabb_algo */
     uint32_t bvh_width;    /* --bvh-width 2|4|8: the CPU device's traversal (0: the widest
                               this CPU runs, 8 with AVX2) */
-    int devices_auto;      /* --devices auto (the default): the CPU and every CUDA device (under
+    int devices_auto;      /* --devices auto (the default): the GPUs, else the CPU (under
                               mpirun this rank's share of them, app/devices.h) */
     int n_devices;
     rs_device_spec devices[RS_MAX_DEVICES];
