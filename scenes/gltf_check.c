@@ -251,6 +251,92 @@ static rs_status parse_json(const char *path, int glb, cJSON **out)
     return RS_OK;
 }
 
+/* ---- texture transforms ----------------------------------------------------------------------- */
+
+/* Whether `v` is an array of exactly two finite numbers. */
+static int two_numbers(const cJSON *v)
+{
+    const cJSON *a, *b;
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 2)
+        return 0;
+    a = v->child;
+    b = a->next;
+    return cJSON_IsNumber(a) && cJSON_IsNumber(b) && isfinite(a->valuedouble) &&
+           isfinite(b->valuedouble);
+}
+
+/* One KHR_texture_transform object `t` found at `where`: offset and scale two numbers each,
+ * rotation a number, texCoord a whole number >= 0 (the extension's schema).  Assimp's reader
+ * asserts on them (rapidjson: a SIGABRT and no line of ours), so they are checked first. */
+static rs_status check_transform(const char *path, const char *where, const cJSON *t)
+{
+    static const char *const pairs[2] = {"offset", "scale"};
+    const cJSON *v;
+    int k;
+    if (!cJSON_IsObject(t))
+        return rs_error_set(RS_ERR_ARG, "%s: %s.KHR_texture_transform: not an object", path,
+                            where);
+    for (k = 0; k < 2; ++k)
+        if ((v = cJSON_GetObjectItemCaseSensitive(t, pairs[k])) && !two_numbers(v))
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: %s.KHR_texture_transform.%s: want two numbers, as [x, y]",
+                                path, where, pairs[k]);
+    v = cJSON_GetObjectItemCaseSensitive(t, "rotation");
+    if (v && !(cJSON_IsNumber(v) && isfinite(v->valuedouble)))
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: %s.KHR_texture_transform.rotation: want a number (radians)", path,
+                            where);
+    v = cJSON_GetObjectItemCaseSensitive(t, "texCoord");
+    if (v && !(cJSON_IsNumber(v) && v->valuedouble >= 0 && v->valuedouble <= 65535 &&
+               v->valuedouble == (double)(int)v->valuedouble))
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: %s.KHR_texture_transform.texCoord: want a whole number >= 0",
+                            path, where);
+    return RS_OK;
+}
+
+/* Every KHR_texture_transform under `node` (a material: its textures and its extensions'
+ * textures, at any depth), `where` naming node. */
+static rs_status check_transforms_in(const char *path, const char *where, const cJSON *node,
+                                     int depth)
+{
+    const cJSON *c;
+    char sub[512];
+    int i = 0;
+    if (depth > 16 || !(cJSON_IsObject(node) || cJSON_IsArray(node)))
+        return RS_OK;
+    for (c = node->child; c; c = c->next, ++i) {
+        rs_status st;
+        if (cJSON_IsObject(node) && c->string && strcmp(c->string, "KHR_texture_transform") == 0) {
+            if ((st = check_transform(path, where, c)) != RS_OK)
+                return st;
+            continue;
+        }
+        if (cJSON_IsObject(node))
+            snprintf(sub, sizeof sub, "%.400s.%.64s", where, c->string ? c->string : "?");
+        else
+            snprintf(sub, sizeof sub, "%.400s[%d]", where, i);
+        if ((st = check_transforms_in(path, sub, c, depth + 1)) != RS_OK)
+            return st;
+    }
+    return RS_OK;
+}
+
+static rs_status check_transforms(const char *path, const cJSON *root)
+{
+    const cJSON *mats = cJSON_GetObjectItemCaseSensitive(root, "materials"), *m;
+    int i = 0;
+    cJSON_ArrayForEach(m, mats)
+    {
+        char where[32];
+        rs_status st;
+        snprintf(where, sizeof where, "materials[%d]", i++);
+        if ((st = check_transforms_in(path, where, m, 0)) != RS_OK)
+            return st;
+    }
+    return RS_OK;
+}
+
 rs_status rs_gltf_preflight(const char *path, int glb)
 {
     char dir[4096];
@@ -265,6 +351,8 @@ rs_status rs_gltf_preflight(const char *path, int glb)
         st = check_uris(path, dir, root, "buffers");
     if (st == RS_OK)
         st = check_uris(path, dir, root, "images");
+    if (st == RS_OK)
+        st = check_transforms(path, root);
     cJSON_Delete(root);
     return st;
 }

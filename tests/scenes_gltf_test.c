@@ -592,6 +592,50 @@ static void test_material_extensions_bad(void **state)
     }
 }
 
+/* KHR_texture_transform values that are not what the extension's schema says: Assimp's reader
+ * asserted on offset and scale that are not two numbers (SIGABRT, no line of ours: issue 39);
+ * now one line naming the file, the material and the field, before Assimp reads it.  The file
+ * is tests/data/texture_transform.gltf with material 1's offset [0.5, 0] replaced. */
+static void test_texture_transform_bad(void **state)
+{
+    static const char *const cases[][2] = {
+        {"\"offset\": [2]", "offset: want two numbers"},
+        {"\"offset\": []", "offset: want two numbers"},
+        {"\"offset\": [\"a\", \"b\"]", "offset: want two numbers"},
+        {"\"offset\": [null, null]", "offset: want two numbers"},
+        {"\"offset\": [[1], [2]]", "offset: want two numbers"},
+        {"\"offset\": [0, 0], \"scale\": [1, 2, 3]", "scale: want two numbers"},
+        {"\"offset\": [0, 0], \"scale\": 2", "scale: want two numbers"},
+        {"\"rotation\": \"x\"", "rotation: want a number"},
+        {"\"texCoord\": -1", "texCoord: want a whole number"},
+        {"\"texCoord\": 0.5", "texCoord: want a whole number"},
+    };
+    static const char *const key = "{\"offset\": [0.5, 0]}";
+    char *text, *at, buf[16384];
+    size_t i, n;
+    FILE *f = fopen(RS_SOURCE_DIR "/tests/data/texture_transform.gltf", "rb");
+    (void)state;
+    assert_non_null(f);
+    text = (char *)calloc(1, 16384);
+    assert_non_null(text);
+    n = fread(text, 1, 16383, f);
+    fclose(f);
+    assert_true(n > 0 && n < 16000);
+    at = strstr(text, key);
+    assert_non_null(at);
+    for (i = 0; i < sizeof cases / sizeof *cases; ++i) {
+        snprintf(buf, sizeof buf, "%.*s{%s}%s", (int)(at - text), text, cases[i][0],
+                 at + strlen(key));
+        expect_bad("badxf.gltf", buf, "materials[1].pbrMetallicRoughness.baseColorTexture."
+                                      "extensions.KHR_texture_transform.",
+                   cases[i][1]);
+    }
+    /* not an object at all */
+    snprintf(buf, sizeof buf, "%.*s[1, 2]%s", (int)(at - text), text, at + strlen(key));
+    expect_bad("badxf.gltf", buf, "KHR_texture_transform: not an object", NULL);
+    free(text);
+}
+
 /* KHR_materials_volume in the image: a slab of clear glass (ior 1: no refraction, no
  * reflection) 2 units thick, two quads facing out, in front of the white sky a glTF file
  * without lights gets.  Each camera ray crosses it straight: the pixel is exp(-sigma_a 2) =
@@ -906,6 +950,7 @@ int main(void)
         cmocka_unit_test(test_transmission),
         cmocka_unit_test(test_material_extensions),
         cmocka_unit_test(test_material_extensions_bad),
+        cmocka_unit_test(test_texture_transform_bad),
         cmocka_unit_test(test_volume_renders),
         cmocka_unit_test(test_alpha_cutout),
         cmocka_unit_test(test_bad_files),
