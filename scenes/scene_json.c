@@ -927,8 +927,9 @@ static rs_status add_punctual(ctx *c, const cJSON *o, const char *path, const ch
         subpath(q, sizeof q, path, "outer");
         if (outer < inner)
             return FAIL(c, q, "the outer cone must not be narrower than the inner");
-        p.cos_inner = cosf(inner * 0.017453292519943295f);
-        p.cos_outer = cosf(outer * 0.017453292519943295f);
+        /* 90 degrees in float radians is a little past pi/2: its cosf is -4.4e-8, held at 0 */
+        p.cos_inner = fmaxf(0.0f, cosf(inner * 0.017453292519943295f));
+        p.cos_outer = fmaxf(0.0f, cosf(outer * 0.017453292519943295f));
     } else {
         p.type = RS_PUNCTUAL_DIRECTIONAL;
         RS_TRY(check_keys(c, o, path, k_dir));
@@ -940,7 +941,13 @@ static rs_status add_punctual(ctx *c, const cJSON *o, const char *path, const ch
         subpath(q, sizeof q, path, "direction");
         return FAIL(c, q, "must not be zero");
     }
-    return rs_scene_add_punctual(c->scene, &p);
+    if (rs_scene_add_punctual(c->scene, &p) != RS_OK) {
+        char msg[300];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        return FAIL(c, path, "%s", msg); /* the file and the object named */
+    }
+    return RS_OK;
 }
 
 /* A mesh file through Assimp: its own materials, one scene material for all of it ("material"),
