@@ -465,7 +465,7 @@ static int opt_envmap_scale(const char *name, const char *v, rs_cli_options *o)
 static int opt_background(const char *name, const char *v, rs_cli_options *o)
 {
     float c[3];
-    int n = 0;
+    int n = 0, whole = 0; /* whole: the last number read ended the text ("0.5," does not) */
     char *end;
     const char *at = v;
     (void)name;
@@ -488,11 +488,13 @@ static int opt_background(const char *name, const char *v, rs_cli_options *o)
         if (end == at || !(x >= 0.0 && x <= 1e12) || (*end && *end != ','))
             break;
         c[n++] = (float)x;
-        if (!*end)
+        if (!*end) {
+            whole = 1;
             break;
+        }
         at = end + 1;
     }
-    if ((n == 1 || n == 3) && !*end) {
+    if ((n == 1 || n == 3) && whole) {
         o->background_kind = RS_BG_COLOR;
         o->background = v;
         o->background_rgb[0] = c[0];

@@ -152,8 +152,13 @@ int rs_filter_parse(const char *text, rs_filter *out, char *why, size_t n)
     if (colon) {
         char *end;
         double w = strtod(colon + 1, &end);
-        if (end == colon + 1 || *end || !(w > 0.0 && w <= 16.0)) {
-            snprintf(why, n, "the %s filter's width '%s' is not a number of pixels in (0, 16]",
+        /* in thousandths of a pixel (what a checkpoint records), from 0.01: a narrower
+         * filter is a point, and Mitchell's weights (1 / width^2) overflowed at 1e-38 */
+        if (end == colon + 1 || *end || !(w >= 0.01 && w <= 16.0) ||
+            fabs(w * 1000.0 - nearbyint(w * 1000.0)) > 1e-6 * w * 1000.0) {
+            snprintf(why, n,
+                     "the %s filter's width '%s' is not a number of pixels from 0.01 to 16 in "
+                     "steps of 0.001",
                      k_names[kind], colon + 1);
             return 0;
         }

@@ -98,6 +98,16 @@ static void test_usage_errors(void **state)
           "megakernel", NULL},
          {"--adaptive", "megakernel"}},
         {{"rendr", "-o", "out.png", NULL}, {"rendr", "command"}},
+        /* issue 39: a trailing comma rendered a grey 0.5; filter widths that rendered something
+         * else (black, the default width) */
+        {{"render", "-o", "out.png", "--spp", "1", "--background", "0.5,", NULL},
+         {"--background", "'0.5,'"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--background", "0.5,0.5,0.5,", NULL},
+         {"--background", "not a colour"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--filter", "mitchell:1e-38", NULL},
+         {"--filter", "0.01"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--filter", "box:0.0004", NULL},
+         {"--filter", "0.001"}},
         {{"render", "-o", "out.png", "--spp", "abc", NULL}, {"--spp", "abc"}},
         {{"render", "-o", "out.png", "--spp", "1", "--width", "12x", NULL}, {"--width", "12x"}},
         {{"render", "-o", "out.png", "--spp", "1", "--width", "0", NULL}, {"--width"}},

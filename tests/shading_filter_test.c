@@ -205,6 +205,20 @@ static void test_parse(void **state)
     assert_int_equal(rs_filter_parse("gaussian:", &f, why, sizeof why), 0);
     assert_int_equal(rs_filter_parse("gaussian:1x", &f, why, sizeof why), 0);
     assert_int_equal(rs_filter_parse("gaussian:nan", &f, why, sizeof why), 0);
+    /* issue 39: widths that rendered something else without a word: mitchell:1e-38 black (its
+     * weights overflowed), box:1e-50 as box:1 (the float is 0, the default), and widths a
+     * checkpoint (thousandths of a pixel) cannot tell apart: box:0.0004 resumed as box:1 */
+    assert_int_equal(rs_filter_parse("mitchell:1e-38", &f, why, sizeof why), 0);
+    assert_non_null(strstr(why, "from 0.01 to 16 in steps of 0.001"));
+    assert_int_equal(rs_filter_parse("box:1e-50", &f, why, sizeof why), 0);
+    assert_int_equal(rs_filter_parse("box:0.0004", &f, why, sizeof why), 0);
+    assert_int_equal(rs_filter_parse("box:1.0004", &f, why, sizeof why), 0);
+    assert_int_equal(rs_filter_parse("box:0.009", &f, why, sizeof why), 0);
+    assert_int_equal(rs_filter_parse("box:0.01", &f, why, sizeof why), 1);
+    assert_true(f.width == 0.01f);
+    assert_int_equal(rs_filter_parse("gaussian:2.125", &f, why, sizeof why), 1);
+    assert_int_equal(rs_filter_parse("mitchell:15.999", &f, why, sizeof why), 1);
+    assert_int_equal(rs_filter_parse("blackman-harris:16", &f, why, sizeof why), 1);
 }
 
 int main(void)
