@@ -2,6 +2,7 @@
 # scripts/install-peers.sh — the other renderers that bench/peers_bench races, in a Python virtual
 # environment of their own (benchmark only; the renderer and its tests never need them).
 #   sh scripts/install-peers.sh [DIR]     (default: build/peers-venv)
+#   sh scripts/install-peers.sh --find-python313   the Python 3.13 it would use, or "none"
 # Installs Debian's python3, python3-venv and libllvm19 (Mitsuba's llvm_ad_rgb variant JIT-compiles
 # with it; peers_bench points DRJIT_LIBLLVM_PATH at it) where they are missing, then Mitsuba 3
 # and LuxCoreRender (pyluxcore) from PyPI into DIR, and Blender's Cycles (bpy) into DIR-cycles:
@@ -15,17 +16,27 @@ MITSUBA=mitsuba==3.9.1
 LUXCORE=pyluxcore==2.11.2
 BPY=bpy==5.2.3
 
+# PY313: a Python 3.13 that runs.  Each candidate is run before it is taken: pyenv's python3.13
+# shim is on PATH even where 3.13 is not the active version, and then it only says "pyenv:
+# python3.13: command not found".
+find_python313() {
+    PY313=
+    for p in "$(command -v python3.13 2>/dev/null || true)" \
+        "$HOME"/.pyenv/versions/3.13*/bin/python3.13; do
+        if [ -n "$p" ] && [ -x "$p" ] &&
+            "$p" -c 'import sys; assert sys.version_info[:2] == (3, 13)' >/dev/null 2>&1; then
+            PY313=$p
+            return 0
+        fi
+    done
+}
+
 cycles_venv() {
     CY="$DIR-cycles"
     if [ -x "$CY/bin/python" ] && "$CY/bin/python" -c "import bpy, numpy" 2>/dev/null; then
         return 0
     fi
-    PY313=$(command -v python3.13 2>/dev/null || true)
-    if [ -z "$PY313" ]; then
-        for p in "$HOME"/.pyenv/versions/3.13*/bin/python3.13; do
-            [ -x "$p" ] && PY313=$p
-        done
-    fi
+    find_python313
     if [ -z "$PY313" ]; then
         echo "install-peers.sh: no python3.13 found: Cycles (bpy 5.2 needs Python 3.13) is skipped" >&2
         return 0
@@ -35,6 +46,12 @@ cycles_venv() {
     "$CY/bin/pip" install -q "$BPY" numpy
     "$CY/bin/python" -c "import bpy; print('install-peers.sh: Blender', bpy.app.version_string, 'in $CY')" 2>/dev/null | tail -1
 }
+
+if [ "${1:-}" = "--find-python313" ]; then # which Python 3.13 the Cycles venv would be made with
+    find_python313
+    echo "${PY313:-none}"
+    exit 0
+fi
 
 # one import per process: mitsuba and pyluxcore in one process abort (their TBBs clash)
 if [ -x "$DIR/bin/python" ] && "$DIR/bin/python" -c "import mitsuba, numpy" 2>/dev/null &&
