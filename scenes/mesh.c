@@ -403,7 +403,9 @@ static rs_status load_texture_ex(rs_scene *s, const struct aiScene *as,
     if (*tmp)
         unlink(tmp);
     if (st != RS_OK) {
-        if (strict) {
+        /* a texture that is there but unusable (a texel NaN, infinite or negative) is refused
+         * even where a missing one only warns */
+        if (strict || st == RS_ERR_ARG) {
             char msg[1200];
             snprintf(msg, sizeof msg, "%s", rs_error_message());
             rs_error_clear();

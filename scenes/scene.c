@@ -3,6 +3,7 @@
 #include "scenes/light_bvh.h"
 #include "scenes/scene_env.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -310,8 +311,30 @@ rs_status rs_scene_add_texture(rs_scene *s, const rs_texture *t, uint32_t *id)
     return RS_OK;
 }
 
+/* Every texel finite and >= 0 (radiance or reflectance): a NaN texel spread through the mip
+ * pyramid into every coarser level, a negative one made negative pixels (issue 39).  `what`
+ * names the image in the message (the file, or "an image"). */
+static rs_status check_texels(const char *what, uint32_t w, const float *rgb, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!(rgb[i] >= 0.0f && rgb[i] <= FLT_MAX))
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: texel (%u, %u) is %s (an image's texels must be finite and "
+                                ">= 0)",
+                                what, (unsigned)((i / 3) % w), (unsigned)((i / 3) / w),
+                                isnan(rgb[i])   ? "not finite (NaN)"
+                                : isinf(rgb[i]) ? "not finite (infinite)"
+                                                : "negative");
+    return RS_OK;
+}
+
 static rs_status add_image_owned(rs_scene *s, uint32_t w, uint32_t h, float *rgb, uint32_t *id)
 {
+    if (check_texels("an image", w, rgb, (size_t)w * h * 3) != RS_OK) {
+        rs_free(rgb);
+        return RS_ERR_ARG;
+    }
     if (!grow((void **)&s->images, &s->cap_images, s->n_images + 1, sizeof *s->images)) {
         rs_free(rgb);
         return rs_error_set(RS_ERR_NOMEM, "out of memory adding an image");
@@ -345,6 +368,10 @@ rs_status rs_scene_load_image(rs_scene *s, const char *path, uint32_t *id)
     rs_status st = rs_image_read_linear(path, &w, &h, &rgb);
     if (st != RS_OK)
         return st;
+    if ((st = check_texels(path, w, rgb, (size_t)w * h * 3)) != RS_OK) {
+        rs_free(rgb);
+        return st;
+    }
     return add_image_owned(s, w, h, rgb, id);
 }
 
@@ -355,6 +382,10 @@ rs_status rs_scene_load_image_data(rs_scene *s, const char *path, uint32_t *id)
     rs_status st = rs_image_read(path, &w, &h, &rgb);
     if (st != RS_OK)
         return st;
+    if ((st = check_texels(path, w, rgb, (size_t)w * h * 3)) != RS_OK) {
+        rs_free(rgb);
+        return st;
+    }
     return add_image_owned(s, w, h, rgb, id);
 }
 

@@ -785,6 +785,52 @@ static void test_bad_maps(void **state)
     rmdir(dir);
 }
 
+/* Image textures with a NaN, infinite or negative texel are refused as environment maps are,
+ * by one line naming the scene, the file and the texel (issue 39: they were accepted, and the
+ * mip pyramid carried one NaN texel into every coarser level: rows of a far floor 10-83% darker;
+ * a negative texel gave negative pixels). */
+static void test_bad_image_textures(void **state)
+{
+    char dir[] = "/tmp/rs_tex_XXXXXX", p[512], sp[512];
+    static const char *const cases[][2] = {
+        {"nan.pfm", "texel (0, 1) is not finite (NaN)"},
+        {"inf.pfm", "texel (0, 1) is not finite (infinite)"},
+        {"neg.pfm", "texel (0, 1) is negative"},
+    };
+    size_t k;
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    snprintf(p, sizeof p, "%s/nan.pfm", dir);
+    write_pfm(p, 4, 2, 0.5f, NAN);
+    snprintf(p, sizeof p, "%s/inf.pfm", dir);
+    write_pfm(p, 4, 2, 0.5f, INFINITY);
+    snprintf(p, sizeof p, "%s/neg.pfm", dir);
+    write_pfm(p, 4, 2, 0.5f, -0.25f);
+    snprintf(sp, sizeof sp, "%s/scene.json", dir);
+    for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        FILE *f = fopen(sp, "w");
+        rs_scene *s = (rs_scene *)0x1;
+        assert_non_null(f);
+        fprintf(f, "{\"camera\":{\"from\":[0,0,5],\"at\":[0,0,0]},\"textures\":{\"t\":"
+                   "{\"type\":\"image\",\"file\":\"%s\"}},\"materials\":{\"m\":"
+                   "{\"type\":\"lambertian\",\"texture\":\"t\"}},\"objects\":[{\"type\":"
+                   "\"sphere\",\"center\":[0,0,0],\"radius\":1,\"material\":\"m\"}]}",
+                cases[k][0]);
+        fclose(f);
+        rs_error_clear();
+        assert_int_not_equal(rs_scene_load_json(sp, &s), RS_OK);
+        print_message("%s\n", rs_error_message());
+        assert_null(strchr(rs_error_message(), '\n'));
+        assert_non_null(strstr(rs_error_message(), "scene.json"));
+        assert_non_null(strstr(rs_error_message(), cases[k][0]));
+        assert_non_null(strstr(rs_error_message(), cases[k][1]));
+        rs_error_clear();
+        remove_in(dir, cases[k][0]);
+    }
+    remove(sp);
+    rmdir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -795,6 +841,7 @@ int main(void)
         cmocka_unit_test(test_mixed_lights_agree), cmocka_unit_test(test_pbr_emitter),
         cmocka_unit_test(test_bad_maps),          cmocka_unit_test(test_uniform_map),
         cmocka_unit_test(test_constant_background), cmocka_unit_test(test_uniform_sky_cosine),
+        cmocka_unit_test(test_bad_image_textures),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
