@@ -320,7 +320,12 @@ static rs_status open_input(const char *path, rs_status fail, OIIO::ImageInput::
     rs_status st = rs_file_check(path, RS_FILE_MAX_IMAGE_BYTES, nullptr);
     if (st != RS_OK)
         return st;
-    *in = OIIO::ImageInput::open(path);
+    // colours as stored: PNG, TIFF and the rest keep colour and alpha apart (glTF's images
+    // among them: not premultiplied), and OpenImageIO would otherwise multiply the colour by
+    // the alpha on reading (a white texel of alpha 128 read as 0.5, 0.215 once decoded)
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    *in = OIIO::ImageInput::open(path, &config);
     if (!*in)
         return rs_error_set(fail, "%s: cannot open image: %s", path, OIIO::geterror().c_str());
     return RS_OK;

@@ -384,8 +384,10 @@ static void test_alpha_cutout(void **state)
     static const struct {
         const char *factor, *mode;
         int left, right; /* whether the emitter shows */
-    } cases[] = {{"1", "MASK", 1, 0}, {"0.3", "MASK", 1, 1}, {"1", "OPAQUE", 0, 0},
-                 {"0.3", "OPAQUE", 0, 0}};
+        int untextured;  /* the factor alone (issue 39: alpha 0 without a texture still hid) */
+    } cases[] = {{"1", "MASK", 1, 0, 0},      {"0.3", "MASK", 1, 1, 0}, {"1", "OPAQUE", 0, 0, 0},
+                 {"0.3", "OPAQUE", 0, 0, 0}, {"0", "MASK", 1, 1, 1},   {"0.3", "MASK", 1, 1, 1},
+                 {"0.7", "MASK", 0, 0, 1},   {"0", "OPAQUE", 0, 0, 1}};
     size_t c;
     (void)state;
     write_full_files();
@@ -396,15 +398,23 @@ static void test_alpha_cutout(void **state)
         float *ref = NULL;
         uint32_t width;
         snprintf(json, sizeof json, k, cases[c].factor, cases[c].mode, "");
+        if (cases[c].untextured) {
+            static const char tex[] = ",\"baseColorTexture\":{\"index\":0}";
+            m = strstr(json, tex);
+            assert_non_null(m);
+            memmove(m, m + strlen(tex), strlen(m + strlen(tex)) + 1);
+        }
         /* a second mesh, the same quad with material 1 */
         m = strstr(json, "\"material\":0}]}]");
         assert_non_null(m);
         snprintf(buf, sizeof buf, "%.*s\"material\":0}]},{\"primitives\":[{\"attributes\":"
-                 "{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":2},\"indices\":3,\"material\":1}]}]%s",
-                 (int)(m - json), json, m + strlen("\"material\":0}]}]"));
+                 "{\"POSITION\":0,\"NORMAL\":1%s},\"indices\":3,\"material\":1}]}]%s",
+                 (int)(m - json), json, cases[c].untextured ? "" : ",\"TEXCOORD_0\":2",
+                 m + strlen("\"material\":0}]}]"));
         write_text("alpha.gltf", buf);
         s = load("alpha.gltf", NULL);
-        assert_int_equal(s->n_masks != 0, strcmp(cases[c].mode, "MASK") == 0);
+        assert_int_equal(s->n_masks != 0, strcmp(cases[c].mode, "MASK") == 0 &&
+                                              (!cases[c].untextured || cases[c].left));
         for (width = 2; width <= 8; width *= 2) {
             rt_args a = rt_defaults("", 32, 2);
             float *img;
@@ -424,8 +434,9 @@ static void test_alpha_cutout(void **state)
                         right += p[0];
                 }
             if (width == 2)
-                print_message("alpha %s %s: left %.2f, right %.2f\n", cases[c].factor,
-                              cases[c].mode, left, right);
+                print_message("alpha %s %s%s: left %.2f, right %.2f\n", cases[c].factor,
+                              cases[c].mode, cases[c].untextured ? " untextured" : "", left,
+                              right);
             if ((left > 60.0) != cases[c].left || (right > 60.0) != cases[c].right)
                 fail_msg("alpha %s %s, %u-wide: left %.2f, right %.2f (60 pixels of ~2 when the "
                          "emitter shows)",

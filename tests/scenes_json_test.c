@@ -318,6 +318,29 @@ static const bad_case g_bad[] = {
     {"{" CAM "," MAT ",\"objects\":[],\"a\\nb\":1}", {"unknown key 'a?b'"}},
 };
 
+/* An RGBA PNG's colour is read as stored, not multiplied by its alpha (issue 39: OpenImageIO
+ * associates alpha by default, and a white texel of alpha 128 read as 0.5, 0.215 once decoded
+ * from sRGB; glTF's and PNG's colours are not premultiplied).  tests/data/white_alpha128.png:
+ * 2x1, (255, 255, 255, 128) twice. */
+static void test_rgba_not_premultiplied(void **state)
+{
+    uint32_t w = 0, h = 0;
+    float *rgb = NULL, *alpha = NULL;
+    (void)state;
+    if (rs_image_read_linear(RS_SOURCE_DIR "/tests/data/white_alpha128.png", &w, &h, &rgb) != RS_OK)
+        fail_msg("%s", rs_error_message());
+    assert_true(w == 2 && h == 1);
+    print_message("white, alpha 128: read as %g %g %g\n", rgb[0], rgb[1], rgb[2]);
+    assert_true(rgb[0] == 1.0f && rgb[1] == 1.0f && rgb[2] == 1.0f && rgb[3] == 1.0f);
+    rs_free(rgb);
+    assert_int_equal(rs_image_read_alpha(RS_SOURCE_DIR "/tests/data/white_alpha128.png", &w, &h,
+                                         &alpha),
+                     RS_OK);
+    assert_non_null(alpha);
+    assert_true(fabsf(alpha[0] - 128.0f / 255.0f) < 1e-6f);
+    rs_free(alpha);
+}
+
 /* A spot light's documented widest cone, outer 90 degrees, loads (issue 39: cosf of 90 degrees
  * in float radians is -4.4e-8, and the light was refused by a line naming neither file nor
  * object): its cosines are held at 0. */
@@ -763,6 +786,7 @@ int main(void)
         cmocka_unit_test(test_image_messages),
         cmocka_unit_test(test_pfm_round_trip),
         cmocka_unit_test(test_spot_cone_90),
+        cmocka_unit_test(test_rgba_not_premultiplied),
         cmocka_unit_test(test_mutations_never_crash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
