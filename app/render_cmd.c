@@ -105,9 +105,10 @@ int rs_run_check_outputs(const rs_cli_options *o, render_run *r)
         return rc;
     if (rs_image_check_output(r->out) != RS_OK)
         return rs_app_fail(RS_EXIT_USAGE, NULL);
-    if (o->denoise) { /* OIDN is loaded at run time: its absence stops the run here */
+    if (o->denoise) { /* OIDN is loaded at run time: its absence stops the run here, as does
+                       * a library that cannot make a CPU device and its filter */
         char why[400];
-        if (!rs_denoise_available(why, sizeof why)) {
+        if (!rs_denoise_probe(why, sizeof why)) {
             fprintf(stderr, "raystream: --denoise: %s\n", why);
             return RS_EXIT_RUNTIME;
         }

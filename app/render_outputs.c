@@ -299,10 +299,12 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
 {
     rs_report rep;
     char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
-    int i, ok = 1, replaced = 0;
+    int i, ok = 1, replaced = 0, undenoised = 0;
     rs_film_resolve(r->film, r->rgb);
+    /* a denoise that still fails after the render (checked before it: rs_denoise_probe) loses
+     * nothing: the outputs are written with the image as rendered, then the failure reported */
     if (o->denoise && !denoise(r))
-        return RS_EXIT_RUNTIME;
+        undenoised = 1;
     make_report(o, r, &rep);
     if (o->stats)
         rs_report_print_table(&rep);
@@ -329,5 +331,11 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
         return RS_EXIT_RUNTIME;
     }
     rs_report_print_summary(&rep);
+    if (undenoised) {
+        fprintf(stderr, "raystream: --denoise failed after the render: %s was written as "
+                        "rendered, not denoised\n",
+                r->out);
+        return RS_EXIT_RUNTIME;
+    }
     return code;
 }

@@ -175,6 +175,40 @@ static int load(char *why, size_t n)
 
 int rs_denoise_available(char *why, size_t n) { return load(why, n); }
 
+int rs_denoise_probe(char *why, size_t n)
+{
+    const oidn_lib *L = &g_oidn;
+    rs_oidn_device dev;
+    rs_oidn_filter f;
+    const char *m = NULL;
+    int code;
+    if (!load(why, n))
+        return 0;
+    L->get_device_error(NULL, NULL); /* forget an earlier unqueried error of this thread */
+    dev = L->new_device(RS_OIDN_DEVICE_TYPE_CPU);
+    if (!dev) {
+        code = L->get_device_error(NULL, &m);
+        rs_say(why, n, "Open Image Denoise (%s) cannot make its CPU device: %s", L->path,
+               m && m[0] ? m : code ? "an error without a message" : "no reason given");
+        return 0;
+    }
+    L->set_device_int(dev, "verbose", 0);
+    L->commit_device(dev);
+    f = (code = L->get_device_error(dev, &m)) == 0 ? L->new_filter(dev, "RT") : NULL;
+    if (f)
+        L->release_filter(f);
+    else if (code == 0)
+        code = L->get_device_error(dev, &m);
+    if (!f) /* the message, before the device that owns it goes */
+        rs_say(why, n, "Open Image Denoise (%s) cannot make the RT filter on its CPU device: %s",
+               L->path, m && m[0] ? m : code ? "an error without a message" : "no reason given");
+    L->release_device(dev);
+    if (!f)
+        return 0;
+    rs_say(why, n, "%s", "");
+    return 1;
+}
+
 /* ---- one denoise on one device ---- */
 
 /* What OIDN reported on a device: its first error. */

@@ -35,6 +35,10 @@ extern "C" {
  * NULL) saying what is missing and how to get it (sh scripts/install-deps.sh, or
  * RS_OIDN_LIBRARY=PATH).  Loads the library if it is not loaded yet; makes no device. */
 int rs_denoise_available(char *why, size_t n);
+/* rs_denoise_available, then a CPU device and its RT filter made and released: what a denoise
+ * needs first, tried before a render (an OIDN that loads without its CPU device library failed
+ * only after the render).  1, or 0 with why[n]. */
+int rs_denoise_probe(char *why, size_t n);
 
 /* Denoises `beauty` (w*h*3 floats, linear HDR radiance) into `out` (w*h*3 floats; may be
  * `beauty` itself) with OIDN's "RT" filter, hdr on.

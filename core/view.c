@@ -149,10 +149,13 @@ int rs_view_from_name(const char *name, float exposure_ev, rs_view *out, char *w
                  (int)sizeof v.name - 1);
         return 0;
     }
-    if (!rs_view_ocio_find(name, ocio_why, sizeof ocio_why)) {
+    switch (rs_view_ocio_find(name, ocio_why, sizeof ocio_why)) {
+    case 1: break;
+    case 0:
         snprintf(why, n, "unknown view '%s' (built-in views: %s; %s)", name,
                  rs_view_builtin_names(), ocio_why);
         return 0;
+    default: snprintf(why, n, "%s", ocio_why); return 0;
     }
     v.kind = RS_VIEW_OCIO;
     snprintf(v.name, sizeof v.name, "%s", name);

@@ -64,7 +64,9 @@ void rs_view_pbr_neutral_rgb(const float in[3], float out[3]);
 /* The OpenColorIO half (core/view_ocio.cpp with OpenImageIO, core/view_ocio_none.c without).
  * rs_view_ocio_available: 1 when this build's OpenImageIO has OpenColorIO.
  * rs_view_ocio_find: 1 when $OCIO is set, its config loads and its default display has the
- * view `name`; else 0 with the reason in why[n], which lists the config's views when it loaded.
+ * view `name`, whose processor can be made (its LUTs read); else 0 with the reason in why[n],
+ * which lists the config's views when it loaded, or -1 when the view is there but cannot be
+ * made (why[n]: OpenColorIO's reason, on one line).
  * rs_view_ocio_apply: the display transform in place on npix RGB pixels (already exposed). */
 int rs_view_ocio_available(void);
 int rs_view_ocio_find(const char *name, char *why, size_t n);

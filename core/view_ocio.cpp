@@ -71,10 +71,20 @@ OIIO::ColorConfig *load(ocio_state &s)
     return s.config.get();
 }
 
+// One line: OpenColorIO's messages may span several.
+std::string one_line(std::string e)
+{
+    std::replace(e.begin(), e.end(), '\n', ' ');
+    std::replace(e.begin(), e.end(), '\r', ' ');
+    while (!e.empty() && e.back() == ' ')
+        e.pop_back();
+    return e;
+}
+
 void put(char *why, size_t n, const std::string &text)
 {
     if (n)
-        std::snprintf(why, n, "%s", text.c_str());
+        std::snprintf(why, n, "%s", one_line(text).c_str());
 }
 
 } // namespace
@@ -101,8 +111,20 @@ extern "C" int rs_view_ocio_find(const char *name, char *why, size_t n)
         std::vector<std::string> views = cfg->getViewNames(s.display);
         std::string list;
         for (const std::string &v : views) {
-            if (v == name)
-                return 1;
+            if (v == name) {
+                // its processor made now, not when the image is written after the render (a
+                // missing or corrupt LUT, a colour space the config lacks)
+                OIIO::ColorProcessorHandle p =
+                    cfg->createDisplayTransform(s.display, name, s.input);
+                if (p)
+                    return 1;
+                std::string e = cfg->geterror();
+                put(why, n,
+                    "view '" + std::string(name) + "' of display '" + s.display + "' in $OCIO " +
+                        "cannot be made: " +
+                        (e.empty() ? std::string("OpenColorIO cannot make the transform") : e));
+                return -1;
+            }
             list += (list.empty() ? "" : ", ") + v;
         }
         put(why, n, "views of display '" + s.display + "' in $OCIO: " + list);
@@ -132,7 +154,7 @@ extern "C" rs_status rs_view_ocio_apply(const char *name, float *rgb, size_t npi
                 return rs_error_set(RS_ERR_ARG, "view '%s' of display '%s' from '%s': %s", name,
                                     s.display.c_str(), s.input.c_str(),
                                     e.empty() ? "OpenColorIO cannot make the transform"
-                                              : e.c_str());
+                                              : one_line(e).c_str());
             }
         }
         // rows of at most `block` pixels (apply counts in int), run in parallel: OCIO's CPU
@@ -150,7 +172,7 @@ extern "C" rs_status rs_view_ocio_apply(const char *name, float *rgb, size_t npi
         }
         return RS_OK;
     } catch (const std::exception &ex) {
-        return rs_error_set(RS_ERR_ARG, "view '%s': %s", name, ex.what());
+        return rs_error_set(RS_ERR_ARG, "view '%s': %s", name, one_line(ex.what()).c_str());
     } catch (...) {
         return rs_error_set(RS_ERR_ARG, "view '%s': unknown OpenColorIO error", name);
     }

@@ -164,6 +164,13 @@ static void test_names(void **state)
     assert_false(rs_view_from_name("no-such-view", 0.0f, &v, why, sizeof why));
     assert_non_null(strstr(why, "no-such-view"));
     assert_non_null(strstr(why, "standard, filmic (or agx), pbr-neutral"));
+    /* a view whose LUT is missing: refused when the view is named, before any render (issue
+     * 39: found when the image was written, after the render, in several lines) */
+    assert_false(rs_view_from_name("Lut", 0.0f, &v, why, sizeof why));
+    printf("Lut: %s\n", why);
+    assert_non_null(strstr(why, "view 'Lut'"));
+    assert_non_null(strstr(why, "missing-lut.spi1d"));
+    assert_null(strchr(why, '\n'));
     assert_null(strchr(why, '\n'));
     assert_false(rs_view_from_name("Filmic", 0.0f, &v, why, sizeof why)); /* exact names */
     assert_false(rs_view_from_name("", 0.0f, &v, why, sizeof why));
@@ -352,6 +359,7 @@ static const char ocio_config[] =
     "  TestDisplay:\n"
     "    - !<View> {name: Raw, colorspace: linear}\n"
     "    - !<View> {name: Gamma, colorspace: gamma22}\n"
+    "    - !<View> {name: Lut, colorspace: lut}\n"
     "\n"
     "colorspaces:\n"
     "  - !<ColorSpace>\n"
@@ -365,7 +373,14 @@ static const char ocio_config[] =
     "    bitdepth: 32f\n"
     "    isdata: false\n"
     "    allocation: uniform\n"
-    "    to_reference: !<ExponentTransform> {value: [2.2, 2.2, 2.2, 1]}\n";
+    "    to_reference: !<ExponentTransform> {value: [2.2, 2.2, 2.2, 1]}\n"
+    "\n"
+    "  - !<ColorSpace>\n"
+    "    name: lut\n"
+    "    bitdepth: 32f\n"
+    "    isdata: false\n"
+    "    allocation: uniform\n"
+    "    from_reference: !<FileTransform> {src: missing-lut.spi1d, interpolation: linear}\n";
 
 static void test_ocio(void **state)
 {
@@ -389,7 +404,7 @@ static void test_ocio(void **state)
     assert_true(rs_view_from_name("filmic", 0.0f, &v, why, sizeof why));
     assert_int_equal(v.kind, RS_VIEW_FILMIC);
     assert_false(rs_view_from_name("Log", 0.0f, &v, why, sizeof why));
-    assert_non_null(strstr(why, "Raw, Gamma"));
+    assert_non_null(strstr(why, "Raw, Gamma, Lut"));
     assert_non_null(strstr(why, "standard, filmic (or agx), pbr-neutral"));
 
     for (i = 0; i < RAMP_N * 3; ++i)
