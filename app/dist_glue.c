@@ -440,6 +440,7 @@ static int dist_run_adaptive(const rs_cli_options *o, render_run *r, const rs_di
         fprintf(stderr, "raystream: --checkpoint %s: not updated: the stop left gaps in the "
                         "adaptive round under way; the last one written stays\n",
                 r->ckpt_out->path);
+        r->ckpt_out->dropped = 1; /* not renamed over the last one written */
         r->ckpt_out = NULL;
     }
     if (st == RS_ERR_CANCELLED) {

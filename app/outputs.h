@@ -30,6 +30,8 @@ typedef struct rs_output {
     const char *may_replace; /* input: an input file this output may replace (the checkpoint
                                 over the --resume file it continues), or NULL */
     int in_place;       /* output: path is such a file; written directly, after everything else */
+    int dropped;        /* output: not written after all (a checkpoint that keeps its last
+                           contents): nothing to rename */
     char staged[RS_OUTPUT_PATH_MAX]; /* output: "path.tmp-PID" */
 } rs_output;
 

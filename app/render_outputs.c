@@ -319,7 +319,7 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
         ok = write_image(o, r, &rep);
     replaced = ok;
     for (i = 1; ok && i < r->n_outs; ++i)
-        if (!r->outs[i].in_place)
+        if (!r->outs[i].in_place && !r->outs[i].dropped)
             ok = rs_output_commit(&r->outs[i]);
     if (ok && r->stats_out && r->stats_out->in_place)
         ok = rs_report_write_json(&rep, r->stats_out->path, r->stats_out->path);

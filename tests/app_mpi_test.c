@@ -534,6 +534,34 @@ static void test_ctrl_c_stops_every_rank(void **state)
     proc_free(&p);
 }
 
+/* An adaptive job with --checkpoint whose rank dies without mpirun's recovery: mpirun stops
+ * the others (SIGTERM) within a round whose dead rank's passes are missing; the checkpoint keeps
+ * the last one written (said once) and the partial image is written without a failure (issue
+ * 39: rank 0 then failed renaming the checkpoint it had never written: "cannot put the finished
+ * file in place", "the run failed; some outputs were already replaced"). */
+static void test_adaptive_stop_keeps_checkpoint(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                       SIZE, "--spp", "64", "--adaptive", "0.05", "--mpi-pass",
+                                       "1", "--mpi-timeout", "2", "-q", "-o", "many.exr",
+                                       "--checkpoint", "many.ckpt", NULL};
+    proc p;
+    char path[256];
+    setenv("RS_MPI_FAULT", "die:2:2", 1);
+    mpirun(&p, f, 3, 0, args);
+    setenv("RS_MPI_FAULT", "", 1);
+    EXPECT(&p, !p.timed_out, "the job did not end");
+    printf("  %s\n", strstr(p.err.data, "not updated") ? "stopped within a round: checkpoint kept"
+                                                       : "stopped between rounds");
+    EXPECT(&p, strstr(p.err.data, "the run failed") == NULL &&
+                   strstr(p.err.data, "cannot put the finished file") == NULL,
+           "a stopped adaptive job with --checkpoint failed its outputs: %s", p.err.data);
+    path_in(f, "many.exr", path, sizeof path);
+    EXPECT(&p, file_exists(path), "no partial image");
+    proc_free(&p);
+}
+
 static void test_unsupported_options(void **state)
 {
     const fixture *f = (const fixture *)*state;
@@ -603,6 +631,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_periodic_checkpoints, setup, teardown),
         cmocka_unit_test_setup_teardown(test_time_limit_whole_passes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_ctrl_c_stops_every_rank, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_adaptive_stop_keeps_checkpoint, setup, teardown),
         cmocka_unit_test_setup_teardown(test_unsupported_options, setup, teardown),
     };
     find_mpi();
