@@ -385,7 +385,7 @@ static int read_number(const char *path, int mat, const char *ext, const cJSON *
 }
 
 static int read_colour(const char *path, int mat, const char *ext, const cJSON *obj,
-                       const char *key, float *out)
+                       const char *key, double hi, float *out)
 {
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     int i;
@@ -398,9 +398,14 @@ static int read_colour(const char *path, int mat, const char *ext, const cJSON *
     }
     for (i = 0; i < 3; ++i) {
         const cJSON *c = cJSON_GetArrayItem(v, i);
-        if (!cJSON_IsNumber(c) || !(c->valuedouble >= 0.0 && c->valuedouble <= 1.0)) {
-            rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%s.%s[%d]: not a number in "
-                         "[0, 1]", path, mat, ext, key, i);
+        if (!cJSON_IsNumber(c) || !(c->valuedouble >= 0.0 && c->valuedouble <= hi) ||
+            !isfinite(c->valuedouble)) {
+            if (hi < INFINITY)
+                rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%s.%s[%d]: not a number in "
+                             "[0, %g]", path, mat, ext, key, i, hi);
+            else
+                rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%s.%s[%d]: not a finite "
+                             "number >= 0", path, mat, ext, key, i);
             return -1;
         }
         out[i] = (float)c->valuedouble;
@@ -415,12 +420,30 @@ static const cJSON *ext_of(const cJSON *mat, const char *name)
     return cJSON_IsObject(x) ? x : NULL;
 }
 
+/* Material i's "extensions" and each extension in it objects, as the schema says (one that was
+ * a string or an array was skipped without a word). */
+static rs_status check_ext_objects(const char *path, int i, const cJSON *mat)
+{
+    const cJSON *e = cJSON_GetObjectItemCaseSensitive(mat, "extensions"), *x;
+    if (!e)
+        return RS_OK;
+    if (!cJSON_IsObject(e))
+        return rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions: not an object", path, i);
+    for (x = e->child; x; x = x->next)
+        if (!cJSON_IsObject(x))
+            return rs_error_set(RS_ERR_ARG, "%s: materials[%d].extensions.%.80s: not an object",
+                                path, i, x->string ? x->string : "?");
+    return RS_OK;
+}
+
 static rs_status read_material(const char *path, int i, const cJSON *mat, rs_gltf_mat_ext *m)
 {
     const cJSON *x;
     *m = rs_gltf_mat_ext_default();
     if (!cJSON_IsObject(mat))
         return RS_OK;
+    if (check_ext_objects(path, i, mat) != RS_OK)
+        return RS_ERR_ARG;
     if ((x = ext_of(mat, "KHR_materials_emissive_strength")) &&
         read_number(path, i, "KHR_materials_emissive_strength", x, "emissiveStrength", 0.0f,
                     INFINITY, 0, &m->emissive_strength) < 0)
@@ -439,13 +462,15 @@ static rs_status read_material(const char *path, int i, const cJSON *mat, rs_glt
     if ((x = ext_of(mat, "KHR_materials_specular")) &&
         (read_number(path, i, "KHR_materials_specular", x, "specularFactor", 0.0f, 1.0f, 0,
                      &m->specular) < 0 ||
-         read_colour(path, i, "KHR_materials_specular", x, "specularColorFactor",
+         /* the schema bounds it below only: F0 = ((ior - 1) / (ior + 1))^2 times it, held
+          * to 1 where it is used */
+         read_colour(path, i, "KHR_materials_specular", x, "specularColorFactor", INFINITY,
                      m->specular_color) < 0))
         return RS_ERR_ARG;
     if ((x = ext_of(mat, "KHR_materials_volume")) &&
         (read_number(path, i, "KHR_materials_volume", x, "attenuationDistance", 0.0f, INFINITY, 1,
                      &m->attenuation_distance) < 0 ||
-         read_colour(path, i, "KHR_materials_volume", x, "attenuationColor",
+         read_colour(path, i, "KHR_materials_volume", x, "attenuationColor", 1.0,
                      m->attenuation_color) < 0))
         return RS_ERR_ARG;
     if ((x = ext_of(mat, "KHR_materials_clearcoat")) &&
@@ -455,7 +480,8 @@ static rs_status read_material(const char *path, int i, const cJSON *mat, rs_glt
                      1.0f, 0, &m->clearcoat_roughness) < 0))
         return RS_ERR_ARG;
     if ((x = ext_of(mat, "KHR_materials_sheen")) &&
-        (read_colour(path, i, "KHR_materials_sheen", x, "sheenColorFactor", m->sheen_color) < 0 ||
+        (read_colour(path, i, "KHR_materials_sheen", x, "sheenColorFactor", 1.0,
+                     m->sheen_color) < 0 ||
          read_number(path, i, "KHR_materials_sheen", x, "sheenRoughnessFactor", 0.0f, 1.0f, 0,
                      &m->sheen_roughness) < 0))
         return RS_ERR_ARG;
@@ -497,8 +523,30 @@ rs_status rs_gltf_read_ext(const char *path, int glb, rs_gltf_ext *out)
                                                              : sizeof out->unread,
                         u->valuestring);
         }
+    /* an extension the file requires and raystream does not read: the file must not load
+     * (glTF 2.0, 3.12); Assimp decodes the two geometry ones itself */
+    used = cJSON_GetObjectItemCaseSensitive(root, "extensionsRequired");
+    if (cJSON_IsArray(used))
+        for (u = used->child; u && st == RS_OK; u = u->next) {
+            static const char *const decoded[] = {"KHR_mesh_quantization",
+                                                  "KHR_draco_mesh_compression"};
+            size_t k;
+            int ours = 0;
+            if (!cJSON_IsString(u))
+                continue;
+            for (k = 0; k < sizeof known / sizeof *known; ++k)
+                ours |= strcmp(u->valuestring, known[k]) == 0;
+            for (k = 0; k < sizeof decoded / sizeof *decoded; ++k)
+                ours |= strcmp(u->valuestring, decoded[k]) == 0;
+            if (!ours)
+                st = rs_error_set(RS_ERR_ARG,
+                                  "%s: requires the extension %.80s (extensionsRequired), which "
+                                  "raystream does not read; a file that requires one must not "
+                                  "load without it",
+                                  path, u->valuestring);
+        }
     mats = cJSON_GetObjectItemCaseSensitive(root, "materials");
-    n = cJSON_IsArray(mats) ? cJSON_GetArraySize(mats) : 0;
+    n = st == RS_OK && cJSON_IsArray(mats) ? cJSON_GetArraySize(mats) : 0;
     if (n > 0) {
         out->materials = (rs_gltf_mat_ext *)rs_alloc((size_t)n, sizeof *out->materials);
         if (!out->materials)

@@ -532,6 +532,14 @@ static void test_material_extensions(void **state)
     expect_v3(m->specular, (float)f0, (float)(f0 * 0.5), (float)(f0 * 0.2), 1e-7f);
     assert_true(m->spec_weight == 0.6f);
     rs_scene_destroy(s);
+    /* specularColorFactor above 1, as the schema allows (issue 39: refused): F0 held to 1 */
+    s = load_ext("spec4.gltf", "\"KHR_materials_ior\",\"KHR_materials_specular\"",
+                 "\"baseColorFactor\":[0.2,0.4,0.6,1],\"metallicFactor\":0",
+                 "\"KHR_materials_ior\":{\"ior\":2},"
+                 "\"KHR_materials_specular\":{\"specularColorFactor\":[4,20,0.5]}");
+    m = &s->materials[s->tri_mat[0]];
+    expect_v3(m->specular, (float)(f0 * 4), 1.0f, (float)(f0 * 0.5), 1e-7f);
+    rs_scene_destroy(s);
     /* unlit: the base colour emitted, nothing reflected */
     s = load_ext("unlit.gltf", "\"KHR_materials_unlit\"", "\"baseColorFactor\":[0.2,0.4,0.6,1]",
                  "\"KHR_materials_unlit\":{}");
@@ -584,8 +592,13 @@ static void test_material_extensions_bad(void **state)
         "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":140}]," VIEWS "}";
     static const char *const cases[][3] = {
         {"\"KHR_materials_ior\":{\"ior\":0.5}", "KHR_materials_ior.ior", "below 1"},
-        {"\"KHR_materials_specular\":{\"specularColorFactor\":[2,0,0]}", "specularColorFactor[0]",
+        {"\"KHR_materials_specular\":{\"specularColorFactor\":[-1,0,0]}",
+         "specularColorFactor[0]", "number >= 0"},
+        {"\"KHR_materials_sheen\":{\"sheenColorFactor\":[2,0,0]}", "sheenColorFactor[0]",
          "[0, 1]"},
+        /* an extension that is not an object was skipped without a word */
+        {"\"KHR_materials_sheen\":\"x\"", "extensions.KHR_materials_sheen", "not an object"},
+        {"\"KHR_materials_ior\":[1.5]", "extensions.KHR_materials_ior", "not an object"},
         {"\"KHR_materials_volume\":{\"attenuationDistance\":0}", "attenuationDistance",
          "above 0"},
         {"\"KHR_materials_emissive_strength\":{\"emissiveStrength\":\"x\"}", "emissiveStrength",
@@ -600,6 +613,17 @@ static void test_material_extensions_bad(void **state)
         snprintf(ext, sizeof ext, "%s", cases[i][0]);
         snprintf(buf, sizeof buf, k, ext, views);
         expect_bad("badext.gltf", buf, cases[i][1], cases[i][2]);
+    }
+    /* a required extension raystream does not read: not loaded (glTF 2.0, 3.12; issue 39: it
+     * rendered with a warning); a required one it reads loads */
+    {
+        char req[8400];
+        snprintf(buf, sizeof buf, k, "", "");
+        snprintf(req, sizeof req, "{\"extensionsRequired\":[\"KHR_materials_iridescence\"],"
+                                  "\"extensionsUsed\":[\"KHR_materials_iridescence\"],%s",
+                 buf + 1);
+        expect_bad("required.gltf", req, "requires the extension KHR_materials_iridescence",
+                   "must not load");
     }
 }
 
