@@ -10,13 +10,16 @@
 #include "core/denoise.h"
 
 #include <dlfcn.h>
+#include <elf.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "core/file.h"
 #include "core/oidn_api.h"
 
 /* The entry points, each once: the struct's fields and the loader's table expand from here. */
@@ -90,11 +93,52 @@ static int resolve(void *lib, const char *path, oidn_lib *o, char *why, size_t n
     return 1;
 }
 
+/* Before dlopen of a path (not a name the loader searches for): a regular file (a FIFO blocked
+ * dlopen for ever) whose ELF header, program headers, segments and section headers all lie
+ * within it (the loader maps a truncated library and dies of SIGBUS touching what is missing).
+ * 1, or 0 with why[n]. */
+static int library_file_ok(const char *path, char *why, size_t n, const char *hint)
+{
+    Elf64_Ehdr eh;
+    uint64_t size = 0;
+    char msg[600];
+    int fd, ok = 1, i;
+    if (!strchr(path, '/'))
+        return 1;
+    if (rs_file_open_quiet(path, (uint64_t)1 << 32, &fd, &size, msg, sizeof msg) != RS_OK) {
+        rs_say(why, n, "Open Image Denoise not loaded: %s%s", msg, hint);
+        return 0;
+    }
+    if (pread(fd, &eh, sizeof eh, 0) != (ssize_t)sizeof eh ||
+        memcmp(eh.e_ident, ELFMAG, SELFMAG) != 0 || eh.e_ident[EI_CLASS] != ELFCLASS64)
+        ok = 0; /* not a 64-bit ELF file: dlopen says so itself, below */
+    else if (eh.e_phentsize != sizeof(Elf64_Phdr) ||
+             eh.e_phoff + (uint64_t)eh.e_phnum * sizeof(Elf64_Phdr) > size ||
+             (eh.e_shnum && eh.e_shoff + (uint64_t)eh.e_shnum * eh.e_shentsize > size))
+        ok = -1;
+    for (i = 0; ok == 1 && i < eh.e_phnum; ++i) {
+        Elf64_Phdr ph;
+        if (pread(fd, &ph, sizeof ph, (off_t)(eh.e_phoff + (uint64_t)i * sizeof ph)) !=
+                (ssize_t)sizeof ph ||
+            ph.p_offset + ph.p_filesz > size)
+            ok = -1;
+    }
+    close(fd);
+    if (ok < 0) {
+        rs_say(why, n, "Open Image Denoise not loaded: %s is cut short (%llu bytes: its ELF "
+               "headers name data past its end)%s", path, (unsigned long long)size, hint);
+        return 0;
+    }
+    return 1;
+}
+
 /* Opens `path` and resolves it: 1 and *o filled; 0 (not opened) or -1 (opened, but not OIDN
  * 2.x) with why[n]. */
 static int try_open(const char *path, oidn_lib *o, char *why, size_t n, const char *hint)
 {
     void *lib;
+    if (!library_file_ok(path, why, n, hint))
+        return 0;
     dlerror();
     lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) {

@@ -16,7 +16,10 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <unistd.h>
 #include <vector>
+
+#include "core/file.h"
 
 namespace
 {
@@ -49,6 +52,16 @@ OIIO::ColorConfig *load(ocio_state &s)
     if (!env || !*env) {
         s.why = "set $OCIO to an OpenColorIO config for its views";
         return nullptr;
+    }
+    {
+        // a regular file of a sane size (a FIFO blocked OpenColorIO's reader for ever)
+        char msg[600];
+        int fd;
+        if (rs_file_open_quiet(env, (uint64_t)64 << 20, &fd, nullptr, msg, sizeof msg) != RS_OK) {
+            s.why = std::string("$OCIO: ") + msg;
+            return nullptr;
+        }
+        close(fd);
     }
     auto cfg = std::make_unique<OIIO::ColorConfig>(env);
     if (cfg->has_error()) {

@@ -25,12 +25,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #ifndef RS_SOURCE_DIR
 #  define RS_SOURCE_DIR "."
 #endif
 
 #include "cli_harness.h"
+#include "core/view.h"
 
 
 /* Renders builtin:cornell small with `filter` and the extra args (NULL-terminated, up to 6)
@@ -281,6 +284,39 @@ static void test_denoise(void **state)
     path_in(f, "never.png", path, sizeof path);
     EXPECT(&p, !file_exists(path), "--denoise without OIDN wrote an image");
     proc_free(&p);
+    {
+        /* RS_OIDN_LIBRARY naming a FIFO (dlopen blocked for ever) or a library cut short (the
+         * loader died of SIGBUS): one line each, before any render (issue 39) */
+        char fifo[256], cut[256], buf[65536];
+        FILE *in = fopen(RS_FAKE_OIDN, "rb"), *out;
+        size_t got;
+        path_in(f, "oidn.fifo", fifo, sizeof fifo);
+        path_in(f, "libcut.so.2", cut, sizeof cut);
+        assert_int_equal(mkfifo(fifo, 0600), 0);
+        setenv("RS_OIDN_LIBRARY", fifo, 1);
+        run_expect(f, missing, 1, &p);
+        EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "oidn.fifo") &&
+                       strstr(p.err.data, "regular file"),
+               "RS_OIDN_LIBRARY naming a FIFO: %s", p.err.data);
+        proc_free(&p);
+        assert_non_null(in);
+        got = fread(buf, 1, sizeof buf, in);
+        fclose(in);
+        assert_true(got > 4096);
+        out = fopen(cut, "wb");
+        assert_non_null(out);
+        fwrite(buf, 1, got / 2, out); /* its headers whole, its segments and tables cut */
+        fclose(out);
+        setenv("RS_OIDN_LIBRARY", cut, 1);
+        run_expect(f, missing, 1, &p);
+        unsetenv("RS_OIDN_LIBRARY");
+        EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "libcut.so.2") &&
+                       strstr(p.err.data, "cut short"),
+               "RS_OIDN_LIBRARY naming a library cut short: %s", p.err.data);
+        proc_free(&p);
+        unlink(fifo);
+        unlink(cut);
+    }
     run(&p, f->dir, DEFAULT_TIMEOUT_S, den);
     if (exited_with(&p, 1) && strstr(p.err.data, "raystream: --denoise: ")) {
         printf("  skipped: %s", p.err.data); /* no OIDN here, or a sanitizer build */
@@ -363,6 +399,29 @@ static void test_denoise(void **state)
     }
 }
 
+/* $OCIO naming a FIFO: one line, not a hang (issue 39: OpenColorIO's reader blocked for ever). */
+static void test_ocio_fifo(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "--view", "Foo", "-q", "-o", "never.png", NULL};
+    char fifo[256];
+    proc p;
+    if (!rs_view_ocio_available()) {
+        printf("  skipped: this build's OpenImageIO has no OpenColorIO\n");
+        skip();
+    }
+    path_in(f, "config.fifo", fifo, sizeof fifo);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    setenv("OCIO", fifo, 1);
+    run_expect(f, args, 2, &p);
+    unsetenv("OCIO");
+    EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "config.fifo") &&
+                   strstr(p.err.data, "not a regular file"),
+           "$OCIO naming a FIFO: %s", p.err.data);
+    proc_free(&p);
+    unlink(fifo);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -371,6 +430,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_background_and_gltf_default, setup, teardown),
         cmocka_unit_test_setup_teardown(test_sky_options_checked, setup, teardown),
         cmocka_unit_test_setup_teardown(test_denoise, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_ocio_fifo, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
