@@ -399,6 +399,53 @@ static void test_denoise(void **state)
     }
 }
 
+/* A corrupt PNG texture of a glTF file, beside it or as a data: URI: one line of ours, no
+ * line of libpng's own (issue 39 saw a second one; not reproduced since, kept as a guard). */
+static void test_corrupt_texture_one_line(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const unsigned char bad_png[] = {
+        0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0, 0, 0, 16,
+        0,    0,   0,   16,  8,     2,     0,    0,    0, 0x90, 0x91, 0x68, 0x36, 0, 0, 0, 5,
+        'I',  'D', 'A', 'T', 'x',   'x',   'x',  'x',  'x'};
+    static const char *const args[] = {"render", "bad.gltf", "--spp", "1", "--width", "16",
+                                       "--height", "16", "-q", "-o", "never.png", NULL};
+    static const char k_uri[] = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAABCAIAAAB7QOjdAAAADUlEQVR4nGP4zwAE/wEHAAH/4iOeWQAAAABJRU5ErkJggg==";
+    static const char k_bad64[] = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAABAAAAAQCAIAAACQkWg2AAAABUlEQVR4eHh4eA==";
+    char *text, *at, path[256], *doc;
+    size_t n;
+    FILE *in = fopen(RS_SOURCE_DIR "/tests/data/texture_transform.gltf", "rb"), *out;
+    int k;
+    proc p;
+    assert_non_null(in);
+    text = (char *)calloc(1, 16384);
+    doc = (char *)calloc(1, 16384);
+    assert_true(text && doc);
+    n = fread(text, 1, 16383, in);
+    fclose(in);
+    assert_true(n > 0);
+    at = strstr(text, k_uri);
+    assert_non_null(at);
+    path_in(f, "bad.png", path, sizeof path);
+    out = fopen(path, "wb");
+    assert_non_null(out);
+    fwrite(bad_png, 1, sizeof bad_png, out);
+    fclose(out);
+    for (k = 0; k < 2; ++k) {
+        snprintf(doc, 16384, "%.*s%s%s", (int)(at - text), text, k == 0 ? "bad.png" : k_bad64,
+                 at + strlen(k_uri));
+        write_in(f, "bad.gltf", doc);
+        run_expect(f, args, 1, &p);
+        EXPECT(&p, one_line(&p.err) && strstr(p.err.data, "bad.gltf") &&
+                       strstr(p.err.data, "IDAT"),
+               "a corrupt PNG texture (%s) is not one line: %s", k == 0 ? "a file" : "data: URI",
+               p.err.data);
+        proc_free(&p);
+    }
+    free(text);
+    free(doc);
+}
+
 /* $OCIO naming a FIFO: one line, not a hang (issue 39: OpenColorIO's reader blocked for ever). */
 static void test_ocio_fifo(void **state)
 {
@@ -431,6 +478,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_sky_options_checked, setup, teardown),
         cmocka_unit_test_setup_teardown(test_denoise, setup, teardown),
         cmocka_unit_test_setup_teardown(test_ocio_fifo, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_corrupt_texture_one_line, setup, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
 }
