@@ -176,6 +176,10 @@ int rs_run_load_scene(const rs_cli_options *o, render_run *r)
     load_args a;
     a.o = o;
     a.r = r;
+    /* only what this render reads: the light BVH for --light-sampler bvh, the mip pyramids for
+     * trilinear textures (a large scene or texture spent gigabytes on them otherwise) */
+    rs_scene_set_extras(o->light_sampler == RS_LIGHT_SAMPLER_BVH,
+                        o->texture_filter == RS_TEXTURE_TRILINEAR);
     return rs_load_watch_run(o->mesh ? o->mesh : o->scene, load_and_light, &a);
 }
 

@@ -2,8 +2,11 @@
 #include "core/alloc.h"
 
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 static atomic_long g_fail_after = -1;
 static rs_alloc_observer g_observer; /* a test hook: set while single-threaded (alloc.h) */
@@ -76,3 +79,25 @@ void rs_alloc_set_observer(rs_alloc_observer fn, void *user)
 }
 
 void rs_alloc_fail_after(long n) { atomic_store(&g_fail_after, n < 0 ? -1 : n); }
+
+uint64_t rs_memory_budget(void)
+{
+    struct rlimit rl;
+    uint64_t budget = 0;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0)
+        budget = (uint64_t)pages * (uint64_t)page;
+    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+        unsigned long long size = 0;
+        uint64_t left = (uint64_t)rl.rlim_cur;
+        FILE *f = fopen("/proc/self/statm", "r"); /* pages mapped now */
+        if (f) {
+            if (fscanf(f, "%llu", &size) == 1 && page > 0)
+                left = size * (uint64_t)page < left ? left - size * (uint64_t)page : 0;
+            fclose(f);
+        }
+        if (budget == 0 || left < budget)
+            budget = left;
+    }
+    return budget;
+}

@@ -28,6 +28,10 @@ typedef void (*rs_alloc_observer)(void *user, void *p, size_t bytes);
 void rs_alloc_set_observer(rs_alloc_observer fn, void *user);
 /* Overflow-checked a * b; returns 0 and leaves *out alone on overflow. */
 int rs_mul_size(size_t a, size_t b, size_t *out);
+/* Bytes this process may still allocate, for checks before a large allocation whose size is
+ * known from a small input (an image's header): the address-space limit (ulimit -v) less what
+ * is mapped now, at most the machine's physical memory; 0 when neither can be read. */
+uint64_t rs_memory_budget(void);
 #ifdef __cplusplus
 }
 #endif

@@ -361,8 +361,21 @@ rs_status rs_scene_build_light_bvh(rs_scene *s)
     s->light_trail = NULL;
     s->n_light_nodes = 0;
     s->light_bvh_mass = 0.0f;
+    s->light_bvh_built = 1;
     if (s->n_lights == 0)
         return RS_OK;
+    {
+        /* bounded before anything is allocated: a small file can hold millions of emitters */
+        uint64_t need = (uint64_t)s->n_lights *
+                        (2 * sizeof(rec) + 2 * sizeof(uint64_t) + 2 * sizeof(rs_light_node));
+        uint64_t budget = rs_memory_budget();
+        if (budget && need > budget)
+            return rs_error_set(RS_ERR_NOMEM,
+                                "the light BVH over %u lights takes %.0f MB, more than the %.0f "
+                                "MB this process may use (--light-sampler power needs none)",
+                                s->n_lights, (double)need / 1048576.0,
+                                (double)budget / 1048576.0);
+    }
     memset(&b, 0, sizeof b);
     b.recs = (rec *)rs_alloc(s->n_lights, sizeof *b.recs);
     b.tmp = (rec *)rs_alloc(s->n_lights, sizeof *b.tmp);

@@ -653,6 +653,16 @@ static rs_status build_pyramid(rs_image *im)
     return RS_OK;
 }
 
+static struct {
+    int light_bvh, pyramids;
+} g_extras = {1, 1};
+
+void rs_scene_set_extras(int light_bvh, int pyramids)
+{
+    g_extras.light_bvh = light_bvh != 0;
+    g_extras.pyramids = pyramids != 0;
+}
+
 /* Pyramids for every image an image texture uses (an image used only as the environment map
  * keeps one level: shading/envmap.h samples its texels).  A build without OpenImageIO has no
  * resampler: its images keep one level, and their lookups stay bilinear. */
@@ -660,7 +670,7 @@ static rs_status build_pyramids(rs_scene *s)
 {
     uint32_t i;
     rs_status st;
-    if (!rs_image_can_downsample())
+    if (!rs_image_can_downsample() || !g_extras.pyramids)
         return RS_OK;
     for (i = 0; i < s->n_textures; ++i)
         if (s->textures[i].type == RS_TEX_IMAGE && s->textures[i].image < s->n_images &&
@@ -865,7 +875,11 @@ rs_status rs_scene_finalize(rs_scene *s)
                        ? s->env_pick + (1.0f - s->env_pick) * s->light_cdf[s->n_area_lights]
                        : 1.0f;
     {
-        rs_status st = rs_scene_build_light_bvh(s); /* --light-sampler bvh (scenes/light_bvh.h) */
+        /* --light-sampler bvh (scenes/light_bvh.h), where the render may use it */
+        rs_status st = RS_OK;
+        s->light_bvh_built = 0;
+        if (g_extras.light_bvh)
+            st = rs_scene_build_light_bvh(s);
         if (st != RS_OK)
             return st;
     }

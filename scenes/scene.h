@@ -262,6 +262,7 @@ typedef struct rs_scene {
                                    child at depth k) under a leading 1 bit; 0: not in the BVH */
     float light_bvh_mass;       /* the BVH's lights' share of the lights' power (the rest:
                                    directional lights, picked by power) */
+    int light_bvh_built;        /* rs_scene_build_light_bvh ran (rs_scene_set_extras) */
     float area_mass;        /* the probability that light sampling picks the map or an emitter
                                (1 without punctual lights) */
     int32_t *prim_light; /* per global primitive: index into lights, or -1 */
@@ -574,6 +575,14 @@ typedef enum rs_scene_part {
 /* Checks the scene and builds its light tables.  RS_ERR_ARG naming the part (and bad_part,
  * bad_index saying which) for a scene outside what the renderer holds. */
 rs_status rs_scene_finalize(rs_scene *s);
+
+/* What rs_scene_finalize builds that only some renders read: the light BVH (--light-sampler
+ * bvh) and the image textures' mip pyramids (trilinear lookups, the default texture filter).
+ * Both by default; the CLI leaves out what its render will not read (issue 39: a scene of 10^7
+ * emitters spent 2.2 GB on a light BVH a power-sampled render never reads, a 16384^2 texture
+ * its pyramid under --texture-filter bilinear).  Process-wide: set before scenes are loaded.
+ * Without them, a render that asks for them is refused by rs_render_constants. */
+void rs_scene_set_extras(int light_bvh, int pyramids);
 
 /* A copy of a finalized scene's arrays in memory that `ops` allocates and fills: the host's, or
  * a CUDA device's for the megakernel (scheduler/device_copy.h builds both), whose shading code

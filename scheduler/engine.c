@@ -41,6 +41,10 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
         return rs_error_set(RS_ERR_ARG,
                             "the film already holds %llu samples, more than %ux%u at %u spp",
                             (unsigned long long)st->path_begin, st->width, st->height, st->spp);
+    if (st->light_sampler == RS_LIGHT_SAMPLER_BVH && scene->n_lights > 0 &&
+        !scene->light_bvh_built)
+        return rs_error_set(RS_ERR_ARG, "--light-sampler bvh: the scene was loaded without its "
+                                        "light BVH (rs_scene_set_extras)");
     memset(it, 0, sizeof *it);
     it->scene = scene;
     it->camera = rs_camera_make(scene->camera.from, scene->camera.at, scene->camera.up,

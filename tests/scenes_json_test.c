@@ -17,6 +17,8 @@
 #include <fcntl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <sys/resource.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -339,6 +341,62 @@ static void test_rgba_not_premultiplied(void **state)
     assert_non_null(alpha);
     assert_true(fabsf(alpha[0] - 128.0f / 255.0f) < 1e-6f);
     rs_free(alpha);
+}
+
+/* An image whose decoded floats exceed what the process may allocate is refused from its
+ * header, by one line naming it and the sizes, before anything is allocated (issue 39: a 0.8 MB
+ * PNG of 16384^2 took 3.3 GB under a 4 GB limit: a whole copy of its channels beside the
+ * result, now read a strip of rows at a time).  A child process under an address-space limit
+ * 30 MB above what it has mapped reads a 2048^2 PNG (48 MB of floats); the same image reads in
+ * the parent, unlimited, bit for bit as written. */
+static void test_image_memory_bound(void **state)
+{
+    char dir[] = "/tmp/rs_mem_XXXXXX", png[256];
+    const uint32_t n = 2048;
+    float *rgb = (float *)malloc((size_t)n * n * 3 * sizeof(float)), *back = NULL;
+    uint32_t w, h;
+    size_t i;
+    pid_t pid;
+    int status = 0;
+    (void)state;
+    assert_non_null(rgb);
+    for (i = 0; i < (size_t)n * n * 3; ++i)
+        rgb[i] = (float)((i * 2654435761u) >> 24) / 255.0f;
+    assert_non_null(mkdtemp(dir));
+    snprintf(png, sizeof png, "%s/big.png", dir);
+    assert_int_equal(rs_image_write(png, n, n, rgb), RS_OK);
+    free(rgb);
+    fflush(NULL);
+    pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        struct rlimit rl;
+        unsigned long long pages = 0;
+        FILE *f = fopen("/proc/self/statm", "r");
+        float *got = NULL;
+        rs_status st;
+        if (!f || fscanf(f, "%llu", &pages) != 1)
+            _exit(3);
+        fclose(f);
+        rl.rlim_cur = rl.rlim_max = pages * (unsigned long long)sysconf(_SC_PAGESIZE) + (30u << 20);
+        if (setrlimit(RLIMIT_AS, &rl) != 0)
+            _exit(4);
+        st = rs_image_read(png, &w, &h, &got);
+        fprintf(stderr, "under the limit: %s\n", rs_error_message());
+        _exit(st == RS_ERR_NOMEM && strstr(rs_error_message(), "big.png") &&
+                      strstr(rs_error_message(), "2048x2048") &&
+                      strstr(rs_error_message(), "as floats, more than")
+                  ? 0
+                  : 1);
+    }
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+    assert_int_equal(rs_image_read(png, &w, &h, &back), RS_OK);
+    assert_true(w == n && h == n);
+    rs_free(back);
+    remove(png);
+    rmdir(dir);
 }
 
 /* A spot light's documented widest cone, outer 90 degrees, loads (issue 39: cosf of 90 degrees
@@ -787,6 +845,7 @@ int main(void)
         cmocka_unit_test(test_pfm_round_trip),
         cmocka_unit_test(test_spot_cone_90),
         cmocka_unit_test(test_rgba_not_premultiplied),
+        cmocka_unit_test(test_image_memory_bound),
         cmocka_unit_test(test_mutations_never_crash),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

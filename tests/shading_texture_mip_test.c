@@ -15,6 +15,7 @@
 #include <cmocka.h>
 
 #include "render_util.h"
+#include "scenes/builtin.h"
 #include "scenes/gltf.h"
 #include "shading/path.h"
 
@@ -531,6 +532,48 @@ static void test_khr_texture_transform(void **state)
     rs_scene_destroy(s);
 }
 
+/* rs_scene_set_extras: without pyramids (the CLI under --texture-filter bilinear) a texture's
+ * image keeps its one level, with them (the default) it has its pyramid; without the light BVH
+ * (--light-sampler power) none is built, and a render asking for it is refused (issue 39: both
+ * were built for every render, gigabytes for a large texture or 10^7 emitters). */
+static void test_extras_only_where_read(void **state)
+{
+    char path[4096];
+    const char *src = __FILE__, *slash = strrchr(src, '/');
+    rs_scene *s = NULL, *lit = NULL;
+    rs_render_settings st;
+    rs_render_consts it;
+    (void)state;
+    snprintf(path, sizeof path, "%.*s/data/texture_transform.gltf", slash ? (int)(slash - src) : 1,
+             slash ? src : ".");
+    rs_scene_set_extras(0, 0);
+    assert_int_equal(rs_scene_load_gltf(path, NULL, &s), RS_OK);
+    assert_int_equal(rs_builtin_create("many-lights", &lit), RS_OK);
+    rs_scene_set_extras(1, 1);
+    assert_true(s->images[gltf_texture(s, 0)->image].levels == 1);
+    assert_true(lit->n_lights > 100 && !lit->light_bvh_built && lit->light_nodes == NULL);
+    memset(&st, 0, sizeof st);
+    st.width = st.height = 8;
+    st.spp = 1;
+    st.max_depth = 4;
+    st.light_sampler = RS_LIGHT_SAMPLER_BVH;
+    rs_error_clear();
+    assert_int_not_equal(rs_render_constants(lit, &st, &it), RS_OK);
+    assert_non_null(strstr(rs_error_message(), "without its light BVH"));
+    rs_error_clear();
+    st.light_sampler = RS_LIGHT_SAMPLER_POWER;
+    assert_int_equal(rs_render_constants(lit, &st, &it), RS_OK);
+    rs_scene_destroy(s);
+    rs_scene_destroy(lit);
+    /* the defaults: both */
+    assert_int_equal(rs_scene_load_gltf(path, NULL, &s), RS_OK);
+    assert_int_equal(rs_builtin_create("many-lights", &lit), RS_OK);
+    assert_true(s->images[gltf_texture(s, 0)->image].levels > 1);
+    assert_true(lit->light_bvh_built && lit->light_nodes != NULL);
+    rs_scene_destroy(s);
+    rs_scene_destroy(lit);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -539,6 +582,7 @@ int main(void)
         cmocka_unit_test(test_lod_monotone_in_distance),
         cmocka_unit_test(test_ground_plane_converges),
         cmocka_unit_test(test_khr_texture_transform),
+        cmocka_unit_test(test_extras_only_where_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
