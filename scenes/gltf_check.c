@@ -499,6 +499,16 @@ static void append_name(char *list, size_t n, const char *name)
         snprintf(list + used, n - used, ", ...");
 }
 
+/* Whether `name` is one of names[0..n). */
+static int name_in(const char *name, const char *const *names, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; ++k)
+        if (strcmp(name, names[k]) == 0)
+            return 1;
+    return 0;
+}
+
 rs_status rs_gltf_read_ext(const char *path, int glb, rs_gltf_ext *out)
 {
     static const char *const known[] = {RS_GLTF_READ_EXTENSIONS};
@@ -513,12 +523,10 @@ rs_status rs_gltf_read_ext(const char *path, int glb, rs_gltf_ext *out)
     used = cJSON_GetObjectItemCaseSensitive(root, "extensionsUsed");
     if (cJSON_IsArray(used))
         for (u = used->child; u; u = u->next) {
-            size_t k;
-            int ours = 0;
+            int ours;
             if (!cJSON_IsString(u))
                 continue;
-            for (k = 0; k < sizeof known / sizeof *known; ++k)
-                ours |= strcmp(u->valuestring, known[k]) == 0;
+            ours = name_in(u->valuestring, known, sizeof known / sizeof *known);
             append_name(ours ? out->used : out->unread, ours ? sizeof out->used
                                                              : sizeof out->unread,
                         u->valuestring);
@@ -530,15 +538,10 @@ rs_status rs_gltf_read_ext(const char *path, int glb, rs_gltf_ext *out)
         for (u = used->child; u && st == RS_OK; u = u->next) {
             static const char *const decoded[] = {"KHR_mesh_quantization",
                                                   "KHR_draco_mesh_compression"};
-            size_t k;
-            int ours = 0;
             if (!cJSON_IsString(u))
                 continue;
-            for (k = 0; k < sizeof known / sizeof *known; ++k)
-                ours |= strcmp(u->valuestring, known[k]) == 0;
-            for (k = 0; k < sizeof decoded / sizeof *decoded; ++k)
-                ours |= strcmp(u->valuestring, decoded[k]) == 0;
-            if (!ours)
+            if (!name_in(u->valuestring, known, sizeof known / sizeof *known) &&
+                !name_in(u->valuestring, decoded, sizeof decoded / sizeof *decoded))
                 st = rs_error_set(RS_ERR_ARG,
                                   "%s: requires the extension %.80s (extensionsRequired), which "
                                   "raystream does not read; a file that requires one must not "
