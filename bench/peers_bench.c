@@ -49,6 +49,7 @@
 #include "core/parallel.h"
 #include "scenes/builtin.h"
 #include "scenes/scene_json.h"
+#include "scenes/scene_export.h"
 #include "machine.h"
 #include "render_util.h"
 
@@ -57,7 +58,7 @@
     "  --quick             raystream only, small, one thread (the test suite's smoke run)\n"    \
     "  --scenes LIST       cornell,interior (default both; interior needs ../shared/models)\n"  \
     "  --threads LIST      thread counts, each pinned to the first cores (default 1,2)\n"      \
-    "  --size N            image width and height (default 256)\n"                             \
+    "  --size N            image width and height (default 256; WxH with --export)\n"         \
     "  --levels A,B,...    sample counts measured (default 4,16,64,256; interior 4,16,64)\n"   \
     "  --ref-spp N         samples of each converged reference (default 1024)\n"               \
     "  --runs N            interleaved rounds, the median is kept (default 3)\n"              \
@@ -66,6 +67,8 @@
     "  --cycles-venv DIR   Cycles (bpy) venv (default $RS_CYCLES_VENV or the venv + -cycles)\n" \
     "  --no-peers          raystream's rows only\n"                                             \
     "  --keep DIR          keep the exported scenes and images in DIR\n"                        \
+    "  --export DIR        only write each scene for the peers and for raystream into DIR/NAME\n" \
+    "                      (scene.xml + OBJs, scene.json; --size, --depth apply), then stop\n"   \
     "Install the peers with: sh scripts/install-peers.sh\n"
 #define MAX_LEVELS 12
 #define MAX_RUNS   9
@@ -925,12 +928,53 @@ static int race(rs_scene *scene, const char *title, const options *o)
     return 1;
 }
 
+/* --export DIR: each scene of `which` as the peers get it (DIR/NAME/scene.xml and its OBJs,
+ * peers.json) and as raystream's own scene file (DIR/NAME/scene.json: the same scene, for
+ * `raystream render` on another device: bench/gpu_bench.py races Mitsuba's cuda_ad_rgb with
+ * it), at --size and each scene's depth; prints "NAME DIR/NAME DEPTH" a scene.  0 or 1. */
+static int export_scenes(const char *dir, const char *which, const options *o)
+{
+    static const char *const names[2] = {"cornell", "interior"};
+    int k;
+    if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "%s: cannot make %s: %s\n", prog, dir, strerror(errno));
+        return 1;
+    }
+    for (k = 0; k < 2; ++k) {
+        rs_scene *scene = NULL;
+        char xml[700], json[700], own[700];
+        if (!strstr(which, names[k]))
+            continue;
+        if (k == 0 && rs_builtin_create("cornell", &scene) != RS_OK) {
+            fprintf(stderr, "%s: %s\n", prog, rs_error_message());
+            return 1;
+        }
+        if (k == 1 && !(scene = make_interior()))
+            continue; /* said why */
+        DEPTH = o->depth ? o->depth : k == 0 ? 50 : 16;
+        snprintf(tmp_dir, sizeof tmp_dir, "%s/%s", dir, names[k]);
+        snprintf(xml, sizeof xml, "%s/scene.xml", tmp_dir);
+        snprintf(json, sizeof json, "%s/peers.json", tmp_dir);
+        snprintf(own, sizeof own, "%s/scene.json", tmp_dir);
+        if ((mkdir(tmp_dir, 0777) != 0 && errno != EEXIST) || !export_mitsuba(scene, xml, json) ||
+            rs_scene_export_json(scene, own) != RS_OK) {
+            fprintf(stderr, "%s: exporting %s into %s failed: %s\n", prog, names[k], tmp_dir,
+                    errno ? strerror(errno) : rs_error_message());
+            rs_scene_destroy(scene);
+            return 1;
+        }
+        printf("%s %s %u\n", names[k], tmp_dir, DEPTH);
+        rs_scene_destroy(scene);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     options o;
-    const char *keep = NULL, *which = "cornell,interior";
+    const char *keep = NULL, *which = "cornell,interior", *export_dir = NULL;
     char default_venv[1024], default_cycles[1100];
-    uint32_t size = 256;
+    uint32_t size = 256, height = 0;
     int i, ok = 1;
     memset(&o, 0, sizeof o);
     o.levels[0] = 4, o.levels[1] = 16, o.levels[2] = 64, o.levels[3] = 256;
@@ -947,7 +991,11 @@ int main(int argc, char **argv)
         if (strcmp(argv[i], "--quick") == 0) {
             o.quick = 1;
         } else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
-            size = (uint32_t)atoi(argv[++i]);
+            /* N, or WxH (with --export only: the races' block test wants a square) */
+            unsigned a = 0, b = 0;
+            int got = sscanf(argv[++i], "%ux%u", &a, &b);
+            size = a;
+            height = got == 2 ? b : a;
         } else if (strcmp(argv[i], "--levels") == 0 && i + 1 < argc) {
             if (!parse_levels(argv[++i], o.levels, &o.n_levels)) {
                 fprintf(stderr, "%s: --levels takes two or more increasing counts: 4,16,64\n",
@@ -976,6 +1024,8 @@ int main(int argc, char **argv)
             o.peers = 0;
         } else if (strcmp(argv[i], "--keep") == 0 && i + 1 < argc) {
             keep = argv[++i];
+        } else if (strcmp(argv[i], "--export") == 0 && i + 1 < argc) {
+            export_dir = argv[++i];
         } else if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
             fputs(USAGE, stdout);
             return 0;
@@ -1000,12 +1050,23 @@ int main(int argc, char **argv)
         o.threads[0] = 1, o.n_threads = 1;
     }
     W = H = size;
-    if (W < BLOCK || W > 4096 || o.ref_spp < 2 || o.runs < 1 || o.runs > MAX_RUNS) {
+    if (height && height != size) {
+        if (!export_dir) {
+            fprintf(stderr, "%s: --size WxH goes with --export only (the races are square)\n",
+                    prog);
+            return 2;
+        }
+        H = height;
+    }
+    if (W < BLOCK || W > 4096 || H < BLOCK || H > 4096 || o.ref_spp < 2 || o.runs < 1 ||
+        o.runs > MAX_RUNS) {
         fprintf(stderr, "%s: --size %u..4096, --ref-spp >= 2, --runs 1..%d\n", prog, BLOCK,
                 MAX_RUNS);
         return 2;
     }
 
+    if (export_dir)
+        return export_scenes(export_dir, which, &o);
     if (keep) {
         if (mkdir(keep, 0777) != 0 && errno != EEXIST) {
             fprintf(stderr, "%s: cannot make %s: %s\n", prog, keep, strerror(errno));

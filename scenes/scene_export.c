@@ -22,13 +22,15 @@ static void vec(FILE *f, rs_vec3 v)
     fputc(']', f);
 }
 
-/* "DIR/STEM-image-N.exr" for image i of the file at `path`, and its name relative to the file. */
+/* "DIR/STEM-image-N.exr" for image i of the file at `path`, and its name relative to the file
+ * (.pfm where the build has no OpenImageIO: both keep the floats exactly). */
 static void image_name(const char *path, uint32_t i, char *full, size_t n, char *rel, size_t rn)
 {
     const char *slash = strrchr(path, '/'), *base = slash ? slash + 1 : path;
     const char *dot = strrchr(base, '.');
     int stem = dot ? (int)(dot - base) : (int)strlen(base);
-    snprintf(rel, rn, "%.*s-image-%u.exr", stem, base, i);
+    snprintf(rel, rn, "%.*s-image-%u.%s", stem, base, i,
+             strncmp(rs_image_library_version(), "none", 4) == 0 ? "pfm" : "exr");
     if (slash)
         snprintf(full, n, "%.*s/%s", (int)(slash - path), path, rel);
     else

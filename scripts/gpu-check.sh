@@ -9,7 +9,8 @@
 #                                       cJSON, Assimp and its libraries, pkgconf) into .gpu-debs/
 #                                       and the living room's meshes and sky (no textures) from
 #                                       ../shared/models into .gpu-models/, both git-ignored, for
-#                                       the run to carry
+#                                       the run to carry; Mitsuba 3's wheels for the bench into
+#                                       .gpu-peers/ (carry it too)
 #   sh scripts/gpu-check.sh [--bench [--quick]] [--no-suite]
 #                                       there (carry .gpu-debs and .gpu-models): unpack the .debs
 #                                       into a prefix (never into /) that pkgconf reads through
@@ -30,7 +31,8 @@
 #        cpu image byte for byte (.pfm); then builtin:many-lights with the light BVH and
 #        scripts/make-gltf-samples.py's spheres (every glTF material extension; Assimp carried)
 #        on cpu, gpu and the GPU megakernel, byte for byte too; --timeline pictures;
-#     4. with --bench: bench/gpu_bench.py (the Cornell box 512x512 and the living room, untextured:
+#     4. with --bench: bench/gpu_bench.py (the Cornell box 512x512 and the living room's interior,
+#        Mitsuba 3 cuda_ad_rgb beside raystream where .gpu-peers is carried;
 #        samples/s and time to RMSE 0.01 for the CPU, the GPU wavefront, CPU + GPU, the GPU with
 #        host shading and the megakernel; docs/gpu.md);
 #     5. compute-sanitizer --tool memcheck over gpu_trace_test's gpucheck tests (the trace kernel,
@@ -62,6 +64,41 @@ exclude() {
         echo "/$1/" >>"$info/exclude"
     fi
 }
+# Mitsuba 3 for the bench's peer rows (issue 38): the wheels of the lent machine's Python 3.12,
+# only the cuda_ad_rgb and scalar_rgb variants and the plugins the bench's scenes use, without
+# data/srgb.coeff (spectral upsampling, unused by the RGB variants), packed with xz -9 into
+# .gpu-peers/mitsuba.tar.xz (about 20 MB), unpacked there onto PYTHONPATH.
+MI_PLUGINS="path perspective independent ldsampler hdrfilm box obj twosided diffuse area constant
+srgb uniform d65 regular merge"
+fetch_mitsuba() {
+    rm -rf .gpu-peers
+    mkdir -p .gpu-peers/whl .gpu-peers/site
+    if ! python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.12 \
+        --platform manylinux_2_28_x86_64 mitsuba==3.9.1 drjit==1.5.0 -d .gpu-peers/whl; then
+        echo "gpu-check: the Mitsuba wheels could not be fetched: the bench's Mitsuba rows are left out"
+        rm -rf .gpu-peers
+        return 0
+    fi
+    python3 -c 'import glob, sys, zipfile
+for w in glob.glob(".gpu-peers/whl/*.whl"):
+    zipfile.ZipFile(w).extractall(".gpu-peers/site")'
+    (
+        cd .gpu-peers/site/mitsuba
+        for f in *_ad_*.so scalar_*.so; do
+            case $f in cuda_ad_rgb.* | scalar_rgb.*) ;; *) rm -f "$f" ;; esac
+        done
+        for f in plugins/*.so; do
+            keep=
+            for p in $MI_PLUGINS; do [ "$f" = "plugins/$p.so" ] && keep=1; done
+            [ -n "$keep" ] || rm -f "$f"
+        done
+        rm -rf data/srgb.coeff include cmake ./*.pyi
+    )
+    tar -C .gpu-peers -cf - site | xz -9 -T0 >.gpu-peers/mitsuba.tar.xz
+    rm -rf .gpu-peers/whl .gpu-peers/site
+    exclude .gpu-peers
+    echo "gpu-check: .gpu-peers/mitsuba.tar.xz ($(du -h .gpu-peers/mitsuba.tar.xz | cut -f1)) ready: carry \".gpu-peers\" too"
+}
 if [ "${1:-}" = "--fetch" ]; then
     mkdir -p .gpu-debs
     # shellcheck disable=SC2086 # the list is meant to split
@@ -71,14 +108,24 @@ if [ "${1:-}" = "--fetch" ]; then
     if [ -d "$models/living-room" ]; then
         rm -rf .gpu-models
         mkdir -p .gpu-models/living-room
-        cp -r "$models/living-room/meshes" "$models/living-room/sky.pfm" \
-            "$models/living-room/living-room.raystream.json" .gpu-models/living-room/
+        cp -r "$models/living-room/meshes" "$models/living-room/sky.pfm" .gpu-models/living-room/
+        # without its textures (PNG: the PFM-only build there reads none), albedo 0.5 instead
+        python3 -c 'import json, sys
+s = json.load(open(sys.argv[1]))
+s.pop("textures", None)
+for m in s["materials"].values():
+    if "texture" in m:
+        del m["texture"]
+        m["albedo"] = [0.5, 0.5, 0.5]
+json.dump(s, open(sys.argv[2], "w"))' "$models/living-room/living-room.raystream.json" \
+            .gpu-models/living-room/living-room.raystream.json
         exclude .gpu-models
         echo "gpu-check: .gpu-debs and .gpu-models ready; run with carry [\".gpu-debs\", \".gpu-models\"]"
     else
         echo "gpu-check: $models/living-room is absent: the bench will render the Cornell box only"
         echo "gpu-check: .gpu-debs ready; run with carry [\".gpu-debs\"]"
     fi
+    fetch_mitsuba
     exit 0
 fi
 bench=
@@ -245,7 +292,14 @@ if [ -n "$bench" ]; then
     [ -d "$models" ] || models=../shared/models
     rc=0
     # shellcheck disable=SC2086
-    python3 bench/gpu_bench.py --raystream build-gpu/raystream --models "$models" \
+    mi=
+    if [ -f .gpu-peers/mitsuba.tar.xz ]; then # Mitsuba 3's wheels, carried (fetch_mitsuba)
+        mkdir -p /tmp/gpu-check-mitsuba
+        xz -dc .gpu-peers/mitsuba.tar.xz | tar -C /tmp/gpu-check-mitsuba -xf - && mi=/tmp/gpu-check-mitsuba/site
+    fi
+    # shellcheck disable=SC2086
+    PYTHONPATH=${mi:+$mi:}${PYTHONPATH:-} RS_MODELS_DIR=$models \
+        python3 bench/gpu_bench.py --raystream build-gpu/raystream --models "$models" \
         --out "$out/bench" $quick >"$out/gpu_bench.txt" 2>&1 || rc=$?
     if [ $rc = 0 ]; then say "gpu_bench: see gpu_bench.txt"; else failed "gpu_bench (exit $rc): $(tail -2 "$out/gpu_bench.txt")"; fi
     copy_back
