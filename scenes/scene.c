@@ -798,6 +798,13 @@ rs_status rs_scene_finalize(rs_scene *s)
     nl += s->n_punctuals;
     if (nl > 0) {
         double radius = s->n_punctuals ? rs_scene_bound_radius(s) : 1.0;
+        uint64_t need = (uint64_t)nl * (sizeof *s->lights + sizeof *s->light_cdf);
+        uint64_t budget = rs_memory_budget();
+        if (budget && need > budget) /* before the allocation: a small file can copy millions */
+            return rs_error_set(RS_ERR_NOMEM,
+                                "%u lights take %.0f MB of light tables, more than the %.0f MB "
+                                "this process may use",
+                                nl, (double)need / 1048576.0, (double)budget / 1048576.0);
         s->lights = (rs_light *)rs_alloc(nl, sizeof *s->lights);
         s->light_cdf = (float *)rs_alloc(nl + 1, sizeof *s->light_cdf);
         if (!s->lights || !s->light_cdf)
