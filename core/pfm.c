@@ -90,8 +90,8 @@ rs_status rs_pfm_read_channel(const char *path, const char *channel, uint32_t *w
     rs_status st;
     *data = NULL;
     if (!c || !*c)
-        return rs_error_set(RS_ERR_ARG, "%s: no channel %s (a .pfm holds R, G and B only)",
-                            path, channel);
+        return rs_error_set(RS_ERR_ARG, "%s: no channel %s (a .pfm holds R, G and B only)", path,
+                            channel);
     st = rs_pfm_read(path, w, h, &rgb);
     if (st != RS_OK)
         return st;

@@ -17,16 +17,23 @@ static void *g_user;
 
 static int late(void) { return getenv("FAKE_OIDN_LATE") != NULL; }
 
-EXPORT void *oidnNewDevice(int type) { (void)type; return late() ? &g_dummy : NULL; }
+EXPORT void *oidnNewDevice(int type)
+{
+    (void)type;
+    return late() ? &g_dummy : NULL;
+}
 EXPORT void oidnCommitDevice(void *dev) { (void)dev; }
 EXPORT void oidnReleaseDevice(void *dev) { (void)dev; }
 EXPORT void oidnSetDeviceInt(void *dev, const char *name, int value)
 {
     (void)dev, (void)name, (void)value;
 }
-EXPORT int oidnGetDeviceInt(void *dev, const char *name) { (void)dev, (void)name; return 0; }
-EXPORT void oidnSetDeviceErrorFunction(void *dev, void (*fn)(void *, int, const char *),
-                                       void *user)
+EXPORT int oidnGetDeviceInt(void *dev, const char *name)
+{
+    (void)dev, (void)name;
+    return 0;
+}
+EXPORT void oidnSetDeviceErrorFunction(void *dev, void (*fn)(void *, int, const char *), void *user)
 {
     (void)dev;
     g_fn = fn;
