@@ -4,9 +4,9 @@
 #   sh scripts/fuzz.sh [SECONDS] [HARNESS...]   (default: 60 s each, every harness)
 # HARNESS: scene_json, mesh, cli_options.  Each harness starts from its corpus in
 # build-fuzz/corpus/HARNESS (kept between runs, so later runs go deeper), seeded from the inputs
-# already in the repository: tests/data (meshes), scenes/examples and tests/fuzz/seeds (scenes,
-# glTF files with every material extension and texture transform we read,
-# command lines); nothing is copied into the repository.  An input that crashes, hangs (over
+# already in the repository: tests/data (meshes; gltf_*.gltf: every material extension and
+# texture transform we read), scenes/examples and tests/fuzz/seeds (scenes, command lines);
+# nothing is copied into the repository.  An input that crashes, hangs (over
 # -timeout=10 s), leaks or trips a sanitizer is saved as build-fuzz/findings/HARNESS-*; give it a
 # regression test (tests/data or a case in the module's cmocka test) and a fix.
 # Exit status: 0 when no harness found anything, 1 otherwise (every harness still runs).
@@ -47,7 +47,7 @@ found=0
 for h in $harnesses; do
     case "$h" in
     scene_json) seeds="scenes/examples tests/fuzz/seeds/scene_json"; max_len=65536 ;;
-    mesh) seeds="tests/data tests/fuzz/seeds/mesh"; max_len=16384 ;;
+    mesh) seeds="tests/data"; max_len=16384 ;;
     cli_options) seeds="tests/fuzz/seeds/cli_options"; max_len=1024 ;;
     *)
         echo "fuzz.sh: unknown harness '$h' (scene_json, mesh, cli_options)" >&2
