@@ -79,11 +79,7 @@ static size_t stage_layout(char *base, uint32_t cap, rs_ray_soa *rays, rs_hit_so
                            uint8_t **occ)
 {
     size_t off = 0;
-#define RS_CUT(ptr, type, count)                                                                   \
-  do {                                                                                             \
-    (ptr) = base ? (type *)(void *)(base + off) : NULL;                                            \
-    off += ((size_t)(count) * sizeof(type) + 255u) & ~(size_t)255u;                                \
-  } while (0);
+#define RS_CUT(ptr, type, count) RS_CUDA_CUT(base, off, ptr, type, count);
 #define RS_CUT_RAY(type, name) RS_CUT(rays->name, type, cap)
 #define RS_CUT_HIT(type, name) RS_CUT(hits->name, type, cap)
     RS_RAY_FIELDS(RS_CUT_RAY)

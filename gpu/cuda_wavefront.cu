@@ -127,11 +127,7 @@ const void *rs_cuda_wf_entry(int k)
 static size_t slot_layout(char *base, uint32_t cap, rs_cuda_wf_slot *s)
 {
     size_t off = 0;
-#define RS_CUT(ptr, type, count)                                                                   \
-  do {                                                                                             \
-    (ptr) = base ? (type *)(void *)(base + off) : NULL;                                            \
-    off += ((size_t)(count) * sizeof(type) + 255u) & ~(size_t)255u;                                \
-  } while (0);
+#define RS_CUT(ptr, type, count) RS_CUDA_CUT(base, off, ptr, type, count);
 #define RS_CUT_PATH(type, name) RS_CUT(s->paths.name, type, cap)
 #define RS_CUT_Q0(type, name)   RS_CUT(s->queue[0].name, type, cap)
 #define RS_CUT_Q1(type, name)   RS_CUT(s->queue[1].name, type, cap)

@@ -39,6 +39,14 @@
 /* The wavefront's kernels: 0 raygen, 1 trace, 2 shade, 3 resolve, 4 film, 5 the trace kernel
  * for geometry without instances (accel/trace.h rs_trace_one_flat). */
 #define RS_CUDA_WF_ENTRIES 6
+
+/* Cuts `count` elements of `type` for `ptr` at byte `off` of the block at `base` (NULL: only
+ * measures), each array 256-byte aligned: the staging sets' and the wavefront slots' layouts. */
+#define RS_CUDA_CUT(base, off, ptr, type, count)                                                   \
+  do {                                                                                             \
+    (ptr) = (base) ? (type *)(void *)((base) + (off)) : NULL;                                      \
+    (off) += ((size_t)(count) * sizeof(type) + 255u) & ~(size_t)255u;                              \
+  } while (0)
 /* Paths per wave of the wavefront (two in flight): enough to fill an H200 (132 SMs x 2048
  * threads) several times over at every segment but the last few. */
 #define RS_CUDA_WF_WAVE (1u << 21)
