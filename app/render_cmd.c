@@ -269,22 +269,31 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
 {
     int n = make_devices(o, r);
     rs_device *sched_devs[RS_MAX_DEVICES];
-    int i, n_sched = 0;
+    int i, n_sched = 0, host_pdev = 0, trace_only = 0;
     if (n < 0)
         return RS_EXIT_RUNTIME;
-    /* devices that run paths whole (a GPU, or its fallback) run the stream integrator's stages
-     * themselves, shading included, beside the others (the CPU: the stream engine), unless
-     * --shade-on host keeps all shading on the host */
+    /* devices that run paths whole (a GPU, or its fallback; the CPU, each of its threads a wave
+     * of its own) run the stream integrator's stages themselves, shading included, unless
+     * --shade-on host keeps all shading on the host (the devices then only trace).  A device that
+     * can only trace (one wrapped by RS_FAULT) needs the stream engine: the CPU then shades for
+     * it and traces beside it there. */
+    for (i = 0; !o->megakernel && i < n; ++i)
+        trace_only += !r->devs[i]->ops->render_paths;
     for (i = 0; !o->megakernel && i < n; ++i) {
-        if (!o->shade_host && r->devs[i]->ops->render_paths &&
-            r->n_pdev < RS_ENGINE_MAX_PATH_DEVICES)
-            r->pdev[r->n_pdev++] = r->devs[i];
+        rs_device *d = r->devs[i];
+        if (!o->shade_host && d->ops->render_paths && r->n_pdev < RS_ENGINE_MAX_PATH_DEVICES &&
+            !(trace_only && (d->flags & RS_DEVICE_HOST_PATHS)))
+            r->pdev[r->n_pdev++] = d;
         else
-            sched_devs[n_sched++] = r->devs[i];
+            sched_devs[n_sched++] = d;
     }
-    if (r->n_pdev && n_sched && r->threads > 1) {
-        /* each GPU's host thread waits on it with a core of its own */
-        int left = r->threads - r->n_pdev > 0 ? r->threads - r->n_pdev : 1;
+    for (i = 0; i < r->n_pdev; ++i)
+        host_pdev += r->pdev[i]->threads > 0;
+    if (r->n_pdev && (n_sched || host_pdev) && r->n_pdev > host_pdev && r->threads > 1) {
+        /* each GPU's host thread waits on it with a core of its own; the CPU (the stream
+         * engine, or the CPU device's waves) has the rest */
+        int gpus = n_sched ? r->n_pdev : r->n_pdev - host_pdev;
+        int left = r->threads - gpus > 0 ? r->threads - gpus : 1;
         rs_cores_init(&r->cores, left);
         r->st.threads = left;
     }

@@ -83,6 +83,8 @@ typedef struct row {
     /* raystream */
     rs_sampler sampler;
     int megakernel;
+    int shade_host; /* the stream engine shading on the render thread (--shade-on host) instead
+                       of the CPU device's own waves (the default) */
     /* a peer: bench/peers/SCRIPT SCENE VARIANT SAMPLER ... */
     const char *script, *scene_file, *variant, *mi_sampler, *name, *python;
     /* results */
@@ -344,6 +346,7 @@ static float *render_raystream(const rs_scene *scene, const row *r, uint32_t spp
     a.threads = threads;
     a.sampler = r->sampler;
     a.megakernel = r->megakernel;
+    a.wavefront = !r->megakernel && !r->shade_host; /* the CLI's default: the CPU's own waves */
     a.bvh = RS_BVH_SAH;
     a.cli_bvh = 1; /* the renderer's own tree: 8-wide where AVX2 runs */
     a.max_depth = DEPTH;
@@ -764,6 +767,9 @@ static int race(rs_scene *scene, const char *title, const options *o)
     memset(refs, 0, sizeof refs);
     rows[n_rows].label = "raystream stream, sobol (default)";
     rows[n_rows++].sampler = RS_SAMPLER_SOBOL;
+    rows[n_rows].label = "raystream stream --shade-on host, sobol";
+    rows[n_rows].sampler = RS_SAMPLER_SOBOL;
+    rows[n_rows++].shade_host = 1;
     rows[n_rows].label = "raystream megakernel, sobol";
     rows[n_rows].sampler = RS_SAMPLER_SOBOL;
     rows[n_rows++].megakernel = 1;

@@ -73,6 +73,10 @@ static void cpu_destroy(rs_device *d)
 {
     cpu_impl *c = (cpu_impl *)d->impl;
     if (c) {
+        int k;
+        for (k = 0; k < c->n_wave; ++k)
+            rs_wave_buffers_destroy(&c->wave[k]);
+        rs_free(c->wave);
         rs_bvh4_destroy(c->bvh4);
         rs_bvh8_destroy(c->bvh8);
     }
@@ -85,6 +89,7 @@ static const rs_device_ops cpu_ops = {
     .trace = cpu_trace,
     .destroy = cpu_destroy,
     .render_pass = rs_cpu_render_pass, /* host memory, no scene copy: no upload_scene */
+    .render_paths = rs_cpu_render_paths,
 };
 
 rs_status rs_cpu_device_create(int threads, const char *name, rs_device **out)
@@ -122,6 +127,7 @@ rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out
     c->strategy = o->strategy;
     d->ops = &cpu_ops;
     d->impl = c;
+    d->flags = RS_DEVICE_HOST_PATHS;
     d->threads = o->threads < 1 ? 1 : o->threads;
     snprintf(d->name, sizeof d->name, "%s", o->name ? o->name : "cpu");
     *out = d;

@@ -5,6 +5,7 @@
 #include "accel/bvh4.h"
 #include "accel/bvh8.h"
 #include "cpu/cpu_device.h"
+#include "streams/wave.h"
 
 typedef struct cpu_impl {
     rs_geom geom; /* the caller's arrays, borrowed */
@@ -15,10 +16,17 @@ typedef struct cpu_impl {
     rs_cores *cores;
     rs_par_strategy strategy;
     int uploaded;
+    rs_wave_buffers *wave; /* render_paths: one wave's buffers per thread (cpu_paths.c) */
+    int n_wave;
 } cpu_impl;
 
 /* The device's render_pass (cpu/cpu_megakernel.c): the thesis's per-pixel loop. */
 rs_status rs_cpu_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                              rs_path_counts *counts);
+
+/* The device's render_paths (cpu/cpu_paths.c): each thread runs waves of its own through every
+ * stage. */
+rs_status rs_cpu_render_paths(rs_device *d, const rs_paths_job *job, uint64_t p0, uint64_t p1,
+                              uint64_t *done, rs_path_counts *counts);
 
 #endif

@@ -33,6 +33,10 @@ typedef struct rs_device rs_device;
 
 /* Device flags. */
 #define RS_DEVICE_OWN_MEMORY 1u /* traces in memory of its own (a GPU), not on host threads */
+/* Its render_paths runs the host's own stages on host threads (the CPU device): where another
+ * device can only trace, it stays with that one in the stream engine instead (somebody must
+ * shade for it, and it traces too). */
+#define RS_DEVICE_HOST_PATHS 2u
 
 /* One call of the megakernel's pass loop: what render_pass needs besides its sample range. */
 typedef struct rs_pass_job {
@@ -88,7 +92,8 @@ typedef struct rs_device_ops {
      * Stops early, with RS_OK, when job->cancelled says so. */
     rs_status (*render_pass)(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                              rs_path_counts *counts);
-    /* Optional (NULL: the device only traces for the host's stages).  After upload_scene: paths
+    /* Optional (NULL: the device only traces for the host's stages).  After upload_scene (where
+     * the device has one; a host device reads the host scene in place, after upload): paths
      * [p0, p1) of job's plan run whole where the device is (the wavefront: camera rays, both
      * traversals, shading, shadow rays, compaction and the film, each a stage over the device's
      * own path state; per wave only counts cross to the host), in waves of consecutive paths,

@@ -98,7 +98,8 @@ rs_status rs_engine_create_paths(const rs_scene *scene, const rs_render_settings
         return rs_error_set(RS_ERR_ARG, "%d devices that run paths whole: 1 to %d", n,
                             RS_ENGINE_MAX_PATH_DEVICES);
     for (k = 0; k < n; ++k)
-        if (!devs[k] || !devs[k]->ops->render_paths || !devs[k]->ops->upload_scene)
+        if (!devs[k] || !devs[k]->ops->render_paths ||
+            (rs_device_owns_memory(devs[k]) && !devs[k]->ops->upload_scene))
             return rs_error_set(RS_ERR_ARG, "device %s cannot run paths whole (no wavefront)",
                                 devs[k] ? devs[k]->name : "(none)");
     return engine_make(scene, settings, sched, NULL, devs, n, out);

@@ -19,8 +19,10 @@
 #include "core/clock.h"
 #include "scheduler/engine_impl.h"
 
-/* The first call's paths (a GPU's wave), the fewest and the most per call. */
+/* The first call's paths (a GPU's wave; a host device's: a few waves per thread), the fewest and
+ * the most per call. */
 #define RS_PATHS_FIRST_CALL (1ull << 21)
+#define RS_PATHS_FIRST_HOST_CALL (4ull * RS_RENDER_HOST_WAVE)
 #define RS_PATHS_MIN_CALL   (1ull << 16)
 #define RS_PATHS_MAX_CALL   (1ull << 28)
 /* Seconds of work per call once the device's rate is known. */
@@ -92,7 +94,8 @@ rs_status rs_paths_setup(rs_engine *e)
     rs_status st = RS_OK;
     int k;
     for (k = 0; k < e->n_pdev && st == RS_OK; ++k)
-        st = e->pdev[k]->ops->upload_scene(e->pdev[k], e->scene, &e->it);
+        if (e->pdev[k]->ops->upload_scene) /* a host device reads the host scene in place */
+            st = e->pdev[k]->ops->upload_scene(e->pdev[k], e->scene, &e->it);
     if (st == RS_OK && (e->sched || e->n_pdev > 1))
         for (k = 0; k < e->n_pdev && st == RS_OK; ++k)
             st = rs_film_create(e->st.width, e->st.height, &e->pfilm[k]);
@@ -123,7 +126,9 @@ static void pdev_loop(pdev_ctx *p)
     const rs_render_hooks *hooks = c->hooks;
     rs_film *own = c->lock ? e->pfilm[p->k] : c->film;
     rs_paths_job job;
-    uint64_t per = RS_PATHS_FIRST_CALL, lo, n;
+    uint64_t per = rs_device_owns_memory(d) ? RS_PATHS_FIRST_CALL
+                                            : RS_PATHS_FIRST_HOST_CALL * (uint64_t)d->threads,
+             lo, n;
     double ran_s = 0.0, ran_paths = 0.0;
 
     memset(&job, 0, sizeof job);

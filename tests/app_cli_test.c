@@ -1024,16 +1024,22 @@ static int slurp(const char *path, char *buf, size_t cap)
     return 1;
 }
 
-/* --stats and --stats-json time every stage under its name; --timeline draws a lane per device
- * and one for the render thread, for both integrators. */
+/* --stats and --stats-json time every stage under its name (--shade-on host: the stage table);
+ * --timeline draws a lane per device and one for the render thread, for both integrators, and
+ * by default (every device running its paths whole) a lane per device with its calls. */
 static void test_stage_stats_and_timeline(void **state)
 {
     const fixture *f = (const fixture *)*state;
     /* large enough that every stage takes a measurable time (at 24x24 and 4 spp the shadow
      * rays' wait once printed 0.000000 s) */
     static const char *const stream_args[] = {
-        "render",       "--width", "48",         "--spp", "8",  "--devices", "cpu:1,gpu", "--stats",
-        "--stats-json", "st.json", "--timeline", "s.svg", "-o", "s.exr",     NULL};
+        "render",  "--width", "48",         "--spp",   "8",          "--devices", "cpu:1,gpu",
+        "--shade-on", "host", "--stats",    "--stats-json", "st.json", "--timeline", "s.svg",
+        "-o",      "s.exr",   NULL};
+    /* by default each device runs its paths whole: one lane each, spans of whole calls */
+    static const char *const paths_args[] = {
+        "render",  "--width", "48", "--spp", "8", "--devices", "cpu:1,gpu", "--stats",
+        "--timeline", "p.svg", "-o", "p.exr", NULL};
     static const char *const mk_args[] = {
         "render", "--width",    "24",    "--spp", "4",  "--integrator", "megakernel", "--devices",
         "cpu",    "--timeline", "m.svg", "-q",    "-o", "m.exr",        NULL};
@@ -1069,6 +1075,17 @@ static void test_stage_stats_and_timeline(void **state)
            "the timeline should have a lane per device and one for shading");
     EXPECT(&p, strstr(svg, "trace-closest") && strstr(svg, "shade"),
            "the timeline should name the stages it shows");
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, paths_args);
+    EXPECT(&p, exited_with(&p, 0), "the render of whole paths with --timeline should succeed");
+    EXPECT(&p,
+           strstr(p.err.data, "cpu (wavefront)") && strstr(p.err.data, "gpu-fallback:0 (wavefront)"),
+           "--stats should show both devices running their paths whole");
+    snprintf(path, sizeof path, "%s/p.svg", f->dir);
+    EXPECT(&p,
+           slurp(path, svg, sizeof svg) && strstr(svg, "pass") && strstr(svg, "cpu (wavefront)") &&
+               strstr(svg, "gpu-fallback:0"),
+           "the timeline should show each device's calls on its lane");
     run(&q, f->dir, DEFAULT_TIMEOUT_S, mk_args);
     EXPECT(&q, exited_with(&q, 0), "the megakernel render with --timeline should succeed");
     snprintf(path, sizeof path, "%s/m.svg", f->dir);
