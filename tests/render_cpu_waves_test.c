@@ -300,9 +300,12 @@ static void test_beside_the_fallback(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_gpucheck_every_mode), cmocka_unit_test(test_many_lights_bvh),
-        cmocka_unit_test(test_adaptive),            cmocka_unit_test(test_every_traversal),
-        cmocka_unit_test(test_split_runs),          cmocka_unit_test(test_cancel_leaves_a_prefix),
+        cmocka_unit_test(test_gpucheck_every_mode),
+        cmocka_unit_test(test_many_lights_bvh),
+        cmocka_unit_test(test_adaptive),
+        cmocka_unit_test(test_every_traversal),
+        cmocka_unit_test(test_split_runs),
+        cmocka_unit_test(test_cancel_leaves_a_prefix),
         cmocka_unit_test(test_beside_the_fallback),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
