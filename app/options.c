@@ -237,10 +237,12 @@ static void help_render_devices(void)
           "                      megakernel (the thesis's per-pixel loop, on one device: the\n"
           "                      cpu, or a gpu (CUDA, one thread per pixel); auto picks the\n"
           "                      gpu where there is one; same image)\n"
-          "  --shade-on WHERE    stream integrator: device (default): a GPU runs its paths\n"
-          "                      whole, shading included (its own wavefront; --devices auto\n"
-          "                      then takes the GPU alone); host: the devices only trace and\n"
-          "                      the host shades every ray (the thesis's design); same image\n"
+          "  --shade-on WHERE    stream integrator: device (default): each device runs its\n"
+          "                      paths whole, shading included (a GPU its own wavefront,\n"
+          "                      --devices auto then takes the GPU alone; each CPU thread a\n"
+          "                      wave of its own); host: the devices only trace and the\n"
+          "                      render thread shades every ray (the thesis's design); same\n"
+          "                      image\n"
           "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
           "                      tasks (the thesis's three OpenMP strategies)\n",
           stdout);

@@ -9,8 +9,9 @@
  * --new-args: more options for the new build's renders only (e.g. "--filter box" against a build
  * from before pixel filters, whose only filter was that box).
  *
- * The matrix: scenes x samplers x estimators x {stream on the CPU, stream on the CPU and the GPU
- * fallback, the megakernel on the CPU, the megakernel on the fallback} (a real GPU where there
+ * The matrix: scenes x samplers x estimators x {stream on the CPU (its own waves, and shaded on
+ * the render thread: --shade-on host), stream on the CPU and the GPU fallback (both ways), the
+ * megakernel on the CPU, the megakernel on the fallback} (a real GPU where there
  * is one, through --devices gpu), and the plans: the same render stopped by a checkpoint and
  * resumed, and adaptive sampling on one and two devices.  Exit 0 when every image is the same,
  * 1 with a line per difference.  --quick (the test suite's smoke run) takes two scenes, one
@@ -30,7 +31,9 @@
 
 static const char *k_devices[][2] = {
     {"stream cpu", "--devices cpu"},
+    {"stream cpu, shaded on the render thread", "--devices cpu --shade-on host"},
     {"stream cpu+gpu", "--devices cpu,gpu"},
+    {"stream cpu+gpu, shaded on the render thread", "--devices cpu,gpu --shade-on host"},
     {"megakernel cpu", "--integrator megakernel --devices cpu"},
     {"megakernel gpu", "--integrator megakernel --devices gpu"},
 };
@@ -188,7 +191,7 @@ int main(int argc, char **argv)
                          "%s --width 40 --height 30 --spp 6 --max-depth 8 --seed 3 --sampler %s "
                          "--sampling %s",
                          scenes[a], samplers[b], estimators[e]);
-                for (d = 0; d < 4; ++d) {
+                for (d = 0; d < (int)(sizeof k_devices / sizeof k_devices[0]); ++d) {
                     snprintf(args, sizeof args, "%s %s", base, k_devices[d][1]);
                     snprintf(label, sizeof label, "%s %s %s, %s", scenes[a], samplers[b],
                              estimators[e], k_devices[d][0]);
