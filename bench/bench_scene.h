@@ -5,6 +5,8 @@
  *   soup:N          N random triangles (edges up to ~2 units) in a cube that grows with the cube
  *                   root of N, so every N sees about the same density;
  *   builtin:NAME    a built-in scene (its meshes from the shared models folder);
+ *   FILE.json       a raystream scene file (scenes/scene_json.c; its own camera), e.g. the shared
+ *                   models' living room;
  *   FILE            any mesh file, read by the real importer (scenes/mesh.c) into an empty scene.
  * Scenes without a camera of their own (soup, files) get a pinhole camera on the diagonal
  * (1, 0.6, 1.4) of their bounding box that just holds the bounding sphere.
@@ -15,8 +17,11 @@
  *            the side the camera ray came from, spread evenly over the hits in pixel order
  *            (incoherent directions, as a path tracer's second segment);
  *   shadow   from the same points as the diffuse rays to a uniform point on one of the scene's
- *            lights (picked by area), or, for a scene without lights, on a square the size of the
- *            bounding box floating half a box above it; tmax stops just short of the light.
+ *            lights (picked by area); for a scene lit only by its environment (the living room
+ *            through its windows), toward the sky as the renderer samples a constant one: a
+ *            second cosine-distributed direction about the normal, tmax infinite; for a scene
+ *            with neither, to a point on a square the size of the bounding box floating half a
+ *            box above it; tmax stops just short of a light or the square.
  * Secondary rays start 1e-4 of the scene's diagonal off the surface (tmin).  The primary hits
  * they start from are found with a median BVH the helper builds and throws away. */
 #ifndef RS_BENCH_BENCH_SCENE_H
@@ -31,6 +36,8 @@
 #include "accel/bvh.h"
 #include "scenes/builtin.h"
 #include "scenes/mesh.h"
+#include "scenes/scene_json.h"
+#include "shading/envmap.h"
 #include "shading/camera.h"
 #include "test_rand.h"
 
@@ -121,6 +128,11 @@ static inline int bs_load(const char *spec, const char *models_dir, bs_scene *ou
         if (st == RS_OK)
             st = rs_scene_finalize(out->scene);
         snprintf(out->label, sizeof out->label, "soup of %ld random triangles", n);
+    } else if (strlen(spec) > 5 && strcmp(spec + strlen(spec) - 5, ".json") == 0) {
+        const char *base = strrchr(spec, '/');
+        st = rs_scene_load_json_ex(spec, NULL, &out->scene);
+        has_camera = 1;
+        snprintf(out->label, sizeof out->label, "%s", base ? base + 1 : spec);
     } else {
         rs_mesh_opts mo;
         rs_mesh_info info;
@@ -291,6 +303,13 @@ static inline int bs_make_rays(const bs_scene *s, uint32_t w, uint32_t n_seconda
         if (rs_v3_length2(d) < 1e-12f)
             d = n;
         sets[BS_DIFFUSE].rays[i] = mk_ray(p, rs_v3_normalize(d), eps, INFINITY);
+        if (s->scene->n_area_lights == 0 && rs_env_present(s->scene)) {
+            /* toward the sky: anything in the way occludes */
+            l = rs_v3_add(n, rnd_unit(&seed));
+            sets[BS_SHADOW].rays[i] =
+                mk_ray(p, rs_v3_length2(l) < 1e-12f ? n : rs_v3_normalize(l), eps, INFINITY);
+            continue;
+        }
         l = rs_v3_sub(bs_light_point(s, &seed), p);
         dist = rs_v3_length(l);
         sets[BS_SHADOW].rays[i] =

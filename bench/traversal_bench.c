@@ -1,7 +1,7 @@
 /* bench/traversal_bench.c — the CPU traversal kernels' speed, and Intel Embree's on the same rays.
  *
- * For each scene (bench/bench_scene.h; by default the teapot+bunny Cornell box, the bunny and the
- * dragon from the shared models) it builds our BVH (binned SAH by default, --bvh) and traces the
+ * For each scene (bench/bench_scene.h; by default the teapot+bunny Cornell box, the bunny, the
+ * dragon and the living room, lit by its sky through the windows, from the shared models) it builds our BVH (binned SAH by default, --bvh) and traces the
  * three ray sets, primary, diffuse-bounce and shadow, with both queries, closest hit and any hit,
  * with our kernels: the binary traversal every device shares (rs_bvh_closest / rs_bvh_occluded,
  * what the CUDA kernels and the GPU fallback run), the 4-wide SSE traversal (accel/bvh4.h) and the
@@ -513,7 +513,7 @@ int main(int argc, char **argv)
 {
     settings st;
     const char *models = NULL, *csv = NULL, *scenes[MAX_SCENES];
-    char paths[2][4200];
+    char paths[3][4200];
     int quick = 0, i, ok = 1, n_scenes = 0;
 
     memset(&st, 0, sizeof st);
@@ -600,6 +600,9 @@ int main(int argc, char **argv)
             scenes[n_scenes++] = paths[0];
             snprintf(paths[1], sizeof paths[1], "%s/dragon/dragon_100k.ply", dir);
             scenes[n_scenes++] = paths[1];
+            /* a real interior: the rays an architectural scene's paths trace (issue 40) */
+            snprintf(paths[2], sizeof paths[2], "%s/living-room/living-room.raystream.json", dir);
+            scenes[n_scenes++] = paths[2];
         } else {
             printf("\n(no shared models folder at %s: the Cornell box and a soup instead)\n",
                    rs_builtin_models_dir(models));

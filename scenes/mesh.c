@@ -139,6 +139,107 @@ static int ext_is(const char *path, const char *ext)
     return 1;
 }
 
+#define RS_PLY_WALK_ELEMS 16 /* elements a strict parse keeps for the walk */
+
+/* The ascii data's lists, walked token by token over the elements a strict header parse kept
+ * (chunk by chunk: ply_walk_chunk): Assimp reads a list's length from its leading digits as a
+ * 32-bit number whatever the header's length type, and reserves that many values before it reads
+ * them (a fuzzed "4555555555t" asked for 30 GiB).  A length above what the rest of the file could
+ * hold (two bytes an item: a digit and a blank) is refused with its line. */
+typedef struct ply_walk {
+    const rs_ply_elem *elems;
+    int n_elems, e, p;  /* the element and the property the next token belongs to */
+    uint64_t inst;      /* the instance (line) of element e */
+    int64_t list_left;  /* items left in the current list; -1: at a property's first token */
+    uint64_t value;     /* the token's leading digits so far (capped) */
+    int in_tok, digits; /* inside a token; its leading digits still running */
+    uint64_t line, max_items;
+} ply_walk;
+
+/* Steps past elements without a property (they take no line) and finished ones. */
+static void ply_walk_settle(ply_walk *w)
+{
+    while (w->e < w->n_elems &&
+           (w->elems[w->e].n_props == 0 || w->inst >= w->elems[w->e].count)) {
+        w->e++;
+        w->inst = 0;
+    }
+}
+
+/* One whole token of the data; 0 when it is a list length too long for the file. */
+static int ply_walk_token(ply_walk *w)
+{
+    const rs_ply_elem *el;
+    if (w->e >= w->n_elems || w->p >= w->elems[w->e].n_props)
+        return 1; /* past the declared data, or extra tokens on a line: Assimp's to judge */
+    el = &w->elems[w->e];
+    if (w->list_left > 0) {
+        if (--w->list_left == 0) {
+            w->list_left = -1;
+            w->p++;
+        }
+        return 1;
+    }
+    if (el->props[w->p].len_type == RS_PLY_NONE) {
+        w->p++;
+        return 1;
+    }
+    if (w->value > w->max_items)
+        return 0;
+    w->list_left = (int64_t)w->value;
+    if (w->list_left == 0) {
+        w->list_left = -1;
+        w->p++;
+    }
+    return 1;
+}
+
+static rs_status ply_list_error(const ply_walk *w, const char *path)
+{
+    if (w->value >= (1ull << 40))
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: PLY data line %llu: a list of over 10^12 items (the file holds "
+                            "%llu bytes)",
+                            path, (unsigned long long)w->line,
+                            (unsigned long long)(2u * (w->max_items - 1u)));
+    return rs_error_set(RS_ERR_ARG,
+                        "%s: PLY data line %llu: a list of %llu items, more than the file's "
+                        "data could hold",
+                        path, (unsigned long long)w->line, (unsigned long long)w->value);
+}
+
+static rs_status ply_walk_chunk(ply_walk *w, const char *path, const char *buf, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        char c = buf[i];
+        if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+            if (w->in_tok && !ply_walk_token(w))
+                return ply_list_error(w, path);
+            w->in_tok = 0;
+            if (c == '\n') {
+                w->line++;
+                w->p = 0;
+                w->list_left = -1;
+                if (w->e < w->n_elems) {
+                    w->inst++;
+                    ply_walk_settle(w);
+                }
+            }
+        } else if (!w->in_tok) {
+            w->in_tok = 1;
+            w->value = c >= '0' && c <= '9' ? (uint64_t)(c - '0') : 0;
+            w->digits = (c >= '0' && c <= '9') || c == '+';
+        } else if (w->digits && c >= '0' && c <= '9') {
+            if (w->value < (1ull << 40))
+                w->value = w->value * 10u + (uint64_t)(c - '0');
+        } else {
+            w->digits = 0;
+        }
+    }
+    return RS_OK;
+}
+
 /* Checks a file that says it is PLY (*is_ply set: 1, or 2 for one of triangle strips, which
  * Assimp does not read: a stripped model came out as one triangle; scenes/ply_strips.h does);
  * any other file passes. */
@@ -149,7 +250,9 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
     char *buf;
     size_t n, i;
     int last_nl;
-    rs_ply_header h;
+    rs_ply_header h, strict;
+    rs_ply_elem *elems;
+    ply_walk w;
     rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
     *is_ply_out = 0;
     if (st != RS_OK)
@@ -177,18 +280,44 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
         rs_free(buf);
         return st;
     }
+    /* the elements and properties, to walk the lists (a header only the loose parse takes is
+     * left to Assimp as before) */
+    memset(&w, 0, sizeof w);
+    elems = (rs_ply_elem *)rs_alloc(RS_PLY_WALK_ELEMS, sizeof *elems);
+    memset(&strict, 0, sizeof strict);
+    strict.elems = elems;
+    strict.max_elems = elems ? RS_PLY_WALK_ELEMS : 0;
+    if (elems && rs_ply_parse_header(path, buf, n, size, 1, &strict) == RS_OK) {
+        w.elems = elems;
+        w.n_elems = strict.n_elems;
+        w.list_left = -1;
+        w.line = 1;
+        w.max_items = (size - h.data_at) / 2u + 1u;
+        ply_walk_settle(&w);
+    }
+    rs_error_clear();
     /* the ascii data's lines: every newline, and a last line without one */
     for (i = h.data_at; i < n; ++i)
         lines += buf[i] == '\n';
     last_nl = n == h.data_at || buf[n - 1] == '\n';
-    while (lines < h.need_lines && (n = fread(buf, 1, RS_PLY_MAX_HEADER, f)) > 0) {
+    st = ply_walk_chunk(&w, path, buf + h.data_at, n - h.data_at);
+    while (st == RS_OK && (n = fread(buf, 1, RS_PLY_MAX_HEADER, f)) > 0) {
         for (i = 0; i < n; ++i)
             lines += buf[i] == '\n';
         last_nl = buf[n - 1] == '\n';
+        if (w.e < w.n_elems)
+            st = ply_walk_chunk(&w, path, buf, n);
+        else if (lines >= h.need_lines)
+            break;
     }
+    if (st == RS_OK && w.in_tok && !ply_walk_token(&w)) /* a last token without a newline */
+        st = ply_list_error(&w, path);
     lines += !last_nl;
     fclose(f);
     rs_free(buf);
+    rs_free(elems);
+    if (st != RS_OK)
+        return st;
     if (lines < h.need_lines)
         return rs_error_set(RS_ERR_ARG,
                             "%s: PLY header declares %llu elements, but its ascii data has only "

@@ -474,8 +474,8 @@ static void test_file_kinds(void **state)
 }
 
 /* A PLY whose header is cut before end_header (Assimp's reader spins on it for ever), one
- * that declares more elements than its bytes could hold, and a .ply that is not PLY: each an
- * error naming the file, at once. */
+ * that declares more elements than its bytes could hold, an ascii list longer than the file,
+ * and a .ply that is not PLY: each an error naming the file, at once. */
 static void test_ply_headers(void **state)
 {
     static const struct {
@@ -506,6 +506,18 @@ static void test_ply_headers(void **state)
          "line 3 is not 'element NAME COUNT'"},
         {"ply\nformat ascii 1.0\nelement vertex 4294967296\nproperty float x\nend_header\n0\n",
          "line 3 is not 'element NAME COUNT'"},
+        /* found by tests/fuzz/fuzz_mesh: Assimp reads an ascii list's length from its leading
+         * digits as 32 bits whatever its type and reserves as many values (30 GiB here): a
+         * length the file cannot hold is refused, with its data line (the 2nd face's, line 5;
+         * the first's 3 fits) */
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n4555555555t z\n",
+         "PLY data line 5: a list of 4555555555 items, more than"},
+        {"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n455555555555555555555555555 0 1 2",
+         "PLY data line 4: a list of over 10^12 items"},
         /* binary: 3 vertices of 12 bytes and a face of at least 1 need 37 bytes, not 20 */
         {"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
          "property float y\nproperty float z\nelement face 1\n"
