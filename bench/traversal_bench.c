@@ -15,8 +15,10 @@
  * build quality MEDIUM, the default) and traces the same rays with rtcIntersect1 / rtcOccluded1
  * in the same loops, prints our widest kernel's ratio to Embree, and checks that both find the
  * same answers: the same occlusion, and the same closest primitive or a hit at the same distance
- * (relative 1e-4: a tie between neighbours).  A disagreement on more than 0.1% of any set fails the
- * run.
+ * (relative 1e-4: a tie between neighbours).  A disagreement on more than 0.1% of any set (and
+ * more than 16 rays: --quick's 64x64 Cornell box has 8 primary rays that graze its walls' edges,
+ * hit by one test and missed by the other, Embree's watertight pair of triangles against our
+ * parallelogram) fails the run.
  *
  *   traversal_bench [--quick] [--scene SPEC]... [--models DIR] [--bvh NAME] [--size W]
  *                   [--secondary N] [--runs N] [--threads N] [--no-embree] [--csv FILE]
@@ -444,7 +446,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
             }
             if (embree) {
                 bad[k][q] = disagreements(&ans[best], &ans[ENGINE_EMBREE], sets[k].n, q);
-                if (bad[k][q] > sets[k].n / 1000) {
+                if (bad[k][q] > (sets[k].n / 1000 > 16 ? sets[k].n / 1000 : 16)) {
                     fprintf(stderr,
                             "traversal_bench: %s: Embree and raystream disagree on %u of %u %s "
                             "rays (%s)\n",
