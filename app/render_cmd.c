@@ -269,7 +269,7 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
 {
     int n = make_devices(o, r);
     rs_device *sched_devs[RS_MAX_DEVICES];
-    int i, n_sched = 0, host_pdev = 0, trace_only = 0;
+    int i, n_sched = 0, gpus = 0, trace_only = 0;
     if (n < 0)
         return RS_EXIT_RUNTIME;
     /* devices that run paths whole (a GPU, or its fallback; the CPU, each of its threads a wave
@@ -288,11 +288,10 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
             sched_devs[n_sched++] = d;
     }
     for (i = 0; i < r->n_pdev; ++i)
-        host_pdev += r->pdev[i]->threads > 0;
-    if (r->n_pdev && (n_sched || host_pdev) && r->n_pdev > host_pdev && r->threads > 1) {
+        gpus += !(r->pdev[i]->flags & RS_DEVICE_HOST_PATHS);
+    if (gpus && (n_sched || gpus < r->n_pdev) && r->threads > 1) {
         /* each GPU's host thread waits on it with a core of its own; the CPU (the stream
-         * engine, or the CPU device's waves) has the rest */
-        int gpus = n_sched ? r->n_pdev : r->n_pdev - host_pdev;
+         * engine, or the CPU device's own waves) has the rest */
         int left = r->threads - gpus > 0 ? r->threads - gpus : 1;
         rs_cores_init(&r->cores, left);
         r->st.threads = left;
