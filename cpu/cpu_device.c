@@ -34,8 +34,6 @@ static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
 static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t begin, uint32_t end)
 {
     const cpu_impl *c = (const cpu_impl *)d->impl;
-    const rs_bvh_view *bv = &c->bvh;
-    const rs_geom *g = &c->geom;
     long i;
     int threads;
     if (!c->uploaded)
@@ -49,7 +47,7 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (threads > 1 && end - begin >= 512u)
         for (i = 0; i < runs; ++i) {
             uint32_t b0 = begin + (uint32_t)i * 64u;
-            rs_bvh8_trace(c->bvh8, g, batch, b0, end - b0 < 64u ? end : b0 + 64u);
+            rs_cpu_trace_range(c, batch, b0, end - b0 < 64u ? end : b0 + 64u);
         }
         rs_cores_release(c->cores, threads);
         return RS_OK;
@@ -59,12 +57,8 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
      * costs more than it saves. */
 #pragma omp parallel for num_threads(threads)                                                      \
     schedule(dynamic, 256) if (threads > 1 && end - begin >= 512u)
-    for (i = (long)begin; i < (long)end; ++i) {
-        if (c->bvh4)
-            rs_bvh4_trace_one(c->bvh4, g, batch, (uint32_t)i);
-        else
-            rs_trace_one(bv, g, batch, (uint32_t)i);
-    }
+    for (i = (long)begin; i < (long)end; ++i)
+        rs_cpu_trace_range(c, batch, (uint32_t)i, (uint32_t)i + 1u);
     rs_cores_release(c->cores, threads);
     return RS_OK;
 }

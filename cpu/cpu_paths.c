@@ -43,22 +43,6 @@ typedef struct paths_ctx {
     rs_path_counts counts;
 } paths_ctx;
 
-/* Rays [0, batch->count) on the widest tree the device holds. */
-static void trace_all(const cpu_impl *c, const rs_trace_batch *batch)
-{
-    uint32_t i, n = batch->count;
-    if (c->bvh8) {
-        rs_bvh8_trace(c->bvh8, &c->geom, batch, 0, n);
-        return;
-    }
-    for (i = 0; i < n; ++i) {
-        if (c->bvh4)
-            rs_bvh4_trace_one(c->bvh4, &c->geom, batch, i);
-        else
-            rs_trace_one(&c->bvh, &c->geom, batch, i);
-    }
-}
-
 /* Paths [start, start + count) of the plan from camera rays to their end, on this thread. */
 static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers *b, uint64_t start,
                      uint32_t count, rs_path_counts *counts)
@@ -80,7 +64,7 @@ static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers
         tb.count = alive;
         tb.rays = b->ext[cur];
         tb.hits = b->hits;
-        trace_all(c, &tb);
+        rs_cpu_trace_range(c, &tb, 0, tb.count);
         counts->closest += alive;
         if (bounce > counts->max_bounce)
             counts->max_bounce = bounce;
@@ -92,7 +76,7 @@ static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers
             tb.count = n_shadow;
             tb.rays = b->shadow;
             tb.occluded = b->occluded;
-            trace_all(c, &tb);
+            rs_cpu_trace_range(c, &tb, 0, tb.count);
             rs_stage_resolve_shadows(&ex, &b->shadow, b->occluded, n_shadow, &b->paths);
             counts->shadow += n_shadow;
         }

@@ -20,6 +20,23 @@ typedef struct cpu_impl {
     int n_wave;
 } cpu_impl;
 
+/* Rays [begin, end) of `batch` on the widest tree the device holds (accel/trace.h's answers). */
+static inline void rs_cpu_trace_range(const cpu_impl *c, const rs_trace_batch *batch,
+                                      uint32_t begin, uint32_t end)
+{
+    uint32_t i;
+    if (c->bvh8) {
+        rs_bvh8_trace(c->bvh8, &c->geom, batch, begin, end);
+        return;
+    }
+    for (i = begin; i < end; ++i) {
+        if (c->bvh4)
+            rs_bvh4_trace_one(c->bvh4, &c->geom, batch, i);
+        else
+            rs_trace_one(&c->bvh, &c->geom, batch, i);
+    }
+}
+
 /* The device's render_pass (cpu/cpu_megakernel.c): the thesis's per-pixel loop. */
 rs_status rs_cpu_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, uint32_t n,
                              rs_path_counts *counts);
