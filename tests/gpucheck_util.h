@@ -31,6 +31,30 @@ static const gc_case gc_cases[] = {
 };
 #define GC_N_CASES ((int)(sizeof gc_cases / sizeof gc_cases[0]))
 
+/* builtin:many-lights with the light BVH picking the lights (48x48, 4 spp, 2 threads): what the
+ * device comparisons render besides gpucheck. */
+static inline rt_args gc_many_lights_bvh_args(void)
+{
+    rt_args a = rt_defaults("many-lights", 48, 4);
+    a.threads = 2;
+    a.sampler = RS_SAMPLER_SOBOL;
+    a.light_sampler = RS_LIGHT_SAMPLER_BVH;
+    return a;
+}
+
+/* Adaptive sampling on the Cornell box (40x40, at most 32 spp, 2 threads): plans over some
+ * pixels; its statistics into *st. */
+static inline rt_args gc_adaptive_args(rs_adaptive_stats *st)
+{
+    rt_args a = rt_defaults("cornell", 40, 32);
+    a.threads = 2;
+    a.sampler = RS_SAMPLER_SOBOL;
+    a.adaptive.threshold = 0.05f;
+    a.adaptive.min_spp = 4;
+    a.adaptive_out = st;
+    return a;
+}
+
 static inline rt_args gc_args(const gc_case *c)
 {
     rt_args a = rt_defaults("gpucheck", GC_W, GC_SPP);

@@ -56,25 +56,15 @@ static void test_gpucheck_every_mode(void **state)
 
 static void test_many_lights_bvh(void **state)
 {
-    rt_args a = rt_defaults("many-lights", 48, 4);
     (void)state;
-    a.threads = 2;
-    a.sampler = RS_SAMPLER_SOBOL;
-    a.light_sampler = RS_LIGHT_SAMPLER_BVH;
-    same_as_stream("many-lights, light BVH", a);
+    same_as_stream("many-lights, light BVH", gc_many_lights_bvh_args());
 }
 
 static void test_adaptive(void **state)
 {
-    rt_args a = rt_defaults("cornell", 40, 32);
     rs_adaptive_stats st;
     (void)state;
-    a.threads = 2;
-    a.sampler = RS_SAMPLER_SOBOL;
-    a.adaptive.threshold = 0.05f;
-    a.adaptive.min_spp = 4;
-    a.adaptive_out = &st;
-    same_as_stream("cornell, adaptive", a);
+    same_as_stream("cornell, adaptive", gc_adaptive_args(&st));
     assert_true(st.rounds > 1); /* plans over some pixels were run */
 }
 
