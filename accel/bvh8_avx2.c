@@ -13,6 +13,7 @@
 #    pragma GCC push_options
 #    pragma GCC target("avx2")
 #  endif
+#  include <float.h>
 #  include <immintrin.h>
 #  include <string.h>
 
@@ -252,6 +253,430 @@ int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray)
     return walk8_occluded(b, g, ray);
 }
 
+/* ---- Packets: eight rays walked through the tree together ----
+ *
+ * Rays that start close together and point the same way (a row of camera rays, the first
+ * bounce off one surface) visit mostly the same nodes.  Walked one at a time each pays for the
+ * walk: loading a node, the eight-lane box test, sorting and pushing the lanes hit, mispredicted
+ * branches.  Walked as a packet (Embree's "hybrid" traversal, Wald et al. 2001) the rays are the
+ * lanes: a node's child is tested against all eight rays at once, and a leaf's triangle too, so
+ * the walk's bookkeeping is paid once for eight rays where they agree.
+ *
+ * The same answers, bit for bit, as walk8_closest and walk8_occluded: each ray's box tests and
+ * primitive tests are the single-ray walk's operations in its order (a ray's slab distances are
+ * the near and far plane's, which min and max of the two planes' pick exactly when 1 / d is
+ * finite and nonzero; rays with another direction are walked alone), and the closest hit is the
+ * least (t, prim) by rs_hit_better whatever the order of the visit (accel/wide_walk.h). */
+
+/* The stack entry for lane `lane` of node `n`, number `node` (wide_walk.h's RS_WIDE_REF). */
+#  define RS_WIDE_LEAF_OR_NODE(n, node, lane)                                                      \
+    ((n)->count[lane] ? RS_WIDE_LEAF | (node) << 3 | (lane) : (n)->child[lane])
+
+/* A packet entry with this many lanes or fewer left is walked one lane at a time from there:
+ * rays that have parted ways share nothing more (on the living room's diffuse rays, 3 and 4
+ * were the fastest of 0 to 6; docs/performance.md). */
+#  define PK8_ALONE 3
+
+typedef struct pk8 {
+    __m256 o[3], d[3], inv[3], tmin;
+    float tmax[8];  /* per lane, cut just past each hit (closest) */
+    rs_ray ray[8];  /* each lane's ray, for the leaves walked one lane at a time */
+} pk8;
+
+/* Child c of node n against the packet's rays: the lanes whose ray enters the box inside
+ * (tmin, tmax), and their entry distances. */
+static inline uint32_t pk8_child(const rs_bvh8_node *n, uint32_t c, const pk8 *p, __m256 tmaxv,
+                                 __m256 *tn_out)
+{
+    __m256 t0x = MUL(SUB(_mm256_broadcast_ss(&n->b[0][c]), p->o[0]), p->inv[0]);
+    __m256 t1x = MUL(SUB(_mm256_broadcast_ss(&n->b[3][c]), p->o[0]), p->inv[0]);
+    __m256 t0y = MUL(SUB(_mm256_broadcast_ss(&n->b[1][c]), p->o[1]), p->inv[1]);
+    __m256 t1y = MUL(SUB(_mm256_broadcast_ss(&n->b[4][c]), p->o[1]), p->inv[1]);
+    __m256 t0z = MUL(SUB(_mm256_broadcast_ss(&n->b[2][c]), p->o[2]), p->inv[2]);
+    __m256 t1z = MUL(SUB(_mm256_broadcast_ss(&n->b[5][c]), p->o[2]), p->inv[2]);
+    __m256 tn = _mm256_max_ps(_mm256_max_ps(_mm256_min_ps(t0x, t1x), _mm256_min_ps(t0y, t1y)),
+                              _mm256_max_ps(_mm256_min_ps(t0z, t1z), p->tmin));
+    __m256 tf = _mm256_min_ps(_mm256_min_ps(_mm256_max_ps(t0x, t1x), _mm256_max_ps(t0y, t1y)),
+                              _mm256_min_ps(_mm256_max_ps(t0z, t1z), tmaxv));
+    *tn_out = tn;
+    return (uint32_t)_mm256_movemask_ps(CMP_LE(tn, MUL(tf, _mm256_set1_ps(RS_BVH_SLACK))));
+}
+
+/* tri8_hit with the roles swapped: triangle k of block b against the packet's eight rays. */
+static inline uint32_t pk8_tri(const rs_bvh8_tri8 *b, uint32_t k, const pk8 *p, __m256 tmaxv,
+                               __m256 *t, __m256 *u, __m256 *v)
+{
+    __m256 e1x = _mm256_broadcast_ss(&b->e1[0][k]), e1y = _mm256_broadcast_ss(&b->e1[1][k]);
+    __m256 e1z = _mm256_broadcast_ss(&b->e1[2][k]), e2x = _mm256_broadcast_ss(&b->e2[0][k]);
+    __m256 e2y = _mm256_broadcast_ss(&b->e2[1][k]), e2z = _mm256_broadcast_ss(&b->e2[2][k]);
+    __m256 dx = p->d[0], dy = p->d[1], dz = p->d[2];
+    __m256 px = SUB(MUL(dy, e2z), MUL(dz, e2y));
+    __m256 py = SUB(MUL(dz, e2x), MUL(dx, e2z));
+    __m256 pz = SUB(MUL(dx, e2y), MUL(dy, e2x));
+    __m256 det = ADD(ADD(MUL(e1x, px), MUL(e1y, py)), MUL(e1z, pz));
+    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    __m256 inv = _mm256_div_ps(one, det);
+    __m256 sx = SUB(p->o[0], _mm256_broadcast_ss(&b->v0[0][k]));
+    __m256 sy = SUB(p->o[1], _mm256_broadcast_ss(&b->v0[1][k]));
+    __m256 sz = SUB(p->o[2], _mm256_broadcast_ss(&b->v0[2][k]));
+    __m256 bu = MUL(ADD(ADD(MUL(sx, px), MUL(sy, py)), MUL(sz, pz)), inv);
+    __m256 qx = SUB(MUL(sy, e1z), MUL(sz, e1y));
+    __m256 qy = SUB(MUL(sz, e1x), MUL(sx, e1z));
+    __m256 qz = SUB(MUL(sx, e1y), MUL(sy, e1x));
+    __m256 bv = MUL(ADD(ADD(MUL(dx, qx), MUL(dy, qy)), MUL(dz, qz)), inv);
+    __m256 tt = MUL(ADD(ADD(MUL(e2x, qx), MUL(e2y, qy)), MUL(e2z, qz)), inv);
+    __m256 ok = CMP_NE(det, zero);
+    ok = AND(ok, AND(CMP_GE(bu, zero), CMP_LE(bu, one)));
+    ok = AND(ok, AND(CMP_GE(bv, zero), CMP_LE(ADD(bu, bv), one)));
+    ok = AND(ok, AND(CMP_GT(tt, p->tmin), CMP_LT(tt, tmaxv)));
+    *t = tt;
+    *u = bu;
+    *v = bv;
+    return (uint32_t)_mm256_movemask_ps(ok);
+}
+
+/* quad8_hit with the roles swapped: parallelogram k of block b against the packet's rays. */
+static inline uint32_t pk8_quad(const rs_bvh8_quad8 *b, uint32_t k, const pk8 *p, __m256 tmaxv,
+                                __m256 *t, __m256 *a, __m256 *bb)
+{
+    __m256 wx = _mm256_broadcast_ss(&b->w[0][k]), wy = _mm256_broadcast_ss(&b->w[1][k]);
+    __m256 wz = _mm256_broadcast_ss(&b->w[2][k]);
+    __m256 qx = _mm256_broadcast_ss(&b->q[0][k]), qy = _mm256_broadcast_ss(&b->q[1][k]);
+    __m256 qz = _mm256_broadcast_ss(&b->q[2][k]);
+    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    __m256 denom = ADD(ADD(MUL(wx, p->d[0]), MUL(wy, p->d[1])), MUL(wz, p->d[2]));
+    __m256 ox = SUB(qx, p->o[0]), oy = SUB(qy, p->o[1]), oz = SUB(qz, p->o[2]);
+    __m256 num = ADD(ADD(MUL(wx, ox), MUL(wy, oy)), MUL(wz, oz));
+    __m256 tt = _mm256_div_ps(num, denom);
+    __m256 ok = AND(CMP_NE(denom, zero), AND(CMP_GT(tt, p->tmin), CMP_LT(tt, tmaxv)));
+    __m256 ux, uy, uz, vx, vy, vz, hx, hy, hz, cx, cy, cz, al, ex, ey, ez, be;
+    if (_mm256_movemask_ps(ok) == 0)
+        return 0;
+    ux = _mm256_broadcast_ss(&b->u[0][k]);
+    uy = _mm256_broadcast_ss(&b->u[1][k]);
+    uz = _mm256_broadcast_ss(&b->u[2][k]);
+    vx = _mm256_broadcast_ss(&b->v[0][k]);
+    vy = _mm256_broadcast_ss(&b->v[1][k]);
+    vz = _mm256_broadcast_ss(&b->v[2][k]);
+    hx = SUB(MUL(p->d[0], tt), ox);
+    hy = SUB(MUL(p->d[1], tt), oy);
+    hz = SUB(MUL(p->d[2], tt), oz);
+    cx = SUB(MUL(hy, vz), MUL(hz, vy));
+    cy = SUB(MUL(hz, vx), MUL(hx, vz));
+    cz = SUB(MUL(hx, vy), MUL(hy, vx));
+    al = ADD(ADD(MUL(wx, cx), MUL(wy, cy)), MUL(wz, cz));
+    ex = SUB(MUL(uy, hz), MUL(uz, hy));
+    ey = SUB(MUL(uz, hx), MUL(ux, hz));
+    ez = SUB(MUL(ux, hy), MUL(uy, hx));
+    be = ADD(ADD(MUL(wx, ex), MUL(wy, ey)), MUL(wz, ez));
+    ok = AND(ok, AND(CMP_GE(al, zero), CMP_LE(al, one)));
+    ok = AND(ok, AND(CMP_GE(be, zero), CMP_LE(be, one)));
+    *t = tt;
+    *a = al;
+    *bb = be;
+    return (uint32_t)_mm256_movemask_ps(ok);
+}
+
+/* Lanes `m` of a primitive test's answers, each taken if better (rs_hit_better), the lane's ray
+ * cut just past it. */
+static inline void pk8_take(pk8 *p, rs_hit *hit, uint32_t m, __m256 tv, __m256 uv, __m256 vv,
+                            uint32_t prim)
+{
+    float t[8], u[8], v[8];
+    _mm256_storeu_ps(t, tv);
+    _mm256_storeu_ps(u, uv);
+    _mm256_storeu_ps(v, vv);
+    while (m) {
+        uint32_t l = (uint32_t)__builtin_ctz(m);
+        m &= m - 1;
+        if (rs_hit_better(t[l], prim, &hit[l])) {
+            p->tmax[l] = rs_float_next_up(t[l]);
+            hit[l].t = t[l];
+            hit[l].u = u[l];
+            hit[l].v = v[l];
+            hit[l].prim = prim;
+        }
+    }
+}
+
+/* A leaf for closest hit, lanes `m` of the packet: packed triangles and parallelograms against
+ * the packet, anything else (spheres, unpacked leaves, instances) one lane at a time through
+ * the single-ray walk's own leaf steps. */
+static void pk8_leaf_closest(const rs_bvh8 *b, const rs_geom *g, uint32_t first, uint32_t count,
+                             pk8 *p, rs_hit *hit, uint32_t m)
+{
+    uint32_t i, k;
+    if ((count & RS_WIDE_PACKED) && !(count & RS_WIDE_SPHERES)) {
+        for (i = 0; i < (count & RS_WIDE_BLOCKS); ++i) {
+            const uint32_t *prim = count & RS_WIDE_QUADS ? b->quad8[first + i].prim
+                                                         : b->tri8[first + i].prim;
+            for (k = 0; k < 8; ++k) {
+                __m256 t, u, v, tmaxv = _mm256_loadu_ps(p->tmax);
+                uint32_t got;
+                if (prim[k] == RS_NO_HIT)
+                    continue;
+                got = (count & RS_WIDE_QUADS
+                                    ? pk8_quad(&b->quad8[first + i], k, p, tmaxv, &t, &u, &v)
+                                    : pk8_tri(&b->tri8[first + i], k, p, tmaxv, &t, &u, &v)) &
+                               m;
+                if (got)
+                    pk8_take(p, hit, got, t, u, v, prim[k]);
+            }
+        }
+        return;
+    }
+    while (m) {
+        uint32_t l = (uint32_t)__builtin_ctz(m);
+        rs_ray r = p->ray[l];
+        m &= m - 1;
+        r.tmax = p->tmax[l];
+        if (count & RS_WIDE_PACKED) {
+            ray8 r8;
+            walk8_ray_init(&r8, r.o, r.d);
+            walk8_packed_closest(b, first, count, &r8, &r, &hit[l]);
+        } else {
+            for (i = 0; i < count; ++i)
+                walk8_leaf_closest(b, g, first + i, &r, &hit[l], NULL);
+        }
+        p->tmax[l] = r.tmax;
+    }
+}
+
+/* The closest hits of the packet's lanes `active` (hit[] set up as walk8_closest does). */
+static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit, uint32_t active)
+{
+    uint32_t stack[RS_BVH8_STACK];
+    uint8_t stack_m[RS_BVH8_STACK];
+    __m256 stack_tn[RS_BVH8_STACK];
+    uint32_t sp = 0;
+    stack[0] = 0;
+    stack_m[0] = (uint8_t)active;
+    stack_tn[0] = _mm256_set1_ps(-FLT_MAX);
+    sp = 1;
+    while (sp > 0) {
+        __m256 tmaxv = _mm256_loadu_ps(p->tmax);
+        uint32_t ref, m;
+        --sp;
+        ref = stack[sp];
+        /* the lanes that can still find a hit no farther than their best so far */
+        m = stack_m[sp] &
+            (uint32_t)_mm256_movemask_ps(
+                CMP_LE(stack_tn[sp], MUL(tmaxv, _mm256_set1_ps(RS_BVH_SLACK))));
+        if (m == 0)
+            continue;
+        if (!(ref & RS_WIDE_LEAF) && __builtin_popcount(m) <= PK8_ALONE) {
+            /* too few lanes left to share the walk: each walks this subtree alone */
+            while (m) {
+                uint32_t l = (uint32_t)__builtin_ctz(m);
+                rs_ray r = p->ray[l];
+                ray8 r8;
+                m &= m - 1;
+                r.tmax = p->tmax[l];
+                walk8_ray_init(&r8, r.o, r.d);
+                walk8_walk_closest(b, g, ref, &r8, &r, &hit[l], NULL);
+                p->tmax[l] = r.tmax;
+            }
+            continue;
+        }
+        if (!(ref & RS_WIDE_LEAF)) {
+            const rs_bvh8_node *n = &b->nodes[ref];
+            uint32_t c, k = 0, order[8], cm[8], j;
+            float near[8];
+            __m256 tn[8];
+            for (c = 0; c < n->n_lanes; ++c) {
+                uint32_t hm = pk8_child(n, c, p, tmaxv, &tn[k]) & m;
+                float t8[8], best = FLT_MAX;
+                uint32_t mm = hm;
+                if (hm == 0)
+                    continue;
+                _mm256_storeu_ps(t8, tn[k]);
+                while (mm) {
+                    uint32_t l = (uint32_t)__builtin_ctz(mm);
+                    mm &= mm - 1;
+                    best = t8[l] < best ? t8[l] : best;
+                }
+                /* insertion by the nearest entry among the lanes that hit, far first */
+                for (j = k; j > 0 && near[j - 1] < best; --j) {
+                    near[j] = near[j - 1];
+                    order[j] = order[j - 1];
+                    cm[j] = cm[j - 1];
+                }
+                near[j] = best;
+                order[j] = c | k << 8;
+                cm[j] = hm;
+                ++k;
+            }
+            for (j = 0; j < k; ++j) {
+                RS_ASSERT(sp < RS_BVH8_STACK);
+                stack[sp] = RS_WIDE_LEAF_OR_NODE(n, ref, order[j] & 0xffu);
+                stack_m[sp] = (uint8_t)cm[j];
+                stack_tn[sp++] = tn[order[j] >> 8];
+            }
+        } else {
+            const rs_bvh8_node *n = &b->nodes[(ref & ~RS_WIDE_LEAF) >> 3];
+            uint32_t lane = ref & 7u;
+            pk8_leaf_closest(b, g, n->child[lane], n->count[lane], p, hit, m);
+        }
+    }
+}
+
+/* Any hit for the packet's lanes `active`: the mask of those blocked. */
+static uint32_t pk8_occluded(const rs_bvh8 *b, const rs_geom *g, pk8 *p, uint32_t active)
+{
+    uint32_t stack[RS_BVH8_STACK];
+    uint8_t stack_m[RS_BVH8_STACK];
+    uint32_t sp = 1, done = 0, i, k;
+    __m256 tmaxv = _mm256_loadu_ps(p->tmax);
+    stack[0] = 0;
+    stack_m[0] = (uint8_t)active;
+    while (sp > 0 && done != active) {
+        uint32_t ref = stack[--sp], m = stack_m[sp] & ~done;
+        if (m == 0)
+            continue;
+        if (!(ref & RS_WIDE_LEAF) && __builtin_popcount(m) <= PK8_ALONE) {
+            while (m) {
+                uint32_t l = (uint32_t)__builtin_ctz(m);
+                ray8 r8;
+                m &= m - 1;
+                walk8_ray_init(&r8, p->ray[l].o, p->ray[l].d);
+                if (walk8_walk_occluded(b, g, ref, &r8, &p->ray[l], NULL))
+                    done |= 1u << l;
+            }
+            continue;
+        }
+        if (!(ref & RS_WIDE_LEAF)) {
+            const rs_bvh8_node *n = &b->nodes[ref];
+            uint32_t c;
+            for (c = 0; c < n->n_lanes; ++c) {
+                __m256 tn;
+                uint32_t hm = pk8_child(n, c, p, tmaxv, &tn) & m;
+                if (hm) {
+                    RS_ASSERT(sp < RS_BVH8_STACK);
+                    stack[sp] = RS_WIDE_LEAF_OR_NODE(n, ref, c);
+                    stack_m[sp++] = (uint8_t)hm;
+                }
+            }
+        } else {
+            const rs_bvh8_node *n = &b->nodes[(ref & ~RS_WIDE_LEAF) >> 3];
+            uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane];
+            if ((count & RS_WIDE_PACKED) && !(count & RS_WIDE_SPHERES)) {
+                for (i = 0; i < (count & RS_WIDE_BLOCKS) && m; ++i) {
+                    const uint32_t *prim = count & RS_WIDE_QUADS ? b->quad8[first + i].prim
+                                                                 : b->tri8[first + i].prim;
+                    for (k = 0; k < 8 && m; ++k) {
+                        __m256 t, u, v;
+                        uint32_t got;
+                        if (prim[k] == RS_NO_HIT)
+                            continue;
+                        got =
+                            (count & RS_WIDE_QUADS
+                                 ? pk8_quad(&b->quad8[first + i], k, p, tmaxv, &t, &u, &v)
+                                 : pk8_tri(&b->tri8[first + i], k, p, tmaxv, &t, &u, &v)) &
+                            m;
+                        done |= got;
+                        m &= ~got;
+                    }
+                }
+            } else {
+                while (m) {
+                    uint32_t l = (uint32_t)__builtin_ctz(m), blocked = 0;
+                    m &= m - 1;
+                    if (count & RS_WIDE_PACKED) {
+                        ray8 r8;
+                        walk8_ray_init(&r8, p->ray[l].o, p->ray[l].d);
+                        blocked = (uint32_t)walk8_packed_occluded(b, first, count, &r8, &p->ray[l]);
+                    } else {
+                        for (i = 0; i < count && !blocked; ++i)
+                            blocked = (uint32_t)walk8_leaf_occluded(b, g, first + i, &p->ray[l],
+                                                                    NULL);
+                    }
+                    if (blocked)
+                        done |= 1u << l;
+                }
+            }
+        }
+    }
+    return done;
+}
+
+/* Whether 1 / d has a component that is infinite or zero: such a ray is walked alone. */
+static inline int pk8_general(rs_vec3 d)
+{
+    rs_vec3 iv = rs_bvh_inv_dir(d);
+    return !(iv.x - iv.x == 0.0f) || iv.x == 0.0f || !(iv.y - iv.y == 0.0f) || iv.y == 0.0f ||
+           !(iv.z - iv.z == 0.0f) || iv.z == 0.0f;
+}
+
+void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
+                           uint32_t begin, uint32_t end)
+{
+    uint32_t i, l;
+    if (b->n_nodes == 0 || end - begin < 8) {
+        rs_bvh8_trace(b, g, batch, begin, end);
+        return;
+    }
+    for (i = begin; i < end; i += 8) {
+        uint32_t n = end - i < 8 ? end - i : 8, active = 0;
+        float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8], ix[8], iy[8], iz[8], tmin[8];
+        pk8 p;
+        rs_hit hit[8];
+        for (l = 0; l < 8; ++l) {
+            uint32_t j = i + (l < n ? l : 0);
+            rs_vec3 inv;
+            p.ray[l] = rs_ray_soa_get(&batch->rays, j);
+            if (l < n && !pk8_general(p.ray[l].d))
+                active |= 1u << l;
+            inv = rs_bvh_inv_dir(p.ray[l].d);
+            ox[l] = p.ray[l].o.x;
+            oy[l] = p.ray[l].o.y;
+            oz[l] = p.ray[l].o.z;
+            dx[l] = p.ray[l].d.x;
+            dy[l] = p.ray[l].d.y;
+            dz[l] = p.ray[l].d.z;
+            ix[l] = inv.x;
+            iy[l] = inv.y;
+            iz[l] = inv.z;
+            tmin[l] = p.ray[l].tmin;
+            p.tmax[l] = p.ray[l].tmax;
+            hit[l].prim = RS_NO_HIT;
+            hit[l].t = p.ray[l].tmax;
+            hit[l].u = hit[l].v = 0.0f;
+        }
+        if (__builtin_popcount(active) < 2) {
+            rs_bvh8_trace(b, g, batch, i, i + n);
+            continue;
+        }
+        /* lanes that are not in the packet take lane 0's ray, masked off */
+        p.o[0] = _mm256_loadu_ps(ox);
+        p.o[1] = _mm256_loadu_ps(oy);
+        p.o[2] = _mm256_loadu_ps(oz);
+        p.d[0] = _mm256_loadu_ps(dx);
+        p.d[1] = _mm256_loadu_ps(dy);
+        p.d[2] = _mm256_loadu_ps(dz);
+        p.inv[0] = _mm256_loadu_ps(ix);
+        p.inv[1] = _mm256_loadu_ps(iy);
+        p.inv[2] = _mm256_loadu_ps(iz);
+        p.tmin = _mm256_loadu_ps(tmin);
+        if (batch->kind == RS_TRACE_CLOSEST) {
+            pk8_closest(b, g, &p, hit, active);
+            for (l = 0; l < n; ++l) {
+                if (active & (1u << l))
+                    rs_hit_soa_set(&batch->hits, i + l, &hit[l]);
+                else
+                    rs_bvh8_trace(b, g, batch, i + l, i + l + 1);
+            }
+        } else {
+            uint32_t blocked = pk8_occluded(b, g, &p, active);
+            for (l = 0; l < n; ++l) {
+                if (active & (1u << l))
+                    batch->occluded[i + l] = (uint8_t)((blocked >> l) & 1u);
+                else
+                    rs_bvh8_trace(b, g, batch, i + l, i + l + 1);
+            }
+        }
+    }
+}
+
 void rs_bvh8_trace(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
                    uint32_t begin, uint32_t end)
 {
@@ -275,6 +700,17 @@ void rs_bvh8_trace(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *bat
 #  endif
 
 #else /* no AVX2 build: rs_bvh8_supported() is 0 and these are never called */
+
+void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
+                           uint32_t begin, uint32_t end)
+{
+    (void)b;
+    (void)g;
+    (void)batch;
+    (void)begin;
+    (void)end;
+    RS_ASSERT(0);
+}
 
 int rs_bvh8_closest(const rs_bvh8 *b, const rs_geom *g, rs_ray ray, rs_hit *hit)
 {

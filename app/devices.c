@@ -156,6 +156,7 @@ static rs_status create_cpu(const rs_cli_options *o, const device_plan *p, int i
     co.bvh_width = o->no_bvh ? 2 : o->bvh_width; /* 4-wide leaves hold < 2^15 */
     co.cores = cores;
     co.strategy = o->strategy;
+    co.walk = o->cpu_walk;
     return rs_cpu_device_create_opts(&co, out);
 }
 

@@ -244,7 +244,11 @@ static void help_render_devices(void)
           "                      render thread shades every ray (the thesis's design); same\n"
           "                      image\n"
           "  --cpu-strategy S    how CPU threads split work: for-dynamic (default), columns,\n"
-          "                      tasks (the thesis's three OpenMP strategies)\n",
+          "                      tasks (the thesis's three OpenMP strategies)\n"
+          "  --cpu-walk W        how each CPU thread's waves walk the 8-wide BVH: auto\n"
+          "                      (default: each thread times both on its first waves and\n"
+          "                      keeps the faster, per kind of ray), single (each ray alone)\n"
+          "                      or packets (eight neighbouring rays together); same image\n",
           stdout);
 }
 
@@ -598,6 +602,14 @@ static int opt_cpu_strategy(const char *name, const char *v, rs_cli_options *o)
     return RS_EXIT_OK;
 }
 
+static int opt_cpu_walk(const char *name, const char *v, rs_cli_options *o)
+{
+    (void)name;
+    if (!rs_cpu_walk_parse(v, &o->cpu_walk))
+        return usage_error("--cpu-walk: '%s'%s (use auto, single or packets)", v, "");
+    return RS_EXIT_OK;
+}
+
 static int opt_timeline(const char *name, const char *v, rs_cli_options *o)
 {
     size_t n = strlen(v);
@@ -756,6 +768,7 @@ static const opt_row options[] = {
     ROW_CALL("--integrator", opt_integrator),
     ROW_CALL("--shade-on", opt_shade_on),
     ROW_CALL("--cpu-strategy", opt_cpu_strategy),
+    ROW_CALL("--cpu-walk", opt_cpu_walk),
     ROW_NUM("--stats", OPT_FLAG, stats, 0, 0),
     ROW_TEXT("--stats-json", NULL, stats_json, "a file name"),
     ROW_CALL("--timeline", opt_timeline),

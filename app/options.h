@@ -5,6 +5,7 @@
 #include <stdint.h>
 
 #include "accel/bvh.h"
+#include "cpu/cpu_device.h"
 #include "shading/integrator.h"
 
 #define RS_EXIT_OK          0
@@ -86,6 +87,7 @@ typedef struct rs_cli_options {
                                  (the thesis's design); default: a device that can runs its
                                  paths whole (a GPU's wavefront) */
     rs_par_strategy strategy; /* --cpu-strategy */
+    rs_cpu_walk cpu_walk;     /* --cpu-walk */
     int no_bvh;               /* --no-bvh: every ray tests every primitive */
     int flatten_instances;    /* --flatten-instances: instances copied, one-level BVH */
     int stats;                /* --stats: a per-device table after the render */

@@ -34,6 +34,7 @@
 #include "bench_scene.h"
 #include "core/parallel.h"
 #include "machine.h"
+#include "streams/batch.h"
 
 #ifdef RS_HAVE_EMBREE
 #  include <embree3/rtcore.h>
@@ -44,7 +45,7 @@
 #define CHUNK      256
 
 enum { Q_CLOSEST = 0, Q_ANY = 1 };
-enum { ENGINE_BIN = 0, ENGINE_BVH4 = 1, ENGINE_BVH8 = 2, ENGINE_EMBREE = 3, N_ENGINES = 4 };
+enum { ENGINE_BIN = 0, ENGINE_BVH4 = 1, ENGINE_BVH8 = 2, ENGINE_PK = 3, ENGINE_EMBREE = 4, N_ENGINES = 5 };
 
 /* Answers of one engine on one set: the closest hit's prim and t, or occlusion. */
 typedef struct answers {
@@ -68,6 +69,8 @@ typedef struct ours_ctx {
     const rs_bvh4 *b4;
     const rs_bvh8 *b8;
     const rs_geom *g;
+    const bs_rays *sets;             /* the packet walk's rays: sets[k] as a stream, batch[k] */
+    rs_trace_batch batch[BS_N_SETS];
 } ours_ctx;
 
 /* Our kernel `e` (ENGINE_BIN, _BVH4, _BVH8) over the set. */
@@ -305,6 +308,64 @@ static double run_bvh8(const void *ctx, const bs_rays *s, int q, int threads, an
     return trace_ours((const ours_ctx *)ctx, ENGINE_BVH8, s, q, threads, a);
 }
 
+/* The 8-wide tree's packet walk (rs_bvh8_trace_packets: eight neighbouring rays at a time, what
+ * the CPU device's waves pick where it is faster) over the set, from its stream copy, in chunks of
+ * CHUNK rays. */
+static double run_pk(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
+{
+    const ours_ctx *c = (const ours_ctx *)ctx;
+    rs_trace_batch b = c->batch[s - c->sets];
+    long i, n = ((long)s->n + CHUNK - 1) / CHUNK;
+    double t0 = rs_now_s(), dt;
+    (void)threads;
+    b.kind = q == Q_CLOSEST ? RS_TRACE_CLOSEST : RS_TRACE_OCCLUDED;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (i = 0; i < n; ++i) {
+        uint32_t b0 = (uint32_t)i * CHUNK;
+        rs_bvh8_trace_packets(c->b8, c->g, &b, b0, s->n - b0 < CHUNK ? s->n : b0 + CHUNK);
+    }
+    dt = rs_now_s() - t0;
+    for (i = 0; i < (long)s->n; ++i) {
+        if (q == Q_CLOSEST) {
+            a->prim[i] = b.hits.prim[i];
+            a->t[i] = b.hits.t[i];
+        } else {
+            a->occluded[i] = b.occluded[i];
+        }
+    }
+    return dt;
+}
+
+/* The sets as streams for run_pk; 0 when out of memory. */
+static int pk_batches(ours_ctx *c, const bs_rays *sets)
+{
+    int k;
+    uint32_t i;
+    c->sets = sets;
+    for (k = 0; k < BS_N_SETS; ++k) {
+        rs_trace_batch *b = &c->batch[k];
+        if (rs_ray_soa_init(&b->rays, sets[k].n ? sets[k].n : 1) != RS_OK ||
+            rs_hit_soa_init(&b->hits, sets[k].n ? sets[k].n : 1) != RS_OK ||
+            !(b->occluded = (uint8_t *)malloc(sets[k].n ? sets[k].n : 1)))
+            return 0;
+        for (i = 0; i < sets[k].n; ++i)
+            rs_ray_soa_set(&b->rays, i, &sets[k].rays[i], i);
+        b->count = sets[k].n;
+    }
+    return 1;
+}
+
+static void pk_batches_free(ours_ctx *c)
+{
+    int k;
+    for (k = 0; k < BS_N_SETS; ++k) {
+        rs_ray_soa_free(&c->batch[k].rays);
+        rs_hit_soa_free(&c->batch[k].hits);
+        free(c->batch[k].occluded);
+    }
+    memset(c->batch, 0, sizeof c->batch);
+}
+
 /* The same answers bit for bit: 0, else the index of the first difference + 1. */
 static uint32_t first_difference(const answers *x, const answers *y, uint32_t n, int q)
 {
@@ -343,7 +404,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
 {
     const settings *st = (const settings *)ctx;
     static const char *const QNAME[2] = {"closest", "any"};
-    static const char *const ENAME[3] = {"binary", "4-wide", "8-wide"};
+    static const char *const ENAME[4] = {"binary", "4-wide", "8-wide", "8-wide packets"};
     bs_rays sets[BS_N_SETS];
     rs_bvh_build_opts bo;
     rs_bvh *bvh = NULL;
@@ -351,9 +412,9 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     rs_bvh8 *bvh8 = NULL;
     ours_ctx ours;
     answers ans[N_ENGINES];
-    trace_fn fns[N_ENGINES] = {run_bin, run_bvh4, run_bvh8, NULL};
+    trace_fn fns[N_ENGINES] = {run_bin, run_bvh4, run_bvh8, run_pk, NULL};
     const void *ctxs[N_ENGINES];
-    int on1[N_ENGINES] = {1, 1, 0, 0}, onn[N_ENGINES] = {0, 0, 0, 0};
+    int on1[N_ENGINES] = {1, 1, 0, 0, 0}, onn[N_ENGINES] = {0, 0, 0, 0, 0};
     double m[BS_N_SETS][2][N_ENGINES][2]; /* [set][query][engine][1 thread, all threads] */
     uint32_t bad[BS_N_SETS][2], hits[BS_N_SETS][2];
     double build_s, embree_build_s = 0.0;
@@ -364,6 +425,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     fns[ENGINE_EMBREE] = run_embree;
 #endif
     memset(ans, 0, sizeof ans);
+    memset(&ours, 0, sizeof ours);
     memset(bad, 0, sizeof bad);
     memset(m, 0, sizeof m);
     if (!bs_make_rays(sc, st->size, st->n_secondary, sets))
@@ -386,7 +448,11 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     ours.b4 = bvh4;
     ours.b8 = bvh8;
     ours.g = &sc->g;
-    on1[ENGINE_BVH8] = rs_bvh8_supported();
+    on1[ENGINE_BVH8] = on1[ENGINE_PK] = rs_bvh8_supported();
+    if (on1[ENGINE_PK] && !pk_batches(&ours, sets)) {
+        fprintf(stderr, "traversal_bench: out of memory\n");
+        goto out;
+    }
     best = on1[ENGINE_BVH8] ? ENGINE_BVH8 : ENGINE_BVH4; /* what the CPU device runs */
     onn[best] = 1;
     for (e = 0; e < N_ENGINES; ++e)
@@ -434,7 +500,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
                     h += q == Q_ANY ? ans[0].occluded[i] : ans[0].prim[i] != RS_NO_HIT;
                 hits[k][q] = h;
             }
-            for (e = ENGINE_BVH4; e <= ENGINE_BVH8; ++e) {
+            for (e = ENGINE_BVH4; e <= ENGINE_PK; ++e) {
                 uint32_t d = on1[e] ? first_difference(&ans[ENGINE_BIN], &ans[e], sets[k].n, q) : 0;
                 if (d) {
                     fprintf(stderr,
@@ -468,21 +534,22 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     if (!on1[ENGINE_BVH8])
         printf("; this CPU has no AVX2: the 8-wide kernel is left out");
     printf("\n\n");
-    printf("| rays | query | hit %% | binary Mrays/s 1 thr | 4-wide 1 thr | 8-wide 1 thr | %s %d thr "
-           "| %s vs binary 1 thr",
+    printf("| rays | query | hit %% | binary Mrays/s 1 thr | 4-wide 1 thr | 8-wide 1 thr | 8-wide "
+           "packets 1 thr | %s %d thr | %s vs binary 1 thr",
            ENAME[best], st->threads, ENAME[best]);
     if (embree)
         printf(" | Embree 1 thr | Embree %d thr | ours/Embree 1 thr | ours/Embree %d thr | "
                "answers differ",
                st->threads, st->threads);
-    printf(" |\n|---|---|---:|---:|---:|---:|---:|---:|%s\n",
+    printf(" |\n|---|---|---:|---:|---:|---:|---:|---:|---:|%s\n",
            embree ? "---:|---:|---:|---:|---:|" : "");
     for (k = 0; k < BS_N_SETS; ++k)
         for (q = 0; q < 2; ++q) {
             double hp = sets[k].n ? 100.0 * hits[k][q] / sets[k].n : 0.0;
-            printf("| %s | %s | %.1f | %.2f | %.2f | %.2f | %.2f | %.2fx", sets[k].name, QNAME[q],
-                   hp, m[k][q][ENGINE_BIN][0], m[k][q][ENGINE_BVH4][0], m[k][q][ENGINE_BVH8][0],
-                   m[k][q][best][1], m[k][q][best][0] / m[k][q][ENGINE_BIN][0]);
+            printf("| %s | %s | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2fx", sets[k].name,
+                   QNAME[q], hp, m[k][q][ENGINE_BIN][0], m[k][q][ENGINE_BVH4][0],
+                   m[k][q][ENGINE_BVH8][0], m[k][q][ENGINE_PK][0], m[k][q][best][1],
+                   m[k][q][best][0] / m[k][q][ENGINE_BIN][0]);
             if (embree)
                 printf(" | %.2f | %.2f | %.2fx | %.2fx | %u", m[k][q][ENGINE_EMBREE][0],
                        m[k][q][ENGINE_EMBREE][1],
@@ -490,9 +557,10 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
                        m[k][q][best][1] / m[k][q][ENGINE_EMBREE][1], bad[k][q]);
             printf(" |\n");
             if (st->csv)
-                fprintf(st->csv, "%s,%s,%s,%s,%u,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u\n", sc->label,
-                        st->bvh_name, sets[k].name, QNAME[q], sets[k].n, m[k][q][ENGINE_BIN][0],
-                        m[k][q][ENGINE_BVH4][0], m[k][q][ENGINE_BVH8][0], m[k][q][best][1],
+                fprintf(st->csv, "%s,%s,%s,%s,%u,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u\n",
+                        sc->label, st->bvh_name, sets[k].name, QNAME[q], sets[k].n,
+                        m[k][q][ENGINE_BIN][0], m[k][q][ENGINE_BVH4][0], m[k][q][ENGINE_BVH8][0],
+                        m[k][q][ENGINE_PK][0], m[k][q][best][1],
                         m[k][q][ENGINE_EMBREE][0], m[k][q][ENGINE_EMBREE][1], bad[k][q]);
         }
     ok = 1;
@@ -502,6 +570,7 @@ out:
 #endif
     for (e = 0; e < N_ENGINES; ++e)
         answers_free(&ans[e]);
+    pk_batches_free(&ours);
     rs_bvh8_destroy(bvh8);
     rs_bvh4_destroy(bvh4);
     rs_bvh_destroy(bvh);
@@ -573,7 +642,8 @@ int main(int argc, char **argv)
     if (csv) {
         st.csv = rs_bench_csv_open("traversal_bench", csv,
                                    "scene,bvh,rays,query,n,binary_mrays_1thr,bvh4_mrays_1thr,"
-                                   "bvh8_mrays_1thr,cpu_kernel_mrays_nthr,embree_mrays_1thr,"
+                                   "bvh8_mrays_1thr,bvh8_packets_mrays_1thr,"
+                                   "cpu_kernel_mrays_nthr,embree_mrays_1thr,"
                                    "embree_mrays_nthr,answers_differ\n");
         if (!st.csv)
             return 1;

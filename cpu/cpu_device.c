@@ -27,6 +27,8 @@ static rs_status cpu_upload(rs_device *d, const rs_geom *g, const rs_bvh *bvh)
         if (st != RS_OK)
             return st;
     }
+    if (c->picks) /* what the threads measured was for the old scene */
+        memset(c->picks, 0, (size_t)d->threads * rs_cpu_walk_picks_size());
     c->uploaded = 1;
     return RS_OK;
 }
@@ -44,7 +46,8 @@ static rs_status cpu_trace(rs_device *d, const rs_trace_batch *batch, uint32_t b
         /* the 8-wide kernel is a function of its own (compiled for AVX2): called on runs of
          * 64 rays, 4 runs to a dynamic chunk as below */
         long runs = ((long)(end - begin) + 63) / 64;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 4) if (threads > 1 && end - begin >= 512u)
+#pragma omp parallel for num_threads(threads)                                                      \
+    schedule(dynamic, 4) if (threads > 1 && end - begin >= 512u)
         for (i = 0; i < runs; ++i) {
             uint32_t b0 = begin + (uint32_t)i * 64u;
             rs_cpu_trace_range(c, batch, b0, end - b0 < 64u ? end : b0 + 64u);
@@ -71,11 +74,33 @@ static void cpu_destroy(rs_device *d)
         for (k = 0; k < c->n_wave; ++k)
             rs_wave_buffers_destroy(&c->wave[k]);
         rs_free(c->wave);
+        rs_free(c->picks);
         rs_bvh4_destroy(c->bvh4);
         rs_bvh8_destroy(c->bvh8);
     }
     rs_free(c);
     rs_free(d);
+}
+
+const char *rs_cpu_walk_name(rs_cpu_walk w)
+{
+    switch (w) {
+    case RS_CPU_WALK_AUTO: return "auto";
+    case RS_CPU_WALK_SINGLE: return "single";
+    case RS_CPU_WALK_PACKETS: return "packets";
+    }
+    return "?";
+}
+
+int rs_cpu_walk_parse(const char *text, rs_cpu_walk *out)
+{
+    int i;
+    for (i = RS_CPU_WALK_AUTO; i <= RS_CPU_WALK_PACKETS; ++i)
+        if (strcmp(text, rs_cpu_walk_name((rs_cpu_walk)i)) == 0) {
+            *out = (rs_cpu_walk)i;
+            return 1;
+        }
+    return 0;
 }
 
 static const rs_device_ops cpu_ops = {
@@ -119,6 +144,7 @@ rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out
     c->width = o->bvh_width ? o->bvh_width : rs_bvh8_supported() ? 8 : 4;
     c->cores = o->cores;
     c->strategy = o->strategy;
+    c->walk = o->walk;
     d->ops = &cpu_ops;
     d->impl = c;
     d->flags = RS_DEVICE_HOST_PATHS;

@@ -11,6 +11,21 @@
 #include "core/parallel.h"
 #include "scheduler/device.h"
 
+/* How the CPU device's own waves (render_paths) walk the 8-wide tree: each ray alone, eight
+ * neighbouring rays as a packet (accel/bvh8.h's rs_bvh8_trace_packets), or, by default, whichever
+ * a thread measured faster on its first waves, for camera rays, the first bounce and the later
+ * ones, closest and any hit apart.  The answers are the same bit for bit, so the choice only
+ * changes the speed. */
+typedef enum rs_cpu_walk {
+    RS_CPU_WALK_AUTO = 0,
+    RS_CPU_WALK_SINGLE,
+    RS_CPU_WALK_PACKETS
+} rs_cpu_walk;
+
+/* "auto", "single", "packets"; the parse returns 0 for another name. */
+const char *rs_cpu_walk_name(rs_cpu_walk w);
+int rs_cpu_walk_parse(const char *text, rs_cpu_walk *out);
+
 typedef struct rs_cpu_device_opts {
     int threads;              /* OpenMP threads per chunk (>= 1) */
     const char *name;         /* copied; NULL: "cpu" */
@@ -20,6 +35,7 @@ typedef struct rs_cpu_device_opts {
                                  test other than the slab test (--isect-aabb). */
     rs_cores *cores;          /* the budget each chunk's team is taken from; NULL: none */
     rs_par_strategy strategy; /* how a chunk is split among the team (zeroed: for-dynamic) */
+    rs_cpu_walk walk;         /* render_paths' traversal (zeroed: auto); the 8-wide tree only */
 } rs_cpu_device_opts;
 
 rs_status rs_cpu_device_create_opts(const rs_cpu_device_opts *o, rs_device **out);

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 #include "cpu/internal.h"
 #include "scheduler/render.h"
 #include "shading/integrator.h"
@@ -30,6 +31,70 @@
 #define CPU_WAVE RS_RENDER_HOST_WAVE
 /* The smallest wave the end of a call is cut into. */
 #define CPU_WAVE_MIN 1024u
+
+/* ---- Which walk traces a wave's rays (rs_cpu_walk) ----
+ * The 8-wide tree answers the same, bit for bit, whether its rays walk alone or eight as a
+ * packet; which is faster depends on how alike neighbouring rays are: on the Cornell box every
+ * ray visits the same few leaves and packets win everywhere, in the living room only camera rays
+ * stay together and a diffuse bounce's packets fall apart (docs/performance.md).  So with `auto`
+ * each thread times both on its first traces of each kind, closest hit and any hit apart for
+ * camera rays, the first bounce and the later ones, and keeps the faster: a trace of at least
+ * WALK_MIN_RAYS rays, the two in turn until each has WALK_TRIES, then the packets where they took
+ * less time per ray by WALK_MARGIN.  Only the speed depends on it. */
+#define WALK_KEYS     6
+#define WALK_MIN_RAYS 512u
+#define WALK_TRIES    3u
+#define WALK_MARGIN   0.97
+
+typedef struct walk_pick {
+    double secs[2];    /* time in the walk: alone (0), packets (1) */
+    uint64_t rays[2];  /* rays it traced */
+    uint32_t tries[2]; /* traces timed */
+    uint32_t pick;     /* 0: not decided yet; 1 + the walk kept */
+} walk_pick;
+
+struct cpu_walk_picks {
+    walk_pick key[WALK_KEYS];
+};
+
+size_t rs_cpu_walk_picks_size(void) { return sizeof(struct cpu_walk_picks); }
+
+/* Traces tb's rays of bounce `bounce` on this thread with the walk c->walk and `picks` say. */
+static void trace_wave(const cpu_impl *c, struct cpu_walk_picks *picks, const rs_trace_batch *tb,
+                       uint32_t bounce)
+{
+    walk_pick *w;
+    uint32_t m;
+    double t0;
+    if (!c->bvh8 || c->walk == RS_CPU_WALK_SINGLE) {
+        rs_cpu_trace_range(c, tb, 0, tb->count);
+        return;
+    }
+    if (c->walk == RS_CPU_WALK_PACKETS) {
+        rs_bvh8_trace_packets(c->bvh8, &c->geom, tb, 0, tb->count);
+        return;
+    }
+    w = &picks->key[(tb->kind == RS_TRACE_CLOSEST ? 0 : 3) + (bounce < 2 ? bounce : 2)];
+    if (w->pick || tb->count < WALK_MIN_RAYS) {
+        if (w->pick == 2)
+            rs_bvh8_trace_packets(c->bvh8, &c->geom, tb, 0, tb->count);
+        else
+            rs_bvh8_trace(c->bvh8, &c->geom, tb, 0, tb->count);
+        return;
+    }
+    m = w->tries[0] <= w->tries[1] ? 0u : 1u;
+    t0 = rs_now_s();
+    if (m)
+        rs_bvh8_trace_packets(c->bvh8, &c->geom, tb, 0, tb->count);
+    else
+        rs_bvh8_trace(c->bvh8, &c->geom, tb, 0, tb->count);
+    w->secs[m] += rs_now_s() - t0;
+    w->rays[m] += tb->count;
+    if (++w->tries[m] >= WALK_TRIES && w->tries[m ^ 1u] >= WALK_TRIES)
+        w->pick = w->secs[1] / (double)w->rays[1] < WALK_MARGIN * w->secs[0] / (double)w->rays[0]
+                      ? 2u
+                      : 1u;
+}
 
 typedef struct paths_ctx {
     cpu_impl *c;
@@ -44,8 +109,9 @@ typedef struct paths_ctx {
 } paths_ctx;
 
 /* Paths [start, start + count) of the plan from camera rays to their end, on this thread. */
-static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers *b, uint64_t start,
-                     uint32_t count, rs_path_counts *counts)
+static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers *b,
+                     struct cpu_walk_picks *picks, uint64_t start, uint32_t count,
+                     rs_path_counts *counts)
 {
     const rs_render_consts *it = job->it;
     rs_path_map map;
@@ -64,7 +130,7 @@ static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers
         tb.count = alive;
         tb.rays = b->ext[cur];
         tb.hits = b->hits;
-        rs_cpu_trace_range(c, &tb, 0, tb.count);
+        trace_wave(c, picks, &tb, bounce);
         counts->closest += alive;
         if (bounce > counts->max_bounce)
             counts->max_bounce = bounce;
@@ -76,7 +142,7 @@ static void run_wave(const cpu_impl *c, const rs_paths_job *job, rs_wave_buffers
             tb.count = n_shadow;
             tb.rays = b->shadow;
             tb.occluded = b->occluded;
-            rs_cpu_trace_range(c, &tb, 0, tb.count);
+            trace_wave(c, picks, &tb, bounce);
             rs_stage_resolve_shadows(&ex, &b->shadow, b->occluded, n_shadow, &b->paths);
             counts->shadow += n_shadow;
         }
@@ -137,7 +203,7 @@ static void worker(paths_ctx *x, int t)
         }
         if (!take_wave(x, &start, &count))
             break;
-        run_wave(x->c, job, b, start, count, &mine);
+        run_wave(x->c, job, b, &x->c->picks[t], start, count, &mine);
         pthread_mutex_lock(&x->lock);
         film_wave(job, b, start, count);
         pthread_mutex_unlock(&x->lock);
@@ -157,8 +223,14 @@ static rs_status wave_buffers_ready(rs_device *d, cpu_impl *c, int threads)
         return RS_OK;
     if (!c->wave) {
         c->wave = (rs_wave_buffers *)rs_calloc((size_t)d->threads, sizeof *c->wave);
-        if (!c->wave)
+        c->picks = (struct cpu_walk_picks *)rs_calloc((size_t)d->threads, sizeof *c->picks);
+        if (!c->wave || !c->picks) {
+            rs_free(c->wave);
+            rs_free(c->picks);
+            c->wave = NULL;
+            c->picks = NULL;
             return rs_error_set(RS_ERR_NOMEM, "device %s: out of memory for its waves", d->name);
+        }
     }
     while (c->n_wave < threads) {
         rs_status st = rs_wave_buffers_create(CPU_WAVE, NULL, &c->wave[c->n_wave]);

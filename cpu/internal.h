@@ -16,8 +16,10 @@ typedef struct cpu_impl {
     rs_cores *cores;
     rs_par_strategy strategy;
     int uploaded;
-    rs_wave_buffers *wave; /* render_paths: one wave's buffers per thread (cpu_paths.c) */
+    rs_wave_buffers *wave;        /* render_paths: one wave's buffers per thread (cpu_paths.c) */
+    struct cpu_walk_picks *picks; /* render_paths: per thread, its measured walk choices */
     int n_wave;
+    rs_cpu_walk walk;
 } cpu_impl;
 
 /* Rays [begin, end) of `batch` on the widest tree the device holds (accel/trace.h's answers). */
@@ -43,6 +45,9 @@ rs_status rs_cpu_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0, 
 
 /* The device's render_paths (cpu/cpu_paths.c): each thread runs waves of its own through every
  * stage. */
+/* Bytes of one thread's walk choices (cpu_paths.c): upload zeroes them (none made). */
+size_t rs_cpu_walk_picks_size(void);
+
 rs_status rs_cpu_render_paths(rs_device *d, const rs_paths_job *job, uint64_t p0, uint64_t p1,
                               uint64_t *done, rs_path_counts *counts);
 

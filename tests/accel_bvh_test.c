@@ -40,6 +40,7 @@
 #include "accel/bvh4.h"
 #include "accel/bvh8.h"
 #include "core/alloc.h"
+#include "streams/batch.h"
 #include "scenes/scene.h"
 
 #include "test_rand.h"
@@ -601,6 +602,160 @@ static void test_shared_vertices_vs_brute_force(void **state)
     soup_free(&s);
 }
 
+/* ---- packets: eight rays walked together (rs_bvh8_trace_packets) ---------------------------- */
+
+enum { PK_RAYS = 6003 }; /* not a multiple of eight: the last packet is short */
+
+/* Ray i of the packet test.  Groups of eight in three kinds: a shared origin and nearly the same
+ * direction (a row of camera rays: the packet stays together), a shared origin and any direction
+ * (a diffuse bounce: it parts), or nothing shared; over a grid (grid > 0) the first kind aims at
+ * neighbouring vertices, where several triangles share the closest t.  Some lanes have a zero
+ * direction component (walked alone), a tmin > 0 or a short tmax. */
+static rs_ray packet_ray(uint64_t *s, long i, const soup *sp, uint32_t grid, float extent,
+                         rs_vec3 *o, rs_vec3 *d0)
+{
+    long lane = i % 8, kind = (i / 8) % 3;
+    rs_vec3 d;
+    float tmin = 0.0f, tmax = T_INF;
+    if (lane == 0) {
+        *o = grid ? rs_v3(rnd_range(s, 0.0, grid), rnd_range(s, 3.0, 20.0), rnd_range(s, 0.0, grid))
+                  : rnd_box(s, 1.5f * extent);
+        *d0 = rs_v3_sub(rnd_box(s, 0.5f * extent), *o);
+    }
+    if (kind == 0 && grid) {
+        const rs_tri *t = &sp->tris[((uint32_t)(*o).x * 2u * grid + (uint32_t)(*o).z * 2u +
+                                     (uint32_t)lane) %
+                                    sp->g.n_tris];
+        d = rs_v3_sub(lane & 1 ? t->v1 : t->v0, *o);
+    } else if (kind == 0) {
+        d = rs_v3_add(*d0, rnd_box(s, 0.02f * rs_v3_length(*d0)));
+    } else if (kind == 1) {
+        d = rnd_unit(s);
+    } else {
+        *o = rnd_box(s, 1.5f * extent);
+        d = rs_v3_sub(rnd_box(s, extent), *o);
+    }
+    if (i % 29 == 7) {
+        d.x = 0.0f;
+        if (rs_v3_is_zero(d))
+            d.y = 1.0f;
+    }
+    if (i % 13 == 4)
+        tmin = rnd_range(s, 0.0, extent);
+    if (i % 11 == 3)
+        tmax = rnd_range(s, 0.0, 2.0 * extent);
+    return mk_ray(*o, d, tmin, tmax);
+}
+
+/* rs_bvh8_trace_packets against rs_bvh8_trace (itself checked against brute force above): the
+ * same closest hit, bit for bit, and the same occlusion, for rays cut into packets from offset 0
+ * and from offset 3.  Returns the rays that hit. */
+static long expect_packets_match(const rs_bvh8 *b8, const rs_geom *g, const soup *sp,
+                                 uint32_t grid, float extent, const char *what)
+{
+    rs_trace_batch one, pk;
+    rs_vec3 o = rs_v3(0, 0, 0), d0 = rs_v3(0, 0, 1);
+    uint64_t rs = 0x9ac7e75;
+    uint32_t i, from;
+    long hits = 0;
+    memset(&one, 0, sizeof one);
+    memset(&pk, 0, sizeof pk);
+    assert_int_equal(rs_ray_soa_init(&one.rays, PK_RAYS), RS_OK);
+    assert_int_equal(rs_hit_soa_init(&one.hits, PK_RAYS), RS_OK);
+    assert_int_equal(rs_hit_soa_init(&pk.hits, PK_RAYS), RS_OK);
+    one.occluded = (uint8_t *)calloc(PK_RAYS, 1);
+    pk.occluded = (uint8_t *)calloc(PK_RAYS, 1);
+    assert_non_null(one.occluded);
+    assert_non_null(pk.occluded);
+    for (i = 0; i < PK_RAYS; ++i) {
+        rs_ray r = packet_ray(&rs, i, sp, grid, extent, &o, &d0);
+        rs_ray_soa_set(&one.rays, i, &r, i);
+    }
+    one.count = pk.count = PK_RAYS;
+    pk.rays = one.rays;
+    for (from = 0; from <= 3; from += 3) {
+        one.kind = pk.kind = RS_TRACE_CLOSEST;
+        rs_bvh8_trace(b8, g, &one, from, PK_RAYS);
+        rs_bvh8_trace_packets(b8, g, &pk, from, PK_RAYS);
+        one.kind = pk.kind = RS_TRACE_OCCLUDED;
+        rs_bvh8_trace(b8, g, &one, from, PK_RAYS);
+        rs_bvh8_trace_packets(b8, g, &pk, from, PK_RAYS);
+        for (i = from; i < PK_RAYS; ++i) {
+            rs_hit a = rs_hit_soa_get(&one.hits, i), b = rs_hit_soa_get(&pk.hits, i);
+            if (memcmp(&a, &b, sizeof a) != 0 || one.occluded[i] != pk.occluded[i]) {
+                char ray[256];
+                rs_ray r = rs_ray_soa_get(&one.rays, i);
+                describe_ray(ray, sizeof ray, &r);
+                fail_msg("%s, ray %u (packets from %u): packets prim %u t %.9g u %.9g v %.9g "
+                         "occluded %d, alone prim %u t %.9g u %.9g v %.9g occluded %d; %s",
+                         what, i, from, b.prim, b.t, b.u, b.v, pk.occluded[i], a.prim, a.t, a.u,
+                         a.v, one.occluded[i], ray);
+            }
+            hits += from == 0 && a.prim != RS_NO_HIT;
+        }
+    }
+    free(one.occluded);
+    free(pk.occluded);
+    rs_ray_soa_free(&one.rays);
+    rs_hit_soa_free(&one.hits);
+    rs_hit_soa_free(&pk.hits);
+    return hits;
+}
+
+/* The packet walk on each kind of leaf: triangles, parallelograms and spheres packed in blocks,
+ * all three mixed, the watertight test's unpacked leaves, and a grid whose rays meet vertices
+ * (ties broken by primitive number whatever the order of the visit). */
+static void test_packets_match_single(void **state)
+{
+    soup s, q;
+    long hits;
+    int k;
+    (void)state;
+    if (!rs_bvh8_supported()) {
+        print_message("this CPU has no AVX2: the 8-wide packets are not tested\n");
+        return;
+    }
+    soup_random(&s, 0x9acc);
+    for (k = 0; k < 5; ++k) {
+        static const char *const name[5] = {"mixed soup", "triangles", "parallelograms",
+                                            "spheres", "watertight triangles"};
+        rs_bvh *b;
+        rs_bvh8 *b8 = NULL;
+        q = s;
+        if (k == 1 || k == 4)
+            q.g.n_spheres = q.g.n_quads = 0;
+        if (k == 2)
+            q.g.n_spheres = q.g.n_tris = 0;
+        if (k == 3)
+            q.g.n_quads = q.g.n_tris = 0;
+        if (k == 4)
+            q.g.tri_algo = RS_ISECT_TRI_WATERTIGHT;
+        b = build_sah_blocks(&q.g, 8, 8);
+        assert_int_equal(rs_bvh8_build(b, &q.g, &b8), RS_OK);
+        assert_true(k == 4 ? b8->n_packed == 0 : b8->n_packed > 0);
+        hits = expect_packets_match(b8, &q.g, &q, 0, SOUP, name[k]);
+        print_message("packets, %s: %d rays, %ld hit\n", name[k], PK_RAYS, hits);
+        assert_true(hits > PK_RAYS / 20 && hits < PK_RAYS - PK_RAYS / 20);
+        rs_bvh8_destroy(b8);
+        rs_bvh_destroy(b);
+    }
+    soup_free(&s);
+    {
+        enum { GRID = 24 };
+        rs_bvh *b;
+        rs_bvh8 *b8 = NULL;
+        soup_grid(&s, GRID, 0x9e1d);
+        b = build_sah_blocks(&s.g, 8, 8);
+        assert_int_equal(rs_bvh8_build(b, &s.g, &b8), RS_OK);
+        hits = expect_packets_match(b8, &s.g, &s, GRID, (float)GRID, "grid");
+        print_message("packets, grid: %d rays, %ld hit\n", PK_RAYS, hits);
+        assert_true(hits > PK_RAYS / 3);
+        rs_bvh8_destroy(b8);
+        rs_bvh_destroy(b);
+        soup_free(&s);
+    }
+}
+
 /* ---- edge cases ---------------------------------------------------------------------------- */
 
 static void test_empty(void **state)
@@ -971,6 +1126,8 @@ static void test_wide_instances(void **state)
         inst_hits += want.prim != RS_NO_HIT && want.prim >= rs_geom_own_count(&g);
     }
     print_message("wide instances: 20000 rays, %ld hit, %ld on instances\n", hits, inst_hits);
+    if (b8) /* the packet walk takes instances' leaves one lane at a time, the same answers */
+        assert_true(expect_packets_match(b8, &g, NULL, 0, 3.0f, "instances") > PK_RAYS / 20);
     assert_true(inst_hits > 2000); /* the rays do reach the instances */
     rs_bvh8_destroy(b8);
     rs_bvh4_destroy(b4);
@@ -1062,6 +1219,7 @@ int main(void)
         cmocka_unit_test(test_structure),
         cmocka_unit_test(test_random_rays_vs_brute_force),
         cmocka_unit_test(test_shared_vertices_vs_brute_force),
+        cmocka_unit_test(test_packets_match_single),
         cmocka_unit_test(test_empty),
         cmocka_unit_test(test_single_primitive),
         cmocka_unit_test(test_identical_centroids),

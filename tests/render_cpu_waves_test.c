@@ -4,7 +4,8 @@
  *
  * - Images: builtin:gpucheck in every sampling mode and sampler, on 1, 2 and 3 threads;
  *   builtin:many-lights with the light BVH; adaptive sampling (plans over some pixels); each of
- *   the CPU's traversals (binary, 4-wide, 8-wide where the CPU has AVX2): bit for bit.
+ *   the CPU's traversals (binary, 4-wide, 8-wide where the CPU has AVX2) and the 8-wide tree's
+ *   walks (rays alone, packets of eight, the measured choice): bit for bit.
  * - Calls that end inside waves and passes (plans cut at odd paths, run last first), and a call
  *   cancelled part way: what it says it did is a prefix of its paths, and the film holds exactly
  *   those (the stream engine's film of that prefix, byte for byte), every thread's wave included.
@@ -85,6 +86,40 @@ static void test_every_traversal(void **state)
         a.bvh_width = widths[k];
         snprintf(what, sizeof what, "rtiow-final, %u-wide traversal", widths[k]);
         same_as_stream(what, a);
+    }
+}
+
+/* The CPU's waves on the 8-wide tree with each walk (rays alone, packets of eight, the measured
+ * choice): the stream engine's image each time, on scenes of triangles, parallelograms and
+ * spheres (gpucheck's cases, motion blur among them) and on the CLI's tree. */
+static void test_every_walk(void **state)
+{
+    static const rs_cpu_walk walks[] = {RS_CPU_WALK_SINGLE, RS_CPU_WALK_PACKETS, RS_CPU_WALK_AUTO};
+    size_t k;
+    int c;
+    (void)state;
+    if (!rs_bvh8_supported()) {
+        print_message("no AVX2: the 8-wide walks are not compared\n");
+        return;
+    }
+    for (k = 0; k < sizeof walks / sizeof walks[0]; ++k) {
+        char what[96];
+        rt_args a = rt_defaults("rtiow-final", 48, 4);
+        a.threads = 2;
+        a.sampler = RS_SAMPLER_SOBOL;
+        a.cli_bvh = 1;
+        a.cpu_walk = walks[k];
+        snprintf(what, sizeof what, "rtiow-final, CLI tree, walk %s", rs_cpu_walk_name(walks[k]));
+        same_as_stream(what, a);
+        for (c = 0; c < GC_N_CASES; ++c) {
+            a = gc_args(&gc_cases[c]);
+            a.threads = 1 + (int)k % 2;
+            a.bvh_width = 8;
+            a.cpu_walk = walks[k];
+            snprintf(what, sizeof what, "%s, walk %s", gc_cases[c].name,
+                     rs_cpu_walk_name(walks[k]));
+            same_as_stream(what, a);
+        }
     }
 }
 
@@ -294,6 +329,7 @@ int main(void)
         cmocka_unit_test(test_many_lights_bvh),
         cmocka_unit_test(test_adaptive),
         cmocka_unit_test(test_every_traversal),
+        cmocka_unit_test(test_every_walk),
         cmocka_unit_test(test_split_runs),
         cmocka_unit_test(test_cancel_leaves_a_prefix),
         cmocka_unit_test(test_beside_the_fallback),

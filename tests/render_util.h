@@ -37,6 +37,7 @@ typedef struct rt_args {
     int fail_after;     /* > 0: the second device fails after this many chunks (RS_FAULT) */
     int shared_cores;   /* devices and shading share a budget of `threads` cores */
     uint32_t bvh_width; /* the CPU device's traversal: 2, 4 or 8 (0: 4) */
+    rs_cpu_walk cpu_walk; /* how the CPU device's own waves walk the 8-wide tree (zeroed: auto) */
     int cli_bvh;        /* the CLI's tree instead: the widest traversal this CPU runs (bvh_width is
                            ignored) over leaves the size of its blocks (rs_bvh_wide_leaf_size) */
     rs_adaptive adaptive;            /* threshold > 0: rs_render_adaptive (the stream integrator) */
@@ -146,6 +147,7 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     co.threads = a->threads;
     co.cores = budget;
     co.strategy = a->strategy;
+    co.walk = a->cpu_walk;
     co.bvh_width = a->no_bvh ? 2 : a->cli_bvh ? 0 : a->bvh_width ? a->bvh_width : 4;
     memset(&bo, 0, sizeof bo);
     bo.max_leaf = a->no_bvh ? UINT32_MAX : 0;
