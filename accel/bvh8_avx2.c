@@ -279,8 +279,10 @@ int rs_bvh8_occluded(const rs_bvh8 *b, const rs_geom *g, rs_ray ray)
 
 typedef struct pk8 {
     __m256 o[3], d[3], inv[3], tmin;
-    float tmax[8];  /* per lane, cut just past each hit (closest) */
-    rs_ray ray[8];  /* each lane's ray, for the leaves walked one lane at a time */
+    int octant; /* the lanes' directions all have the same signs: near and far planes known */
+    uint32_t near[3], far[3]; /* then each axis's near and far plane's row of rs_bvh8_node.b */
+    float tmax[8];            /* per lane, cut just past each hit (closest) */
+    rs_ray ray[8];            /* each lane's ray, for the leaves walked one lane at a time */
 } pk8;
 
 /* Child c of node n against the packet's rays: the lanes whose ray enters the box inside
@@ -288,6 +290,19 @@ typedef struct pk8 {
 static inline uint32_t pk8_child(const rs_bvh8_node *n, uint32_t c, const pk8 *p, __m256 tmaxv,
                                  __m256 *tn_out)
 {
+    if (p->octant) { /* walk8_lanes' planes: the same distances, no min and max to pick them */
+        __m256 nx = MUL(SUB(_mm256_broadcast_ss(&n->b[p->near[0]][c]), p->o[0]), p->inv[0]);
+        __m256 ny = MUL(SUB(_mm256_broadcast_ss(&n->b[p->near[1]][c]), p->o[1]), p->inv[1]);
+        __m256 nz = MUL(SUB(_mm256_broadcast_ss(&n->b[p->near[2]][c]), p->o[2]), p->inv[2]);
+        __m256 fx = MUL(SUB(_mm256_broadcast_ss(&n->b[p->far[0]][c]), p->o[0]), p->inv[0]);
+        __m256 fy = MUL(SUB(_mm256_broadcast_ss(&n->b[p->far[1]][c]), p->o[1]), p->inv[1]);
+        __m256 fz = MUL(SUB(_mm256_broadcast_ss(&n->b[p->far[2]][c]), p->o[2]), p->inv[2]);
+        __m256 tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, p->tmin));
+        __m256 tf = _mm256_min_ps(_mm256_min_ps(fx, fy), _mm256_min_ps(fz, tmaxv));
+        *tn_out = tn;
+        return (uint32_t)_mm256_movemask_ps(CMP_LE(tn, MUL(tf, _mm256_set1_ps(RS_BVH_SLACK))));
+    }
+    {
     __m256 t0x = MUL(SUB(_mm256_broadcast_ss(&n->b[0][c]), p->o[0]), p->inv[0]);
     __m256 t1x = MUL(SUB(_mm256_broadcast_ss(&n->b[3][c]), p->o[0]), p->inv[0]);
     __m256 t0y = MUL(SUB(_mm256_broadcast_ss(&n->b[1][c]), p->o[1]), p->inv[1]);
@@ -300,6 +315,7 @@ static inline uint32_t pk8_child(const rs_bvh8_node *n, uint32_t c, const pk8 *p
                               _mm256_min_ps(_mm256_max_ps(t0z, t1z), tmaxv));
     *tn_out = tn;
     return (uint32_t)_mm256_movemask_ps(CMP_LE(tn, MUL(tf, _mm256_set1_ps(RS_BVH_SLACK))));
+    }
 }
 
 /* tri8_hit with the roles swapped: triangle k of block b against the packet's eight rays. */
@@ -485,17 +501,12 @@ static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit,
             __m256 tn[8];
             for (c = 0; c < n->n_lanes; ++c) {
                 uint32_t hm = pk8_child(n, c, p, tmaxv, &tn[k]) & m;
-                float t8[8], best = FLT_MAX;
-                uint32_t mm = hm;
+                float t8[8], best;
                 if (hm == 0)
                     continue;
                 _mm256_storeu_ps(t8, tn[k]);
-                while (mm) {
-                    uint32_t l = (uint32_t)__builtin_ctz(mm);
-                    mm &= mm - 1;
-                    best = t8[l] < best ? t8[l] : best;
-                }
-                /* insertion by the nearest entry among the lanes that hit, far first */
+                best = t8[__builtin_ctz(hm)];
+                /* insertion by the first lane's entry distance, far first */
                 for (j = k; j > 0 && near[j - 1] < best; --j) {
                     near[j] = near[j - 1];
                     order[j] = order[j - 1];
@@ -645,6 +656,21 @@ void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_ba
         if (__builtin_popcount(active) < 2) {
             rs_bvh8_trace(b, g, batch, i, i + n);
             continue;
+        }
+        {
+            /* the signs of the packet's directions, where they agree */
+            uint32_t neg[3] = {0, 0, 0}, a;
+            for (l = 0; l < 8; ++l)
+                if (active & (1u << l)) {
+                    neg[0] |= 1u << (ix[l] < 0.0f);
+                    neg[1] |= 1u << (iy[l] < 0.0f);
+                    neg[2] |= 1u << (iz[l] < 0.0f);
+                }
+            p.octant = neg[0] != 3u && neg[1] != 3u && neg[2] != 3u;
+            for (a = 0; a < 3; ++a) {
+                p.near[a] = a + (neg[a] == 2u ? 3u : 0u);
+                p.far[a] = a + (neg[a] == 2u ? 0u : 3u);
+            }
         }
         /* lanes that are not in the packet take lane 0's ray, masked off */
         p.o[0] = _mm256_loadu_ps(ox);
