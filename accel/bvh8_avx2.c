@@ -531,20 +531,58 @@ static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit,
     }
 }
 
-/* Any hit for the packet's lanes `active`: the mask of those blocked. */
+/* A leaf for any hit, lanes `m` of the packet: the mask of those it blocks.  Packed triangles and
+ * parallelograms against the packet, anything else one lane at a time (walk8_leaf_run_occluded). */
+static uint32_t pk8_leaf_occluded(const rs_bvh8 *b, const rs_geom *g, uint32_t first,
+                                  uint32_t count, pk8 *p, __m256 tmaxv, uint32_t m)
+{
+    uint32_t i, k, done = 0;
+    if ((count & RS_WIDE_PACKED) && !(count & RS_WIDE_SPHERES)) {
+        for (i = 0; i < (count & RS_WIDE_BLOCKS) && m; ++i) {
+            const uint32_t *prim =
+                count & RS_WIDE_QUADS ? b->quad8[first + i].prim : b->tri8[first + i].prim;
+            for (k = 0; k < 8 && m; ++k) {
+                __m256 t, u, v;
+                uint32_t got;
+                if (prim[k] == RS_NO_HIT)
+                    continue;
+                got = (count & RS_WIDE_QUADS
+                           ? pk8_quad(&b->quad8[first + i], k, p, tmaxv, &t, &u, &v)
+                           : pk8_tri(&b->tri8[first + i], k, p, tmaxv, &t, &u, &v)) &
+                      m;
+                done |= got;
+                m &= ~got;
+            }
+        }
+        return done;
+    }
+    while (m) {
+        uint32_t l = (uint32_t)__builtin_ctz(m);
+        ray8 r8;
+        m &= m - 1;
+        walk8_ray_init(&r8, p->ray[l].o, p->ray[l].d);
+        if (walk8_leaf_run_occluded(b, g, first, count, &r8, &p->ray[l], NULL))
+            done |= 1u << l;
+    }
+    return done;
+}
+
+/* Any hit for the packet's lanes `active`: the mask of those blocked.  As walk8_occluded, the
+ * leaves among a node's children hit are tested at once and the other children pushed. */
 static uint32_t pk8_occluded(const rs_bvh8 *b, const rs_geom *g, pk8 *p, uint32_t active)
 {
     uint32_t stack[RS_BVH8_STACK];
     uint8_t stack_m[RS_BVH8_STACK];
-    uint32_t sp = 1, done = 0, i, k;
+    uint32_t sp = 1, done = 0;
     __m256 tmaxv = _mm256_loadu_ps(p->tmax);
     stack[0] = 0;
     stack_m[0] = (uint8_t)active;
     while (sp > 0 && done != active) {
-        uint32_t ref = stack[--sp], m = stack_m[sp] & ~done;
+        uint32_t ref = stack[--sp], m = stack_m[sp] & ~done, c;
+        const rs_bvh8_node *n = &b->nodes[ref];
         if (m == 0)
             continue;
-        if (!(ref & RS_WIDE_LEAF) && __builtin_popcount(m) <= PK8_ALONE) {
+        if (__builtin_popcount(m) <= PK8_ALONE) {
             while (m) {
                 uint32_t l = (uint32_t)__builtin_ctz(m);
                 ray8 r8;
@@ -555,55 +593,19 @@ static uint32_t pk8_occluded(const rs_bvh8 *b, const rs_geom *g, pk8 *p, uint32_
             }
             continue;
         }
-        if (!(ref & RS_WIDE_LEAF)) {
-            const rs_bvh8_node *n = &b->nodes[ref];
-            uint32_t c;
-            for (c = 0; c < n->n_lanes; ++c) {
-                __m256 tn;
-                uint32_t hm = pk8_child(n, c, p, tmaxv, &tn) & m;
-                if (hm) {
-                    RS_ASSERT(sp < RS_BVH8_STACK);
-                    stack[sp] = RS_WIDE_LEAF_OR_NODE(n, ref, c);
-                    stack_m[sp++] = (uint8_t)hm;
-                }
-            }
-        } else {
-            const rs_bvh8_node *n = &b->nodes[(ref & ~RS_WIDE_LEAF) >> 3];
-            uint32_t lane = ref & 7u, first = n->child[lane], count = n->count[lane];
-            if ((count & RS_WIDE_PACKED) && !(count & RS_WIDE_SPHERES)) {
-                for (i = 0; i < (count & RS_WIDE_BLOCKS) && m; ++i) {
-                    const uint32_t *prim = count & RS_WIDE_QUADS ? b->quad8[first + i].prim
-                                                                 : b->tri8[first + i].prim;
-                    for (k = 0; k < 8 && m; ++k) {
-                        __m256 t, u, v;
-                        uint32_t got;
-                        if (prim[k] == RS_NO_HIT)
-                            continue;
-                        got =
-                            (count & RS_WIDE_QUADS
-                                 ? pk8_quad(&b->quad8[first + i], k, p, tmaxv, &t, &u, &v)
-                                 : pk8_tri(&b->tri8[first + i], k, p, tmaxv, &t, &u, &v)) &
-                            m;
-                        done |= got;
-                        m &= ~got;
-                    }
-                }
+        for (c = 0; c < n->n_lanes && m; ++c) {
+            __m256 tn;
+            uint32_t hm = pk8_child(n, c, p, tmaxv, &tn) & m;
+            if (!hm)
+                continue;
+            if (n->count[c]) {
+                uint32_t got = pk8_leaf_occluded(b, g, n->child[c], n->count[c], p, tmaxv, hm);
+                done |= got;
+                m &= ~got;
             } else {
-                while (m) {
-                    uint32_t l = (uint32_t)__builtin_ctz(m), blocked = 0;
-                    m &= m - 1;
-                    if (count & RS_WIDE_PACKED) {
-                        ray8 r8;
-                        walk8_ray_init(&r8, p->ray[l].o, p->ray[l].d);
-                        blocked = (uint32_t)walk8_packed_occluded(b, first, count, &r8, &p->ray[l]);
-                    } else {
-                        for (i = 0; i < count && !blocked; ++i)
-                            blocked = (uint32_t)walk8_leaf_occluded(b, g, first + i, &p->ray[l],
-                                                                    NULL);
-                    }
-                    if (blocked)
-                        done |= 1u << l;
-                }
+                RS_ASSERT(sp < RS_BVH8_STACK);
+                stack[sp] = n->child[c];
+                stack_m[sp++] = (uint8_t)hm;
             }
         }
     }

@@ -261,8 +261,26 @@ RS_HD_HOT void RS_WIDE_FN(walk_closest)(const RS_WIDE_TREE *b, const rs_geom *g,
     }
 }
 
-/* Whether anything under root `root` blocks the ray inside (tmin, tmax): every lane hit pushed,
- * none sorted. */
+/* Whether a leaf (its first entry and count as a node lane holds them) blocks the ray. */
+RS_HD_HOT int RS_WIDE_FN(leaf_run_occluded)(const RS_WIDE_TREE *b, const rs_geom *g, uint32_t first,
+                                            uint32_t count, const RS_WIDE_RAY *r,
+                                            const rs_ray *ray, const rs_instance *in)
+{
+    uint32_t i;
+#ifdef RS_WIDE_TRI_HIT
+    if (count & RS_WIDE_PACKED)
+        return RS_WIDE_FN(packed_occluded)(b, first, count, r, ray);
+#else
+    (void)r;
+#endif
+    for (i = 0; i < count; ++i)
+        if (RS_WIDE_FN(leaf_occluded)(b, g, first + i, ray, in))
+            return 1;
+    return 0;
+}
+
+/* Whether anything under root `root` blocks the ray inside (tmin, tmax): the leaves among a
+ * node's lanes hit tested at once, the other lanes pushed, none sorted. */
 RS_HD_HOT int RS_WIDE_FN(walk_occluded)(const RS_WIDE_TREE *b, const rs_geom *g, uint32_t root,
                                         const RS_WIDE_RAY *r, const rs_ray *ray,
                                         const rs_instance *in)
@@ -276,26 +294,31 @@ RS_HD_HOT int RS_WIDE_FN(walk_occluded)(const RS_WIDE_TREE *b, const rs_geom *g,
             const RS_WIDE_NODE *n = &b->nodes[ref];
             RS_WIDE_TN tnv;
             uint32_t mask = RS_WIDE_FN(lanes)(n, r, in != NULL, ray->tmin, ray->tmax, &tnv);
+            /* the leaves hit first, now: a shadow ray is blocked in a leaf, and a node pushed
+             * may never need its visit (docs/traversal.md, "Leaves first for any hit") */
+            uint32_t leaves = 0, l;
+            for (l = 0; l < RS_WIDE_W; ++l)
+                leaves |= (uint32_t)(n->count[l] != 0) << l;
+            leaves &= mask;
+            mask &= ~leaves;
+            while (leaves) {
+                l = (uint32_t)__builtin_ctz(leaves);
+                leaves &= leaves - 1;
+                if (RS_WIDE_FN(leaf_run_occluded)(b, g, n->child[l], n->count[l], r, ray, in))
+                    return 1;
+            }
             while (mask) {
-                uint32_t l = (uint32_t)__builtin_ctz(mask);
+                l = (uint32_t)__builtin_ctz(mask);
                 mask &= mask - 1;
                 RS_ASSERT(sp < RS_WIDE_STACK);
                 stack[sp++] = RS_WIDE_REF(n, ref, l);
             }
         } else {
+            /* a leaf entry as the root */
             const RS_WIDE_NODE *n = &b->nodes[(ref & ~RS_WIDE_LEAF) >> RS_WIDE_SHIFT];
-            uint32_t lane = ref & (RS_WIDE_W - 1u), first = n->child[lane], count = n->count[lane];
-            uint32_t i;
-#ifdef RS_WIDE_TRI_HIT
-            if (count & RS_WIDE_PACKED) {
-                if (RS_WIDE_FN(packed_occluded)(b, first, count, r, ray))
-                    return 1;
-                continue;
-            }
-#endif
-            for (i = 0; i < count; ++i)
-                if (RS_WIDE_FN(leaf_occluded)(b, g, first + i, ray, in))
-                    return 1;
+            uint32_t lane = ref & (RS_WIDE_W - 1u);
+            if (RS_WIDE_FN(leaf_run_occluded)(b, g, n->child[lane], n->count[lane], r, ray, in))
+                return 1;
         }
     }
     return 0;
