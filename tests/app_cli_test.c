@@ -126,6 +126,8 @@ static void test_usage_errors(void **state)
          {"--integrator", "bdpt"}},
         {{"render", "-o", "out.png", "--spp", "1", "--cpu-strategy", "guided", NULL},
          {"--cpu-strategy", "guided"}},
+        {{"render", "-o", "out.png", "--spp", "1", "--cpu-walk", "pairs", NULL},
+         {"--cpu-walk", "pairs"}},
         {{"render", "-o", "out.png", "--spp", "1", "--integrator", "megakernel", "--devices",
           "cpu,gpu", NULL},
          {"megakernel", "one device"}},
@@ -826,6 +828,12 @@ static void test_threads_and_chunks_change_nothing(void **state)
          "--integrator", "megakernel", "--cpu-strategy", "columns", "-o", "mk.exr", NULL},
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
          "--cpu-strategy", "tasks", "--no-bvh", "-o", "nb.exr", NULL},
+        /* the CPU's waves walking the 8-wide tree eight rays at a time, or one (the same hits;
+         * the 4-wide tree where the CPU has no AVX2) */
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2",
+         "--cpu-walk", "packets", "-o", "pk.exr", NULL},
+        {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "1",
+         "--cpu-walk", "single", "-o", "sg.exr", NULL},
         /* the LBVH with its sort on the GPU (here: a warning, then the host's): the same tree */
         {"render", "--width", "40", "--height", "40", "--spp", "8", "-q", "--threads", "2", "--bvh",
          "lbvh", "--bvh-device", "gpu", "-o", "lg.exr", NULL},
