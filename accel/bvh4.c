@@ -23,7 +23,8 @@ static void set_box(void *node, uint32_t i, const rs_bvh_node *l)
 
 static const rs_wide_layout layout = {
     "4-wide BVH", 4, RS_BVH4_MAX_NODES, sizeof(rs_bvh4_node), offsetof(rs_bvh4_node, child),
-    offsetof(rs_bvh4_node, count), offsetof(rs_bvh4_node, n_lanes), sizeof(rs_bvh4_tri4),
+    offsetof(rs_bvh4_node, count), offsetof(rs_bvh4_node, n_lanes),
+    offsetof(rs_bvh4_node, leaf_mask), sizeof(rs_bvh4_tri4),
     sizeof(rs_bvh4_quad4), set_box};
 
 rs_status rs_bvh4_build(const rs_bvh *b, const rs_geom *g, rs_bvh4 **out)

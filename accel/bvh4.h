@@ -46,7 +46,7 @@ typedef struct rs_bvh4_node {
     uint32_t child[4];
     uint16_t count[4];
     uint32_t n_lanes;
-    uint32_t pad_;
+    uint32_t leaf_mask; /* bit i: lane i is a leaf (count[i] != 0) */
 } rs_bvh4_node;
 
 typedef struct rs_bvh4_tri4 {

@@ -24,7 +24,8 @@ static void set_box(void *node, uint32_t i, const rs_bvh_node *l)
 
 static const rs_wide_layout layout = {
     "8-wide BVH", 8, RS_BVH8_MAX_NODES, sizeof(rs_bvh8_node), offsetof(rs_bvh8_node, child),
-    offsetof(rs_bvh8_node, count), offsetof(rs_bvh8_node, n_lanes), sizeof(rs_bvh8_tri8),
+    offsetof(rs_bvh8_node, count), offsetof(rs_bvh8_node, n_lanes),
+    offsetof(rs_bvh8_node, leaf_mask), sizeof(rs_bvh8_tri8),
     sizeof(rs_bvh8_quad8), set_box};
 
 rs_status rs_bvh8_build(const rs_bvh *b, const rs_geom *g, rs_bvh8 **out)

@@ -37,7 +37,8 @@ typedef struct rs_bvh8_node {
     uint32_t child[8];
     uint16_t count[8];
     uint32_t n_lanes;
-    uint32_t pad_[3];
+    uint32_t leaf_mask; /* bit i: lane i is a leaf (count[i] != 0) */
+    uint32_t pad_[2];
 } rs_bvh8_node;
 
 /* Packed leaves' blocks: rs_bvh4_tri4 and rs_bvh4_quad4 with eight lanes (320 and 416 bytes). */

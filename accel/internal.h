@@ -101,13 +101,14 @@ rs_status rs_bvh_wide_plan(const rs_bvh *b, rs_leaf_packer *p, const char *what,
                            uint32_t max_nodes, uint32_t *cap_nodes);
 
 /* A wide tree's node layout, for the collapse below: bytes per node, where its child[width],
- * count[width] and n_lanes fields lie, and how a lane's box is written (l NULL: an unused lane,
- * which no ray may enter); the block sizes of its triangle and parallelogram blocks. */
+ * count[width], n_lanes and leaf_mask fields lie, and how a lane's box is written (l NULL: an
+ * unused lane, which no ray may enter); the block sizes of its triangle and parallelogram
+ * blocks. */
 #define RS_WIDE_MAX 8u
 typedef struct rs_wide_layout {
     const char *what; /* "4-wide BVH", for messages */
     uint32_t width, max_nodes;
-    size_t node_size, child_offset, count_offset, n_lanes_offset;
+    size_t node_size, child_offset, count_offset, n_lanes_offset, leaf_mask_offset;
     size_t tri_size, quad_size;
     void (*set_box)(void *node, uint32_t lane, const rs_bvh_node *l);
 } rs_wide_layout;

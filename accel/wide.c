@@ -245,6 +245,12 @@ static uint32_t collapse_node(collapse *c, uint32_t src, uint32_t dst)
                 (uint32_t)rs_leaf_lane(&c->pk, &bn[lanes[i]], &child[i], &count[i]);
         }
     }
+    {
+        uint32_t leaves = 0;
+        for (i = 0; i < n; ++i)
+            leaves |= (uint32_t)(count[i] != 0) << i;
+        *(uint32_t *)(void *)(d + c->L->leaf_mask_offset) = leaves;
+    }
     for (i = 0; i < n; ++i) {
         if (bn[lanes[i]].count == 0) {
             uint32_t next = c->out->n_nodes++, below;

@@ -296,10 +296,7 @@ RS_HD_HOT int RS_WIDE_FN(walk_occluded)(const RS_WIDE_TREE *b, const rs_geom *g,
             uint32_t mask = RS_WIDE_FN(lanes)(n, r, in != NULL, ray->tmin, ray->tmax, &tnv);
             /* the leaves hit first, now: a shadow ray is blocked in a leaf, and a node pushed
              * may never need its visit (docs/traversal.md, "Leaves first for any hit") */
-            uint32_t leaves = 0, l;
-            for (l = 0; l < RS_WIDE_W; ++l)
-                leaves |= (uint32_t)(n->count[l] != 0) << l;
-            leaves &= mask;
+            uint32_t leaves = n->leaf_mask & mask, l;
             mask &= ~leaves;
             while (leaves) {
                 l = (uint32_t)__builtin_ctz(leaves);
