@@ -126,22 +126,25 @@ static inline void walk8_tn_store(float tn[8], const __m256 *v) { _mm256_storeu_
 #  define MUL(a, b)    _mm256_mul_ps(a, b)
 #  define AND(a, b)    _mm256_and_ps(a, b)
 
-/* rs_bvh4_tri4_hit on eight triangles: rs_isect_tri's operations in its order. */
-static inline uint32_t tri8_hit(const rs_bvh8_tri8 *b, const ray8 *r, float tmin, float tmax,
-                                float t[8], float u[8], float v[8])
+/* rs_isect_tri's operations in its order on eight (triangle, ray) pairs: lane i tests triangle
+ * (v0, e1, e2)[i] against ray (o, d)[i] inside (tmin, tmax)[i].  A block against one ray
+ * broadcasts the ray, a packet against one triangle broadcasts the triangle: the same arithmetic
+ * either way, so the same bits.  The mask of lanes hit, and t, u, v per lane. */
+static inline uint32_t tri_test8(const __m256 v0[3], const __m256 e1[3], const __m256 e2[3],
+                                 const __m256 o[3], const __m256 d[3], __m256 tmin, __m256 tmax,
+                                 __m256 *t, __m256 *u, __m256 *v)
 {
-    __m256 e1x = LD(b->e1[0]), e1y = LD(b->e1[1]), e1z = LD(b->e1[2]);
-    __m256 e2x = LD(b->e2[0]), e2y = LD(b->e2[1]), e2z = LD(b->e2[2]);
-    __m256 dx = r->d[0], dy = r->d[1], dz = r->d[2];
+    __m256 e1x = e1[0], e1y = e1[1], e1z = e1[2], e2x = e2[0], e2y = e2[1], e2z = e2[2];
+    __m256 dx = d[0], dy = d[1], dz = d[2];
     __m256 px = SUB(MUL(dy, e2z), MUL(dz, e2y));
     __m256 py = SUB(MUL(dz, e2x), MUL(dx, e2z));
     __m256 pz = SUB(MUL(dx, e2y), MUL(dy, e2x));
     __m256 det = ADD(ADD(MUL(e1x, px), MUL(e1y, py)), MUL(e1z, pz));
     __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     __m256 inv = _mm256_div_ps(one, det);
-    __m256 sx = SUB(r->o[0], LD(b->v0[0]));
-    __m256 sy = SUB(r->o[1], LD(b->v0[1]));
-    __m256 sz = SUB(r->o[2], LD(b->v0[2]));
+    __m256 sx = SUB(o[0], v0[0]);
+    __m256 sy = SUB(o[1], v0[1]);
+    __m256 sz = SUB(o[2], v0[2]);
     __m256 bu = MUL(ADD(ADD(MUL(sx, px), MUL(sy, py)), MUL(sz, pz)), inv);
     __m256 qx = SUB(MUL(sy, e1z), MUL(sz, e1y));
     __m256 qy = SUB(MUL(sz, e1x), MUL(sx, e1z));
@@ -151,49 +154,82 @@ static inline uint32_t tri8_hit(const rs_bvh8_tri8 *b, const ray8 *r, float tmin
     __m256 ok = CMP_NE(det, zero);
     ok = AND(ok, AND(CMP_GE(bu, zero), CMP_LE(bu, one)));
     ok = AND(ok, AND(CMP_GE(bv, zero), CMP_LE(ADD(bu, bv), one)));
-    ok = AND(ok, AND(CMP_GT(tt, _mm256_set1_ps(tmin)), CMP_LT(tt, _mm256_set1_ps(tmax))));
-    _mm256_storeu_ps(t, tt);
-    _mm256_storeu_ps(u, bu);
-    _mm256_storeu_ps(v, bv);
+    ok = AND(ok, AND(CMP_GT(tt, tmin), CMP_LT(tt, tmax)));
+    *t = tt;
+    *u = bu;
+    *v = bv;
     return (uint32_t)_mm256_movemask_ps(ok);
 }
 
-/* rs_bvh4_quad4_hit on eight parallelograms: rs_isect_quad's operations in its order. */
+/* rs_isect_quad's operations in its order on eight (parallelogram, ray) pairs, as tri_test8:
+ * parallelogram (q, u, v, w)[i] against ray (o, d)[i].  The mask of lanes hit, t, a, b. */
+static inline uint32_t quad_test8(const __m256 q[3], const __m256 u[3], const __m256 v[3],
+                                  const __m256 w[3], const __m256 o[3], const __m256 d[3],
+                                  __m256 tmin, __m256 tmax, __m256 *t, __m256 *a, __m256 *bb)
+{
+    __m256 wx = w[0], wy = w[1], wz = w[2];
+    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    __m256 denom = ADD(ADD(MUL(wx, d[0]), MUL(wy, d[1])), MUL(wz, d[2]));
+    __m256 ox = SUB(q[0], o[0]), oy = SUB(q[1], o[1]), oz = SUB(q[2], o[2]);
+    __m256 num = ADD(ADD(MUL(wx, ox), MUL(wy, oy)), MUL(wz, oz));
+    __m256 tt = _mm256_div_ps(num, denom);
+    __m256 ok = AND(CMP_NE(denom, zero), AND(CMP_GT(tt, tmin), CMP_LT(tt, tmax)));
+    __m256 hx, hy, hz, cx, cy, cz, al, ex, ey, ez, be;
+    if (_mm256_movemask_ps(ok) == 0)
+        return 0;
+    hx = SUB(MUL(d[0], tt), ox);
+    hy = SUB(MUL(d[1], tt), oy);
+    hz = SUB(MUL(d[2], tt), oz);
+    cx = SUB(MUL(hy, v[2]), MUL(hz, v[1]));
+    cy = SUB(MUL(hz, v[0]), MUL(hx, v[2]));
+    cz = SUB(MUL(hx, v[1]), MUL(hy, v[0]));
+    al = ADD(ADD(MUL(wx, cx), MUL(wy, cy)), MUL(wz, cz));
+    ex = SUB(MUL(u[1], hz), MUL(u[2], hy));
+    ey = SUB(MUL(u[2], hx), MUL(u[0], hz));
+    ez = SUB(MUL(u[0], hy), MUL(u[1], hx));
+    be = ADD(ADD(MUL(wx, ex), MUL(wy, ey)), MUL(wz, ez));
+    ok = AND(ok, AND(CMP_GE(al, zero), CMP_LE(al, one)));
+    ok = AND(ok, AND(CMP_GE(be, zero), CMP_LE(be, one)));
+    *t = tt;
+    *a = al;
+    *bb = be;
+    return (uint32_t)_mm256_movemask_ps(ok);
+}
+
+/* Three rows of a block's lanes: LD3(b->v0) is {v0[0], v0[1], v0[2]} as vectors. */
+#  define LD3(x)       {LD((x)[0]), LD((x)[1]), LD((x)[2])}
+/* Lane k of three rows, broadcast. */
+#  define BC3(x, k)    {_mm256_broadcast_ss(&(x)[0][k]), _mm256_broadcast_ss(&(x)[1][k]), \
+                        _mm256_broadcast_ss(&(x)[2][k])}
+
+/* rs_bvh4_tri4_hit on eight triangles: one ray against a block. */
+static inline uint32_t tri8_hit(const rs_bvh8_tri8 *b, const ray8 *r, float tmin, float tmax,
+                                float t[8], float u[8], float v[8])
+{
+    const __m256 v0[3] = LD3(b->v0), e1[3] = LD3(b->e1), e2[3] = LD3(b->e2);
+    __m256 tv, uv, vv;
+    uint32_t m = tri_test8(v0, e1, e2, r->o, r->d, _mm256_set1_ps(tmin), _mm256_set1_ps(tmax),
+                           &tv, &uv, &vv);
+    _mm256_storeu_ps(t, tv);
+    _mm256_storeu_ps(u, uv);
+    _mm256_storeu_ps(v, vv);
+    return m;
+}
+
+/* rs_bvh4_quad4_hit on eight parallelograms: one ray against a block. */
 static inline uint32_t quad8_hit(const rs_bvh8_quad8 *b, const ray8 *r, float tmin, float tmax,
                                  float t[8], float a[8], float bb[8])
 {
-    __m256 wx = LD(b->w[0]), wy = LD(b->w[1]), wz = LD(b->w[2]);
-    __m256 qx = LD(b->q[0]), qy = LD(b->q[1]), qz = LD(b->q[2]);
-    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-    __m256 denom = ADD(ADD(MUL(wx, r->d[0]), MUL(wy, r->d[1])), MUL(wz, r->d[2]));
-    __m256 ox = SUB(qx, r->o[0]), oy = SUB(qy, r->o[1]), oz = SUB(qz, r->o[2]);
-    __m256 num = ADD(ADD(MUL(wx, ox), MUL(wy, oy)), MUL(wz, oz));
-    __m256 tt = _mm256_div_ps(num, denom);
-    __m256 ok = AND(CMP_NE(denom, zero),
-                    AND(CMP_GT(tt, _mm256_set1_ps(tmin)), CMP_LT(tt, _mm256_set1_ps(tmax))));
-    if (_mm256_movemask_ps(ok) == 0)
+    const __m256 q[3] = LD3(b->q), u[3] = LD3(b->u), v[3] = LD3(b->v), w[3] = LD3(b->w);
+    __m256 tv, av, bv;
+    uint32_t m = quad_test8(q, u, v, w, r->o, r->d, _mm256_set1_ps(tmin), _mm256_set1_ps(tmax),
+                            &tv, &av, &bv);
+    if (m == 0)
         return 0;
-    {
-        __m256 ux = LD(b->u[0]), uy = LD(b->u[1]), uz = LD(b->u[2]);
-        __m256 vx = LD(b->v[0]), vy = LD(b->v[1]), vz = LD(b->v[2]);
-        __m256 hx = SUB(MUL(r->d[0], tt), ox);
-        __m256 hy = SUB(MUL(r->d[1], tt), oy);
-        __m256 hz = SUB(MUL(r->d[2], tt), oz);
-        __m256 cx = SUB(MUL(hy, vz), MUL(hz, vy));
-        __m256 cy = SUB(MUL(hz, vx), MUL(hx, vz));
-        __m256 cz = SUB(MUL(hx, vy), MUL(hy, vx));
-        __m256 al = ADD(ADD(MUL(wx, cx), MUL(wy, cy)), MUL(wz, cz));
-        __m256 ex = SUB(MUL(uy, hz), MUL(uz, hy));
-        __m256 ey = SUB(MUL(uz, hx), MUL(ux, hz));
-        __m256 ez = SUB(MUL(ux, hy), MUL(uy, hx));
-        __m256 be = ADD(ADD(MUL(wx, ex), MUL(wy, ey)), MUL(wz, ez));
-        ok = AND(ok, AND(CMP_GE(al, zero), CMP_LE(al, one)));
-        ok = AND(ok, AND(CMP_GE(be, zero), CMP_LE(be, one)));
-        _mm256_storeu_ps(t, tt);
-        _mm256_storeu_ps(a, al);
-        _mm256_storeu_ps(bb, be);
-    }
-    return (uint32_t)_mm256_movemask_ps(ok);
+    _mm256_storeu_ps(t, tv);
+    _mm256_storeu_ps(a, av);
+    _mm256_storeu_ps(bb, bv);
+    return m;
 }
 
 /* rs_isect_sphere on eight spheres: its operations in its order (sqrt and division are
@@ -318,79 +354,21 @@ static inline uint32_t pk8_child(const rs_bvh8_node *n, uint32_t c, const pk8 *p
     }
 }
 
-/* tri8_hit with the roles swapped: triangle k of block b against the packet's eight rays. */
+/* Triangle k of block b against the packet's eight rays. */
 static inline uint32_t pk8_tri(const rs_bvh8_tri8 *b, uint32_t k, const pk8 *p, __m256 tmaxv,
                                __m256 *t, __m256 *u, __m256 *v)
 {
-    __m256 e1x = _mm256_broadcast_ss(&b->e1[0][k]), e1y = _mm256_broadcast_ss(&b->e1[1][k]);
-    __m256 e1z = _mm256_broadcast_ss(&b->e1[2][k]), e2x = _mm256_broadcast_ss(&b->e2[0][k]);
-    __m256 e2y = _mm256_broadcast_ss(&b->e2[1][k]), e2z = _mm256_broadcast_ss(&b->e2[2][k]);
-    __m256 dx = p->d[0], dy = p->d[1], dz = p->d[2];
-    __m256 px = SUB(MUL(dy, e2z), MUL(dz, e2y));
-    __m256 py = SUB(MUL(dz, e2x), MUL(dx, e2z));
-    __m256 pz = SUB(MUL(dx, e2y), MUL(dy, e2x));
-    __m256 det = ADD(ADD(MUL(e1x, px), MUL(e1y, py)), MUL(e1z, pz));
-    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-    __m256 inv = _mm256_div_ps(one, det);
-    __m256 sx = SUB(p->o[0], _mm256_broadcast_ss(&b->v0[0][k]));
-    __m256 sy = SUB(p->o[1], _mm256_broadcast_ss(&b->v0[1][k]));
-    __m256 sz = SUB(p->o[2], _mm256_broadcast_ss(&b->v0[2][k]));
-    __m256 bu = MUL(ADD(ADD(MUL(sx, px), MUL(sy, py)), MUL(sz, pz)), inv);
-    __m256 qx = SUB(MUL(sy, e1z), MUL(sz, e1y));
-    __m256 qy = SUB(MUL(sz, e1x), MUL(sx, e1z));
-    __m256 qz = SUB(MUL(sx, e1y), MUL(sy, e1x));
-    __m256 bv = MUL(ADD(ADD(MUL(dx, qx), MUL(dy, qy)), MUL(dz, qz)), inv);
-    __m256 tt = MUL(ADD(ADD(MUL(e2x, qx), MUL(e2y, qy)), MUL(e2z, qz)), inv);
-    __m256 ok = CMP_NE(det, zero);
-    ok = AND(ok, AND(CMP_GE(bu, zero), CMP_LE(bu, one)));
-    ok = AND(ok, AND(CMP_GE(bv, zero), CMP_LE(ADD(bu, bv), one)));
-    ok = AND(ok, AND(CMP_GT(tt, p->tmin), CMP_LT(tt, tmaxv)));
-    *t = tt;
-    *u = bu;
-    *v = bv;
-    return (uint32_t)_mm256_movemask_ps(ok);
+    const __m256 v0[3] = BC3(b->v0, k), e1[3] = BC3(b->e1, k), e2[3] = BC3(b->e2, k);
+    return tri_test8(v0, e1, e2, p->o, p->d, p->tmin, tmaxv, t, u, v);
 }
 
-/* quad8_hit with the roles swapped: parallelogram k of block b against the packet's rays. */
+/* Parallelogram k of block b against the packet's eight rays. */
 static inline uint32_t pk8_quad(const rs_bvh8_quad8 *b, uint32_t k, const pk8 *p, __m256 tmaxv,
                                 __m256 *t, __m256 *a, __m256 *bb)
 {
-    __m256 wx = _mm256_broadcast_ss(&b->w[0][k]), wy = _mm256_broadcast_ss(&b->w[1][k]);
-    __m256 wz = _mm256_broadcast_ss(&b->w[2][k]);
-    __m256 qx = _mm256_broadcast_ss(&b->q[0][k]), qy = _mm256_broadcast_ss(&b->q[1][k]);
-    __m256 qz = _mm256_broadcast_ss(&b->q[2][k]);
-    __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-    __m256 denom = ADD(ADD(MUL(wx, p->d[0]), MUL(wy, p->d[1])), MUL(wz, p->d[2]));
-    __m256 ox = SUB(qx, p->o[0]), oy = SUB(qy, p->o[1]), oz = SUB(qz, p->o[2]);
-    __m256 num = ADD(ADD(MUL(wx, ox), MUL(wy, oy)), MUL(wz, oz));
-    __m256 tt = _mm256_div_ps(num, denom);
-    __m256 ok = AND(CMP_NE(denom, zero), AND(CMP_GT(tt, p->tmin), CMP_LT(tt, tmaxv)));
-    __m256 ux, uy, uz, vx, vy, vz, hx, hy, hz, cx, cy, cz, al, ex, ey, ez, be;
-    if (_mm256_movemask_ps(ok) == 0)
-        return 0;
-    ux = _mm256_broadcast_ss(&b->u[0][k]);
-    uy = _mm256_broadcast_ss(&b->u[1][k]);
-    uz = _mm256_broadcast_ss(&b->u[2][k]);
-    vx = _mm256_broadcast_ss(&b->v[0][k]);
-    vy = _mm256_broadcast_ss(&b->v[1][k]);
-    vz = _mm256_broadcast_ss(&b->v[2][k]);
-    hx = SUB(MUL(p->d[0], tt), ox);
-    hy = SUB(MUL(p->d[1], tt), oy);
-    hz = SUB(MUL(p->d[2], tt), oz);
-    cx = SUB(MUL(hy, vz), MUL(hz, vy));
-    cy = SUB(MUL(hz, vx), MUL(hx, vz));
-    cz = SUB(MUL(hx, vy), MUL(hy, vx));
-    al = ADD(ADD(MUL(wx, cx), MUL(wy, cy)), MUL(wz, cz));
-    ex = SUB(MUL(uy, hz), MUL(uz, hy));
-    ey = SUB(MUL(uz, hx), MUL(ux, hz));
-    ez = SUB(MUL(ux, hy), MUL(uy, hx));
-    be = ADD(ADD(MUL(wx, ex), MUL(wy, ey)), MUL(wz, ez));
-    ok = AND(ok, AND(CMP_GE(al, zero), CMP_LE(al, one)));
-    ok = AND(ok, AND(CMP_GE(be, zero), CMP_LE(be, one)));
-    *t = tt;
-    *a = al;
-    *bb = be;
-    return (uint32_t)_mm256_movemask_ps(ok);
+    const __m256 q[3] = BC3(b->q, k), u[3] = BC3(b->u, k), v[3] = BC3(b->v, k),
+                 w[3] = BC3(b->w, k);
+    return quad_test8(q, u, v, w, p->o, p->d, p->tmin, tmaxv, t, a, bb);
 }
 
 /* Lanes `m` of a primitive test's answers, each taken if better (rs_hit_better), the lane's ray
