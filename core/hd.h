@@ -21,7 +21,9 @@
 
 /* RS_HD_HOT: a function called once per path vertex that must stay inlined in its caller (the
  * shading loop): kept out of line, rs_shade_next_event cost the Cornell box 15% more shading
- * instructions. */
+ * instructions, and rs_light_sample_one, rs_bsdf_sample and rs_bsdf_pdf_side 6% of its time (a
+ * vector of three floats passed by value is stored in two pieces and read back in one: the load
+ * waits for both stores, a store-forwarding stall at each call). */
 #if defined(__CUDACC__)
 #  define RS_HD_HOT      static __forceinline__ __host__ __device__
 #elif defined(__GNUC__)

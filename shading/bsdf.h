@@ -309,8 +309,8 @@ RS_HD rs_vec3 rs_bsdf_eval(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_v
 }
 
 /* The pdf with which rs_bsdf_sample draws wi (non-delta materials). */
-RS_HD float rs_bsdf_pdf_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
-                             rs_vec3 wi, int front)
+RS_HD_HOT float rs_bsdf_pdf_side(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                                 rs_vec3 wi, int front)
 {
     float ci = rs_v3_dot(n, wi);
     if (m->type >= RS_MAT_CONDUCTOR)
@@ -462,8 +462,8 @@ RS_HD_COLD int rs_bsdf_sample_ggx(const rs_material *m, rs_vec3 albedo, rs_vec3 
 
 /* Draws wi for wo from three uniform numbers.  Returns 0 when the sample carries nothing (below
  * the surface, absorbed): the path ends there. */
-RS_HD int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo, int front,
-                         float u1, float u2, float u3, rs_scatter *out)
+RS_HD_HOT int rs_bsdf_sample(const rs_material *m, rs_vec3 albedo, rs_vec3 n, rs_vec3 wo,
+                             int front, float u1, float u2, float u3, rs_scatter *out)
 {
     rs_onb frame;
     rs_vec3 f;

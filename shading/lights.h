@@ -169,8 +169,8 @@ RS_HD int rs_light_sample_env(const rs_scene *s, rs_vec3 x, rs_vec3 n_x, float e
     return 1;
 }
 
-RS_HD int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
-                              rs_vec3 x, float time, float u1, float u2, rs_light_sample *out);
+RS_HD_HOT int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
+                                  rs_vec3 x, float time, float u1, float u2, rs_light_sample *out);
 
 /* Samples a light of `subset` (RS_LIGHTS_*) as seen from x at `time` on a surface with unit
  * normal n_x (zero: none; a uniform sky is sampled about it, shading/envmap.h); the pdf is relative
@@ -213,8 +213,8 @@ RS_HD int rs_light_sample_from(const rs_scene *s, int subset, rs_vec3 x, rs_vec3
 /* A point on light l, picked with probability `pick` (times inv_mass: relative to a subset),
  * as seen from x at `time`: out's direction, distance, radiance and pdf (pick included).  0
  * when the sample is degenerate. */
-RS_HD int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
-                              rs_vec3 x, float time, float u1, float u2, rs_light_sample *out)
+RS_HD_HOT int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, float inv_mass,
+                                  rs_vec3 x, float time, float u1, float u2, rs_light_sample *out)
 {
     const rs_light *lt = &s->lights[l];
     uint32_t prim = lt->prim;

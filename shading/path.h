@@ -656,7 +656,9 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
     if (bounce + 1 >= it->max_depth)
         return out;
     v.front = rs_v3_dot(v.ng, r.d) < 0.0f;
-    v.n_geo = v.front ? v.ng : rs_v3_neg(v.ng);
+    /* a sign, not a branch: which side a ray meets is unpredictable (a wall's winding), and
+     * x * -1 is -x exactly */
+    v.n_geo = rs_v3_scale(v.ng, v.front ? 1.0f : -1.0f);
     v.wo = rs_v3_neg(r.d);
     v.n = rs_shading_normal(sc, v.prim, h->u, h->v, v.n_geo, v.wo);
     if (v.m->type >= RS_MAT_CONDUCTOR && v.m->normal_tex != RS_NO_TEXTURE)
