@@ -2,6 +2,7 @@
  * integrator.h); the
  * estimators themselves are shading/path.h's. */
 #include "shading/integrator.h"
+#include "shading/shade_wide.h"
 
 #include <string.h>
 
@@ -144,7 +145,10 @@ typedef struct shade_ctx {
     rs_paths *paths;
     rs_ray_soa *next, *shadow;
     const rs_stream_runs *runs;
+    int wide; /* rs_shade_wide_ready */
 } shade_ctx;
+
+#define RS_NO_WIDE 0xffffffffu
 
 /* Shades the entries [begin, end) in order; their next rays go packed to next[begin ...] and
  * their shadow rays to shadow[begin ...], the counts to the range's run record. */
@@ -156,20 +160,49 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
     uint32_t b, k, on = begin, os = begin;
     for (b = begin; b < end; b += BATCH) {
         uint32_t n = end - b < BATCH ? end - b : BATCH;
-        uint32_t pixel[BATCH], sample[BATCH];
-        rs_rng_f4 rb[BATCH], rl[BATCH], pre[2];
+        uint32_t pixel[BATCH], sample[BATCH], wide_at[BATCH], wide_j[BATCH], nw;
+        rs_rng_f4 rb[BATCH], rl[BATCH], pre[2], wide_rb[BATCH], wide_rl[BATCH];
+        rs_ray wide_next[BATCH], wide_shadow[BATCH];
+        uint8_t wide_made[BATCH];
         locate(c->map, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
         if (draws) {
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_BSDF, n, rb);
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);
         }
+        if (c->wide) {
+            /* the common vertices eight at a time (shading/shade_wide.h), the rest below */
+            nw = 0;
+            for (k = 0; k < n; ++k) {
+                wide_at[k] = RS_NO_WIDE;
+                if (rs_shade_wide_entry(c->it->scene, c->hits->prim[b + k])) {
+                    wide_at[k] = nw;
+                    wide_j[nw] = b + k;
+                    wide_rb[nw] = rb[k];
+                    wide_rl[nw] = rl[k];
+                    nw++;
+                }
+            }
+            rs_shade_wide(c->it, c->bounce, c->rays, c->hits, wide_j, nw, wide_rb, wide_rl,
+                          c->paths, wide_made, wide_next, wide_shadow);
+        }
         for (k = 0; k < n; ++k) {
             /* entry j: path p's state loaded from the SoA, shaded, stored back (rs_path_shade_at
              * changes only what the path's next stage reads) */
             uint32_t j = b + k, p = c->rays->path[j], made;
-            rs_ray r = rs_ray_soa_get(c->rays, j), nr, sr;
-            rs_hit h = rs_hit_soa_get(c->hits, j);
-            rs_path_state ps = rs_paths_load(c->paths, p);
+            rs_ray r, nr, sr;
+            rs_hit h;
+            rs_path_state ps;
+            if (c->wide && wide_at[k] != RS_NO_WIDE) {
+                uint32_t w = wide_at[k];
+                if (wide_made[w] & RS_SHADE_SHADOW)
+                    rs_ray_soa_set(c->shadow, os++, &wide_shadow[w], p);
+                if (wide_made[w] & RS_SHADE_NEXT)
+                    rs_ray_soa_set(c->next, on++, &wide_next[w], p);
+                continue;
+            }
+            r = rs_ray_soa_get(c->rays, j);
+            h = rs_hit_soa_get(c->hits, j);
+            ps = rs_paths_load(c->paths, p);
             if (draws) {
                 pre[0] = rb[k];
                 pre[1] = rl[k];
@@ -204,6 +237,7 @@ void rs_stage_shade(const rs_render_consts *it, const rs_path_map *map, const rs
     c.next = next;
     c.shadow = shadow;
     c.runs = runs;
+    c.wide = rs_shade_wide_ready(it, bounce);
     /* shading costs vary by material and by hit or miss: blocks of 512 paths, split as the
      * strategy says */
     rs_parallel_range(ex->strategy, ex->threads, 0, count, 512, shade_range, &c);
