@@ -267,7 +267,7 @@ typedef struct lane_prims {
     uint32_t quad[8];
 } lane_prims;
 
-static void gather_prim(const rs_scene *sc, uint32_t prim, lane_prims *lp, int i)
+WIDE void gather_prim(const rs_scene *sc, uint32_t prim, lane_prims *lp, int i)
 {
     uint32_t p = prim - sc->n_spheres, c;
     rs_vec3 o, a, b, w;
