@@ -2,6 +2,7 @@
 #include "scenes/light_bvh.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <string.h>
 
 #include "core/alloc.h"
@@ -9,6 +10,24 @@
 
 #define BUCKETS   12
 #define MAX_DEPTH 62
+
+/* The deepest a leaf may be (MAX_DEPTH; smaller only in the tests, which check that the bound
+ * holds, rs_light_bvh_set_depth_limit). */
+static _Atomic int g_depth_limit = MAX_DEPTH;
+
+void rs_light_bvh_set_depth_limit(int depth)
+{
+    g_depth_limit = depth < 1 ? 1 : depth > MAX_DEPTH ? MAX_DEPTH : depth;
+}
+
+/* The levels a subtree of n lights split in halves needs below its root: ceil(log2 n). */
+static int halving_levels(uint32_t n)
+{
+    int k = 0;
+    while (k < 32 && (1ull << k) < n)
+        ++k;
+    return k;
+}
 #define PI_D      3.14159265358979323846
 
 /* One light as the build sees it. */
@@ -212,7 +231,10 @@ static int build(builder *b, uint32_t begin, uint32_t end, int depth, uint64_t b
         for (k = 1; k < 3; ++k)
             if (chi[k] - clo[k] > chi[axis] - clo[axis])
                 axis = k;
-        if (depth < MAX_DEPTH - 8 && chi[axis] > clo[axis]) {
+        /* a cost split may leave all but one light on one side; it is taken only while that
+         * side could still be split in halves within the depth limit (halves: as deep as
+         * ceil(log2 n) more), so no leaf is ever deeper than the limit, whatever the lights */
+        if (depth + 1 + halving_levels(end - begin) <= g_depth_limit && chi[axis] > clo[axis]) {
             bound bk[BUCKETS];
             double best = INFINITY, scale = BUCKETS / ((double)chi[axis] - clo[axis]);
             int split = -1, j;

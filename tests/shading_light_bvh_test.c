@@ -313,6 +313,85 @@ static void test_cone_union(void **state)
     }
 }
 
+/* A scene whose cost splits are lopsided: clusters of four lights on a line, each cluster 1.1
+ * times farther out and brighter than the one before, so that a node's bright far end goes to a
+ * child of its own, level after level. */
+static rs_scene *deep_scene(void)
+{
+    rs_scene *s = NULL;
+    rs_material m;
+    uint32_t id, i;
+    assert_int_equal(rs_scene_create("deep", &s), RS_OK);
+    for (i = 0; i < 4 * 285; ++i) {
+        float c = 1e-3f * powf(1.1f, (float)(i / 4)), x = c * (1.0f + 0.002f * (float)(i % 4));
+        m = rs_mat_light(rs_v3_splat(1e-2f * powf(1.1f, (float)(i / 4))), 1);
+        assert_int_equal(rs_scene_add_material(s, &m, &id), RS_OK);
+        assert_int_equal(rs_scene_add_quad(s, rs_v3(x, 0, 0), rs_v3(0.001f * c, 0, 0),
+                                           rs_v3(0, 0, 0.001f * c), id),
+                         RS_OK);
+    }
+    if (rs_scene_finalize(s) != RS_OK)
+        fail_msg("finalize: %s", rs_error_message());
+    assert_non_null(s->light_trail);
+    return s;
+}
+
+/* The deepest light's depth (its trail's marker bit). */
+static uint32_t deepest_light(const rs_scene *s)
+{
+    uint32_t l, deepest = 0;
+    for (l = 0; l < s->n_lights; ++l) {
+        uint32_t depth;
+        assert_true(s->light_trail[l] != 0);
+        depth = 63u - (uint32_t)__builtin_clzll(s->light_trail[l]);
+        deepest = depth > deepest ? depth : deepest;
+    }
+    return deepest;
+}
+
+/* The tree's depth stays within its limit whatever the lights (the 64-bit trails hold 62
+ * levels): with the default limit, and with a limit of 14 that the lopsided scene's cost splits
+ * alone would pass three times over; the pick probabilities the trails give still sum to 1 and
+ * match what the picker returns. */
+static void test_depth_bounded(void **state)
+{
+    static const int limits[] = {62, 14};
+    size_t c;
+    (void)state;
+    for (c = 0; c < sizeof limits / sizeof limits[0]; ++c) {
+        rs_scene *s;
+        uint32_t deepest, l;
+        int k;
+        rs_light_bvh_set_depth_limit(limits[c]);
+        s = deep_scene();
+        deepest = deepest_light(s);
+        print_message("%u lights, depth limit %d: the deepest at depth %u\n", s->n_lights,
+                      limits[c], deepest);
+        assert_true(deepest <= (uint32_t)limits[c]);
+        assert_true(deepest >= 11); /* ceil(log2 1140) */
+        if (limits[c] == 62)
+            assert_true(deepest > 40); /* the cost splits did go deep */
+        for (k = 0; k < 20; ++k) {
+            float along = 1e-3f * powf(1.1f, 285.0f * rnd());
+            rs_vec3 x = rs_v3(along, 1.0f + 5.0f * rnd(), rnd() - 0.5f);
+            double sum = 0;
+            int j;
+            for (l = 0; l < s->n_lights; ++l)
+                sum += rs_light_bvh_pmf(s, x, l);
+            if (!(fabs(sum - 1.0) < 1e-4))
+                fail_msg("point %d: the pick probabilities sum to %.6f", k, sum);
+            for (j = 0; j < 20; ++j) {
+                uint32_t got = 0;
+                float pm;
+                if (rs_light_bvh_pick(s, x, rnd(), &got, &pm))
+                    assert_true(pm == rs_light_bvh_pmf(s, x, got));
+            }
+        }
+        rs_scene_destroy(s);
+    }
+    rs_light_bvh_set_depth_limit(62);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -320,6 +399,7 @@ int main(void)
         cmocka_unit_test(test_pmf),
         cmocka_unit_test(test_chi_square),
         cmocka_unit_test(test_cone_union),
+        cmocka_unit_test(test_depth_bounded),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
