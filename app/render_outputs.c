@@ -299,11 +299,15 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
 {
     rs_report rep;
     char timeline_inner[RS_OUTPUT_PATH_MAX + 8];
-    int i, ok = 1, replaced = 0, undenoised = 0;
+    int i, ok = 1, replaced = 0, undenoised = 0, skipped = 0;
     rs_film_resolve(r->film, r->rgb);
     /* a denoise that still fails after the render (checked before it: rs_denoise_probe) loses
-     * nothing: the outputs are written with the image as rendered, then the failure reported */
-    if (o->denoise && !denoise(r))
+     * nothing: the outputs are written with the image as rendered, then the failure reported.
+     * After Ctrl-C the samples so far are written at once, as rendered: an interrupt asks to
+     * stop, not for seconds more of the denoiser on an image cut short */
+    if (o->denoise && r->interrupted)
+        skipped = 1;
+    else if (o->denoise && !denoise(r))
         undenoised = 1;
     make_report(o, r, &rep);
     if (o->stats)
@@ -331,6 +335,9 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
         return RS_EXIT_RUNTIME;
     }
     rs_report_print_summary(&rep);
+    if (skipped)
+        fprintf(stderr, "raystream: interrupted: %s was written as rendered, not denoised\n",
+                r->out);
     if (undenoised) {
         fprintf(stderr, "raystream: --denoise failed after the render: %s was written as "
                         "rendered, not denoised\n",

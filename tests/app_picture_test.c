@@ -397,6 +397,29 @@ static void test_denoise(void **state)
                "a late denoise failure lost the image or the checkpoint");
         proc_free(&p);
     }
+    {
+        /* Ctrl-C: the samples so far are written at once as rendered, not denoised (issue 41:
+         * the denoiser ran after the interrupt; here it would fail as it ran, status 1) */
+        static const char *const stop[] = {"render", "--denoise", "--width", "64", "--height",
+                                           "64", "--spp", "1000000", "-o", "stopped.png", NULL};
+        int i;
+        setenv("RS_OIDN_LIBRARY", RS_FAKE_OIDN, 1);
+        setenv("FAKE_OIDN_LATE", "1", 1);
+        proc_start(&p, f->dir, stop);
+        unsetenv("FAKE_OIDN_LATE");
+        unsetenv("RS_OIDN_LIBRARY");
+        for (i = 0; i < 15; ++i) /* its handlers installed, rendering */
+            proc_pump(&p, 100);
+        assert_int_equal(kill(p.pid, SIGINT), 0);
+        proc_finish(&p, DEFAULT_TIMEOUT_S);
+        path_in(f, "stopped.png", path, sizeof path);
+        EXPECT(&p, exited_with(&p, 128 + SIGINT), "Ctrl-C with --denoise: not status 130");
+        EXPECT(&p, strstr(p.err.data, "not denoised") && !strstr(p.err.data, "failed as it ran"),
+               "Ctrl-C with --denoise: the denoiser ran, or the skip was not said: %s",
+               p.err.data);
+        EXPECT(&p, file_exists(path), "Ctrl-C with --denoise lost the image");
+        proc_free(&p);
+    }
 }
 
 /* A corrupt PNG texture of a glTF file, beside it or as a data: URI: one line of ours, no
