@@ -616,6 +616,17 @@ static void test_albedo_ggx(void **state)
     m.coat_alpha = 0.09f;
     worst = check_albedo("pbr black, coat 1 r .3", &m, 1.0, -1.0, -1.0, 909);
     assert_true(worst > 0.5); /* grazing: Fc near 1 */
+    {
+        /* head on, Fc is the coat's F0, 0.04 (ior 1.5): over black the coat reflects 0.04 times
+         * its GGX term's albedo (at most 1, near it for a smooth coat), which the bounds above
+         * cannot tell from 0.4 (issue 41: F0 0.40 passed every test) */
+        uint64_t sd = 913;
+        rs_vec3 n, wo = wo_at(&sd, 1.0, &n);
+        estimate e = albedo_mc(&m, n, wo, &sd, ALBEDO_N);
+        print_message("pbr black, coat 1 r .3, head on: rho %.5f (0.04 x the coat's albedo)\n",
+                      e.mean);
+        assert_true(e.mean > 0.035 && e.mean <= 0.04 + Z_SIG * e.se + 1e-5);
+    }
     m = rs_mat_pbr(rs_v3_splat(1.0f), 0.0f, 0.5f);
     m.coat = 1.0f;
     m.coat_alpha = 0.09f;

@@ -313,6 +313,38 @@ static void test_cone_union(void **state)
     }
 }
 
+/* Two equal lights facing a point straight on, one 1 and one 3 away: their importances are
+ * power x cos / distance^2 (Conty and Kulla), so the near one is picked 9 times as often as the
+ * far one (issue 41: the importance without its 1 / d^2 passed every other test here). */
+static void test_inverse_square(void **state)
+{
+    rs_scene *s = NULL;
+    rs_material m = rs_mat_light(rs_v3(2, 2, 2), 0);
+    rs_vec3 x = rs_v3(0.3f, -0.2f, 0.1f);
+    uint32_t id;
+    float p0, p1;
+    (void)state;
+    assert_int_equal(rs_scene_create("two", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &m, &id), RS_OK);
+    /* small squares centred above x, u x v pointing down at it */
+    assert_int_equal(rs_scene_add_quad(s, rs_v3(x.x - 0.01f, x.y + 1.0f, x.z - 0.01f),
+                                       rs_v3(0.02f, 0, 0), rs_v3(0, 0, 0.02f), id),
+                     RS_OK);
+    assert_int_equal(rs_scene_add_quad(s, rs_v3(x.x - 0.01f, x.y + 3.0f, x.z - 0.01f),
+                                       rs_v3(0.02f, 0, 0), rs_v3(0, 0, 0.02f), id),
+                     RS_OK);
+    assert_int_equal(rs_scene_finalize(s), RS_OK);
+    assert_int_equal(s->n_lights, 2);
+    assert_non_null(s->light_trail);
+    p0 = rs_light_bvh_pmf(s, x, 0);
+    p1 = rs_light_bvh_pmf(s, x, 1);
+    print_message("lights 1 and 3 away: picked with %.5f and %.5f (ratio %.4f, 9 expected)\n",
+                  (double)p0, (double)p1, (double)(p0 / p1));
+    assert_true(fabs(p0 + p1 - 1.0) < 1e-5);
+    assert_true(fabs(p0 / p1 - 9.0) < 0.01);
+    rs_scene_destroy(s);
+}
+
 /* A scene whose cost splits are lopsided: clusters of four lights on a line, each cluster 1.1
  * times farther out and brighter than the one before, so that a node's bright far end goes to a
  * child of its own, level after level. */
@@ -400,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_chi_square),
         cmocka_unit_test(test_cone_union),
         cmocka_unit_test(test_depth_bounded),
+        cmocka_unit_test(test_inverse_square),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
