@@ -417,7 +417,7 @@ static int dist_run_adaptive(const rs_cli_options *o, render_run *r, const rs_di
     dr.job.user = &dr;
     dr.job.progress = round_progress;
     dr.t0 = rs_now_s();
-    a.threshold = r->adaptive_t = o->adaptive;
+    a.threshold = o->adaptive;
     a.min_spp = o->adaptive_min_spp;
     memset(&hooks, 0, sizeof hooks);
     hooks.progress = on_dist_progress;

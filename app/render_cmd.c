@@ -395,7 +395,7 @@ static rs_status engine_run(const rs_cli_options *o, render_run *r, const rs_ren
     rs_status rst;
     if (o->adaptive > 0) {
         rs_adaptive a;
-        a.threshold = r->adaptive_t = o->adaptive;
+        a.threshold = o->adaptive;
         a.min_spp = o->adaptive_min_spp;
         rst = rs_adaptive_run(r->engine, &a, &r->ad, hooks, r->film, &r->stats);
         r->adaptive = r->ad.stats;

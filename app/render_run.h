@@ -50,7 +50,6 @@ typedef struct render_run {
     rs_render_stats stats;
     rs_adaptive_stats adaptive; /* --adaptive: rounds, samples, pixels stopped */
     rs_adaptive_state ad;       /* --adaptive: where it stands (a checkpoint saves it) */
-    double adaptive_t;          /* --adaptive's threshold, 0: off */
     char name[64];              /* the scene's stem: default output name */
     char gltf_extensions[512];  /* a glTF file's extensions that raystream read (summary) */
     char lighting[160];         /* how the scene is lit when its file says nothing (a glTF

@@ -18,7 +18,9 @@
  *
  * Thread safety: `trace` is only called from the device's dispatch thread, `upload_scene` and
  * `render_pass` only from the render thread, never both in one render.  `stats` is written by
- * the scheduler under its lock; read it after rs_sched_destroy or through rs_sched_device_stats
+ * the scheduler under its lock (rays, chunks, busy and idle time) and by the device itself
+ * inside the calls above (the bytes it copied: the GPU devices and the fallback, from the one
+ * thread that calls them); read it after rs_sched_destroy or through rs_sched_device_stats
  * (scheduler/sched.h). */
 #ifndef RS_SCHEDULER_DEVICE_H
 #define RS_SCHEDULER_DEVICE_H

@@ -1,6 +1,8 @@
 /* shading/film.h — the image being accumulated: per pixel, the sum of sample radiances and the
- * number of samples.  A pixel's value is the mean (a box filter over the pixel, since samples are
- * jittered uniformly inside it).
+ * number of samples.  A pixel's value is the mean of its samples: the pixel filter is applied by
+ * the camera, which draws each sample's position from the filter's own shape (filter importance
+ * sampling, shading/filter.h; a sample under a negative lobe counts negated), so the film adds
+ * no weights.
  *
  * The sums are exact integers: each sample's radiance is rounded once to a multiple of
  * 1 / RS_FILM_SCALE and added into a 128-bit integer.  Integer addition is associative, so a
