@@ -7,6 +7,20 @@
 #ifndef RS_CORE_HD_H
 #define RS_CORE_HD_H
 
+/* Which pass is reading, for the few functions whose device form differs (intrinsics, the device
+ * copies of constant tables), so that no other file names a compiler: RS_CUDA_SOURCE under nvcc
+ * (its host and device passes alike), RS_DEVICE_PASS in its device pass only. */
+#if defined(__CUDACC__)
+#  define RS_CUDA_SOURCE 1
+#else
+#  define RS_CUDA_SOURCE 0
+#endif
+#if defined(__CUDA_ARCH__)
+#  define RS_DEVICE_PASS 1
+#else
+#  define RS_DEVICE_PASS 0
+#endif
+
 /* RS_HD_COLD: the same for a function off the common path (the GGX materials, normal maps,
  * textured material parameters), kept out of line so that its callers stay small enough to be
  * inlined where the common materials are shaded (measured: inlined, these made the Cornell box's

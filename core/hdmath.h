@@ -36,7 +36,7 @@
 /* The correctly rounded square root: __fsqrt_rn on the device whatever -prec-sqrt says; GCC's
  * and Clang's builtin on the host (an instruction; with math-errno on, which the build turns
  * off, they would also call libm for negative arguments, which never come here). */
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
 #  define RS_HDM_SQRTF(x) __fsqrt_rn(x)
 #elif defined(__GNUC__)
 #  define RS_HDM_SQRTF(x) __builtin_sqrtf(x)
@@ -149,7 +149,7 @@ static const uint32_t rs_hdm_two_over_pi[9] = RS_HDM_TWO_OVER_PI_WORDS;
 static const double rs_hdm_log2_invc[32] = RS_HDM_LOG2_INVC;
 static const double rs_hdm_log2_logc[32] = RS_HDM_LOG2_LOGC;
 static const double rs_hdm_exp2_tab[32] = RS_HDM_EXP2_TAB;
-#if defined(__CUDACC__)
+#if RS_CUDA_SOURCE
 RS_CONST_TABLE uint32_t rs_hdm_two_over_pi_dev[9] = RS_HDM_TWO_OVER_PI_WORDS;
 RS_CONST_TABLE double rs_hdm_log2_invc_dev[32] = RS_HDM_LOG2_INVC;
 RS_CONST_TABLE double rs_hdm_log2_logc_dev[32] = RS_HDM_LOG2_LOGC;
@@ -160,7 +160,7 @@ RS_CONST_TABLE double rs_hdm_exp2_tab_dev[32] = RS_HDM_EXP2_TAB;
 
 RS_HD uint32_t rs_hdm_f2u(float f)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return __float_as_uint(f);
 #else
     uint32_t u;
@@ -171,7 +171,7 @@ RS_HD uint32_t rs_hdm_f2u(float f)
 
 RS_HD float rs_hdm_u2f(uint32_t u)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return __uint_as_float(u);
 #else
     float f;
@@ -182,7 +182,7 @@ RS_HD float rs_hdm_u2f(uint32_t u)
 
 RS_HD uint64_t rs_hdm_d2u(double d)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return (uint64_t)__double_as_longlong(d);
 #else
     uint64_t u;
@@ -193,7 +193,7 @@ RS_HD uint64_t rs_hdm_d2u(double d)
 
 RS_HD double rs_hdm_u2d(uint64_t u)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return __longlong_as_double((long long)u);
 #else
     double d;
@@ -208,7 +208,7 @@ RS_HD double rs_hdm_u2d(uint64_t u)
 /* 2^n as a float, n in [-126, 127] (exact) */
 RS_HD float rs_hdm_pow2(int n) { return rs_hdm_u2f((uint32_t)(n + 127) << 23); }
 
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
 #  define RS_HDM_TABLE(name, i) name##_dev[i]
 #else
 #  define RS_HDM_TABLE(name, i) name[i]

@@ -22,7 +22,7 @@
 
 RS_HD uint32_t rs_reverse_bits(uint32_t x)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return __brev(x);
 #else
     x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);

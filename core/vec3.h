@@ -15,7 +15,7 @@
  * core_vec3_test).  The device keeps CUDA's own. */
 RS_HD float rs_fmaxf(float a, float b)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return fmaxf(a, b);
 #else
     return a > b ? a : (b != b ? a : b);
@@ -24,7 +24,7 @@ RS_HD float rs_fmaxf(float a, float b)
 
 RS_HD float rs_fminf(float a, float b)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return fminf(a, b);
 #else
     return a < b ? a : (b != b ? a : b);

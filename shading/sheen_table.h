@@ -205,7 +205,7 @@
 /* clang-format on */
 
 static const float rs_sheen_albedo_table[RS_SHEEN_TABLE_N][RS_SHEEN_TABLE_N] = RS_SHEEN_TABLE_DATA;
-#if defined(__CUDACC__)
+#if RS_CUDA_SOURCE
 static __device__ const float rs_sheen_albedo_table_dev[RS_SHEEN_TABLE_N][RS_SHEEN_TABLE_N] =
     RS_SHEEN_TABLE_DATA;
 #endif
@@ -213,7 +213,7 @@ static __device__ const float rs_sheen_albedo_table_dev[RS_SHEEN_TABLE_N][RS_SHE
 /* Entry [j][k]: the device's copy in device code, the host's elsewhere. */
 RS_HD float rs_sheen_table_at(int j, int k)
 {
-#if defined(__CUDA_ARCH__)
+#if RS_DEVICE_PASS
     return rs_sheen_albedo_table_dev[j][k];
 #else
     return rs_sheen_albedo_table[j][k];
