@@ -70,8 +70,6 @@ int rs_shade_wide_ready(const rs_render_consts *it, uint32_t bounce)
 }
 
 #if RS_WIDE_HAVE_AVX2
-#  pragma GCC push_options
-#  pragma GCC target("avx2")
 
 typedef float f8 __attribute__((vector_size(32)));
 typedef uint32_t u8 __attribute__((vector_size(32)));
@@ -81,7 +79,8 @@ typedef struct v3 {
     f8 x, y, z;
 } v3;
 
-#  define WIDE static inline __attribute__((always_inline))
+/* every function below is compiled for AVX2 (an attribute each: GCC and Clang both take it) */
+#  define WIDE static inline __attribute__((always_inline, target("avx2")))
 
 WIDE f8 splat(float s) { return (f8){s, s, s, s, s, s, s, s}; }
 WIDE u8 usplat(uint32_t s) { return (u8){s, s, s, s, s, s, s, s}; }
@@ -316,10 +315,10 @@ WIDE void prim_point(const lane_prims *lp, f8 s, f8 t, v3 *p, v3 *err, v3 *ng)
 }
 
 /* Up to eight entries: rs_path_shade_at's path through a Lambertian vertex. */
-static void shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays,
-                   const rs_hit_soa *hits, const uint32_t *entry, uint32_t count,
-                   const rs_rng_f4 *rb, const rs_rng_f4 *rl, rs_paths *paths, uint8_t *made,
-                   rs_ray *next, rs_ray *shadow)
+__attribute__((target("avx2"))) static void
+shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
+       const uint32_t *entry, uint32_t count, const rs_rng_f4 *rb, const rs_rng_f4 *rl,
+       rs_paths *paths, uint8_t *made, rs_ray *next, rs_ray *shadow)
 {
     const rs_scene *sc = it->scene;
     const int nee = rs_scene_has_lights(sc);
@@ -523,7 +522,6 @@ static void shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa
     }
 }
 
-#  pragma GCC pop_options
 #endif
 
 void rs_shade_wide(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays,
