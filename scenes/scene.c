@@ -679,10 +679,13 @@ static rs_status build_pyramids(rs_scene *s)
     return RS_OK;
 }
 
-rs_status rs_scene_finalize(rs_scene *s)
+/* ---- rs_scene_finalize's steps, in order ---- */
+
+/* Every primitive's numbers finite and its shape not degenerate; a prototype triangle's material
+ * exists and emits nothing. */
+static rs_status check_geometry(rs_scene *s)
 {
-    uint32_t i, n = rs_scene_prim_count(s), nl = 0;
-    double total = 0.0, acc = 0.0;
+    uint32_t i;
     for (i = 0; i < s->n_spheres; ++i)
         if (!finite3(s->spheres[i].center) || !isfinite(s->spheres[i].radius) ||
             !(s->spheres[i].radius > 0.0f))
@@ -708,34 +711,28 @@ rs_status rs_scene_finalize(rs_scene *s)
                                             "copied, never instanced", i);
     }
     s->bad_part = RS_PART_NONE;
-    {
-        rs_status st = check_ranges(s);
-        if (st == RS_OK)
-            st = build_pyramids(s);
-        if (st != RS_OK)
-            return st;
-    }
-    {
-        /* instances' triangles are numbered after the scene's own, in instance order */
-        uint64_t base = (uint64_t)n;
-        for (i = 0; i < s->n_instances; ++i) {
-            s->instances[i].prim_base = (uint32_t)base;
-            base += s->instances[i].n_tris;
-        }
-        if (base > 0x7fffffffu)
-            return rs_error_set(RS_ERR_ARG, "the scene has %llu primitives, at most 2^31 - 1",
-                                (unsigned long long)base);
-    }
+    return RS_OK;
+}
 
-    rs_free(s->lights);
-    rs_free(s->light_cdf);
-    rs_free(s->prim_light);
-    s->lights = NULL;
-    s->light_cdf = NULL;
-    s->n_lights = 0;
-    s->prim_light = (int32_t *)rs_alloc(n ? n : 1, sizeof *s->prim_light);
-    if (!s->prim_light)
-        return rs_error_set(RS_ERR_NOMEM, "out of memory preparing lights");
+/* Instances' triangles are numbered after the scene's own n primitives, in instance order. */
+static rs_status number_instances(rs_scene *s, uint32_t n)
+{
+    uint64_t base = (uint64_t)n;
+    uint32_t i;
+    for (i = 0; i < s->n_instances; ++i) {
+        s->instances[i].prim_base = (uint32_t)base;
+        base += s->instances[i].n_tris;
+    }
+    if (base > 0x7fffffffu)
+        return rs_error_set(RS_ERR_ARG, "the scene has %llu primitives, at most 2^31 - 1",
+                            (unsigned long long)base);
+    return RS_OK;
+}
+
+/* Every material's parameters in their ranges. */
+static rs_status check_materials(rs_scene *s)
+{
+    uint32_t i;
     for (i = 0; i < s->n_materials; ++i) {
         const rs_material *m = &s->materials[i];
         if (m->type > RS_MAT_TYPE_LAST)
@@ -765,27 +762,42 @@ rs_status rs_scene_finalize(rs_scene *s)
         if (m->alpha_mask > s->n_masks)
             return rs_error_set(RS_ERR_ARG, "material %u: no alpha mask %u", i, m->alpha_mask);
     }
-    {
-        /* the triangles' cut-outs, for traversal */
-        int any = 0;
-        rs_free(s->tri_mask);
-        s->tri_mask = NULL;
-        for (i = 0; i < s->n_tris && !any; ++i)
-            any = s->materials[s->tri_mat[i]].alpha_mask != 0;
-        if (any) {
-            s->tri_mask = (uint32_t *)rs_alloc(s->n_tris, sizeof *s->tri_mask);
-            if (!s->tri_mask)
-                return rs_error_set(RS_ERR_NOMEM, "out of memory preparing alpha masks");
-            for (i = 0; i < s->n_tris; ++i)
-                s->tri_mask[i] = s->materials[s->tri_mat[i]].alpha_mask;
-        }
-        for (i = 0; i < s->n_inst_tris; ++i)
-            if (s->materials[s->inst_tri_mat[i]].alpha_mask)
-                return rs_error_set(RS_ERR_ARG, "prototype triangle %u has an alpha cut-out: "
-                                                "cut-outs are copied, never instanced", i);
+    return RS_OK;
+}
+
+/* The triangles' cut-outs, for traversal (none on a prototype's triangles). */
+static rs_status build_masks(rs_scene *s)
+{
+    uint32_t i;
+    int any = 0;
+    rs_free(s->tri_mask);
+    s->tri_mask = NULL;
+    for (i = 0; i < s->n_tris && !any; ++i)
+        any = s->materials[s->tri_mat[i]].alpha_mask != 0;
+    if (any) {
+        s->tri_mask = (uint32_t *)rs_alloc(s->n_tris, sizeof *s->tri_mask);
+        if (!s->tri_mask)
+            return rs_error_set(RS_ERR_NOMEM, "out of memory preparing alpha masks");
+        for (i = 0; i < s->n_tris; ++i)
+            s->tri_mask[i] = s->materials[s->tri_mat[i]].alpha_mask;
     }
-    /* Every primitive with an emissive material becomes a samplable light: spheres by the cone
-     * they subtend, quads and triangles by area. */
+    for (i = 0; i < s->n_inst_tris; ++i)
+        if (s->materials[s->inst_tri_mat[i]].alpha_mask)
+            return rs_error_set(RS_ERR_ARG, "prototype triangle %u has an alpha cut-out: "
+                                            "cut-outs are copied, never instanced", i);
+    return RS_OK;
+}
+
+/* The light table over the scene's n own primitives (every one with an emissive material, by
+ * area: spheres sampled by the cone they subtend, quads and triangles by area) and its punctual
+ * lights, each picked in proportion to its power: s->lights, light_cdf, n_area_lights (n_lights
+ * is set by the caller from *n_lights); *total, their summed power.  s->prim_light (allocated by
+ * the caller) maps a primitive to its light or -1. */
+static rs_status build_lights(rs_scene *s, uint32_t n, uint32_t *n_lights, double *total)
+{
+    uint32_t i, nl = 0;
+    double acc = 0.0;
+    *total = 0.0;
     for (i = 0; i < n; ++i) {
         const rs_material *m = rs_scene_prim_material(s, i);
         s->prim_light[i] = -1;
@@ -796,7 +808,10 @@ rs_status rs_scene_finalize(rs_scene *s)
     }
     s->n_area_lights = nl;
     nl += s->n_punctuals;
-    if (nl > 0) {
+    *n_lights = nl;
+    if (nl == 0)
+        return RS_OK;
+    {
         double radius = s->n_punctuals ? rs_scene_bound_radius(s) : 1.0;
         uint64_t need = (uint64_t)nl * (sizeof *s->lights + sizeof *s->light_cdf);
         uint64_t budget = rs_memory_budget();
@@ -824,72 +839,96 @@ rs_status rs_scene_finalize(rs_scene *s)
             lt->prim = RS_LIGHT_PUNCTUAL | i;
             lt->area = 0.0f;
             lt->power = (float)pw;
-            total += pw;
-        }
-        for (i = 0; i < n && s->n_area_lights; ++i) {
-            int32_t l = s->prim_light[i];
-            const rs_material *m;
-            if (l < 0)
-                continue;
-            m = rs_scene_prim_material(s, i);
-            s->lights[l].prim = i;
-            s->lights[l].area = prim_area(s, i);
-            s->lights[l].power = 3.14159265f * s->lights[l].area * luminance(m->emission) *
-                                 ((m->flags & RS_MAT_TWO_SIDED) || m->type == RS_MAT_PBR ? 2.0f
-                                                                                   : 1.0f);
-            total += s->lights[l].power;
-        }
-        s->light_cdf[0] = 0.0f;
-        for (i = 0; i < nl; ++i) {
-            s->lights[i].pick_pdf = (float)(s->lights[i].power / total);
-            acc += s->lights[i].power;
-            s->light_cdf[i + 1] = (float)(acc / total);
-        }
-        s->light_cdf[nl] = 1.0f;
-        if (!(total > 0)) {
-            /* black lights only: nothing to pick (never a 0/0 pick probability) */
-            rs_free(s->lights);
-            rs_free(s->light_cdf);
-            s->lights = NULL;
-            s->light_cdf = NULL;
-            for (i = 0; i < n; ++i)
-                s->prim_light[i] = -1;
-            nl = 0;
-            s->n_area_lights = 0;
+            *total += pw;
         }
     }
-    s->n_lights = nl;
-    {
-        /* the environment map's distribution; light sampling picks it or an emitter in
-         * proportion to their powers, the map's kept within [0.1, 0.9] when both are there
-         * (a map seen through a window is mostly occluded; emitters inside a sky's dome may
-         * be small) */
-        double env_power = 0;
-        rs_status st = rs_scene_env_build(s, &env_power);
-        if (st != RS_OK)
-            return st;
-        if (env_power > 0) {
-            double pick = nl ? env_power / (env_power + total) : 1.0;
-            if (nl)
-                pick = pick < 0.1 ? 0.1 : pick > 0.9 ? 0.9 : pick;
-            s->env_pick = (float)pick;
-            for (i = 0; i < nl; ++i)
-                s->lights[i].pick_pdf *= 1.0f - s->env_pick;
-        }
+    for (i = 0; i < n && s->n_area_lights; ++i) {
+        int32_t l = s->prim_light[i];
+        const rs_material *m;
+        if (l < 0)
+            continue;
+        m = rs_scene_prim_material(s, i);
+        s->lights[l].prim = i;
+        s->lights[l].area = prim_area(s, i);
+        s->lights[l].power = 3.14159265f * s->lights[l].area * luminance(m->emission) *
+                             ((m->flags & RS_MAT_TWO_SIDED) || m->type == RS_MAT_PBR ? 2.0f
+                                                                               : 1.0f);
+        *total += s->lights[l].power;
+    }
+    s->light_cdf[0] = 0.0f;
+    for (i = 0; i < nl; ++i) {
+        s->lights[i].pick_pdf = (float)(s->lights[i].power / *total);
+        acc += s->lights[i].power;
+        s->light_cdf[i + 1] = (float)(acc / *total);
+    }
+    s->light_cdf[nl] = 1.0f;
+    if (!(*total > 0)) {
+        /* black lights only: nothing to pick (never a 0/0 pick probability) */
+        rs_free(s->lights);
+        rs_free(s->light_cdf);
+        s->lights = NULL;
+        s->light_cdf = NULL;
+        for (i = 0; i < n; ++i)
+            s->prim_light[i] = -1;
+        *n_lights = 0;
+        s->n_area_lights = 0;
+    }
+    return RS_OK;
+}
+
+/* The environment map's distribution; light sampling picks it or an emitter in proportion to
+ * their powers (`total`: the emitters' and punctual lights'), the map's kept within [0.1, 0.9]
+ * when both are there (a map seen through a window is mostly occluded; emitters inside a sky's
+ * dome may be small). */
+static rs_status place_environment(rs_scene *s, double total)
+{
+    double env_power = 0;
+    uint32_t i, nl = s->n_lights;
+    rs_status st = rs_scene_env_build(s, &env_power);
+    if (st != RS_OK)
+        return st;
+    if (env_power > 0) {
+        double pick = nl ? env_power / (env_power + total) : 1.0;
+        if (nl)
+            pick = pick < 0.1 ? 0.1 : pick > 0.9 ? 0.9 : pick;
+        s->env_pick = (float)pick;
+        for (i = 0; i < nl; ++i)
+            s->lights[i].pick_pdf *= 1.0f - s->env_pick;
     }
     /* what the mixture's light half may pick: the map and the emitters, not the delta lights */
     s->area_mass = s->n_lights > s->n_area_lights
                        ? s->env_pick + (1.0f - s->env_pick) * s->light_cdf[s->n_area_lights]
                        : 1.0f;
-    {
-        /* --light-sampler bvh (scenes/light_bvh.h), where the render may use it */
-        rs_status st = RS_OK;
-        s->light_bvh_built = 0;
-        if (g_extras.light_bvh)
-            st = rs_scene_build_light_bvh(s);
-        if (st != RS_OK)
-            return st;
-    }
+    return RS_OK;
+}
+
+rs_status rs_scene_finalize(rs_scene *s)
+{
+    uint32_t n = rs_scene_prim_count(s), nl = 0;
+    double total = 0.0;
+    rs_status st;
+    if ((st = check_geometry(s)) != RS_OK || (st = check_ranges(s)) != RS_OK ||
+        (st = build_pyramids(s)) != RS_OK || (st = number_instances(s, n)) != RS_OK)
+        return st;
+    rs_free(s->lights);
+    rs_free(s->light_cdf);
+    rs_free(s->prim_light);
+    s->lights = NULL;
+    s->light_cdf = NULL;
+    s->n_lights = 0;
+    s->prim_light = (int32_t *)rs_alloc(n ? n : 1, sizeof *s->prim_light);
+    if (!s->prim_light)
+        return rs_error_set(RS_ERR_NOMEM, "out of memory preparing lights");
+    if ((st = check_materials(s)) != RS_OK || (st = build_masks(s)) != RS_OK ||
+        (st = build_lights(s, n, &nl, &total)) != RS_OK)
+        return st;
+    s->n_lights = nl;
+    if ((st = place_environment(s, total)) != RS_OK)
+        return st;
+    /* --light-sampler bvh (scenes/light_bvh.h), where the render may use it */
+    s->light_bvh_built = 0;
+    if (g_extras.light_bvh && (st = rs_scene_build_light_bvh(s)) != RS_OK)
+        return st;
     s->finalized = 1;
     return RS_OK;
 }
