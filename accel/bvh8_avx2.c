@@ -373,6 +373,15 @@ static inline uint32_t pk8_quad(const rs_bvh8_quad8 *b, uint32_t k, const pk8 *p
 
 /* Lanes `m` of a primitive test's answers, each taken if better (rs_hit_better), the lane's ray
  * cut just past it. */
+/* Primitive k of packed block `block` (parallelograms where `count` says so, else triangles)
+ * against the packet: pk8_quad's or pk8_tri's mask and answers. */
+static inline uint32_t pk8_prim(const rs_bvh8 *b, uint32_t count, uint32_t block, uint32_t k,
+                                const pk8 *p, __m256 tmaxv, __m256 *t, __m256 *u, __m256 *v)
+{
+    return count & RS_WIDE_QUADS ? pk8_quad(&b->quad8[block], k, p, tmaxv, t, u, v)
+                                 : pk8_tri(&b->tri8[block], k, p, tmaxv, t, u, v);
+}
+
 static inline void pk8_take(pk8 *p, rs_hit *hit, uint32_t m, __m256 tv, __m256 uv, __m256 vv,
                             uint32_t prim)
 {
@@ -409,10 +418,7 @@ static void pk8_leaf_closest(const rs_bvh8 *b, const rs_geom *g, uint32_t first,
                 uint32_t got;
                 if (prim[k] == RS_NO_HIT)
                     continue;
-                got = (count & RS_WIDE_QUADS
-                                    ? pk8_quad(&b->quad8[first + i], k, p, tmaxv, &t, &u, &v)
-                                    : pk8_tri(&b->tri8[first + i], k, p, tmaxv, &t, &u, &v)) &
-                               m;
+                got = pk8_prim(b, count, first + i, k, p, tmaxv, &t, &u, &v) & m;
                 if (got)
                     pk8_take(p, hit, got, t, u, v, prim[k]);
             }
@@ -524,10 +530,7 @@ static uint32_t pk8_leaf_occluded(const rs_bvh8 *b, const rs_geom *g, uint32_t f
                 uint32_t got;
                 if (prim[k] == RS_NO_HIT)
                     continue;
-                got = (count & RS_WIDE_QUADS
-                           ? pk8_quad(&b->quad8[first + i], k, p, tmaxv, &t, &u, &v)
-                           : pk8_tri(&b->tri8[first + i], k, p, tmaxv, &t, &u, &v)) &
-                      m;
+                got = pk8_prim(b, count, first + i, k, p, tmaxv, &t, &u, &v) & m;
                 done |= got;
                 m &= ~got;
             }
