@@ -63,7 +63,7 @@ typedef struct rs_cli_options {
     rs_filter filter;      /* --filter NAME[:WIDTH] (default blackman-harris:1.5) */
     uint32_t texture_filter; /* --texture-filter: rs_texture_filter (shading/texture.h),
                                 0 trilinear (the default) */
-    uint32_t light_sampler; /* --light-sampler: rs_light_sampler (shading/path.h), 0 power */
+    uint32_t light_sampler; /* --light-sampler: rs_light_sampler (shading/light_sampler.h), 0 power */
     const char *view;      /* --view NAME: the display outputs' view transform (core/view.h);
                               NULL: standard */
     float exposure;        /* --exposure EV: display outputs scaled by 2^EV first */

@@ -61,7 +61,7 @@ typedef struct rs_render_settings {
     rs_filter filter;         /* the pixel filter (shading/filter.h); zeroed: a box of one
                                  pixel */
     uint32_t texture_filter;  /* rs_texture_filter (shading/texture.h); zeroed: trilinear */
-    uint32_t light_sampler;   /* rs_light_sampler (shading/path.h); zeroed: by power */
+    uint32_t light_sampler;   /* rs_light_sampler (shading/light_sampler.h); zeroed: by power */
     uint32_t wave_paths;      /* paths in flight; 0: auto (one CPU device: RS_RENDER_HOST_WAVE
                                  per thread on one core, RS_RENDER_HOST_WAVE_FREE per thread
                                  on more; RS_RENDER_DEFAULT_WAVE with a GPU or several

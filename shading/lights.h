@@ -37,8 +37,8 @@ typedef struct rs_light_sample {
 #define RS_LIGHTS_ALL   0 /* every light (MIS's next-event estimation) */
 #define RS_LIGHTS_AREA  1 /* the map and the emitters (the mixture's light half) */
 #define RS_LIGHTS_DELTA 2 /* the punctual lights (the mixture's next-event estimation) */
-#define RS_LIGHTS_BVH   3 /* every light, the bounded ones picked by the light BVH at the point
-                             (--light-sampler bvh: rs_light_sample_bvh) */
+/* How every light's pick is made (by power, or by the light BVH at the point) is the light
+ * sampler's: shading/light_sampler.h. */
 
 /* Whether the map or an emitter can be sampled (the mixture's light half has something). */
 RS_HD int rs_scene_has_area_lights(const rs_scene *s)
@@ -278,63 +278,6 @@ RS_HD_HOT int rs_light_sample_one(const rs_scene *s, uint32_t l, float pick, flo
         out->pdf *= inv_mass;
     out->le = rs_emitted(rs_scene_prim_material(s, prim), n_l, out->wi);
     return 1;
-}
-
-/* The probability that rs_light_sample_bvh picks light l for a vertex whose light pick was
- * taken at `at` (the vertex's offset origin; what MIS needs when a BSDF sample hits l). */
-RS_HD float rs_light_pick_bvh(const rs_scene *s, uint32_t l, rs_vec3 at)
-{
-    if (s->light_trail && s->light_trail[l])
-        return (1.0f - s->env_pick) * s->light_bvh_mass * rs_light_bvh_pmf(s, at, l);
-    return s->lights[l].pick_pdf; /* a directional light: by power (never hit by a ray) */
-}
-
-/* RS_LIGHTS_BVH: the map with its pick probability as ever, else a bounded light picked by the
- * light BVH at `at` (with the BVH's share of the lights' power), else a directional light by
- * power among the directional ones; x, n_x, time, u1, u2 as rs_light_sample_from. */
-RS_HD_COLD int rs_light_sample_bvh(const rs_scene *s, rs_vec3 x, rs_vec3 n_x, rs_vec3 at,
-                                   float time, float u_pick, float u1, float u2,
-                                   rs_light_sample *out)
-{
-    float env_pick = s->env_pick, m = s->light_bvh_mass, pick;
-    uint32_t l = 0, i;
-    if (!rs_scene_has_lights(s))
-        return 0;
-    out->env = 0;
-    out->delta = 0;
-    if (env_pick > 0.0f) {
-        if (u_pick < env_pick)
-            return rs_light_sample_env(s, x, n_x, env_pick, u1, u2, out);
-        u_pick = (u_pick - env_pick) / (1.0f - env_pick);
-    }
-    if (s->n_lights == 0)
-        return 0;
-    if (u_pick < m && s->light_nodes) {
-        float pmf;
-        if (!rs_light_bvh_pick(s, at, rs_fminf(u_pick / m, 0x1.fffffep-1f), &l, &pmf))
-            return 0;
-        pick = (1.0f - env_pick) * m * pmf;
-    } else {
-        /* the directional lights, by their power (1 - m of it) */
-        float total = 0.0f, acc = 0.0f, u;
-        int found = 0;
-        for (i = s->n_area_lights; i < s->n_lights; ++i)
-            if (!s->light_trail || !s->light_trail[i])
-                total += s->lights[i].power;
-        u = (m < 1.0f ? (u_pick - m) / (1.0f - m) : 0.0f) * total;
-        for (i = s->n_area_lights; i < s->n_lights && !found; ++i)
-            if (!s->light_trail || !s->light_trail[i]) {
-                acc += s->lights[i].power;
-                if (u < acc || i + 1 == s->n_lights) {
-                    l = i;
-                    found = 1;
-                }
-            }
-        if (!found || !(total > 0.0f))
-            return 0;
-        pick = s->lights[l].pick_pdf;
-    }
-    return rs_light_sample_one(s, l, pick, 1.0f, x, time, u1, u2, out);
 }
 
 /* The same seen from no surface. */

@@ -34,6 +34,7 @@
 #include "shading/camera.h"
 #include "shading/filter.h"
 #include "shading/dims.h"
+#include "shading/light_sampler.h"
 #include "shading/lights.h"
 #include "shading/spawn.h"
 #include "shading/texture.h"
@@ -54,13 +55,6 @@ typedef enum rs_sampler {
     RS_SAMPLER_ZSOBOL = 2       /* Owen-scrambled Sobol points in Morton order over the image
                                    (core/zsobol.h): blue-noise error across pixels */
 } rs_sampler;
-
-/* How next-event estimation picks a light (--light-sampler; MIS only, the other modes pick by
- * power). */
-typedef enum rs_light_sampler {
-    RS_LIGHT_SAMPLER_POWER = 0, /* in proportion to each light's power, anywhere */
-    RS_LIGHT_SAMPLER_BVH = 1    /* by the light BVH's importance at the point (light_bvh.h) */
-} rs_light_sampler;
 
 /* Path flags. */
 #define RS_PATH_SPECULAR 1u /* the current ray left the camera or a delta BSDF: no MIS weight */
@@ -408,15 +402,6 @@ typedef struct rs_vertex {
     rs_vec3 origin; /* where rays leaving the reflecting side start (rs_spawn_origin) */
 } rs_vertex;
 
-/* The probability that MIS's next-event estimation picks light l at the vertex whose offset
- * origin is `at` (the ray's that found the light): by power, or by the light BVH. */
-RS_HD float rs_path_light_pick(const rs_render_consts *it, uint32_t l, rs_vec3 at)
-{
-    if (it->light_sampler == RS_LIGHT_SAMPLER_BVH)
-        return rs_light_pick_bvh(it->scene, l, at);
-    return it->scene->lights[l].pick_pdf;
-}
-
 /* An emitter hit: its radiance, MIS-weighted against the light sampling that could also have
  * found it when the path came by BSDF sampling (not after a delta bounce or from the camera,
  * where none could). */
@@ -427,11 +412,11 @@ RS_HD void rs_shade_emitter(const rs_render_consts *it, const rs_ray *r, float t
     rs_vec3 le = rs_emitted(m, ng, r->d);
     float w = 1.0f;
     int32_t l = rs_scene_prim_light(sc, prim);
-    if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
-        w = rs_power_heuristic(ps->bsdf_pdf,
-                               rs_light_pdf_hit_pick(sc, (uint32_t)l,
-                                                     rs_path_light_pick(it, (uint32_t)l, r->o),
-                                                     r->o, r->time, r->d, t, ng));
+    if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0) {
+        float pick = rs_light_sampler_pmf(sc, it->light_sampler, (uint32_t)l, r->o);
+        w = rs_power_heuristic(ps->bsdf_pdf, rs_light_pdf_hit_pick(sc, (uint32_t)l, pick, r->o,
+                                                                   r->time, r->d, t, ng));
+    }
     ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, le), w));
 }
 
@@ -468,11 +453,13 @@ RS_HD rs_vec3 rs_vertex_far_origin(const rs_vertex *v)
     return rs_spawn_origin(v->x, v->err, rs_v3_neg(v->n_geo));
 }
 
-/* Next-event estimation (mis): a shadow ray toward a sampled point on a light, its MIS-weighted
- * contribution in ps->pending.  Returns RS_SHADE_SHADOW when it made one. */
+/* Next-event estimation (mis): a shadow ray toward a sampled point on a light of `subset`
+ * (RS_LIGHTS_ALL: picked by `sampler`, an rs_light_sampler; RS_LIGHTS_DELTA: the punctual
+ * lights, by power), its MIS-weighted contribution in ps->pending.  Returns RS_SHADE_SHADOW when
+ * it made one. */
 RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, const rs_ray *r,
                                    rs_rng_f4 rl, rs_vec3 beta, rs_path_state *ps, rs_ray *shadow,
-                                   int subset)
+                                   int subset, uint32_t sampler)
 {
     rs_light_sample ls;
     float c;
@@ -480,9 +467,9 @@ RS_HD_HOT uint32_t rs_shade_next_event(const rs_scene *sc, const rs_vertex *v, c
     int through;
     /* the light seen from the surface point itself (its distance, direction and pdf); only the
      * shadow ray starts at the offset origin */
-    if (subset == RS_LIGHTS_BVH
-            ? !rs_light_sample_bvh(sc, v->x, v->n, v->origin, r->time, rl.v[0], rl.v[1], rl.v[2],
-                                   &ls)
+    if (subset == RS_LIGHTS_ALL
+            ? !rs_light_sampler_sample(sc, sampler, v->x, v->n, v->origin, r->time, rl.v[0],
+                                       rl.v[1], rl.v[2], &ls)
             : !rs_light_sample_from(sc, subset, v->x, v->n, r->time, rl.v[0], rl.v[1], rl.v[2],
                                     &ls))
         return 0;
@@ -644,11 +631,12 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
              * it (constant emission), in full where it cannot (a textured one) */
             float w = 1.0f;
             int32_t l = rs_scene_prim_light(sc, v.prim);
-            if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0)
-                w = rs_power_heuristic(
-                    ps->bsdf_pdf, rs_light_pdf_hit_pick(sc, (uint32_t)l,
-                                                        rs_path_light_pick(it, (uint32_t)l, r.o),
-                                                        r.o, r.time, r.d, h->t, v.ng));
+            if (it->sampling == RS_SAMPLING_MIS && !(ps->flags & RS_PATH_SPECULAR) && l >= 0) {
+                float pick = rs_light_sampler_pmf(sc, it->light_sampler, (uint32_t)l, r.o);
+                w = rs_power_heuristic(ps->bsdf_pdf,
+                                       rs_light_pdf_hit_pick(sc, (uint32_t)l, pick, r.o, r.time,
+                                                             r.d, h->t, v.ng));
+            }
             ps->radiance = rs_v3_add(ps->radiance, rs_v3_scale(rs_v3_mul(beta, v.m->emission), w));
         }
     }
@@ -674,14 +662,14 @@ RS_HD_HOT uint32_t rs_path_shade_at(const rs_render_consts *it, uint32_t pixel, 
         rs_rng_f4 rl = pre ? pre[1] : rs_path_rand(it, pixel, sample, bounce, RS_DIM_LIGHT);
         v.origin = rs_spawn_origin(v.x, v.err, v.n_geo);
         if (it->sampling == RS_SAMPLING_MIS && rs_scene_has_lights(sc))
-            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow,
-                                      it->light_sampler == RS_LIGHT_SAMPLER_BVH ? RS_LIGHTS_BVH
-                                                                                : RS_LIGHTS_ALL);
+            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_ALL,
+                                      it->light_sampler);
         else if (it->sampling == RS_SAMPLING_MIXTURE && sc->n_lights > sc->n_area_lights)
             /* the mixture cannot draw a delta light's direction: next-event estimation does,
              * with the same numbers (the mixture's light half uses them only when it picks the
              * light side, and independently of this shadow ray's outcome) */
-            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_DELTA);
+            out = rs_shade_next_event(sc, &v, &r, rl, beta, ps, shadow, RS_LIGHTS_DELTA,
+                                      RS_LIGHT_SAMPLER_POWER);
         if (!rs_shade_direction(it, &v, &r, rb, rl, &beta, &wi, &pdf))
             return out;
         if (!(rs_v3_dot(wi, v.n_geo) > 0.0f)) {
