@@ -80,6 +80,16 @@
 #  define RS_MUL_EXACT(a, b) ((a) * (b))
 #endif
 
+/* Relaxed atomic adds to memory every thread of a device writes (the wavefront's film): CUDA's
+ * atomicAdd in the device pass, the GCC/Clang builtin on the host (the GPU fallback's threads). */
+#if defined(__CUDA_ARCH__)
+#  define RS_ATOMIC_ADD_U64(p, v) atomicAdd((unsigned long long *)(p), (unsigned long long)(v))
+#  define RS_ATOMIC_ADD_U32(p, v) atomicAdd((unsigned int *)(p), (unsigned int)(v))
+#else
+#  define RS_ATOMIC_ADD_U64(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
+#  define RS_ATOMIC_ADD_U32(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
+#endif
+
 /* A primitive index meaning "no hit". */
 #define RS_NO_HIT 0xffffffffu
 

@@ -358,9 +358,9 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
             uint32_t p, made = rs_wf_shade(it, w, (uint32_t)i, &f->queue[cur], &f->wf_hits, &f->paths,
                                            &nr, &sr, &p);
             if (made & RS_SHADE_SHADOW)
-                rs_ray_soa_set(&f->shadow, RS_WF_ADD32(&n_shadow, 1u), &sr, p);
+                rs_ray_soa_set(&f->shadow, RS_ATOMIC_ADD_U32(&n_shadow, 1u), &sr, p);
             if (made & RS_SHADE_NEXT)
-                rs_ray_soa_set(&f->queue[cur ^ 1], RS_WF_ADD32(&n_next, 1u), &nr, p);
+                rs_ray_soa_set(&f->queue[cur ^ 1], RS_ATOMIC_ADD_U32(&n_next, 1u), &nr, p);
         }
         if (n_shadow) {
             tb.kind = RS_TRACE_OCCLUDED;

@@ -38,14 +38,6 @@
 #include "streams/paths.h"
 #include "streams/stream.h"
 
-#ifdef __CUDA_ARCH__
-#define RS_WF_ADD64(p, v) atomicAdd((unsigned long long *)(p), (unsigned long long)(v))
-#define RS_WF_ADD32(p, v) atomicAdd((unsigned int *)(p), (unsigned int)(v))
-#else
-#define RS_WF_ADD64(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
-#define RS_WF_ADD32(p, v) __atomic_fetch_add((p), (v), __ATOMIC_RELAXED)
-#endif
-
 typedef unsigned long long rs_wf_u64;
 
 /* The device's film (device memory on the GPU, host memory in the fallback). */
@@ -92,10 +84,10 @@ RS_HD void rs_wf_fixed(double x, rs_wf_u64 *lo, rs_wf_u64 *hi)
  * found) carries into the high word, so every order of adds ends at the same sum. */
 RS_HD void rs_wf_add128(rs_wf_u64 *s, rs_wf_u64 lo, rs_wf_u64 hi)
 {
-    rs_wf_u64 old = RS_WF_ADD64(&s[0], lo);
+    rs_wf_u64 old = RS_ATOMIC_ADD_U64(&s[0], lo);
     hi += (rs_wf_u64)(old + lo < old);
     if (hi)
-        (void)RS_WF_ADD64(&s[1], hi);
+        (void)RS_ATOMIC_ADD_U64(&s[1], hi);
 }
 
 /* shading/film.c's sq_of: d (0 <= d < 2^96) in units of 2^-64, three words. */
@@ -113,25 +105,25 @@ RS_HD void rs_wf_sq(double d, rs_wf_u64 w[3])
 /* s[0..2] += w as 192-bit integers, each word's wrap carried into the next. */
 RS_HD void rs_wf_add192(rs_wf_u64 *s, const rs_wf_u64 w[3])
 {
-    rs_wf_u64 old = RS_WF_ADD64(&s[0], w[0]);
+    rs_wf_u64 old = RS_ATOMIC_ADD_U64(&s[0], w[0]);
     rs_wf_u64 mid = w[1] + (rs_wf_u64)(old + w[0] < old), top = w[2];
     top += (rs_wf_u64)(mid < w[1]); /* w[1] + carry wrapped */
     if (mid) {
-        old = RS_WF_ADD64(&s[1], mid);
+        old = RS_ATOMIC_ADD_U64(&s[1], mid);
         top += (rs_wf_u64)(old + mid < old);
     }
     if (top)
-        (void)RS_WF_ADD64(&s[2], top);
+        (void)RS_ATOMIC_ADD_U64(&s[2], top);
 }
 
 /* shading/film.c's rs_film_add onto the device's film. */
 RS_HD void rs_wf_film_add(const rs_wf_film *f, uint32_t pixel, rs_vec3 c)
 {
     rs_wf_u64 lo, hi;
-    (void)RS_WF_ADD32(&f->count[pixel], 1u);
+    (void)RS_ATOMIC_ADD_U32(&f->count[pixel], 1u);
     if (!(fabs(c.x) <= RS_FILM_MAX_SAMPLE && fabs(c.y) <= RS_FILM_MAX_SAMPLE &&
           fabs(c.z) <= RS_FILM_MAX_SAMPLE)) {
-        (void)RS_WF_ADD64(f->nonfinite, 1ull);
+        (void)RS_ATOMIC_ADD_U64(f->nonfinite, 1ull);
         return;
     }
     rs_wf_fixed(c.x, &lo, &hi);
