@@ -74,6 +74,11 @@ RS_HD rs_vec3 rs_v3_max(rs_vec3 a, rs_vec3 b)
 RS_HD float rs_v3_max_comp(rs_vec3 a) { return rs_fmaxf(a.x, rs_fmaxf(a.y, a.z)); }
 RS_HD float rs_v3_get(rs_vec3 a, int axis) { return axis == 0 ? a.x : (axis == 1 ? a.y : a.z); }
 RS_HD int rs_v3_is_zero(rs_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+/* Every component finite (x - x is 0 for a finite x, NaN for an infinite or NaN one). */
+RS_HD int rs_v3_is_finite(rs_vec3 a)
+{
+    return a.x - a.x == 0.0f && a.y - a.y == 0.0f && a.z - a.z == 0.0f;
+}
 
 /* Rotation about the y axis by `deg` degrees (right-handed, as RTIOW's rotate_y). */
 RS_HD rs_vec3 rs_v3_rotate_y(rs_vec3 p, float deg)

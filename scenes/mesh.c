@@ -342,8 +342,6 @@ static int has_empty_face(const struct aiScene *as)
     return 0;
 }
 
-static int finite3(rs_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
-
 /* How a texture's texels are read: colours are sRGB-decoded, data (normals, metallic-roughness)
  * taken as stored. */
 #define TEX_COLOR 0
@@ -875,7 +873,7 @@ static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const rs_xform *
             }
             p = rs_v3(m->mVertices[idx].x, m->mVertices[idx].y, m->mVertices[idx].z);
             v[c] = xf ? rs_xform_point(xf, p) : as_stored_point(p);
-            ok = finite3(v[c]);
+            ok = rs_v3_is_finite(v[c]);
             if (!ok)
                 why = &info->dropped_nonfinite;
             if (m->mTextureCoords[0]) {
@@ -885,7 +883,7 @@ static rs_status add_faces(rs_scene *s, const struct aiMesh *m, const rs_xform *
             if (m->mNormals) {
                 rs_vec3 n = rs_v3(m->mNormals[idx].x, m->mNormals[idx].y, m->mNormals[idx].z);
                 n = xf ? rs_xform_normal(xf, n) : as_stored_normal(n);
-                if (!finite3(n))
+                if (!rs_v3_is_finite(n))
                     n = rs_v3(0, 0, 0);
                 nrm[3 * c] = n.x;
                 nrm[3 * c + 1] = n.y;
@@ -1127,7 +1125,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     rs_status st = RS_OK;
     rs_aabb raw;
     memset(info, 0, sizeof *info);
-    if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !finite3(o->scale))
+    if (o->scale.x == 0 || o->scale.y == 0 || o->scale.z == 0 || !rs_v3_is_finite(o->scale))
         return rs_error_set(RS_ERR_ARG, "%s: scale must be finite and non-zero", path);
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
     st = import_file(path,
@@ -1149,7 +1147,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
         for (k = 0; k < m->mNumVertices; ++k) {
             rs_vec3 p = rs_xform_point(
                 &xf, rs_v3(m->mVertices[k].x, m->mVertices[k].y, m->mVertices[k].z));
-            if (!finite3(p))
+            if (!rs_v3_is_finite(p))
                 continue;
             raw.lo = rs_v3_min(raw.lo, p);
             raw.hi = rs_v3_max(raw.hi, p);
