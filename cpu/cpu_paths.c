@@ -2,8 +2,8 @@
  * waves of its own through every stage of the stream engine, traversal included, so that no
  * thread waits for another between the stages.
  *
- * The stream engine on the render thread (scheduler/render.c) runs one wave at a time through
- * its stage table: the host stages split each stage among the threads and the device's team
+ * The stream engine on the render thread (scheduler/stream_engine.c) runs one wave at a time
+ * through its stage table: the host stages split each stage among the threads and the device's team
  * traces between them, so every stage ends at a barrier and at two threads the render thread
  * waited for traversal for a third of the render (docs/performance.md, "Two threads").  Here a
  * call's paths are cut into waves of at most RS_RENDER_HOST_WAVE consecutive paths (a wave's

@@ -1,7 +1,7 @@
 /* scheduler/device.h — what the render loops know of a device: a table of functions.
  *
  * One device model serves both integrators.  The CPU device (cpu/), the CUDA device and its CPU
- * fallback (gpu/) each fill this table; the engine's stream runs (scheduler/render.c) and
+ * fallback (gpu/) each fill this table; the engine's stream runs (scheduler/stream_engine.c) and
  * megakernel runs (scheduler/passes.c) see nothing else, and cpu/ and gpu/ never include
  * each other.
  *

@@ -1,5 +1,5 @@
 /* scheduler/engine.c — see render.h: the engine's set-up, its runs of plans and the time limit.
- * The stream engine's waves are render.c, the megakernel's calls passes.c. */
+ * The stream engine's waves are stream_engine.c, the megakernel's calls passes.c. */
 #include <float.h>
 #include <string.h>
 

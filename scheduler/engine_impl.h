@@ -1,6 +1,6 @@
 /* scheduler/engine_impl.h — the engine's state, shared by its parts (not a public header):
- * engine.c (set-up, plans, the time limit), render.c (the stream engine's waves) and passes.c
- * (the megakernel's calls). */
+ * engine.c (set-up, plans, the time limit), stream_engine.c (the stream engine's waves) and
+ * passes.c (the megakernel's calls). */
 #ifndef RS_SCHEDULER_ENGINE_IMPL_H
 #define RS_SCHEDULER_ENGINE_IMPL_H
 

@@ -9,9 +9,10 @@
  * sampling (a plan per round, scheduler/adaptive.h), an MPI rank (a plan per pass).  The time
  * limit is the engine's, checked in one place for every driver.
  *
- * The stream engine (render.c).  Paths are processed in waves of at most `wave_paths`
+ * The stream engine (stream_engine.c).  Paths are processed in waves of at most `wave_paths`
  * consecutive paths of the plan, so memory is bounded whatever the image size and spp.  Each
- * wave runs the named stages of rs_stage (scheduler/timeline.h) from the stage table in render.c:
+ * wave runs the named stages of rs_stage (scheduler/timeline.h) from the stage table in
+ * stream_engine.c:
  *
  *   raygen -> trace-closest -> shade -> [trace-shadow -> resolve-shadows] -> compact
  *               ^  (devices, through the scheduler)                            |

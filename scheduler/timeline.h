@@ -12,7 +12,7 @@
 
 #include "core/status.h"
 
-/* The render's named stages (scheduler/render.c runs them in this order for each wave). */
+/* The render's named stages (scheduler/stream_engine.c runs them in this order for each wave). */
 typedef enum rs_stage {
     RS_STAGE_RAYGEN = 0,      /* camera rays and fresh path state */
     RS_STAGE_TRACE_CLOSEST,   /* extension rays with the devices (closest hit) */

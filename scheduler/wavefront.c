@@ -1,8 +1,8 @@
 /* scheduler/wavefront.c — runs of plans on devices that run paths whole (render.h:
  * rs_engine_create_paths): each device's render_paths (a GPU's wavefront, gpu/wavefront.h) takes
  * ranges of the plan in calls of about a quarter of a second of its measured rate; with a
- * scheduler, the stream engine runs beside them on the render thread (render.c), its waves taken
- * from the same ranges.
+ * scheduler, the stream engine runs beside them on the render thread (stream_engine.c), its waves
+ * taken from the same ranges.
  *
  * One device alone runs on the render thread.  Otherwise each device has a thread, and all take
  * their ranges through rs_run_take under the run's lock: whoever is free takes the next range,

@@ -487,8 +487,8 @@ def geometry(kernels, root, width=512, height=512, spps=(1, 64)):
     waves = []
     if tr and tr.bound and None not in const.values():
         for spp in spps:
-            # scheduler/render.c resolve_settings: with a GPU, RS_RENDER_DEFAULT_WAVE paths in
-            # flight in 2 waves, a wave at most the render's paths
+            # scheduler/stream_engine.c resolve_settings: with a GPU, RS_RENDER_DEFAULT_WAVE
+            # paths in flight in 2 waves, a wave at most the render's paths
             wave = min(ceil_div(const["RS_RENDER_DEFAULT_WAVE"], 2), npix * spp)
             waves.append(f"{spp} spp: {min(2, ceil_div(npix * spp, wave))} x {wave:,}")
             # scheduler/sched.c: a GPU's first chunk RS_SCHED_FIRST_GPU, then its rays/s times
@@ -511,7 +511,7 @@ def geometry(kernels, root, width=512, height=512, spps=(1, 64)):
         f"   Wavefront: waves of up to {const['RS_CUDA_WF_WAVE'] or 0:,} paths, cut to a whole "
         "number of the busiest",
         "   kernel's resident threads (gpu/cuda_wavefront.cu; later bounces: the paths still alive).  Trace kernel (--shade-on host): the stream engine's waves in "
-        "flight (scheduler/render.c",
+        "flight (scheduler/stream_engine.c",
         f"   resolve_settings: {'; '.join(waves)} paths) are traced in chunks",
         "   (scheduler/sched.c), each cut into rs_gpu_piece_size pieces (gpu/gpu_device.h), a "
         "launch each",

@@ -1,8 +1,8 @@
 /* shading/integrator.h — the stream engine's host stages of the path tracer: raygen, shade,
  * resolve shadows (rs_stage_*), with the host-only constants they read besides the render's.
  *
- * The render loop (scheduler/render.c) owns the buffers and calls the stages in order; devices
- * trace between them.  Each stage is a parallel loop over one stream and writes each path's
+ * The render loop (scheduler/stream_engine.c) owns the buffers and calls the stages in order;
+ * devices trace between them.  Each stage is a parallel loop over one stream and writes each path's
  * state only from that path's own slot, so results do not depend on thread count or order.
  *
  * A path is named by its index in the wave; its global index g = wave_start + path gives, through

@@ -1,6 +1,6 @@
 /* tests/render_cpu_waves_test.c — the CPU device's render_paths (cpu/cpu_paths.c: each thread
  * runs waves of its own through every stage, traversal inline) against the stream engine on the
- * render thread, which shades while the device traces (scheduler/render.c).
+ * render thread, which shades while the device traces (scheduler/stream_engine.c).
  *
  * - Images: builtin:gpucheck in every sampling mode and sampler, on 1, 2 and 3 threads;
  *   builtin:many-lights with the light BVH; adaptive sampling (plans over some pixels); each of

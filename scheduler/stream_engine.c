@@ -1,6 +1,6 @@
-/* scheduler/render.c — the stream engine's run of a plan (render.h): waves of paths through a
- * table of named stages; each slot (a wave in flight) holds the index of the stage it runs
- * next. */
+/* scheduler/stream_engine.c — the stream engine's run of a plan (render.h): waves of paths
+ * through a table of named stages; each slot (a wave in flight) holds the index of the stage it
+ * runs next. */
 #include <string.h>
 
 #include "core/alloc.h"
