@@ -2,6 +2,7 @@
 // two C++ files of the project; every entry point catches all exceptions and turns them into
 // rs_status + message.
 #include "core/image_io.h"
+#include "core/srgb.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>

@@ -100,14 +100,8 @@ rs_status rs_image_downsample(const float *rgb, uint32_t w, uint32_t h, float *o
 /* 1 where rs_image_downsample works (OpenImageIO is built in), 0 in the PFM-only build. */
 int rs_image_can_downsample(void);
 
-/* The linear value of an sRGB-encoded one in [0, 1]. */
-float rs_srgb_decode(float encoded);
-
 /* "2.4.7" */
 const char *rs_image_library_version(void);
-
-/* The sRGB encoding of a linear value, clamped to [0, 1]. */
-float rs_srgb_encode(float linear);
 
 #ifdef __cplusplus
 }

@@ -1,7 +1,7 @@
-/* core/srgb.c — the sRGB transfer curve (IEC 61966-2-1), both ways; see image_io.h. */
+/* core/srgb.c — the sRGB transfer curve (IEC 61966-2-1), both ways; see srgb.h. */
 #include <math.h>
 
-#include "core/image_io.h"
+#include "core/srgb.h"
 
 float rs_srgb_encode(float x)
 {

@@ -7,7 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "core/image_io.h"
+#include "core/srgb.h"
 #include "core/view.h"
 
 const char *rs_view_builtin_names(void) { return "standard, filmic (or agx), pbr-neutral"; }

@@ -25,6 +25,7 @@
 #include "core/alloc.h"
 #include "core/file.h"
 #include "core/image_io.h"
+#include "core/srgb.h"
 
 /* ---- every file Assimp opens goes through core/file.h ------------------------------------ */
 

@@ -36,6 +36,7 @@
 
 #include "core/alloc.h"
 #include "core/image_io.h"
+#include "core/srgb.h"
 #include "core/view.h"
 
 static char tmpdir[256];

@@ -33,6 +33,7 @@
 
 #include "accel/bvh8.h"
 #include "core/image_io.h"
+#include "core/srgb.h"
 #include "render_util.h"
 #include "scenes/gltf.h"
 #include "scenes/gltf_check.h"
