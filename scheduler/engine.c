@@ -1,5 +1,7 @@
-/* scheduler/engine.c — see render.h: the engine's set-up, its runs of plans and the time limit.
- * The stream engine's waves are stream_engine.c, the megakernel's calls passes.c. */
+/* scheduler/engine.c — see render.h: the engine's set-up and its runs of plans.  A run's
+ * bookkeeping (its ranges, the time limit's cut, shares, the record of paths on the film) is
+ * run.c, the stream engine's waves stream_engine.c, the megakernel's calls passes.c, the path
+ * devices' threads wavefront.c. */
 #include <float.h>
 #include <string.h>
 
@@ -228,73 +230,6 @@ rs_status rs_engine_run(rs_engine *e, const rs_work_plan *plan, const rs_render_
         e->any_done = 1;
     rs_render_stats_add(&e->total, stats);
     return st;
-}
-
-int rs_run_cancelled(const rs_run *c)
-{
-    return c->hooks && c->hooks->cancel && atomic_load(c->hooks->cancel);
-}
-
-uint64_t rs_run_time_cut(rs_run *c, uint64_t next)
-{
-    const rs_engine *e = c->e;
-    uint64_t n = c->map.n_active, end;
-    if (!(e->st.time_limit_s > 0) || rs_now_s() - e->t_start < e->st.time_limit_s)
-        return UINT64_MAX;
-    uint32_t k;
-    end = (next + n - 1) / n * n;
-    if (!e->any_done && c->plan->todo.n) { /* the render's first pass is always finished */
-        uint64_t first = (c->plan->todo.r[0][0] / n + 1) * n;
-        if (end < first)
-            end = first;
-    }
-    /* The paths between the plan's ranges are on the film already (a checkpoint's, which has
-     * gaps where devices finished ranges out of order): where such paths lie past `end`, the
-     * passes they are in are finished too, so that every pixel ends with the same samples.
-     * Scanning the later ranges in order: one that starts past `end` after a gap moves `end` to
-     * the end of its start's pass, which may take in the next. */
-    for (k = c->range + 1; k < c->n_ranges; ++k) {
-        uint64_t lo = c->plan->todo.r[k][0];
-        if (lo > end && lo > c->plan->todo.r[k - 1][1])
-            end = (lo + n - 1) / n * n;
-    }
-    if (end < c->end_path || c->range + 1 < c->n_ranges) {
-        int dropped = end < c->end_path;
-        if (end < c->end_path)
-            c->end_path = end > c->next_path ? end : c->next_path;
-        /* later ranges: those that start before `end` stay, the last cut there (rs_run_more) */
-        for (k = c->range + 1; k < c->n_ranges && c->plan->todo.r[k][0] < end; ++k)
-            dropped |= c->plan->todo.r[k][1] > end;
-        dropped |= k < c->n_ranges;
-        c->n_ranges = k;
-        c->cut = end;
-        if (dropped)
-            c->stats->time_limited = 1;
-    }
-    return end;
-}
-
-int rs_run_more(rs_run *c)
-{
-    if (c->n_redo)
-        return 1;
-    while (c->next_path >= c->end_path && c->range + 1 < c->n_ranges) {
-        c->range++;
-        c->next_path = c->plan->todo.r[c->range][0];
-        c->end_path = c->plan->todo.r[c->range][1];
-        if (c->end_path > c->cut) /* the time limit's cut (rs_run_time_cut) */
-            c->end_path = c->cut > c->next_path ? c->cut : c->next_path;
-    }
-    return c->next_path < c->end_path;
-}
-
-rs_status rs_run_on_film(rs_run *c, uint64_t lo, uint64_t hi)
-{
-    if (!rs_path_ranges_add(&c->e->done, lo, hi))
-        return rs_error_set(RS_ERR_NOMEM, "out of memory for the render's record of its paths");
-    if (c->hooks && c->hooks->film_ready)
-        c->hooks->film_ready(c->hooks->user, c->film, &c->e->done);
-    return RS_OK;
 }
 
 /* One plan: [path_begin, all) of every pixel. */

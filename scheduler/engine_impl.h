@@ -1,6 +1,7 @@
 /* scheduler/engine_impl.h — the engine's state, shared by its parts (not a public header):
- * engine.c (set-up, plans, the time limit), stream_engine.c (the stream engine's waves) and
- * passes.c (the megakernel's calls). */
+ * engine.c (set-up, plans), run.c (a run's bookkeeping and the time limit's cut), stream_engine.c
+ * (the stream engine's waves), passes.c (the megakernel's calls) and wavefront.c (the path
+ * devices' threads).  They call down into run.c, never back into engine.c. */
 #ifndef RS_SCHEDULER_ENGINE_IMPL_H
 #define RS_SCHEDULER_ENGINE_IMPL_H
 

@@ -5,10 +5,10 @@
  * taken from the same ranges.
  *
  * One device alone runs on the render thread.  Otherwise each device has a thread, and all take
- * their ranges through rs_run_take under the run's lock: whoever is free takes the next range,
- * sized by its own rate against everyone's so that near the end of the plan each takes what it
- * finishes about when the others finish (guided self-scheduling: the last ranges shrink, so no
- * device is left with a long tail while another waits).  A device adds each call's samples to a
+ * their ranges through rs_run_take (run.c) under the run's lock: whoever is free takes the next
+ * range, sized by its own rate against everyone's so that near the end of the plan each takes
+ * what it finishes about when the others finish (guided self-scheduling: the last ranges shrink,
+ * so no device is left with a long tail while another waits).  A device adds each call's samples to a
  * film of its own, which is merged into the run's film under the lock (exact sums: in any order
  * and any split, the one-device image bit for bit) before the range is recorded and the hooks
  * told.  A device that fails gives its range back, and the others (the stream engine first, on
@@ -27,67 +27,6 @@
 #define RS_PATHS_MAX_CALL   (1ull << 28)
 /* Seconds of work per call once the device's rate is known. */
 #define RS_PATHS_CALL_S 0.25
-/* The fewest paths a guided share falls to. */
-#define RS_PATHS_MIN_SHARE 4096ull
-
-/* Paths left in the plan from the run's position. */
-static uint64_t paths_left(const rs_run *c)
-{
-    uint64_t left = c->end_path > c->next_path ? c->end_path - c->next_path : 0;
-    uint32_t r;
-    for (r = c->range + 1; r < c->n_ranges; ++r)
-        left += c->plan->todo.r[r][1] - c->plan->todo.r[r][0];
-    return left;
-}
-
-int rs_run_take(rs_run *c, int who, uint64_t most, uint64_t *lo, uint64_t *n)
-{
-    int got = 0;
-    rs_run_lock(c);
-    if (c->n_redo) {
-        uint64_t *r = c->redo[c->n_redo - 1];
-        *lo = r[0];
-        *n = r[1] - r[0] < most ? r[1] - r[0] : most;
-        r[0] += *n;
-        if (r[0] == r[1])
-            c->n_redo--;
-        got = 1;
-    } else if (!rs_run_cancelled(c)) {
-        (void)rs_run_time_cut(c, c->next_path);
-        if (rs_run_more(c)) {
-            uint64_t left = c->end_path - c->next_path, want = most;
-            if (c->lock && c->rate[who] <= 0) {
-                /* its first take, rate unknown: at most a quarter of an even share, and the
-                 * stream engine (far slower than a GPU) a small wave per thread */
-                uint64_t even = paths_left(c) / (4u * (uint64_t)(c->e->n_pdev + 1));
-                if (who == c->e->n_pdev && want > (uint64_t)RS_RENDER_HOST_WAVE * c->e->st.threads)
-                    want = (uint64_t)RS_RENDER_HOST_WAVE * c->e->st.threads;
-                if (want > even)
-                    want = even > RS_PATHS_MIN_SHARE ? even : RS_PATHS_MIN_SHARE;
-            } else if (c->lock) {
-                /* a share of what is left, in proportion to this one's rate, about a quarter
-                 * of the time everyone together still needs (and never over `most`) */
-                double total = 0.0, t;
-                int k;
-                for (k = 0; k <= c->e->n_pdev; ++k)
-                    total += c->rate[k];
-                t = (double)paths_left(c) / total / 4.0;
-                t = c->rate[who] * t;
-                want = t < (double)RS_PATHS_MIN_SHARE ? RS_PATHS_MIN_SHARE
-                       : t < (double)most             ? (uint64_t)t
-                                                      : most;
-            }
-            if (want > most) /* never past what the taker can hold (a wave's buffers) */
-                want = most;
-            *lo = c->next_path;
-            *n = left < want ? left : want;
-            c->next_path += *n;
-            got = 1;
-        }
-    }
-    rs_run_unlock(c);
-    return got;
-}
 
 rs_status rs_paths_setup(rs_engine *e)
 {
