@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "app/render_run.h"
+#include "app/fail.h"
 #include "cpu/cpu_device.h"
 #include "gpu/gpu_device.h"
 

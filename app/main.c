@@ -16,13 +16,6 @@
 #include "gpu/gpu_device.h"
 #include "scenes/builtin.h"
 
-int rs_app_fail(int code, const char *what)
-{
-    const char *msg = rs_error_message();
-    fprintf(stderr, "raystream: %s%s%s\n", what ? what : "", what && *msg ? ": " : "", msg);
-    return code;
-}
-
 static int cmd_version(void)
 {
     const char *why = "";

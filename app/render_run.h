@@ -1,6 +1,6 @@
-/* app/render_run.h — what one `raystream render` makes and the named steps that make it, shared
- * by the render command (render_cmd.c), its outputs (render_outputs.c) and its MPI glue
- * (dist_glue.c).  Internal to app/.
+/* app/render_run.h — what one `raystream render` makes and the named steps that make it
+ * (render_steps.c, scene_load.c, render_outputs.c), shared by the render command (render_cmd.c)
+ * and its MPI glue (dist_glue.c).  Internal to app/.
  *
  * The steps run in this order, each returning an exit code (RS_EXIT_*; a failure has printed
  * one line): rs_run_load_scene, rs_run_settings, rs_run_check_outputs, rs_run_make_film,
@@ -11,6 +11,7 @@
 
 #include "app/checkpoint.h"
 #include "app/distributed.h"
+#include "app/fail.h"
 #include "app/options.h"
 #include "app/outputs.h"
 #include "app/progress.h"
@@ -76,10 +77,7 @@ typedef struct render_run {
     rs_dist_fault dist_fault; /* RS_MPI_FAULT */
 } render_run;
 
-/* Prints "raystream: WHAT: <the first error's message>" and returns `code`. */
-int rs_app_fail(int code, const char *what);
-
-/* The steps (render_cmd.c, render_outputs.c); see the top of this file. */
+/* The steps (render_steps.c, scene_load.c, render_outputs.c); see the top of this file. */
 int rs_run_load_scene(const rs_cli_options *o, render_run *r); /* under the load watchdog */
 void rs_run_settings(const rs_cli_options *o, render_run *r);
 int rs_run_check_outputs(const rs_cli_options *o, render_run *r);
