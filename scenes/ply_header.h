@@ -1,5 +1,5 @@
 /* scenes/ply_header.h — the one PLY header parser, for the mesh import's check before Assimp
- * (scenes/mesh.c) and for the triangle-strip reader (scenes/ply_strips.h).
+ * (scenes/mesh_import.c) and for the triangle-strip reader (scenes/ply_strips.h).
  *
  * A header must reach end_header within its first RS_PLY_MAX_HEADER bytes (Assimp's PLY reader
  * spins for ever on a header cut before it), and every "element NAME COUNT" line must be exactly
@@ -7,7 +7,7 @@
  * 64 GiB).  What the header declares is checked against the bytes after end_header: every
  * element instance counts against them (Assimp allocates each one), and in binary the instances'
  * fixed-size properties (a list counts its length field only) must fit.  An ascii body's lines
- * are counted by the caller against `need_lines` (scenes/mesh.c reads the file in pieces).
+ * are counted by the caller against `need_lines` (scenes/mesh_import.c reads the file in pieces).
  *
  * Two modes: a loose one that leaves what it does not know to Assimp (unknown keywords, types and
  * formats), and a strict one for our own reader, which also keeps every element and property

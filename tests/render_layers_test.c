@@ -1,5 +1,5 @@
 /* tests/render_layers_test.c — glTF's material layers (KHR_materials_specular, _clearcoat,
- * _sheen, _volume, _unlit as the loader makes them: scenes/mesh.c) shade with RS_HD code, so
+ * _sheen, _volume, _unlit as the loader makes them: scenes/mesh_materials.c) shade with RS_HD code, so
  * every integrator and device gives the same image bit for bit: the stream engine on the CPU, on
  * the CPU and the GPU's host fallback together, on the fallback alone, and the megakernel.  The
  * scene: a sheen floor, a coated sphere, a sphere with a coloured specular layer, a sphere of
