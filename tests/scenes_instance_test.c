@@ -1,5 +1,5 @@
 /* tests/scenes_instance_test.c — instances over the two-level BVH (core/geom.h, accel/bvh.c,
- * scenes/scene_json.c):
+ * scenes/json_objects.c):
  *   - a scene file's top-level instances of groups of triangles (nested groups, a mesh file with
  *     UVs and normals, rotations, a non-uniform scale, a mirror, a 4x4 matrix) are placed, not
  *     copied: one prototype, five instances; a group with an emitter is copied;
