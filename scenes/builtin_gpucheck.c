@@ -285,32 +285,41 @@ static rs_status add_punctual(rs_scene *s, uint32_t type, rs_vec3 pos, rs_vec3 d
     return rs_scene_add_punctual(s, &p);
 }
 
-rs_status rs_builtin_build_gpucheck(rs_scene *s)
-{
-    rs_material m;
-    uint32_t id, t_floor, t_stripes, t_solid, t_base, t_normal, t_mr, t_emit, i_base, i_normal,
-        i_mr, i_sky, mask, glass, lambert, proto_first, proto_count;
-    rs_vec3 gold_eta = rs_v3(0.143f, 0.375f, 1.442f), gold_k = rs_v3(3.983f, 2.386f, 1.603f);
+/* The scene's textures and the images they read. */
+typedef struct gc_tex {
+    uint32_t floor, stripes, solid, base, normal, mr, emit, sky_image;
+} gc_tex;
 
-    /* textures */
+static rs_status gc_textures(rs_scene *s, gc_tex *t)
+{
+    uint32_t i_base, i_normal, i_mr;
     RS_TRY(add_base_image(s, &i_base));
     RS_TRY(add_normal_image(s, &i_normal));
     RS_TRY(add_mr_image(s, &i_mr));
-    RS_TRY(add_sky_image(s, &i_sky));
+    RS_TRY(add_sky_image(s, &t->sky_image));
     RS_TRY(add_texture(s, RS_TEX_CHECKER, rs_v3(.7f, .7f, .7f), rs_v3(.25f, .25f, .3f), 0.5f, 0,
-                       &t_floor));
+                       &t->floor));
     RS_TRY(add_texture(s, RS_TEX_STRIPES, rs_v3(.9f, .85f, .2f), rs_v3(.2f, .3f, .8f), 6.0f, 0,
-                       &t_stripes));
-    RS_TRY(add_texture(s, RS_TEX_SOLID, rs_v3(.3f, .7f, .4f), rs_v3(0, 0, 0), 1.0f, 0, &t_solid));
-    RS_TRY(add_texture(s, RS_TEX_IMAGE, rs_v3(0, 0, 0), rs_v3(0, 0, 0), 1.0f, i_base, &t_base));
-    RS_TRY(add_texture(s, RS_TEX_IMAGE, rs_v3(0, 0, 0), rs_v3(0, 0, 0), 1.0f, i_normal, &t_normal));
-    RS_TRY(add_texture(s, RS_TEX_IMAGE, rs_v3(0, 0, 0), rs_v3(0, 0, 0), 1.0f, i_mr, &t_mr));
+                       &t->stripes));
+    RS_TRY(add_texture(s, RS_TEX_SOLID, rs_v3(.3f, .7f, .4f), rs_v3(0, 0, 0), 1.0f, 0, &t->solid));
+    RS_TRY(add_texture(s, RS_TEX_IMAGE, rs_v3(0, 0, 0), rs_v3(0, 0, 0), 1.0f, i_base, &t->base));
     RS_TRY(
-        add_texture(s, RS_TEX_STRIPES, rs_v3(1, .6f, .2f), rs_v3(.1f, .1f, .1f), 4.0f, 0, &t_emit));
+        add_texture(s, RS_TEX_IMAGE, rs_v3(0, 0, 0), rs_v3(0, 0, 0), 1.0f, i_normal, &t->normal));
+    RS_TRY(add_texture(s, RS_TEX_IMAGE, rs_v3(0, 0, 0), rs_v3(0, 0, 0), 1.0f, i_mr, &t->mr));
+    RS_TRY(add_texture(s, RS_TEX_STRIPES, rs_v3(1, .6f, .2f), rs_v3(.1f, .1f, .1f), 4.0f, 0,
+                       &t->emit));
+    return RS_OK;
+}
 
+/* The floor, and the back row of spheres: the GGX conductors, rough glass, pbr. */
+static rs_status gc_floor_and_back_row(rs_scene *s, const gc_tex *t)
+{
+    rs_material m;
+    uint32_t id;
+    rs_vec3 gold_eta = rs_v3(0.143f, 0.375f, 1.442f), gold_k = rs_v3(3.983f, 2.386f, 1.603f);
     /* the floor: a textured quad */
     m = rs_mat_lambertian(rs_v3_splat(1.0f));
-    m.albedo_tex = t_floor;
+    m.albedo_tex = t->floor;
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(rs_scene_add_quad(s, rs_v3(-7, 0, 5), rs_v3(14, 0, 0), rs_v3(0, 0, -12), id));
 
@@ -331,10 +340,17 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
     m.emission = rs_v3(.6f, .15f, .05f); /* constant: a light, sampled */
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(3.4f, 0.6f, -2), 0.6f, id));
+    return RS_OK;
+}
 
+/* The middle row: the thesis's materials on small spheres, and the moving sphere. */
+static rs_status gc_middle_row(rs_scene *s, const gc_tex *t)
+{
+    rs_material m;
+    uint32_t id, glass, lambert;
     /* middle row (z = -0.6): the thesis's materials on small spheres */
     m = rs_mat_disney_diffuse(rs_v3_splat(1.0f), 0.6f);
-    m.albedo_tex = t_base; /* an image on a sphere: longitude/latitude UVs */
+    m.albedo_tex = t->base; /* an image on a sphere: longitude/latitude UVs */
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(-4.2f, 0.4f, -0.6f), 0.4f, id));
     RS_TRY(add_mat(s, rs_mat_phong(rs_v3(.1f, .3f, .6f), rs_v3(.4f, .4f, .4f), 40.0f), &id));
@@ -349,11 +365,11 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(-2.6f, 0.35f, 2.3f), 0.35f, id));
     m = rs_mat_diffuse_uniform(rs_v3_splat(1.0f));
-    m.albedo_tex = t_stripes;
+    m.albedo_tex = t->stripes;
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(1.2f, 0.35f, 2.2f), 0.35f, id));
     m = rs_mat_lambertian(rs_v3_splat(1.0f));
-    m.albedo_tex = t_solid;
+    m.albedo_tex = t->solid;
     m.flags |= RS_MAT_UNIFORM_SAMPLING;
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(2.3f, 0.35f, 2.3f), 0.35f, id));
@@ -362,7 +378,14 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
     RS_TRY(add_mat(s, rs_mat_lambertian(rs_v3(.8f, .2f, .6f)), &lambert));
     RS_TRY(rs_scene_add_moving_sphere(s, rs_v3(3.3f, 0.45f, 1.0f), 0.0f, rs_v3(3.3f, 0.95f, 1.0f),
                                       1.0f, 0.45f, lambert));
+    return RS_OK;
+}
 
+/* The area lights, the pbr patch and tile, a two-sided emitter and the alpha cut-out. */
+static rs_status gc_lights_and_patches(rs_scene *s, const gc_tex *t)
+{
+    rs_material m;
+    uint32_t id, mask;
     /* lights: a sphere, a one-sided quad facing down, a two-sided triangle (after the patch) */
     RS_TRY(add_mat(s, rs_mat_light(rs_v3(8, 6, 3), 0), &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(-2.8f, 1.6f, 0.6f), 0.15f, id));
@@ -372,17 +395,17 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
     /* the pbr patch: base colour image, normal map, metallic-roughness map; triangles with UVs
      * and vertex normals */
     m = rs_mat_pbr(rs_v3_splat(1.0f), 1.0f, 0.7f);
-    m.albedo_tex = t_base;
-    m.normal_tex = t_normal;
+    m.albedo_tex = t->base;
+    m.normal_tex = t->normal;
     m.normal_scale = 0.8f;
-    m.mr_tex = t_mr;
+    m.mr_tex = t->mr;
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(add_patch(s, -2.0f, 0.0f, 0.4f, id));
 
     /* a pbr tile with a textured emission (found by paths only), two triangles with UVs */
     m = rs_mat_pbr(rs_v3(.2f, .2f, .2f), 0.0f, 0.5f);
     m.emission = rs_v3(3, 3, 3);
-    m.emission_tex = t_emit;
+    m.emission_tex = t->emit;
     RS_TRY(add_mat(s, m, &id));
     {
         rs_vec3 v[3];
@@ -402,11 +425,18 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
     /* the alpha cut-out: an upright square of striped triangles with holes, in front of glass */
     RS_TRY(add_holes_mask(s, &mask));
     m = rs_mat_lambertian(rs_v3_splat(1.0f));
-    m.albedo_tex = t_stripes;
+    m.albedo_tex = t->stripes;
     m.alpha_mask = mask;
     RS_TRY(add_mat(s, m, &id));
     RS_TRY(add_upright_square(s, rs_v3(0.6f, 0.0f, 0.9f), 1.1f, id));
+    return RS_OK;
+}
 
+/* Two instances of a pyramid prototype, one placed obliquely, one mirrored and sheared. */
+static rs_status gc_pyramids(rs_scene *s, const gc_tex *tex)
+{
+    rs_material m;
+    uint32_t proto_first, proto_count;
     /* the instanced pyramid: sides alternating a rough Schlick conductor and a normal-mapped pbr
      * with UVs and vertex normals */
     {
@@ -415,8 +445,8 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
         rs_xform r, sc, t, x, sh;
         RS_TRY(add_mat(s, rs_mat_conductor_f0(rs_v3(.9f, .9f, .95f), 0.3f), &a));
         m = rs_mat_pbr(rs_v3(.3f, .6f, .9f), 0.2f, 0.35f);
-        m.albedo_tex = t_base;
-        m.normal_tex = t_normal;
+        m.albedo_tex = tex->base;
+        m.normal_tex = tex->normal;
         m.normal_scale = 1.0f;
         RS_TRY(add_mat(s, m, &b));
         RS_TRY(add_pyramid_prototype(s, a, b, &proto_first, &proto_count));
@@ -438,7 +468,12 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
         x = rs_xform_compose(&t, &x);
         RS_TRY(place(s, proto_first, proto_count, &x));
     }
+    return RS_OK;
+}
 
+/* The punctual lights, the environment map and the camera. */
+static rs_status gc_lights_map_camera(rs_scene *s, uint32_t sky_image)
+{
     /* punctual lights */
     RS_TRY(add_punctual(s, RS_PUNCTUAL_POINT, rs_v3(1.5f, 2.5f, 2.5f), rs_v3(0, 0, 0),
                         rs_v3(6, 5, 4), 0, 0));
@@ -454,7 +489,7 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
         rot[0] = (float)cos(a), rot[1] = 0, rot[2] = (float)sin(a);
         rot[3] = 0, rot[4] = 1, rot[5] = 0;
         rot[6] = (float)-sin(a), rot[7] = 0, rot[8] = (float)cos(a);
-        RS_TRY(rs_scene_set_environment(s, i_sky, rs_v3(1.0f, 0.95f, 0.9f), rot));
+        RS_TRY(rs_scene_set_environment(s, sky_image, rs_v3(1.0f, 0.95f, 0.9f), rot));
     }
 
     s->camera.from = rs_v3(0.0f, 3.4f, 9.0f);
@@ -468,6 +503,16 @@ rs_status rs_builtin_build_gpucheck(rs_scene *s)
     s->background = rs_v3(0, 0, 0); /* the map replaces it */
     s->width = 96;
     s->height = 64;
-    (void)glass;
     return RS_OK;
+}
+
+rs_status rs_builtin_build_gpucheck(rs_scene *s)
+{
+    gc_tex t;
+    RS_TRY(gc_textures(s, &t));
+    RS_TRY(gc_floor_and_back_row(s, &t));
+    RS_TRY(gc_middle_row(s, &t));
+    RS_TRY(gc_lights_and_patches(s, &t));
+    RS_TRY(gc_pyramids(s, &t));
+    return gc_lights_map_camera(s, t.sky_image);
 }

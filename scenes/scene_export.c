@@ -8,6 +8,7 @@
 
 #include "core/file.h"
 #include "core/image_io.h"
+#include "core/try.h"
 
 static void num(FILE *f, float x) { fprintf(f, "%.9g", (double)x); }
 
@@ -37,10 +38,22 @@ static void image_name(const char *path, uint32_t i, char *full, size_t n, char 
         snprintf(full, n, "%s", rel);
 }
 
-static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m, uint32_t i)
+/* Whether pbr material m is what a scene file's "pbr" holds: a base colour (or its texture),
+ * metallic and roughness, none of glTF's other textures, emission, cut-outs or layers. */
+static int pbr_plain(const rs_material *m)
 {
-    const char *albedo_key = "albedo";
-    fprintf(f, "    \"m%u\": { \"type\": ", i);
+    return m->mr_tex == RS_NO_TEXTURE && m->emission_tex == RS_NO_TEXTURE &&
+           m->normal_tex == RS_NO_TEXTURE && rs_v3_is_zero(m->emission) && !m->alpha_mask &&
+           m->spec_weight == 1.0f && m->specular.x == 0.04f && m->specular.y == 0.04f &&
+           m->specular.z == 0.04f && !(m->coat > 0.0f) && rs_v3_is_zero(m->sheen);
+}
+
+/* Material i's type and the parameters of its type; *albedo_key the key its colour goes under,
+ * or NULL when the material is written whole (an emitter, a conductor by eta and k). */
+static rs_status write_material_type(FILE *f, const rs_material *m, uint32_t i,
+                                     const char **albedo_key)
+{
+    *albedo_key = "albedo";
     switch (m->type) {
     case RS_MAT_LAMBERTIAN: fputs("\"lambertian\"", f); break;
     case RS_MAT_DIFFUSE_UNIFORM: fputs("\"diffuse_uniform\"", f); break;
@@ -53,7 +66,7 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         vec(f, m->specular);
         fputs(", \"exponent\": ", f);
         num(f, m->exponent);
-        albedo_key = "kd";
+        *albedo_key = "kd";
         break;
     case RS_MAT_METAL:
         fputs("\"metal\", \"fuzz\": ", f);
@@ -64,26 +77,26 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         num(f, m->ior);
         if (m->flags & RS_MAT_EXACT_FRESNEL)
             fputs(", \"fresnel\": \"exact\"", f);
-        albedo_key = "tint";
+        *albedo_key = "tint";
         break;
     case RS_MAT_DIFFUSE_LIGHT:
         fputs("\"light\", \"emission\": ", f);
         vec(f, m->emission);
         if (m->flags & RS_MAT_TWO_SIDED)
             fputs(", \"two_sided\": true", f);
-        fputs(" }", f);
+        *albedo_key = NULL;
         return RS_OK;
     case RS_MAT_CONDUCTOR:
         fputs("\"conductor\", \"roughness\": ", f);
         num(f, sqrtf(m->alpha));
         if (m->flags & RS_MAT_F0_COLOR) {
-            albedo_key = "color";
+            *albedo_key = "color";
         } else {
             fputs(", \"eta\": ", f);
             vec(f, m->eta);
             fputs(", \"k\": ", f);
             vec(f, m->k);
-            fputs(" }", f);
+            *albedo_key = NULL;
             return RS_OK;
         }
         break;
@@ -95,13 +108,10 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         num(f, m->ior);
         fputs(", \"roughness\": ", f);
         num(f, sqrtf(m->alpha));
-        albedo_key = "tint";
+        *albedo_key = "tint";
         break;
     case RS_MAT_PBR:
-        if (m->mr_tex != RS_NO_TEXTURE || m->emission_tex != RS_NO_TEXTURE ||
-            m->normal_tex != RS_NO_TEXTURE || !rs_v3_is_zero(m->emission) || m->alpha_mask ||
-            m->spec_weight != 1.0f || m->specular.x != 0.04f || m->specular.y != 0.04f ||
-            m->specular.z != 0.04f || m->coat > 0.0f || !rs_v3_is_zero(m->sheen))
+        if (!pbr_plain(m))
             return rs_error_set(RS_ERR_ARG, "material %u: a pbr material's metallic-roughness, "
                                             "emissive and normal textures, alpha cut-outs and "
                                             "glTF specular, clearcoat and sheen layers have "
@@ -112,9 +122,21 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         num(f, m->metallic);
         fputs(", \"roughness\": ", f);
         num(f, sqrtf(m->alpha));
-        albedo_key = "base_color";
+        *albedo_key = "base_color";
         break;
     default: return rs_error_set(RS_ERR_ARG, "material %u: unknown type %u", i, m->type);
+    }
+    return RS_OK;
+}
+
+static rs_status write_material(FILE *f, const rs_material *m, uint32_t i)
+{
+    const char *albedo_key;
+    fprintf(f, "    \"m%u\": { \"type\": ", i);
+    RS_TRY(write_material_type(f, m, i, &albedo_key));
+    if (!albedo_key) {
+        fputs(" }", f);
+        return RS_OK;
     }
     if (m->flags & RS_MAT_UNIFORM_SAMPLING)
         fputs(", \"importance_sampling\": false", f);
@@ -126,15 +148,13 @@ static rs_status write_material(FILE *f, const rs_scene *s, const rs_material *m
         vec(f, m->albedo);
         fputs(" }", f);
     }
-    (void)s;
     return RS_OK;
 }
 
-static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
+/* The camera and the image size. */
+static void write_camera(FILE *f, const rs_scene *s)
 {
     const rs_camera_desc *c = &s->camera;
-    uint32_t i, first = 1;
-    rs_status st = RS_OK;
     fputs("{\n  \"camera\": { \"from\": ", f);
     vec(f, c->from);
     fputs(", \"at\": ", f);
@@ -159,14 +179,25 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
         fputc(']', f);
     }
     fprintf(f, " },\n  \"image\": { \"width\": %u, \"height\": %u },\n", s->width, s->height);
-    /* every image as an EXR beside the file */
+}
+
+/* Every image as an EXR (a PFM without OpenImageIO) beside the file. */
+static rs_status write_images(const rs_scene *s, const char *path)
+{
+    uint32_t i;
+    rs_status st = RS_OK;
     for (i = 0; i < s->n_images && st == RS_OK; ++i) {
         char full[1024], rel[512];
         image_name(path, i, full, sizeof full, rel, sizeof rel);
         st = rs_image_write(full, s->images[i].width, s->images[i].height, s->images[i].rgb);
     }
-    if (st != RS_OK)
-        return st;
+    return st;
+}
+
+/* The environment map, the RTIOW sky or the constant background. */
+static void write_background(FILE *f, const rs_scene *s, const char *path)
+{
+    uint32_t i;
     if (s->env_image != RS_NO_TEXTURE) {
         char full[1024], rel[512];
         const float *r = s->env_rot;
@@ -191,6 +222,11 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
         vec(f, s->background);
         fputs(",\n", f);
     }
+}
+
+static void write_textures(FILE *f, const rs_scene *s, const char *path)
+{
+    uint32_t i;
     if (s->n_textures) {
         fputs("  \"textures\": {\n", f);
         for (i = 0; i < s->n_textures; ++i) {
@@ -215,14 +251,24 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
         }
         fputs("  },\n", f);
     }
+}
+
+static rs_status write_materials(FILE *f, const rs_scene *s)
+{
+    uint32_t i;
+    rs_status st = RS_OK;
     fputs("  \"materials\": {\n", f);
     for (i = 0; i < s->n_materials && st == RS_OK; ++i) {
-        st = write_material(f, s, &s->materials[i], i);
+        st = write_material(f, &s->materials[i], i);
         fputs(i + 1 < s->n_materials ? ",\n" : "\n", f);
     }
-    if (st != RS_OK)
-        return st;
-    fputs("  },\n  \"objects\": [\n", f);
+    return st;
+}
+
+/* The spheres and parallelograms, each after a comma unless *first. */
+static void write_spheres_quads(FILE *f, const rs_scene *s, uint32_t *first_io)
+{
+    uint32_t i, first = *first_io;
     for (i = 0; i < s->n_spheres; ++i, first = 0) {
         fprintf(f, "%s    { \"type\": \"sphere\", \"center\": ", first ? "" : ",\n");
         vec(f, s->spheres[i].center);
@@ -243,6 +289,12 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
         vec(f, s->quads[i].v);
         fprintf(f, ", \"material\": \"m%u\" }", s->quad_mat[i]);
     }
+    *first_io = first;
+}
+
+static void write_triangles(FILE *f, const rs_scene *s, uint32_t *first_io)
+{
+    uint32_t i, first = *first_io;
     for (i = 0; i < s->n_tris; ++i, first = 0) {
         fprintf(f, "%s    { \"type\": \"triangle\", \"vertices\": [", first ? "" : ",\n");
         vec(f, s->tris[i].v0);
@@ -269,6 +321,12 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
         }
         fprintf(f, ", \"material\": \"m%u\" }", s->tri_mat[i]);
     }
+    *first_io = first;
+}
+
+static void write_punctuals(FILE *f, const rs_scene *s, uint32_t first)
+{
+    uint32_t i;
     for (i = 0; i < s->n_punctuals; ++i, first = 0) {
         const rs_punctual *p = &s->punctuals[i];
         static const char *const kind[] = {"point_light", "spot_light", "directional_light"};
@@ -291,6 +349,20 @@ static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
         }
         fputs(" }", f);
     }
+}
+
+static rs_status write_all(FILE *f, const rs_scene *s, const char *path)
+{
+    uint32_t first = 1;
+    write_camera(f, s);
+    RS_TRY(write_images(s, path));
+    write_background(f, s, path);
+    write_textures(f, s, path);
+    RS_TRY(write_materials(f, s));
+    fputs("  },\n  \"objects\": [\n", f);
+    write_spheres_quads(f, s, &first);
+    write_triangles(f, s, &first);
+    write_punctuals(f, s, first);
     fputs("\n  ]\n}\n", f);
     return RS_OK;
 }
