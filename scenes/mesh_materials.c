@@ -237,55 +237,43 @@ static rs_vec3 clamp01(rs_vec3 c)
     return rs_v3(fminf(fmaxf(c.x, 0), 1), fminf(fmaxf(c.y, 0), 1), fminf(fmaxf(c.z, 0), 1));
 }
 
-/* glTF's metallic-roughness material (Assimp sets a metallic factor for it): base colour and
- * its texture, metallic and roughness and their texture, emission and its texture, the normal
- * map. */
-static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
-                                  const struct aiMaterial *am, const rs_gltf_mat_ext *x,
-                                  const char *mesh, const char *dir, int strict, uint32_t *id)
+/* KHR_materials_transmission (mostly transmitting): rough glass of the material's index
+ * (KHR_materials_ior, else 1.5), tinted by the base colour; the transmission texture is not
+ * read.  KHR_materials_volume's attenuation as the glass's absorption. */
+static rs_status add_pbr_glass(rs_scene *s, const struct aiMaterial *am, const rs_gltf_mat_ext *x,
+                               struct aiColor4D base, ai_real rough, uint32_t *id)
 {
-    struct aiColor4D base = {1, 1, 1, 1}, ke = {0, 0, 0, 1};
-    ai_real metal = 1, rough = 1, scale = 1, trans = 0, strength = 1;
-    unsigned int one = 1;
     rs_material m;
-    uint32_t t;
-    rs_gltf_mat_ext none = rs_gltf_mat_ext_default();
-    if (!x)
-        x = &none;
-    aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base);
-    aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &ke);
-    aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &one);
+    unsigned int one;
+    ai_real ior = 1.5f;
+    float r = fminf(fmaxf(rough, 0), 1);
+    int c;
     one = 1;
-    aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &rough, &one);
-    one = 1;
-    if (aiGetMaterialFloatArray(am, AI_MATKEY_TRANSMISSION_FACTOR, &trans, &one) ==
-            aiReturn_SUCCESS &&
-        trans >= 0.5f && metal < 0.5f) {
-        /* KHR_materials_transmission (mostly transmitting): rough glass of the material's index
-         * (KHR_materials_ior, else 1.5), tinted by the base colour; the transmission texture
-         * is not read */
-        ai_real ior = 1.5f;
-        float r = fminf(fmaxf(rough, 0), 1);
-        int c;
-        one = 1;
-        aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &ior, &one);
-        if (x->ior != 1.5f)
-            ior = x->ior; /* our reading of KHR_materials_ior (checked) */
-        m = rs_mat_rough_dielectric(isfinite(ior) && ior > 1e-3f && ior < 100 ? ior : 1.5f, r * r);
-        m.albedo = clamp01(rs_v3(base.r, base.g, base.b));
-        if (isfinite(x->attenuation_distance)) {
-            /* KHR_materials_volume: what is left after attenuationDistance is attenuationColor
-             * (a channel of 0 taken as 1e-6, so that the coefficient stays finite) */
-            float sig[3];
-            for (c = 0; c < 3; ++c)
-                sig[c] = (float)(-log(fmax((double)x->attenuation_color[c], 1e-6)) /
-                                 x->attenuation_distance);
-            m.sigma_a = rs_v3(sig[0], sig[1], sig[2]);
-        }
-        return rs_scene_add_material(s, &m, id);
+    aiGetMaterialFloatArray(am, AI_MATKEY_REFRACTI, &ior, &one);
+    if (x->ior != 1.5f)
+        ior = x->ior; /* our reading of KHR_materials_ior (checked) */
+    m = rs_mat_rough_dielectric(isfinite(ior) && ior > 1e-3f && ior < 100 ? ior : 1.5f, r * r);
+    m.albedo = clamp01(rs_v3(base.r, base.g, base.b));
+    if (isfinite(x->attenuation_distance)) {
+        /* KHR_materials_volume: what is left after attenuationDistance is attenuationColor
+         * (a channel of 0 taken as 1e-6, so that the coefficient stays finite) */
+        float sig[3];
+        for (c = 0; c < 3; ++c)
+            sig[c] = (float)(-log(fmax((double)x->attenuation_color[c], 1e-6)) /
+                             x->attenuation_distance);
+        m.sigma_a = rs_v3(sig[0], sig[1], sig[2]);
     }
-    m = rs_mat_pbr(clamp01(rs_v3(base.r, base.g, base.b)), fminf(fmaxf(metal, 0), 1),
-                   fminf(fmaxf(rough, 0), 1));
+    return rs_scene_add_material(s, &m, id);
+}
+
+/* The pbr material's emission (times KHR_materials_emissive_strength) and its layers: the
+ * dielectric one (KHR_materials_ior, KHR_materials_specular), sheen and clearcoat. */
+static void pbr_layers(rs_material *mp, const struct aiMaterial *am, const rs_gltf_mat_ext *x,
+                       struct aiColor4D ke)
+{
+    rs_material m = *mp;
+    ai_real strength = 1;
+    unsigned int one;
     m.emission = rs_v3(fmaxf(ke.r, 0), fmaxf(ke.g, 0), fmaxf(ke.b, 0));
     one = 1;
     if (x->emissive_strength != 1.0f)
@@ -311,8 +299,15 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         m.coat = x->clearcoat;
         m.coat_alpha = a < RS_GGX_DELTA_ALPHA ? RS_GGX_DELTA_ALPHA : a;
     }
-    if (!isfinite(m.emission.x + m.emission.y + m.emission.z))
-        return rs_error_set(RS_ERR_ARG, "%s: a material's emissive factor is not finite", mesh);
+    *mp = m;
+}
+
+/* The base colour texture (glTF's, else a diffuse one), the factor baked into its texels. */
+static rs_status pbr_base_texture(rs_scene *s, const struct aiScene *as,
+                                  const struct aiMaterial *am, const char *mesh, const char *dir,
+                                  int strict, rs_material *m)
+{
+    uint32_t t;
     if (load_texture(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_COLOR, strict, &t) !=
         RS_OK)
         return RS_ERR_ARG;
@@ -324,35 +319,89 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         rs_image *im = &s->images[s->textures[t].image];
         size_t i, n = (size_t)im->width * im->height;
         for (i = 0; i < n; ++i) {
-            im->rgb[3 * i] *= m.albedo.x;
-            im->rgb[3 * i + 1] *= m.albedo.y;
-            im->rgb[3 * i + 2] *= m.albedo.z;
+            im->rgb[3 * i] *= m->albedo.x;
+            im->rgb[3 * i + 1] *= m->albedo.y;
+            im->rgb[3 * i + 2] *= m->albedo.z;
         }
-        m.albedo_tex = t;
-        m.albedo = rs_v3_splat(1.0f);
+        m->albedo_tex = t;
+        m->albedo = rs_v3_splat(1.0f);
     }
-    {
-        /* glTF's alpha cut-out: MASK at its alphaCutoff, BLEND taken as a mask at 0.5 (no
-         * partial transparency); the base colour texture's alpha times the factor's */
-        struct aiString mode;
-        ai_real cutoff = 0.5f;
-        if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) == aiReturn_SUCCESS &&
-            (strcmp(mode.data, "MASK") == 0 || strcmp(mode.data, "BLEND") == 0)) {
-            alpha_req ar;
-            one = 1;
-            if (strcmp(mode.data, "MASK") == 0)
-                aiGetMaterialFloatArray(am, AI_MATKEY_GLTF_ALPHACUTOFF, &cutoff, &one);
-            ar.scale = isfinite(base.a) ? fminf(fmaxf(base.a, 0), 1) : 1.0f;
-            ar.cutoff = isfinite(cutoff) ? cutoff : 0.5f;
-            if (load_texture_ex(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_DATA, strict,
-                                &ar, &m.alpha_mask) != RS_OK)
-                return RS_ERR_ARG;
-            /* no alpha texels: the factor alone, all or nothing */
-            if (!m.alpha_mask && ar.scale < ar.cutoff &&
-                rs_scene_add_mask(s, 1, 1, NULL, ar.scale, ar.cutoff, &m.alpha_mask) != RS_OK)
-                return RS_ERR_ARG;
-        }
+    return RS_OK;
+}
+
+/* glTF's alpha cut-out: MASK at its alphaCutoff, BLEND taken as a mask at 0.5 (no partial
+ * transparency); the base colour texture's alpha times the factor's (base_a). */
+static rs_status pbr_alpha(rs_scene *s, const struct aiScene *as, const struct aiMaterial *am,
+                           const char *mesh, const char *dir, int strict, ai_real base_a,
+                           uint32_t *alpha_mask)
+{
+    struct aiString mode;
+    ai_real cutoff = 0.5f;
+    if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) == aiReturn_SUCCESS &&
+        (strcmp(mode.data, "MASK") == 0 || strcmp(mode.data, "BLEND") == 0)) {
+        alpha_req ar;
+        unsigned int one = 1;
+        if (strcmp(mode.data, "MASK") == 0)
+            aiGetMaterialFloatArray(am, AI_MATKEY_GLTF_ALPHACUTOFF, &cutoff, &one);
+        ar.scale = isfinite(base_a) ? fminf(fmaxf(base_a, 0), 1) : 1.0f;
+        ar.cutoff = isfinite(cutoff) ? cutoff : 0.5f;
+        if (load_texture_ex(s, as, am, aiTextureType_BASE_COLOR, mesh, dir, TEX_DATA, strict,
+                            &ar, alpha_mask) != RS_OK)
+            return RS_ERR_ARG;
+        /* no alpha texels: the factor alone, all or nothing */
+        if (!*alpha_mask && ar.scale < ar.cutoff &&
+            rs_scene_add_mask(s, 1, 1, NULL, ar.scale, ar.cutoff, alpha_mask) != RS_OK)
+            return RS_ERR_ARG;
     }
+    return RS_OK;
+}
+
+/* KHR_materials_unlit: the base colour (its texture's too), emitted; nothing reflected. */
+static void pbr_unlit(rs_material *m)
+{
+    m->emission = m->albedo;
+    m->emission_tex = m->albedo_tex;
+    m->albedo = rs_v3_splat(0.0f);
+    m->albedo_tex = RS_NO_TEXTURE;
+    m->metallic = 0.0f;
+    m->spec_weight = 0.0f;
+    m->coat = 0.0f;
+    m->sheen = rs_v3_splat(0.0f);
+    m->mr_tex = m->normal_tex = RS_NO_TEXTURE;
+}
+
+/* glTF's metallic-roughness material (Assimp sets a metallic factor for it): base colour and
+ * its texture, metallic and roughness and their texture, emission and its texture, the normal
+ * map. */
+static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
+                                  const struct aiMaterial *am, const rs_gltf_mat_ext *x,
+                                  const char *mesh, const char *dir, int strict, uint32_t *id)
+{
+    struct aiColor4D base = {1, 1, 1, 1}, ke = {0, 0, 0, 1};
+    ai_real metal = 1, rough = 1, scale = 1, trans = 0;
+    unsigned int one = 1;
+    rs_material m;
+    rs_gltf_mat_ext none = rs_gltf_mat_ext_default();
+    if (!x)
+        x = &none;
+    aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base);
+    aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &ke);
+    aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &metal, &one);
+    one = 1;
+    aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &rough, &one);
+    one = 1;
+    if (aiGetMaterialFloatArray(am, AI_MATKEY_TRANSMISSION_FACTOR, &trans, &one) ==
+            aiReturn_SUCCESS &&
+        trans >= 0.5f && metal < 0.5f)
+        return add_pbr_glass(s, am, x, base, rough, id);
+    m = rs_mat_pbr(clamp01(rs_v3(base.r, base.g, base.b)), fminf(fmaxf(metal, 0), 1),
+                   fminf(fmaxf(rough, 0), 1));
+    pbr_layers(&m, am, x, ke);
+    if (!isfinite(m.emission.x + m.emission.y + m.emission.z))
+        return rs_error_set(RS_ERR_ARG, "%s: a material's emissive factor is not finite", mesh);
+    if (pbr_base_texture(s, as, am, mesh, dir, strict, &m) != RS_OK ||
+        pbr_alpha(s, as, am, mesh, dir, strict, base.a, &m.alpha_mask) != RS_OK)
+        return RS_ERR_ARG;
     if (load_texture(s, as, am, aiTextureType_UNKNOWN, mesh, dir, TEX_DATA, strict,
                      &m.mr_tex) != RS_OK ||
         load_texture(s, as, am, aiTextureType_EMISSIVE, mesh, dir, TEX_COLOR, strict,
@@ -362,18 +411,8 @@ static rs_status add_pbr_material(rs_scene *s, const struct aiScene *as,
         return RS_ERR_ARG;
     if (m.emission_tex != RS_NO_TEXTURE && rs_v3_is_zero(m.emission))
         m.emission_tex = RS_NO_TEXTURE; /* a texture times a zero factor */
-    if (x->unlit) {
-        /* KHR_materials_unlit: the base colour (its texture's too), emitted; nothing reflected */
-        m.emission = m.albedo;
-        m.emission_tex = m.albedo_tex;
-        m.albedo = rs_v3_splat(0.0f);
-        m.albedo_tex = RS_NO_TEXTURE;
-        m.metallic = 0.0f;
-        m.spec_weight = 0.0f;
-        m.coat = 0.0f;
-        m.sheen = rs_v3_splat(0.0f);
-        m.mr_tex = m.normal_tex = RS_NO_TEXTURE;
-    }
+    if (x->unlit)
+        pbr_unlit(&m);
     one = 1;
     if (m.normal_tex != RS_NO_TEXTURE &&
         aiGetMaterialFloatArray(am, "$tex.scale", aiTextureType_NORMALS, 0, &scale, &one) ==
