@@ -20,6 +20,7 @@
 #include "core/file.h"
 #include "core/image_io.h"
 #include "core/srgb.h"
+#include "core/try.h"
 
 /* How a texture's texels are read: colours are sRGB-decoded, data (normals, metallic-roughness)
  * taken as stored. */
@@ -103,17 +104,125 @@ static rs_status load_texture(rs_scene *s, const struct aiScene *as, const struc
     return load_texture_ex(s, as, am, type, mesh, dir, data, strict, NULL, id);
 }
 
+/* Embedded texture t (raw BGRA texels, top row first) as a scene image in *image, or with
+ * `alpha` its alpha channel as a mask in *id. */
+static rs_status embedded_texels(rs_scene *s, const struct aiTexture *t, const char *name,
+                                 const char *mesh, int data, const alpha_req *alpha, uint32_t *id,
+                                 uint32_t *image)
+{
+    float *rgb;
+    uint32_t i, n;
+    rs_status st;
+    if ((uint64_t)t->mWidth * t->mHeight > RS_IMAGE_MAX_PIXELS)
+        return rs_error_set(RS_ERR_ARG, "%s: embedded texture %s is too large", mesh, name);
+    n = t->mWidth * t->mHeight;
+    if (alpha) {
+        float *a = (float *)rs_alloc(n ? n : 1, sizeof *a);
+        if (!a)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
+        for (i = 0; i < n; ++i)
+            a[i] = t->pcData[i].a / 255.0f;
+        st = rs_scene_add_mask(s, t->mWidth, t->mHeight, a, alpha->scale, alpha->cutoff, id);
+        rs_free(a);
+        return st;
+    }
+    rgb = (float *)rs_alloc((size_t)n * 3, sizeof *rgb);
+    if (!rgb)
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
+    for (i = 0; i < n; ++i) {
+        const struct aiTexel *px = &t->pcData[i];
+        rgb[3 * i] = px->r / 255.0f;
+        rgb[3 * i + 1] = px->g / 255.0f;
+        rgb[3 * i + 2] = px->b / 255.0f;
+        if (!data) {
+            int c;
+            for (c = 0; c < 3; ++c)
+                rgb[3 * i + c] = rs_srgb_decode(rgb[3 * i + c]);
+        }
+    }
+    st = rs_scene_add_image(s, t->mWidth, t->mHeight, rgb, image);
+    rs_free(rgb);
+    return st;
+}
+
+/* Embedded texture t's compressed bytes (mWidth of them, a format hint) written to a temporary
+ * file, whose name goes in tmp[tmp_n] (for OpenImageIO to read, then unlinked by the caller). */
+static rs_status embedded_to_file(const struct aiTexture *t, const char *name, const char *mesh,
+                                  char *tmp, size_t tmp_n)
+{
+    size_t bytes = t->mWidth;
+    FILE *f;
+    int fd;
+    snprintf(tmp, tmp_n, "/tmp/raystream-tex-XXXXXX.%.8s",
+             t->achFormatHint[0] ? t->achFormatHint : "png");
+    fd = mkstemps(tmp, (int)strlen(strrchr(tmp, '.')));
+    if (fd < 0) {
+        *tmp = 0;
+        return rs_error_set(RS_ERR_IO, "%s: cannot write embedded texture %s to /tmp", mesh, name);
+    }
+    f = fdopen(fd, "wb");
+    if (!f || fwrite(t->pcData, 1, bytes, f) != bytes) {
+        if (f)
+            fclose(f);
+        else
+            close(fd);
+        unlink(tmp);
+        *tmp = 0;
+        return rs_error_set(RS_ERR_IO, "%s: cannot write embedded texture %s to /tmp", mesh, name);
+    }
+    fclose(f);
+    return RS_OK;
+}
+
+/* Image file `path` (tex: as the material names it) as a scene image in *image, or with `alpha`
+ * its alpha channel as a mask in *id.  A texture that is not a regular file of a sane size (a
+ * FIFO, /dev/zero, a folder) is refused outright, as is one that is there but unusable (a texel
+ * NaN, infinite or negative); a missing or unreadable one fails only a strict import, else warns
+ * (*loaded 0: keep the colour). */
+static rs_status texture_file(rs_scene *s, const char *path, const char *tex, const char *mesh,
+                              int data, int strict, const alpha_req *alpha, uint32_t *id,
+                              uint32_t *image, int *loaded)
+{
+    char why[1200];
+    rs_status st;
+    int fd;
+    *loaded = 0;
+    st = rs_file_open_quiet(path, RS_FILE_MAX_IMAGE_BYTES, &fd, NULL, why, sizeof why);
+    if (st == RS_ERR_ARG)
+        return rs_error_set(st, "%s: %s", mesh, why);
+    if (st == RS_OK)
+        close(fd);
+    rs_error_clear();
+    st = alpha ? load_mask_file(s, path, alpha, id)
+         : data ? rs_scene_load_image_data(s, path, image)
+                : rs_scene_load_image(s, path, image);
+    if (st != RS_OK) {
+        if (strict || st == RS_ERR_ARG) {
+            char msg[1200];
+            snprintf(msg, sizeof msg, "%s", rs_error_message());
+            rs_error_clear();
+            return rs_error_set(st, "%s: texture %s: %s", mesh, tex, msg);
+        }
+        /* a missing texture file: keep the colour, say so once */
+        fprintf(stderr, "raystream: warning: %s\n", rs_error_message());
+        rs_error_clear();
+        return RS_OK;
+    }
+    *loaded = 1;
+    return RS_OK;
+}
+
 static rs_status load_texture_ex(rs_scene *s, const struct aiScene *as,
                                  const struct aiMaterial *am, enum aiTextureType type,
                                  const char *mesh, const char *dir, int data, int strict,
                                  const alpha_req *alpha, uint32_t *id)
 {
     struct aiString tex;
-    char path[2048], why[1200], tmp[64] = "";
-    uint32_t image;
+    char path[2048], tmp[64] = "";
+    uint32_t image = 0;
     rs_texture tx;
     rs_status st;
-    int fd;
+    int loaded = 0;
     *id = alpha ? 0 : RS_NO_TEXTURE;
     if (aiGetMaterialTexture(am, type, 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) !=
             aiReturn_SUCCESS ||
@@ -123,108 +232,31 @@ static rs_status load_texture_ex(rs_scene *s, const struct aiScene *as,
         /* embedded: compressed bytes (mHeight 0, mWidth bytes, a format hint), or raw texels */
         long k = strtol(tex.data + 1, NULL, 10);
         const struct aiTexture *t;
-        FILE *f;
-        size_t bytes;
         if (!as || k < 0 || (unsigned long)k >= as->mNumTextures || !as->mTextures[k])
             return rs_error_set(RS_ERR_ARG, "%s: a material names embedded texture %s, which "
                                             "the file does not have", mesh, tex.data);
         t = as->mTextures[k];
         if (t->mHeight != 0) {
-            /* raw BGRA texels, top row first */
-            float *rgb;
-            uint32_t i, n;
-            if ((uint64_t)t->mWidth * t->mHeight > RS_IMAGE_MAX_PIXELS)
-                return rs_error_set(RS_ERR_ARG, "%s: embedded texture %s is too large", mesh,
-                                    tex.data);
-            n = t->mWidth * t->mHeight;
-            if (alpha) {
-                float *a = (float *)rs_alloc(n ? n : 1, sizeof *a);
-                if (!a)
-                    return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
-                for (i = 0; i < n; ++i)
-                    a[i] = t->pcData[i].a / 255.0f;
-                st = rs_scene_add_mask(s, t->mWidth, t->mHeight, a, alpha->scale, alpha->cutoff,
-                                       id);
-                rs_free(a);
+            st = embedded_texels(s, t, tex.data, mesh, data, alpha, id, &image);
+            if (st != RS_OK || alpha)
                 return st;
-            }
-            rgb = (float *)rs_alloc((size_t)n * 3, sizeof *rgb);
-            if (!rgb)
-                return rs_error_set(RS_ERR_NOMEM, "%s: out of memory for a texture", mesh);
-            for (i = 0; i < n; ++i) {
-                const struct aiTexel *px = &t->pcData[i];
-                rgb[3 * i] = px->r / 255.0f;
-                rgb[3 * i + 1] = px->g / 255.0f;
-                rgb[3 * i + 2] = px->b / 255.0f;
-                if (!data) {
-                    int c;
-                    for (c = 0; c < 3; ++c)
-                        rgb[3 * i + c] = rs_srgb_decode(rgb[3 * i + c]);
-                }
-            }
-            st = rs_scene_add_image(s, t->mWidth, t->mHeight, rgb, &image);
-            rs_free(rgb);
-            if (st != RS_OK)
-                return st;
-            goto made;
+            loaded = 1;
+        } else {
+            RS_TRY(embedded_to_file(t, tex.data, mesh, tmp, sizeof tmp));
+            snprintf(path, sizeof path, "%s", tmp);
         }
-        bytes = t->mWidth;
-        snprintf(tmp, sizeof tmp, "/tmp/raystream-tex-XXXXXX.%.8s",
-                 t->achFormatHint[0] ? t->achFormatHint : "png");
-        fd = mkstemps(tmp, (int)strlen(strrchr(tmp, '.')));
-        if (fd < 0)
-            return rs_error_set(RS_ERR_IO, "%s: cannot write embedded texture %s to /tmp", mesh,
-                                tex.data);
-        f = fdopen(fd, "wb");
-        if (!f || fwrite(t->pcData, 1, bytes, f) != bytes) {
-            if (f)
-                fclose(f);
-            else
-                close(fd);
-            unlink(tmp);
-            return rs_error_set(RS_ERR_IO, "%s: cannot write embedded texture %s to /tmp", mesh,
-                                tex.data);
-        }
-        fclose(f);
-        snprintf(path, sizeof path, "%s", tmp);
     } else if (tex.data[0] == '/') {
         snprintf(path, sizeof path, "%s", tex.data);
     } else {
         snprintf(path, sizeof path, "%s/%s", dir, tex.data);
     }
-    /* a texture that is not a regular file of a sane size (a FIFO, /dev/zero, a folder) is
-     * refused outright; a missing or unreadable one fails only a strict import */
-    st = rs_file_open_quiet(path, RS_FILE_MAX_IMAGE_BYTES, &fd, NULL, why, sizeof why);
-    if (st == RS_ERR_ARG) {
+    if (!loaded) {
+        st = texture_file(s, path, tex.data, mesh, data, strict, alpha, id, &image, &loaded);
         if (*tmp)
             unlink(tmp);
-        return rs_error_set(st, "%s: %s", mesh, why);
+        if (st != RS_OK || !loaded || alpha)
+            return st; /* an error, a missing texture's warning, or the mask made */
     }
-    if (st == RS_OK)
-        close(fd);
-    rs_error_clear();
-    st = alpha ? load_mask_file(s, path, alpha, id)
-         : data ? rs_scene_load_image_data(s, path, &image)
-                : rs_scene_load_image(s, path, &image);
-    if (*tmp)
-        unlink(tmp);
-    if (st != RS_OK) {
-        /* a texture that is there but unusable (a texel NaN, infinite or negative) is refused
-         * even where a missing one only warns */
-        if (strict || st == RS_ERR_ARG) {
-            char msg[1200];
-            snprintf(msg, sizeof msg, "%s", rs_error_message());
-            rs_error_clear();
-            return rs_error_set(st, "%s: texture %s: %s", mesh, tex.data, msg);
-        }
-        /* a missing texture file: keep the colour, say so once */
-        fprintf(stderr, "raystream: warning: %s\n", rs_error_message());
-        rs_error_clear();
-        return RS_OK;
-    }
-    if (alpha)
-        return RS_OK; /* the mask is made */
-made:
     memset(&tx, 0, sizeof tx);
     tx.type = RS_TEX_IMAGE;
     tx.image = image;
