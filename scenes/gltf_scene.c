@@ -167,14 +167,125 @@ static void gltf_camera(gltf_ctx *g)
     d->focus_dist = 0;
 }
 
+/* The materials the file's meshes use (in the file's order), or a default; *emissive counts
+ * those that emit. */
+static rs_status gltf_materials(gltf_ctx *g, const char *dir, uint32_t *emissive)
+{
+    rs_status st = RS_OK;
+    uint32_t k;
+    *emissive = 0;
+    for (k = 0; k < g->as->mNumMaterials && st == RS_OK; ++k) {
+        uint32_t mi;
+        int used = 0;
+        for (mi = 0; mi < g->as->mNumMeshes && !used; ++mi)
+            used = g->as->mMeshes[mi]->mMaterialIndex == k;
+        if (!used)
+            continue;
+        st = rs_mesh_add_file_material(g->s, g->as, g->as->mMaterials[k],
+                                       rs_mesh_material_ext(&g->ext, k), g->path, dir, 1,
+                                       &g->mat_of[k]);
+        if (st == RS_OK) {
+            g->info.materials++;
+            *emissive += !rs_v3_is_zero(g->s->materials[g->mat_of[k]].emission);
+        }
+    }
+    if (st == RS_OK && g->as->mNumMaterials == 0) {
+        rs_material def = rs_mat_pbr(rs_v3_splat(1.0f), 0.0f, 1.0f);
+        st = rs_scene_add_material(g->s, &def, &g->mat_of[0]);
+    }
+    return st;
+}
+
+/* The camera the options named, not found among the nodes: why (orthographic, a field of view of
+ * 0, or no such name, with the names the file has). */
+static rs_status gltf_camera_missing(const gltf_ctx *g, const char *name)
+{
+    char have[512] = "";
+    uint32_t k;
+    for (k = 0; k < g->as->mNumCameras; ++k) {
+        const struct aiCamera *c = g->as->mCameras[k];
+        if (strcmp(c->mName.data, name) != 0)
+            continue;
+        /* there, but not a camera raystream can look through */
+        if (c->mOrthographicWidth > 0)
+            return rs_error_set(RS_ERR_ARG,
+                                "%s: camera '%s' is orthographic; raystream's cameras are "
+                                "perspective (give the file a perspective camera)",
+                                g->path, name);
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: camera '%s' has a field of view of 0 (its yfov must be "
+                            "above 0)",
+                            g->path, name);
+    }
+    for (k = 0; k < g->as->mNumCameras; ++k)
+        if (strlen(have) + g->as->mCameras[k]->mName.length + 5 < sizeof have) {
+            strcat(have, *have ? ", '" : "'");
+            strcat(have, g->as->mCameras[k]->mName.data);
+            strcat(have, "'");
+        }
+    return rs_error_set(RS_ERR_ARG, "%s: no camera named '%s' (the file has: %s)", g->path, name,
+                        *have ? have : "none");
+}
+
+/* The loaded scene completed: refused if most of its faces were dropped; else its placed bounds,
+ * its camera (the file's or one framing the model), a white sky where nothing lights it, and
+ * rs_scene_finalize (its refusal named with the file). */
+static rs_status gltf_finish(gltf_ctx *g, uint32_t emissive)
+{
+    rs_status st;
+    uint32_t k;
+    if (g->info.triangles == 0 || g->info.dropped > g->info.triangles) {
+        char why[160];
+        return rs_error_set(RS_ERR_ARG, "%s: %s of %u, %u triangles left: the mesh is broken",
+                            g->path, rs_mesh_dropped_text(&g->info, why, sizeof why),
+                            g->info.dropped + g->info.triangles, g->info.triangles);
+    }
+    g->info.bounds.lo = rs_v3_splat(FLT_MAX);
+    g->info.bounds.hi = rs_v3_splat(-FLT_MAX);
+    for (k = 0; k < g->s->n_tris; ++k) {
+        const rs_tri *t = &g->s->tris[k];
+        g->info.bounds.lo = rs_v3_min(g->info.bounds.lo, rs_v3_min(t->v0, rs_v3_min(t->v1, t->v2)));
+        g->info.bounds.hi = rs_v3_max(g->info.bounds.hi, rs_v3_max(t->v0, rs_v3_max(t->v1, t->v2)));
+    }
+    gltf_camera(g);
+    if (g->lights == 0 && emissive == 0)
+        g->s->background = rs_v3_splat(1.0f); /* nothing lights it: a white sky does */
+    st = rs_scene_finalize(g->s);
+    if (st != RS_OK) {
+        char msg[400];
+        snprintf(msg, sizeof msg, "%s", rs_error_message());
+        rs_error_clear();
+        st = rs_error_set(st, "%s: %s", g->path, msg);
+    }
+    return st;
+}
+
+/* What was loaded, a line to opts->log, and the extensions read into opts->extensions. */
+static void gltf_report(const gltf_ctx *g, const rs_gltf_opts *opts)
+{
+    if (opts && opts->log) {
+        char why[160];
+        fprintf(opts->log,
+                "raystream: %s: %u triangles, %u materials, %u lights, camera %s%s%s%s%s%s%s\n",
+                g->path, g->info.triangles, g->info.materials, g->lights,
+                g->camera ? "'" : "(framing the model)", g->camera ? g->camera->mName.data : "",
+                g->camera ? "'" : "", g->info.dropped ? "; " : "",
+                rs_mesh_dropped_text(&g->info, why, sizeof why),
+                g->ext.used[0] ? "; extensions: " : "", g->ext.used);
+    }
+    if (opts && opts->extensions && opts->extensions_n)
+        snprintf(opts->extensions, opts->extensions_n, "%s", g->ext.used);
+}
+
 rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scene **out)
 {
     gltf_ctx g;
     rs_xform id = rs_xform_identity();
     char dir[1024];
     const char *slash = strrchr(path, '/');
+    const char *camera = opts ? opts->camera : NULL;
     rs_status st;
-    uint32_t k, emissive = 0;
+    uint32_t emissive = 0;
     *out = NULL;
     memset(&g, 0, sizeof g);
     g.path = path;
@@ -197,93 +308,16 @@ rs_status rs_scene_load_gltf(const char *path, const rs_gltf_opts *opts, rs_scen
     }
     if (st == RS_OK)
         st = rs_mesh_file_extensions(path, &g.ext);
-    for (k = 0; k < g.as->mNumMaterials && st == RS_OK; ++k) {
-        uint32_t mi;
-        int used = 0;
-        for (mi = 0; mi < g.as->mNumMeshes && !used; ++mi)
-            used = g.as->mMeshes[mi]->mMaterialIndex == k;
-        if (!used)
-            continue;
-        st = rs_mesh_add_file_material(g.s, g.as, g.as->mMaterials[k],
-                                       rs_mesh_material_ext(&g.ext, k), path, dir, 1, &g.mat_of[k]);
-        if (st == RS_OK) {
-            g.info.materials++;
-            emissive += !rs_v3_is_zero(g.s->materials[g.mat_of[k]].emission);
-        }
-    }
-    if (st == RS_OK && g.as->mNumMaterials == 0) {
-        rs_material def = rs_mat_pbr(rs_v3_splat(1.0f), 0.0f, 1.0f);
-        st = rs_scene_add_material(g.s, &def, &g.mat_of[0]);
-    }
     if (st == RS_OK)
-        st = gltf_node(&g, g.as->mRootNode, &id, 0, opts ? opts->camera : NULL);
-    if (st == RS_OK && opts && opts->camera && !g.camera) {
-        for (k = 0; k < g.as->mNumCameras && st == RS_OK; ++k) {
-            const struct aiCamera *c = g.as->mCameras[k];
-            if (strcmp(c->mName.data, opts->camera) != 0)
-                continue;
-            /* there, but not a camera raystream can look through */
-            if (c->mOrthographicWidth > 0)
-                st = rs_error_set(RS_ERR_ARG,
-                                  "%s: camera '%s' is orthographic; raystream's cameras are "
-                                  "perspective (give the file a perspective camera)",
-                                  path, opts->camera);
-            else
-                st = rs_error_set(RS_ERR_ARG,
-                                  "%s: camera '%s' has a field of view of 0 (its yfov must be "
-                                  "above 0)",
-                                  path, opts->camera);
-        }
-    }
-    if (st == RS_OK && opts && opts->camera && !g.camera) {
-        char have[512] = "";
-        for (k = 0; k < g.as->mNumCameras; ++k)
-            if (strlen(have) + g.as->mCameras[k]->mName.length + 5 < sizeof have) {
-                strcat(have, *have ? ", '" : "'");
-                strcat(have, g.as->mCameras[k]->mName.data);
-                strcat(have, "'");
-            }
-        st = rs_error_set(RS_ERR_ARG, "%s: no camera named '%s' (the file has: %s)", path,
-                          opts->camera, *have ? have : "none");
-    }
-    if (st == RS_OK && (g.info.triangles == 0 || g.info.dropped > g.info.triangles)) {
-        char why[160];
-        st = rs_error_set(RS_ERR_ARG, "%s: %s of %u, %u triangles left: the mesh is broken", path,
-                          rs_mesh_dropped_text(&g.info, why, sizeof why),
-                          g.info.dropped + g.info.triangles, g.info.triangles);
-    }
-    if (st == RS_OK) {
-        /* the placed bounds, for a framing camera */
-        g.info.bounds.lo = rs_v3_splat(FLT_MAX);
-        g.info.bounds.hi = rs_v3_splat(-FLT_MAX);
-        for (k = 0; k < g.s->n_tris; ++k) {
-            const rs_tri *t = &g.s->tris[k];
-            g.info.bounds.lo = rs_v3_min(g.info.bounds.lo, rs_v3_min(t->v0, rs_v3_min(t->v1, t->v2)));
-            g.info.bounds.hi = rs_v3_max(g.info.bounds.hi, rs_v3_max(t->v0, rs_v3_max(t->v1, t->v2)));
-        }
-        gltf_camera(&g);
-        if (g.lights == 0 && emissive == 0)
-            g.s->background = rs_v3_splat(1.0f); /* nothing lights it: a white sky does */
-        st = rs_scene_finalize(g.s);
-        if (st != RS_OK) {
-            char msg[400];
-            snprintf(msg, sizeof msg, "%s", rs_error_message());
-            rs_error_clear();
-            st = rs_error_set(st, "%s: %s", path, msg);
-        }
-    }
-    if (st == RS_OK && opts && opts->log) {
-        char why[160];
-        fprintf(opts->log,
-                "raystream: %s: %u triangles, %u materials, %u lights, camera %s%s%s%s%s%s%s\n",
-                path, g.info.triangles, g.info.materials, g.lights,
-                g.camera ? "'" : "(framing the model)", g.camera ? g.camera->mName.data : "",
-                g.camera ? "'" : "", g.info.dropped ? "; " : "",
-                rs_mesh_dropped_text(&g.info, why, sizeof why),
-                g.ext.used[0] ? "; extensions: " : "", g.ext.used);
-    }
-    if (st == RS_OK && opts && opts->extensions && opts->extensions_n)
-        snprintf(opts->extensions, opts->extensions_n, "%s", g.ext.used);
+        st = gltf_materials(&g, dir, &emissive);
+    if (st == RS_OK)
+        st = gltf_node(&g, g.as->mRootNode, &id, 0, camera);
+    if (st == RS_OK && camera && !g.camera)
+        st = gltf_camera_missing(&g, camera);
+    if (st == RS_OK)
+        st = gltf_finish(&g, emissive);
+    if (st == RS_OK)
+        gltf_report(&g, opts);
     rs_gltf_ext_free(&g.ext);
     rs_free(g.mat_of);
     rs_mesh_release(g.as);
