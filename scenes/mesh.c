@@ -158,12 +158,71 @@ const rs_gltf_mat_ext *rs_mesh_material_ext(const rs_gltf_ext *e, uint32_t k)
     return k < e->n_materials ? &e->materials[k] : NULL;
 }
 
+/* The bounds of the finite vertices of every mesh of `as` placed by xf. */
+static rs_aabb placed_bounds(const struct aiScene *as, const rs_xform *xf)
+{
+    rs_aabb raw;
+    uint32_t mi, k;
+    raw.lo = rs_v3_splat(FLT_MAX);
+    raw.hi = rs_v3_splat(-FLT_MAX);
+    for (mi = 0; mi < as->mNumMeshes; ++mi) {
+        const struct aiMesh *m = as->mMeshes[mi];
+        if (!m->mVertices)
+            continue;
+        for (k = 0; k < m->mNumVertices; ++k) {
+            rs_vec3 p = rs_xform_point(
+                xf, rs_v3(m->mVertices[k].x, m->mVertices[k].y, m->mVertices[k].z));
+            if (!rs_v3_is_finite(p))
+                continue;
+            raw.lo = rs_v3_min(raw.lo, p);
+            raw.hi = rs_v3_max(raw.hi, p);
+        }
+    }
+    return raw;
+}
+
+/* The file's materials that its meshes use, in mat_of[k] (the override a scene file names for
+ * material k, else a material made from it; a default one where the file has none). */
+static rs_status file_materials(rs_scene *s, const struct aiScene *as, const char *path,
+                                const char *dir, const rs_mesh_opts *o, uint32_t *mat_of,
+                                rs_mesh_info *info)
+{
+    rs_gltf_ext ext;
+    uint32_t mi, k;
+    rs_status st = rs_mesh_check_overrides(as, path, o);
+    if (st == RS_OK)
+        st = rs_mesh_file_extensions(path, &ext);
+    else
+        memset(&ext, 0, sizeof ext);
+    for (k = 0; k < as->mNumMaterials && st == RS_OK; ++k) {
+        int ov = rs_mesh_override_of(as->mMaterials[k], o), used = 0;
+        for (mi = 0; mi < as->mNumMeshes && !used; ++mi)
+            used = as->mMeshes[mi]->mMaterialIndex == k;
+        mat_of[k] = 0;
+        if (!used)
+            continue; /* (Assimp's unused default material, say): not added */
+        if (ov >= 0) {
+            mat_of[k] = o->override_ids[ov];
+            continue;
+        }
+        st = rs_mesh_add_file_material(s, as, as->mMaterials[k], rs_mesh_material_ext(&ext, k),
+                                       path, dir, o->strict_textures, &mat_of[k]);
+        info->materials++;
+    }
+    rs_gltf_ext_free(&ext);
+    if (st == RS_OK && as->mNumMaterials == 0) {
+        rs_material def = rs_mat_lambertian(rs_v3_splat(0.7f));
+        st = rs_scene_add_material(s, &def, &mat_of[0]);
+    }
+    return st;
+}
+
 rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o,
                             rs_mesh_info *info)
 {
     const struct aiScene *as;
     rs_xform xf;
-    uint32_t *mat_of = NULL, mi, k;
+    uint32_t *mat_of = NULL, mi;
     char dir[1024];
     const char *slash = strrchr(path, '/');
     rs_status st = RS_OK;
@@ -182,21 +241,7 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
 
     /* placement: the bounds of the scaled and rotated (unfitted) vertices decide a fit */
     xf = scale_rotate(o);
-    raw.lo = rs_v3_splat(FLT_MAX);
-    raw.hi = rs_v3_splat(-FLT_MAX);
-    for (mi = 0; mi < as->mNumMeshes; ++mi) {
-        const struct aiMesh *m = as->mMeshes[mi];
-        if (!m->mVertices)
-            continue;
-        for (k = 0; k < m->mNumVertices; ++k) {
-            rs_vec3 p = rs_xform_point(
-                &xf, rs_v3(m->mVertices[k].x, m->mVertices[k].y, m->mVertices[k].z));
-            if (!rs_v3_is_finite(p))
-                continue;
-            raw.lo = rs_v3_min(raw.lo, p);
-            raw.hi = rs_v3_max(raw.hi, p);
-        }
-    }
+    raw = placed_bounds(as, &xf);
     if (!(raw.lo.x <= raw.hi.x)) {
         rs_mesh_release(as);
         return rs_error_set(RS_ERR_ARG, "%s: no finite vertex in the file", path);
@@ -204,37 +249,12 @@ rs_status rs_scene_add_mesh(rs_scene *s, const char *path, const rs_mesh_opts *o
     xf = fit_translate(o, &xf, raw);
 
     if (o->material == RS_MESH_FILE_MATERIALS) {
-        rs_gltf_ext ext;
         mat_of = (uint32_t *)rs_alloc(as->mNumMaterials ? as->mNumMaterials : 1, sizeof *mat_of);
         if (!mat_of) {
             rs_mesh_release(as);
             return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
         }
-        st = rs_mesh_check_overrides(as, path, o);
-        if (st == RS_OK)
-            st = rs_mesh_file_extensions(path, &ext);
-        else
-            memset(&ext, 0, sizeof ext);
-        for (k = 0; k < as->mNumMaterials && st == RS_OK; ++k) {
-            int ov = rs_mesh_override_of(as->mMaterials[k], o), used = 0;
-            for (mi = 0; mi < as->mNumMeshes && !used; ++mi)
-                used = as->mMeshes[mi]->mMaterialIndex == k;
-            mat_of[k] = 0;
-            if (!used)
-                continue; /* (Assimp's unused default material, say): not added */
-            if (ov >= 0) {
-                mat_of[k] = o->override_ids[ov];
-                continue;
-            }
-            st = rs_mesh_add_file_material(s, as, as->mMaterials[k], rs_mesh_material_ext(&ext, k),
-                                           path, dir, o->strict_textures, &mat_of[k]);
-            info->materials++;
-        }
-        rs_gltf_ext_free(&ext);
-        if (st == RS_OK && as->mNumMaterials == 0) {
-            rs_material def = rs_mat_lambertian(rs_v3_splat(0.7f));
-            st = rs_scene_add_material(s, &def, &mat_of[0]);
-        }
+        st = file_materials(s, as, path, dir, o, mat_of, info);
     }
 
     info->bounds.lo = rs_v3_splat(FLT_MAX);
