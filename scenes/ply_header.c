@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/try.h"
+
 /* A header line's first blank-separated words (a line has at most MAX_WORDS that matter: "count"
  * stops there). */
 #define MAX_WORDS 6
@@ -86,14 +88,100 @@ static uint64_t mul_sat(uint64_t a, uint64_t b)
     return a && b > UINT64_MAX / a ? UINT64_MAX : a * b;
 }
 
+/* An "element NAME COUNT" line: its count in *count; kept in h->elems when `strict`. */
+static rs_status element_line(const char *path, unsigned line, const words *ws, int strict,
+                              rs_ply_header *h, uint64_t *count)
+{
+    size_t i;
+    int ok = ws->count == 3;
+    if (word_is(ws, 1, "tristrips"))
+        h->tristrips = 1;
+    for (i = 0; ok && i < ws->n[2]; ++i) {
+        ok = isdigit((unsigned char)ws->w[2][i]);
+        *count = *count > UINT32_MAX ? *count : 10 * *count + (uint64_t)(ws->w[2][i] - '0');
+    }
+    if (!ok || *count > UINT32_MAX)
+        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u is not 'element NAME COUNT'",
+                            path, line);
+    if (strict) {
+        rs_ply_elem *e;
+        if (h->n_elems >= h->max_elems)
+            return rs_error_set(RS_ERR_ARG, "%s: PLY header: more than %d elements", path,
+                                h->max_elems);
+        e = &h->elems[h->n_elems++];
+        memset(e, 0, sizeof *e);
+        word(ws, 1, e->name);
+        e->count = *count;
+    }
+    return RS_OK;
+}
+
+/* A "property TYPE NAME" or "property list LEN_TYPE TYPE NAME" line: its fixed bytes added to
+ * *inst_bytes (a list's length; an unknown type 1 byte, which Assimp refuses itself); kept in the
+ * last element when `strict`. */
+static rs_status property_line(const char *path, unsigned line, const words *ws, int strict,
+                               rs_ply_header *h, uint64_t *inst_bytes)
+{
+    char b[64];
+    int list = word_is(ws, 1, "list");
+    rs_ply_type t = type_of(ws, list ? 2 : 1);
+    rs_ply_elem *e;
+    rs_ply_prop *pr;
+    *inst_bytes = add_sat(*inst_bytes, t == RS_PLY_NONE ? 1 : rs_ply_type_size(t));
+    list = list && ws->count >= 4; /* else a scalar, of the unknown type "list" */
+    if (!strict)
+        return RS_OK;
+    e = &h->elems[h->n_elems - 1];
+    if (e->n_props >= RS_PLY_MAX_PROPS)
+        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: too many properties", path,
+                            line);
+    pr = &e->props[e->n_props++];
+    memset(pr, 0, sizeof *pr);
+    if (list) {
+        /* "property list LEN_TYPE TYPE NAME" */
+        pr->len_type = t;
+        pr->type = type_of(ws, 3);
+        word(ws, 4, pr->name);
+        if (pr->len_type == RS_PLY_NONE || pr->type == RS_PLY_NONE || pr->len_type >= RS_PLY_F32)
+            return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad list property", path,
+                                line);
+    } else if (ws->count == 3) {
+        pr->type = type_of(ws, 1);
+        word(ws, 2, pr->name);
+        if (pr->type == RS_PLY_NONE)
+            return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown type '%s'", path,
+                                line, word(ws, 1, b));
+    } else {
+        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad property", path, line);
+    }
+    return RS_OK;
+}
+
+/* The header read to its end: what it declares must fit in the file's data. */
+static rs_status check_sizes(const char *path, uint64_t file_size, const rs_ply_header *h)
+{
+    uint64_t data = file_size > h->data_at ? file_size - h->data_at : 0;
+    if (h->total > data)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: PLY header declares %llu elements, more than its %llu bytes of "
+                            "data could hold",
+                            path, (unsigned long long)h->total, (unsigned long long)data);
+    if (!h->ascii && h->need_bytes > data)
+        return rs_error_set(RS_ERR_ARG,
+                            "%s: PLY header declares elements of at least %llu bytes, but its "
+                            "binary data has only %llu (a cut file?)",
+                            path, (unsigned long long)h->need_bytes, (unsigned long long)data);
+    return RS_OK;
+}
+
 rs_status rs_ply_parse_header(const char *path, const char *text, size_t n, uint64_t file_size,
                               int strict, rs_ply_header *h)
 {
     const char *p = text, *end = text + (n < RS_PLY_MAX_HEADER ? n : RS_PLY_MAX_HEADER);
     unsigned line = 0;
     /* the element being read: its count, whether it has a property, an instance's fixed bytes */
-    uint64_t count = 0, inst_bytes = 0, data;
-    int has_prop = 0, found = 0;
+    uint64_t count = 0, inst_bytes = 0;
+    int has_prop = 0;
     char a[64], b[64];
     h->n_elems = 0;
     h->ascii = 1;
@@ -134,63 +222,10 @@ rs_status rs_ply_parse_header(const char *path, const char *text, size_t n, uint
             word_is(&ws, 0, "obj_info")) {
             continue;
         } else if (is_elem) {
-            size_t i;
-            int ok = ws.count == 3;
-            if (word_is(&ws, 1, "tristrips"))
-                h->tristrips = 1;
-            for (i = 0; ok && i < ws.n[2]; ++i) {
-                ok = isdigit((unsigned char)ws.w[2][i]);
-                count = count > UINT32_MAX ? count : 10 * count + (uint64_t)(ws.w[2][i] - '0');
-            }
-            if (!ok || count > UINT32_MAX)
-                return rs_error_set(
-                    RS_ERR_ARG, "%s: PLY header line %u is not 'element NAME COUNT'", path, line);
-            if (strict) {
-                rs_ply_elem *e;
-                if (h->n_elems >= h->max_elems)
-                    return rs_error_set(RS_ERR_ARG, "%s: PLY header: more than %d elements", path,
-                                        h->max_elems);
-                e = &h->elems[h->n_elems++];
-                memset(e, 0, sizeof *e);
-                word(&ws, 1, e->name);
-                e->count = count;
-            }
+            RS_TRY(element_line(path, line, &ws, strict, h, &count));
         } else if (word_is(&ws, 0, "property") && (!strict || h->n_elems > 0)) {
-            int list = word_is(&ws, 1, "list");
-            rs_ply_type t = type_of(&ws, list ? 2 : 1);
             has_prop = 1;
-            /* the fixed part: a list's length (its items may be 0); an unknown type 1 byte
-             * (Assimp refuses it itself) */
-            inst_bytes = add_sat(inst_bytes, t == RS_PLY_NONE ? 1 : rs_ply_type_size(t));
-            list = list && ws.count >= 4; /* else a scalar, of the unknown type "list" */
-            if (strict) {
-                rs_ply_elem *e = &h->elems[h->n_elems - 1];
-                rs_ply_prop *pr;
-                if (e->n_props >= RS_PLY_MAX_PROPS)
-                    return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: too many properties",
-                                        path, line);
-                pr = &e->props[e->n_props++];
-                memset(pr, 0, sizeof *pr);
-                if (list) {
-                    /* "property list LEN_TYPE TYPE NAME" */
-                    pr->len_type = t;
-                    pr->type = type_of(&ws, 3);
-                    word(&ws, 4, pr->name);
-                    if (pr->len_type == RS_PLY_NONE || pr->type == RS_PLY_NONE ||
-                        pr->len_type >= RS_PLY_F32)
-                        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad list property",
-                                            path, line);
-                } else if (ws.count == 3) {
-                    pr->type = type_of(&ws, 1);
-                    word(&ws, 2, pr->name);
-                    if (pr->type == RS_PLY_NONE)
-                        return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown type '%s'",
-                                            path, line, word(&ws, 1, b));
-                } else {
-                    return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: bad property", path,
-                                        line);
-                }
-            }
+            RS_TRY(property_line(path, line, &ws, strict, h, &inst_bytes));
         } else if (word_is(&ws, 0, "format") && (!strict || ws.count >= 2)) {
             h->ascii = word_is(&ws, 1, "ascii");
             h->big = word_is(&ws, 1, "binary_big_endian");
@@ -198,28 +233,13 @@ rs_status rs_ply_parse_header(const char *path, const char *text, size_t n, uint
                 return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unknown format '%s'", path,
                                     line, word(&ws, 1, b));
         } else if (is_end) {
-            found = 1;
             h->data_at = (size_t)(p - text);
-            break;
+            return check_sizes(path, file_size, h);
         } else if (strict) {
             return rs_error_set(RS_ERR_ARG, "%s: PLY header line %u: unexpected '%s'", path, line,
                                 word(&ws, 0, a));
         }
     }
-    if (!found)
-        return rs_error_set(RS_ERR_ARG,
-                            "%s: PLY header has no end_header (within its first %u KiB)", path,
-                            RS_PLY_MAX_HEADER >> 10);
-    data = file_size > h->data_at ? file_size - h->data_at : 0;
-    if (h->total > data)
-        return rs_error_set(RS_ERR_ARG,
-                            "%s: PLY header declares %llu elements, more than its %llu bytes of "
-                            "data could hold",
-                            path, (unsigned long long)h->total, (unsigned long long)data);
-    if (!h->ascii && h->need_bytes > data)
-        return rs_error_set(RS_ERR_ARG,
-                            "%s: PLY header declares elements of at least %llu bytes, but its "
-                            "binary data has only %llu (a cut file?)",
-                            path, (unsigned long long)h->need_bytes, (unsigned long long)data);
-    return RS_OK;
+    return rs_error_set(RS_ERR_ARG, "%s: PLY header has no end_header (within its first %u KiB)",
+                        path, RS_PLY_MAX_HEADER >> 10);
 }
