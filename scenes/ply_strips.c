@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/try.h"
 #include "core/file.h"
 #include "scenes/ply_header.h"
 
@@ -144,19 +145,120 @@ static rs_status strip_triangles(rs_ply_strips *out, const uint32_t *idx, size_t
     return RS_OK;
 }
 
+/* The decoding's buffers: the strip being read and the triangles' capacity. */
+typedef struct strip_buf {
+    uint32_t *idx;
+    size_t cap;     /* of idx */
+    size_t tri_cap; /* of out->triangles, in triangles */
+} strip_buf;
+
+/* One list property's values; where it is the strips' list (`strips`), decoded into out's
+ * triangles, a value of -1 restarting the strip. */
+static rs_status read_list(reader *r, const rs_ply_prop *pr, int strips, rs_ply_strips *out,
+                           strip_buf *sb)
+{
+    double cnt, v;
+    uint64_t j, n;
+    size_t run = 0;
+    rs_status st = RS_OK;
+    if (!read_value(r, pr->len_type, &cnt) || !(cnt >= 0) || cnt > 1e9)
+        return cut(r, "a list's length is missing or absurd (a cut file?)");
+    n = (uint64_t)cnt;
+    if (strips && n > sb->cap) {
+        uint32_t *g = (uint32_t *)rs_alloc((size_t)n, sizeof *g);
+        if (!g)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", r->path);
+        rs_free(sb->idx);
+        sb->idx = g;
+        sb->cap = (size_t)n;
+    }
+    for (j = 0; j < n; ++j) {
+        if (!read_value(r, pr->type, &v))
+            return cut(r, "a list ends early (a cut file?)");
+        if (!strips)
+            continue;
+        if (v == -1.0) {
+            /* a restart: the strip so far is done */
+            st = strip_triangles(out, sb->idx, run, &sb->tri_cap);
+            out->strips++;
+            run = 0;
+            if (st != RS_OK)
+                return st;
+            continue;
+        }
+        sb->idx[run++] = v >= 0 && v < 4294967295.0 ? (uint32_t)v : UINT32_MAX;
+    }
+    if (strips && run > 0) {
+        st = strip_triangles(out, sb->idx, run, &sb->tri_cap);
+        out->strips++;
+    }
+    return st;
+}
+
+/* Every instance of element el: a vertex element's x, y and z into out->vertices (allocated
+ * here), a tristrips element's first list decoded, every other value read past. */
+static rs_status read_element(reader *r, const rs_ply_elem *el, rs_ply_strips *out,
+                              strip_buf *sb, int *have_xyz)
+{
+    int is_vertex = strcmp(el->name, "vertex") == 0;
+    int is_strips = strcmp(el->name, "tristrips") == 0;
+    int px = -1, py = -1, pz = -1, pl = -1, k;
+    uint64_t i;
+    for (k = 0; k < el->n_props; ++k) {
+        const rs_ply_prop *pr = &el->props[k];
+        if (is_vertex && pr->len_type == RS_PLY_NONE) {
+            if (strcmp(pr->name, "x") == 0)
+                px = k;
+            else if (strcmp(pr->name, "y") == 0)
+                py = k;
+            else if (strcmp(pr->name, "z") == 0)
+                pz = k;
+        }
+        if (is_strips && pr->len_type != RS_PLY_NONE && pl < 0)
+            pl = k;
+    }
+    if (is_vertex) {
+        if (px < 0 || py < 0 || pz < 0)
+            return rs_error_set(RS_ERR_ARG, "%s: PLY vertices have no x, y and z", r->path);
+        /* the header's count is bounded by the file's size (rs_ply_parse_header) */
+        out->vertices = (float *)rs_alloc(3 * (size_t)el->count + 3, sizeof *out->vertices);
+        if (!out->vertices)
+            return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", r->path);
+        out->n_vertices = (uint32_t)el->count;
+        *have_xyz = 1;
+    }
+    if (is_strips && pl < 0)
+        return rs_error_set(RS_ERR_ARG, "%s: PLY tristrips have no list of vertex indices",
+                            r->path);
+    for (i = 0; i < el->count; ++i)
+        for (k = 0; k < el->n_props; ++k) {
+            const rs_ply_prop *pr = &el->props[k];
+            double v;
+            if (pr->len_type != RS_PLY_NONE) {
+                RS_TRY(read_list(r, pr, is_strips && k == pl, out, sb));
+                continue;
+            }
+            if (!read_value(r, pr->type, &v))
+                return cut(r, "the data ends before the elements the header declares");
+            if (is_vertex && (k == px || k == py || k == pz))
+                out->vertices[3 * i + (k == px ? 0 : k == py ? 1 : 2)] = (float)v;
+        }
+    return RS_OK;
+}
+
 rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
 {
     enum { MAX_ELEMS = 16 };
     rs_ply_elem elems[MAX_ELEMS];
     rs_ply_header h;
     int e, have_xyz = 0;
-    size_t len, cap = 0;
+    size_t len;
     char *text;
     reader r;
-    uint32_t *strip = NULL;
-    size_t strip_cap = 0;
+    strip_buf sb;
     rs_status st;
     memset(out, 0, sizeof *out);
+    memset(&sb, 0, sizeof sb);
     st = rs_file_read(path, RS_FILE_MAX_MESH_BYTES, &text, &len);
     if (st != RS_OK)
         return st;
@@ -174,105 +276,9 @@ rs_status rs_ply_read_strips(const char *path, rs_ply_strips *out)
     r.ascii = h.ascii;
     r.big = h.big;
     r.line = 1;
-    for (e = 0; e < h.n_elems && st == RS_OK; ++e) {
-        rs_ply_elem *el = &elems[e];
-        int is_vertex = strcmp(el->name, "vertex") == 0;
-        int is_strips = strcmp(el->name, "tristrips") == 0;
-        int px = -1, py = -1, pz = -1, pl = -1, k;
-        uint64_t i;
-        for (k = 0; k < el->n_props; ++k) {
-            const rs_ply_prop *pr = &el->props[k];
-            if (is_vertex && pr->len_type == RS_PLY_NONE) {
-                if (strcmp(pr->name, "x") == 0)
-                    px = k;
-                else if (strcmp(pr->name, "y") == 0)
-                    py = k;
-                else if (strcmp(pr->name, "z") == 0)
-                    pz = k;
-            }
-            if (is_strips && pr->len_type != RS_PLY_NONE && pl < 0)
-                pl = k;
-        }
-        if (is_vertex) {
-            if (px < 0 || py < 0 || pz < 0) {
-                st = rs_error_set(RS_ERR_ARG, "%s: PLY vertices have no x, y and z", path);
-                break;
-            }
-            /* the header's count is bounded by the file's size (rs_ply_parse_header) */
-            out->vertices = (float *)rs_alloc(3 * (size_t)el->count + 3, sizeof *out->vertices);
-            if (!out->vertices) {
-                st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
-                break;
-            }
-            out->n_vertices = (uint32_t)el->count;
-            have_xyz = 1;
-        }
-        if (is_strips && pl < 0) {
-            st = rs_error_set(RS_ERR_ARG, "%s: PLY tristrips have no list of vertex indices",
-                              path);
-            break;
-        }
-        for (i = 0; i < el->count && st == RS_OK; ++i) {
-            for (k = 0; k < el->n_props; ++k) {
-                const rs_ply_prop *pr = &el->props[k];
-                double v;
-                if (pr->len_type != RS_PLY_NONE) {
-                    double cnt;
-                    uint64_t j, n;
-                    if (!read_value(&r, pr->len_type, &cnt) || !(cnt >= 0) || cnt > 1e9) {
-                        st = cut(&r, "a list's length is missing or absurd (a cut file?)");
-                        break;
-                    }
-                    n = (uint64_t)cnt;
-                    if (is_strips && k == pl && n > strip_cap) {
-                        uint32_t *g = (uint32_t *)rs_alloc((size_t)n, sizeof *g);
-                        if (!g) {
-                            st = rs_error_set(RS_ERR_NOMEM, "%s: out of memory", path);
-                            break;
-                        }
-                        rs_free(strip);
-                        strip = g;
-                        strip_cap = (size_t)n;
-                    }
-                    {
-                        size_t run = 0;
-                        for (j = 0; j < n; ++j) {
-                            if (!read_value(&r, pr->type, &v)) {
-                                st = cut(&r, "a list ends early (a cut file?)");
-                                break;
-                            }
-                            if (!(is_strips && k == pl))
-                                continue;
-                            if (v == -1.0) {
-                                /* a restart: the strip so far is done */
-                                st = strip_triangles(out, strip, run, &cap);
-                                out->strips++;
-                                run = 0;
-                                if (st != RS_OK)
-                                    break;
-                                continue;
-                            }
-                            strip[run++] = v >= 0 && v < 4294967295.0 ? (uint32_t)v : UINT32_MAX;
-                        }
-                        if (st == RS_OK && is_strips && k == pl && run > 0) {
-                            st = strip_triangles(out, strip, run, &cap);
-                            out->strips++;
-                        }
-                    }
-                    if (st != RS_OK)
-                        break;
-                    continue;
-                }
-                if (!read_value(&r, pr->type, &v)) {
-                    st = cut(&r, "the data ends before the elements the header declares");
-                    break;
-                }
-                if (is_vertex && (k == px || k == py || k == pz))
-                    out->vertices[3 * i + (k == px ? 0 : k == py ? 1 : 2)] = (float)v;
-            }
-        }
-    }
-    rs_free(strip);
+    for (e = 0; e < h.n_elems && st == RS_OK; ++e)
+        st = read_element(&r, &elems[e], out, &sb, &have_xyz);
+    rs_free(sb.idx);
     rs_free(text);
     if (st == RS_OK && !have_xyz)
         st = rs_error_set(RS_ERR_ARG, "%s: PLY file has no vertex element", path);
