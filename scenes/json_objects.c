@@ -345,98 +345,124 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
     return keep_mesh(c, o, first);
 }
 
-static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const char *type)
+/* A sphere, still or moving (to `moving_to` over the shutter, or at `velocity`). */
+static rs_status add_sphere(ctx *c, const cJSON *o, const char *path)
 {
     static const char *const k_sphere[] = {"type",     "center",    "radius",    "material",
                                            "moving_to", "velocity", "transform", NULL};
+    rs_scene *s = c->scene;
+    uint32_t mat;
+    rs_vec3 center, to;
+    float r;
+    RS_TRY(rs_json_check_keys(c, o, path, k_sphere));
+    RS_TRY(rs_json_get_vec3(c, o, path, "center", 1, rs_v3(0, 0, 0), &center));
+    RS_TRY(rs_json_get_num(c, o, path, "radius", 1, 0, 1e-30, 1e30, &r));
+    RS_TRY(rs_json_object_material(c, o, path, &mat));
+    if (cJSON_GetObjectItemCaseSensitive(o, "moving_to") &&
+        cJSON_GetObjectItemCaseSensitive(o, "velocity"))
+        return FAIL(c, path, "give either 'moving_to' or 'velocity', not both");
+    if (cJSON_GetObjectItemCaseSensitive(o, "moving_to")) {
+        /* the centre moves linearly from `center` at time 0 to `moving_to` at time 1 */
+        RS_TRY(rs_json_get_vec3(c, o, path, "moving_to", 1, center, &to));
+        return rs_scene_add_moving_sphere(s, center, 0.0f, to, 1.0f, r, mat);
+    }
+    if (cJSON_GetObjectItemCaseSensitive(o, "velocity")) {
+        /* the centre at time t is center + t velocity (what `raystream export` writes: the
+         * stored motion exactly) */
+        rs_vec3 vel;
+        RS_TRY(rs_json_get_vec3(c, o, path, "velocity", 1, center, &vel));
+        RS_TRY(
+            rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, vel), 1.0f, r, mat));
+        s->sphere_motion[s->n_spheres - 1] = vel;
+        return RS_OK;
+    }
+    return rs_scene_add_sphere(s, center, r, mat);
+}
+
+/* A parallelogram q + a u + b v. */
+static rs_status add_quad(ctx *c, const cJSON *o, const char *path)
+{
     static const char *const k_quad[] = {"type", "q", "u", "v", "material", "transform", NULL};
+    rs_scene *s = c->scene;
+    uint32_t mat;
+    rs_vec3 q, u, v;
+    RS_TRY(rs_json_check_keys(c, o, path, k_quad));
+    RS_TRY(rs_json_get_vec3(c, o, path, "q", 1, rs_v3(0, 0, 0), &q));
+    RS_TRY(rs_json_get_vec3(c, o, path, "u", 1, rs_v3(0, 0, 0), &u));
+    RS_TRY(rs_json_get_vec3(c, o, path, "v", 1, rs_v3(0, 0, 0), &v));
+    if (rs_v3_is_zero(rs_v3_cross(u, v)))
+        return FAIL(c, path, "u and v must span a parallelogram (u x v = 0)");
+    RS_TRY(rs_json_object_material(c, o, path, &mat));
+    return rs_scene_add_quad(s, q, u, v, mat);
+}
+
+/* A triangle, with UVs and vertex normals where given. */
+static rs_status add_triangle(ctx *c, const cJSON *o, const char *path)
+{
     static const char *const k_tri[] = {"type", "vertices", "uv", "normals", "material",
                                         "transform", NULL};
+    rs_scene *s = c->scene;
+    uint32_t mat;
+    const cJSON *vs = cJSON_GetObjectItemCaseSensitive(o, "vertices");
+    const cJSON *uv = cJSON_GetObjectItemCaseSensitive(o, "uv");
+    const cJSON *nrm = cJSON_GetObjectItemCaseSensitive(o, "normals");
+    rs_vec3 p[3];
+    float uvs[6], ns[9];
+    char sp[256];
+    int i;
+    RS_TRY(rs_json_check_keys(c, o, path, k_tri));
+    rs_json_subpath(sp, sizeof sp, path, "vertices");
+    if (!cJSON_IsArray(vs) || cJSON_GetArraySize(vs) != 3)
+        return FAIL(c, vs ? sp : path, vs ? "expected 3 vertices" : "missing 'vertices'");
+    for (i = 0; i < 3; ++i)
+        RS_TRY(rs_json_vec3_of(c, cJSON_GetArrayItem(vs, i), sp, &p[i]));
+    RS_TRY(rs_json_object_material(c, o, path, &mat));
+    if (!uv && !nrm)
+        return rs_scene_add_triangle(s, p[0], p[1], p[2], mat);
+    if (uv) {
+        rs_json_subpath(sp, sizeof sp, path, "uv");
+        RS_TRY(rs_json_read_floats(c, uv, sp, 6, "(u0, v0, u1, v1, u2, v2)", uvs));
+    }
+    if (nrm) {
+        /* unit vertex normals (zeros: the face's), as `raystream export` writes a mesh's */
+        rs_json_subpath(sp, sizeof sp, path, "normals");
+        RS_TRY(rs_json_read_floats(c, nrm, sp, 9, "(three normals)", ns));
+    }
+    if (!nrm)
+        return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
+    return rs_scene_add_triangle_full(s, p, uv ? uvs : NULL, ns, mat);
+}
+
+/* RTIOW's box: six parallelograms, turned about y and moved. */
+static rs_status add_box(ctx *c, const cJSON *o, const char *path)
+{
     static const char *const k_box[] = {"type",      "min",      "max",       "rotate_y",
                                         "translate", "material", "transform", NULL};
     rs_scene *s = c->scene;
     uint32_t mat;
-    if (strcmp(type, "sphere") == 0) {
-        rs_vec3 center, to;
-        float r;
-        RS_TRY(rs_json_check_keys(c, o, path, k_sphere));
-        RS_TRY(rs_json_get_vec3(c, o, path, "center", 1, rs_v3(0, 0, 0), &center));
-        RS_TRY(rs_json_get_num(c, o, path, "radius", 1, 0, 1e-30, 1e30, &r));
-        RS_TRY(rs_json_object_material(c, o, path, &mat));
-        if (cJSON_GetObjectItemCaseSensitive(o, "moving_to") &&
-            cJSON_GetObjectItemCaseSensitive(o, "velocity"))
-            return FAIL(c, path, "give either 'moving_to' or 'velocity', not both");
-        if (cJSON_GetObjectItemCaseSensitive(o, "moving_to")) {
-            /* the centre moves linearly from `center` at time 0 to `moving_to` at time 1 */
-            RS_TRY(rs_json_get_vec3(c, o, path, "moving_to", 1, center, &to));
-            return rs_scene_add_moving_sphere(s, center, 0.0f, to, 1.0f, r, mat);
-        }
-        if (cJSON_GetObjectItemCaseSensitive(o, "velocity")) {
-            /* the centre at time t is center + t velocity (what `raystream export` writes: the
-             * stored motion exactly) */
-            rs_vec3 vel;
-            RS_TRY(rs_json_get_vec3(c, o, path, "velocity", 1, center, &vel));
-            RS_TRY(
-                rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, vel), 1.0f, r, mat));
-            s->sphere_motion[s->n_spheres - 1] = vel;
-            return RS_OK;
-        }
-        return rs_scene_add_sphere(s, center, r, mat);
-    }
-    if (strcmp(type, "quad") == 0) {
-        rs_vec3 q, u, v;
-        RS_TRY(rs_json_check_keys(c, o, path, k_quad));
-        RS_TRY(rs_json_get_vec3(c, o, path, "q", 1, rs_v3(0, 0, 0), &q));
-        RS_TRY(rs_json_get_vec3(c, o, path, "u", 1, rs_v3(0, 0, 0), &u));
-        RS_TRY(rs_json_get_vec3(c, o, path, "v", 1, rs_v3(0, 0, 0), &v));
-        if (rs_v3_is_zero(rs_v3_cross(u, v)))
-            return FAIL(c, path, "u and v must span a parallelogram (u x v = 0)");
-        RS_TRY(rs_json_object_material(c, o, path, &mat));
-        return rs_scene_add_quad(s, q, u, v, mat);
-    }
-    if (strcmp(type, "triangle") == 0) {
-        const cJSON *vs = cJSON_GetObjectItemCaseSensitive(o, "vertices");
-        const cJSON *uv = cJSON_GetObjectItemCaseSensitive(o, "uv");
-        const cJSON *nrm = cJSON_GetObjectItemCaseSensitive(o, "normals");
-        rs_vec3 p[3];
-        float uvs[6], ns[9];
-        char sp[256];
-        int i;
-        RS_TRY(rs_json_check_keys(c, o, path, k_tri));
-        rs_json_subpath(sp, sizeof sp, path, "vertices");
-        if (!cJSON_IsArray(vs) || cJSON_GetArraySize(vs) != 3)
-            return FAIL(c, vs ? sp : path, vs ? "expected 3 vertices" : "missing 'vertices'");
-        for (i = 0; i < 3; ++i)
-            RS_TRY(rs_json_vec3_of(c, cJSON_GetArrayItem(vs, i), sp, &p[i]));
-        RS_TRY(rs_json_object_material(c, o, path, &mat));
-        if (!uv && !nrm)
-            return rs_scene_add_triangle(s, p[0], p[1], p[2], mat);
-        if (uv) {
-            rs_json_subpath(sp, sizeof sp, path, "uv");
-            RS_TRY(rs_json_read_floats(c, uv, sp, 6, "(u0, v0, u1, v1, u2, v2)", uvs));
-        }
-        if (nrm) {
-            /* unit vertex normals (zeros: the face's), as `raystream export` writes a mesh's */
-            rs_json_subpath(sp, sizeof sp, path, "normals");
-            RS_TRY(rs_json_read_floats(c, nrm, sp, 9, "(three normals)", ns));
-        }
-        if (!nrm)
-            return rs_scene_add_triangle_uv(s, p[0], p[1], p[2], uvs, mat);
-        return rs_scene_add_triangle_full(s, p, uv ? uvs : NULL, ns, mat);
-    }
-    if (strcmp(type, "box") == 0) {
-        rs_vec3 lo, hi, t;
-        float rot;
-        RS_TRY(rs_json_check_keys(c, o, path, k_box));
-        RS_TRY(rs_json_get_vec3(c, o, path, "min", 1, rs_v3(0, 0, 0), &lo));
-        RS_TRY(rs_json_get_vec3(c, o, path, "max", 1, rs_v3(0, 0, 0), &hi));
-        if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
-            return FAIL(c, path, "'max' must exceed 'min' on every axis");
-        RS_TRY(rs_json_get_num(c, o, path, "rotate_y", 0, 0.0, -1e6, 1e6, &rot));
-        RS_TRY(rs_json_get_vec3(c, o, path, "translate", 0, rs_v3(0, 0, 0), &t));
-        RS_TRY(rs_json_object_material(c, o, path, &mat));
-        return rs_scene_add_box(s, lo, hi, rot, t, mat);
-    }
+    rs_vec3 lo, hi, t;
+    float rot;
+    RS_TRY(rs_json_check_keys(c, o, path, k_box));
+    RS_TRY(rs_json_get_vec3(c, o, path, "min", 1, rs_v3(0, 0, 0), &lo));
+    RS_TRY(rs_json_get_vec3(c, o, path, "max", 1, rs_v3(0, 0, 0), &hi));
+    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+        return FAIL(c, path, "'max' must exceed 'min' on every axis");
+    RS_TRY(rs_json_get_num(c, o, path, "rotate_y", 0, 0.0, -1e6, 1e6, &rot));
+    RS_TRY(rs_json_get_vec3(c, o, path, "translate", 0, rs_v3(0, 0, 0), &t));
+    RS_TRY(rs_json_object_material(c, o, path, &mat));
+    return rs_scene_add_box(s, lo, hi, rot, t, mat);
+}
+
+static rs_status add_primitive(ctx *c, const cJSON *o, const char *path, const char *type)
+{
+    if (strcmp(type, "sphere") == 0)
+        return add_sphere(c, o, path);
+    if (strcmp(type, "quad") == 0)
+        return add_quad(c, o, path);
+    if (strcmp(type, "triangle") == 0)
+        return add_triangle(c, o, path);
+    if (strcmp(type, "box") == 0)
+        return add_box(c, o, path);
     if (strcmp(type, "mesh") == 0)
         return add_mesh(c, o, path);
     if (strcmp(type, "point_light") == 0 || strcmp(type, "spot_light") == 0 ||
