@@ -133,7 +133,10 @@ static rs_status read_conductor(ctx *c, const cJSON *m, const char *path, float 
     return read_albedo(c, m, path, "color", mat);
 }
 
-rs_status rs_json_read_material(ctx *c, const cJSON *m, const char *path, const char *name)
+/* The diffuse materials: lambertian, diffuse_uniform, disney_diffuse, phong (*known 0 for
+ * another type). */
+static rs_status read_diffuse(ctx *c, const cJSON *m, const char *path, const char *type,
+                              rs_material *mat, int *known)
 {
     static const char *const k_diffuse[] = {"type", "albedo", "texture", "importance_sampling",
                                             NULL};
@@ -141,47 +144,50 @@ rs_status rs_json_read_material(ctx *c, const cJSON *m, const char *path, const 
         "type", "albedo", "texture", "roughness", "importance_sampling", NULL};
     static const char *const k_phong[] = {
         "type", "kd", "texture", "ks", "exponent", "importance_sampling", NULL};
+    *known = 1;
+    if (strcmp(type, "lambertian") == 0 || strcmp(type, "diffuse_uniform") == 0) {
+        *mat = type[0] == 'l' ? rs_mat_lambertian(rs_v3_splat(.5f))
+                             : rs_mat_diffuse_uniform(rs_v3_splat(.5f));
+        RS_TRY(rs_json_check_keys(c, m, path, k_diffuse));
+        RS_TRY(read_albedo(c, m, path, "albedo", mat));
+    } else if (strcmp(type, "disney_diffuse") == 0) {
+        *mat = rs_mat_disney_diffuse(rs_v3_splat(.5f), 0.5f);
+        RS_TRY(rs_json_check_keys(c, m, path, k_disney));
+        RS_TRY(read_albedo(c, m, path, "albedo", mat));
+        RS_TRY(rs_json_get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &mat->roughness));
+    } else if (strcmp(type, "phong") == 0) {
+        *mat = rs_mat_phong(rs_v3_splat(.5f), rs_v3_splat(.5f), 50.0f);
+        RS_TRY(rs_json_check_keys(c, m, path, k_phong));
+        RS_TRY(read_albedo(c, m, path, "kd", mat));
+        RS_TRY(rs_json_get_reflectance(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat->specular));
+        RS_TRY(rs_json_get_num(c, m, path, "exponent", 0, 50.0, 0.0, 1e6, &mat->exponent));
+    } else {
+        *known = 0;
+    }
+    return RS_OK;
+}
+
+/* The specular materials: metal, dielectric, conductor, rough_dielectric (*known 0 for another
+ * type). */
+static rs_status read_specular(ctx *c, const cJSON *m, const char *path, const char *type,
+                               rs_material *mat, int *known)
+{
     static const char *const k_metal[] = {"type", "albedo", "fuzz", NULL};
     static const char *const k_glass[] = {"type", "ior", "tint", "fresnel", NULL};
     static const char *const k_cond[] = {"type",    "metal",     "eta", "k", "color",
                                          "texture", "roughness", NULL};
     static const char *const k_rglass[] = {"type", "ior", "tint", "roughness", NULL};
-    static const char *const k_pbr[] = {"type", "base_color", "texture", "metallic", "roughness",
-                                        NULL};
-    static const char *const k_light[] = {"type", "emission", "two_sided", NULL};
-    rs_material mat;
-    const char *type = "";
-    int is_ok = 1, two = 0;
-    uint32_t id;
-    if (!cJSON_IsObject(m))
-        return FAIL(c, path, "expected an object");
-    RS_TRY(rs_json_get_string(c, m, path, "type", &type));
-    if (strcmp(type, "lambertian") == 0 || strcmp(type, "diffuse_uniform") == 0) {
-        mat = type[0] == 'l' ? rs_mat_lambertian(rs_v3_splat(.5f))
-                             : rs_mat_diffuse_uniform(rs_v3_splat(.5f));
-        RS_TRY(rs_json_check_keys(c, m, path, k_diffuse));
-        RS_TRY(read_albedo(c, m, path, "albedo", &mat));
-    } else if (strcmp(type, "disney_diffuse") == 0) {
-        mat = rs_mat_disney_diffuse(rs_v3_splat(.5f), 0.5f);
-        RS_TRY(rs_json_check_keys(c, m, path, k_disney));
-        RS_TRY(read_albedo(c, m, path, "albedo", &mat));
-        RS_TRY(rs_json_get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &mat.roughness));
-    } else if (strcmp(type, "phong") == 0) {
-        mat = rs_mat_phong(rs_v3_splat(.5f), rs_v3_splat(.5f), 50.0f);
-        RS_TRY(rs_json_check_keys(c, m, path, k_phong));
-        RS_TRY(read_albedo(c, m, path, "kd", &mat));
-        RS_TRY(rs_json_get_reflectance(c, m, path, "ks", 0, rs_v3_splat(.25f), &mat.specular));
-        RS_TRY(rs_json_get_num(c, m, path, "exponent", 0, 50.0, 0.0, 1e6, &mat.exponent));
-    } else if (strcmp(type, "metal") == 0) {
-        mat = rs_mat_metal(rs_v3_splat(.8f), 0.0f);
+    *known = 1;
+    if (strcmp(type, "metal") == 0) {
+        *mat = rs_mat_metal(rs_v3_splat(.8f), 0.0f);
         RS_TRY(rs_json_check_keys(c, m, path, k_metal));
-        RS_TRY(rs_json_get_reflectance(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat.albedo));
-        RS_TRY(rs_json_get_num(c, m, path, "fuzz", 0, 0.0, 0.0, 1.0, &mat.fuzz));
+        RS_TRY(rs_json_get_reflectance(c, m, path, "albedo", 0, rs_v3_splat(.8f), &mat->albedo));
+        RS_TRY(rs_json_get_num(c, m, path, "fuzz", 0, 0.0, 0.0, 1.0, &mat->fuzz));
     } else if (strcmp(type, "dielectric") == 0) {
-        mat = rs_mat_dielectric(1.5f);
+        *mat = rs_mat_dielectric(1.5f);
         RS_TRY(rs_json_check_keys(c, m, path, k_glass));
-        RS_TRY(rs_json_get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat.ior));
-        RS_TRY(rs_json_get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
+        RS_TRY(rs_json_get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &mat->ior));
+        RS_TRY(rs_json_get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat->albedo));
         {
             const cJSON *fr = cJSON_GetObjectItemCaseSensitive(m, "fresnel");
             char p[256];
@@ -190,39 +196,73 @@ rs_status rs_json_read_material(ctx *c, const cJSON *m, const char *path, const 
                                                strcmp(fr->valuestring, "exact") != 0)))
                 return FAIL(c, p, "expected \"schlick\" (the default) or \"exact\"");
             if (fr && strcmp(fr->valuestring, "exact") == 0)
-                mat.flags |= RS_MAT_EXACT_FRESNEL;
+                mat->flags |= RS_MAT_EXACT_FRESNEL;
         }
     } else if (strcmp(type, "conductor") == 0) {
         float r;
         RS_TRY(rs_json_check_keys(c, m, path, k_cond));
         RS_TRY(rs_json_get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
-        RS_TRY(read_conductor(c, m, path, r * r, &mat));
+        RS_TRY(read_conductor(c, m, path, r * r, mat));
     } else if (strcmp(type, "rough_dielectric") == 0) {
         float r, ior;
         RS_TRY(rs_json_check_keys(c, m, path, k_rglass));
         RS_TRY(rs_json_get_num(c, m, path, "ior", 0, 1.5, 1e-3, 100.0, &ior));
         RS_TRY(rs_json_get_num(c, m, path, "roughness", 0, 0.3, 0.0, 1.0, &r));
-        mat = rs_mat_rough_dielectric(ior, r * r);
-        RS_TRY(rs_json_get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat.albedo));
-    } else if (strcmp(type, "pbr") == 0) {
+        *mat = rs_mat_rough_dielectric(ior, r * r);
+        RS_TRY(rs_json_get_reflectance(c, m, path, "tint", 0, rs_v3_splat(1.0f), &mat->albedo));
+    } else {
+        *known = 0;
+    }
+    return RS_OK;
+}
+
+/* The pbr material and the emitter (*known 0 for another type). */
+static rs_status read_pbr_light(ctx *c, const cJSON *m, const char *path, const char *type,
+                                rs_material *mat, int *known)
+{
+    static const char *const k_pbr[] = {"type", "base_color", "texture", "metallic", "roughness",
+                                        NULL};
+    static const char *const k_light[] = {"type", "emission", "two_sided", NULL};
+    int two = 0;
+    *known = 1;
+    if (strcmp(type, "pbr") == 0) {
         float r, metal;
         RS_TRY(rs_json_check_keys(c, m, path, k_pbr));
         RS_TRY(rs_json_get_num(c, m, path, "metallic", 0, 0.0, 0.0, 1.0, &metal));
         RS_TRY(rs_json_get_num(c, m, path, "roughness", 0, 0.5, 0.0, 1.0, &r));
-        mat = rs_mat_pbr(rs_v3_splat(.8f), metal, r);
-        RS_TRY(read_albedo(c, m, path, "base_color", &mat));
+        *mat = rs_mat_pbr(rs_v3_splat(.8f), metal, r);
+        RS_TRY(read_albedo(c, m, path, "base_color", mat));
     } else if (strcmp(type, "light") == 0) {
-        mat = rs_mat_light(rs_v3_splat(1.0f), 0);
+        *mat = rs_mat_light(rs_v3_splat(1.0f), 0);
         RS_TRY(rs_json_check_keys(c, m, path, k_light));
-        RS_TRY(rs_json_get_color(c, m, path, "emission", 1, rs_v3(0, 0, 0), &mat.emission));
+        RS_TRY(rs_json_get_color(c, m, path, "emission", 1, rs_v3(0, 0, 0), &mat->emission));
         RS_TRY(rs_json_get_bool(c, m, path, "two_sided", 0, &two));
-        mat.flags = two ? RS_MAT_TWO_SIDED : 0u;
+        mat->flags = two ? RS_MAT_TWO_SIDED : 0u;
     } else {
+        *known = 0;
+    }
+    return RS_OK;
+}
+
+rs_status rs_json_read_material(ctx *c, const cJSON *m, const char *path, const char *name)
+{
+    rs_material mat;
+    const char *type = "";
+    int is_ok = 1, known = 0;
+    uint32_t id;
+    if (!cJSON_IsObject(m))
+        return FAIL(c, path, "expected an object");
+    RS_TRY(rs_json_get_string(c, m, path, "type", &type));
+    RS_TRY(read_diffuse(c, m, path, type, &mat, &known));
+    if (!known)
+        RS_TRY(read_specular(c, m, path, type, &mat, &known));
+    if (!known)
+        RS_TRY(read_pbr_light(c, m, path, type, &mat, &known));
+    if (!known)
         return FAIL(c, path,
                     "unknown material type '%s' (lambertian, diffuse_uniform, disney_diffuse, "
                     "phong, metal, dielectric, conductor, rough_dielectric, pbr, light)",
                     type);
-    }
     RS_TRY(rs_json_get_bool(c, m, path, "importance_sampling", 1, &is_ok));
     if (!is_ok)
         mat.flags |= RS_MAT_UNIFORM_SAMPLING;
