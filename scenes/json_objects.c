@@ -257,16 +257,82 @@ static rs_status add_punctual(ctx *c, const cJSON *o, const char *path, const ch
 
 /* A mesh file through Assimp: its own materials, one scene material for all of it ("material"),
  * or some of its materials replaced by name ("materials": {"file's name": "scene's name"}). */
+/* A mesh object's "materials": the file's materials replaced by scene materials, by name. */
+static rs_status mesh_overrides(ctx *c, const cJSON *ov, const char *path, const char **names,
+                                uint32_t *ids, uint32_t *n_out)
+{
+    const cJSON *it;
+    char p[256];
+    uint32_t n = 0;
+    rs_json_subpath(p, sizeof p, path, "materials");
+    if (!cJSON_IsObject(ov))
+        return FAIL(c, p, "expected {\"file's material\": \"scene material\", ...}");
+    for (it = ov->child; it; it = it->next) {
+        char q[300];
+        snprintf(q, sizeof q, "%s.%s", p, it->string);
+        if (n >= MAX_OVERRIDES)
+            return FAIL(c, p, "more than %d materials replaced", MAX_OVERRIDES);
+        if (!cJSON_IsString(it) ||
+            !rs_json_lookup(c->materials, c->n_materials, it->valuestring, &ids[n]))
+            return FAIL(c, q, "no material named %s%s%s", cJSON_IsString(it) ? "'" : "",
+                        cJSON_IsString(it) ? it->valuestring : "(not a string)",
+                        cJSON_IsString(it) ? "'" : "");
+        names[n++] = it->string;
+    }
+    *n_out = n;
+    return RS_OK;
+}
+
+/* The thesis's placement, applied to the file's coordinates before the fit: a scale per axis,
+ * then rotations about x, y and z (degrees); and the fit, where asked for. */
+static rs_status mesh_placement(ctx *c, const cJSON *o, const char *path, rs_mesh_opts *mo)
+{
+    static const char *const k_fit[] = {"size", "base", NULL};
+    const cJSON *fit = cJSON_GetObjectItemCaseSensitive(o, "fit");
+    char p[256];
+    RS_TRY(rs_json_get_vec3(c, o, path, "scale", 0, rs_v3(1, 1, 1), &mo->scale));
+    rs_json_subpath(p, sizeof p, path, "scale");
+    if (mo->scale.x == 0 || mo->scale.y == 0 || mo->scale.z == 0)
+        return FAIL(c, p, "a scale must not be 0 (it would flatten the mesh)");
+    RS_TRY(rs_json_get_vec3(c, o, path, "rotate", 0, rs_v3(0, 0, 0), &mo->rotate_deg));
+    if (fit) {
+        rs_json_subpath(p, sizeof p, path, "fit");
+        if (!cJSON_IsObject(fit))
+            return FAIL(c, p, "expected {\"size\": s, \"base\": [x, y, z]}");
+        RS_TRY(rs_json_check_keys(c, fit, p, k_fit));
+        mo->fit = 1;
+        RS_TRY(rs_json_get_num(c, fit, p, "size", 1, 1, 1e-30, 1e30, &mo->fit_size));
+        RS_TRY(rs_json_get_vec3(c, fit, p, "base", 0, rs_v3(0, 0, 0), &mo->fit_base));
+    }
+    return RS_OK;
+}
+
+/* The line for c->log about mesh file `full` as read (n_overrides of its materials replaced). */
+static void mesh_log(const ctx *c, const cJSON *o, const char *full, const rs_mesh_opts *mo,
+                     const rs_mesh_info *info, uint32_t n_overrides)
+{
+    char why[160], mats[160], strips[64] = "";
+    if (mo->material != RS_MESH_FILE_MATERIALS)
+        snprintf(mats, sizeof mats, "material '%s'",
+                 cJSON_GetObjectItemCaseSensitive(o, "material")->valuestring);
+    else
+        snprintf(mats, sizeof mats, "%u material%s from the file%s", info->materials,
+                 info->materials == 1 ? "" : "s",
+                 n_overrides ? " and the scene's replacements" : "");
+    if (info->strips)
+        snprintf(strips, sizeof strips, " (from %u triangle strips)", info->strips);
+    fprintf(c->log, "raystream: %s: %u triangles%s, %s%s%s\n", full, info->triangles, strips,
+            mats, info->dropped ? "; " : "", rs_mesh_dropped_text(info, why, sizeof why));
+}
+
 static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
 {
     static const char *const keys[] = {"type",  "file",   "material", "materials", "scale",
                                        "rotate", "fit",   "transform", NULL};
-    static const char *const k_fit[] = {"size", "base", NULL};
     const char *file = "", *names[MAX_OVERRIDES];
     const cJSON *ov = cJSON_GetObjectItemCaseSensitive(o, "materials");
-    const cJSON *fit = cJSON_GetObjectItemCaseSensitive(o, "fit");
     uint32_t ids[MAX_OVERRIDES], n = 0, k, first;
-    char full[1024], p[256];
+    char full[1024];
     rs_mesh_opts mo = rs_mesh_opts_default(RS_MESH_FILE_MATERIALS);
     rs_mesh_info info;
     rs_status st;
@@ -279,42 +345,12 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
         RS_TRY(rs_json_object_material(c, o, path, &mo.material));
     }
     if (ov) {
-        const cJSON *it;
-        rs_json_subpath(p, sizeof p, path, "materials");
-        if (!cJSON_IsObject(ov))
-            return FAIL(c, p, "expected {\"file's material\": \"scene material\", ...}");
-        for (it = ov->child; it; it = it->next) {
-            char q[300];
-            snprintf(q, sizeof q, "%s.%s", p, it->string);
-            if (n >= MAX_OVERRIDES)
-                return FAIL(c, p, "more than %d materials replaced", MAX_OVERRIDES);
-            if (!cJSON_IsString(it) ||
-                !rs_json_lookup(c->materials, c->n_materials, it->valuestring, &ids[n]))
-                return FAIL(c, q, "no material named %s%s%s", cJSON_IsString(it) ? "'" : "",
-                            cJSON_IsString(it) ? it->valuestring : "(not a string)",
-                            cJSON_IsString(it) ? "'" : "");
-            names[n++] = it->string;
-        }
+        RS_TRY(mesh_overrides(c, ov, path, names, ids, &n));
         mo.override_names = names;
         mo.override_ids = ids;
         mo.n_overrides = n;
     }
-    /* the thesis's placement, applied to the file's coordinates before the fit: a scale per
-     * axis, then rotations about x, y and z (degrees) */
-    RS_TRY(rs_json_get_vec3(c, o, path, "scale", 0, rs_v3(1, 1, 1), &mo.scale));
-    rs_json_subpath(p, sizeof p, path, "scale");
-    if (mo.scale.x == 0 || mo.scale.y == 0 || mo.scale.z == 0)
-        return FAIL(c, p, "a scale must not be 0 (it would flatten the mesh)");
-    RS_TRY(rs_json_get_vec3(c, o, path, "rotate", 0, rs_v3(0, 0, 0), &mo.rotate_deg));
-    if (fit) {
-        rs_json_subpath(p, sizeof p, path, "fit");
-        if (!cJSON_IsObject(fit))
-            return FAIL(c, p, "expected {\"size\": s, \"base\": [x, y, z]}");
-        RS_TRY(rs_json_check_keys(c, fit, p, k_fit));
-        mo.fit = 1;
-        RS_TRY(rs_json_get_num(c, fit, p, "size", 1, 1, 1e-30, 1e30, &mo.fit_size));
-        RS_TRY(rs_json_get_vec3(c, fit, p, "base", 0, rs_v3(0, 0, 0), &mo.fit_base));
-    }
+    RS_TRY(mesh_placement(c, o, path, &mo));
     for (k = 0; k < c->n_meshes; ++k)
         if (c->meshes[k].node == o)
             return copy_mesh(c, &c->meshes[k]);
@@ -328,20 +364,8 @@ static rs_status add_mesh(ctx *c, const cJSON *o, const char *path)
         rs_error_clear();
         return FAIL(c, path, "%s", msg);
     }
-    if (c->log) {
-        char why[160], mats[160];
-        if (mo.material != RS_MESH_FILE_MATERIALS)
-            snprintf(mats, sizeof mats, "material '%s'",
-                     cJSON_GetObjectItemCaseSensitive(o, "material")->valuestring);
-        else
-            snprintf(mats, sizeof mats, "%u material%s from the file%s", info.materials,
-                     info.materials == 1 ? "" : "s", n ? " and the scene's replacements" : "");
-        char strips[64] = "";
-        if (info.strips)
-            snprintf(strips, sizeof strips, " (from %u triangle strips)", info.strips);
-        fprintf(c->log, "raystream: %s: %u triangles%s, %s%s%s\n", full, info.triangles, strips,
-                mats, info.dropped ? "; " : "", rs_mesh_dropped_text(&info, why, sizeof why));
-    }
+    if (c->log)
+        mesh_log(c, o, full, &mo, &info, n);
     return keep_mesh(c, o, first);
 }
 
