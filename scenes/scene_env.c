@@ -71,6 +71,51 @@ double rs_scene_bound_radius(const rs_scene *s)
     }
 }
 
+/* No map: a constant background colour is a uniform sky, light-sampled as one (over the
+ * sphere, MIS-weighted against BSDF rays that escape), as pbrt's and Mitsuba's constant emitters
+ * are; before, only BSDF rays that escaped saw it.  The RTIOW gradient (background_sky) is not
+ * sampled.  Its power in *power (left 0 otherwise). */
+static void constant_background(rs_scene *s, double *power)
+{
+    const rs_vec3 b = s->background;
+    const float rgb[3] = {b.x, b.y, b.z};
+    if (!s->background_sky && isfinite(b.x) && isfinite(b.y) && isfinite(b.z) && b.x >= 0 &&
+        b.y >= 0 && b.z >= 0 && luminance(rgb) > 0) {
+        double r = rs_scene_bound_radius(s);
+        s->env_uniform = 1;
+        s->env_uniform_le = b;
+        *power = PI * r * r * (double)luminance(rgb) * 4.0 * PI;
+    }
+}
+
+/* Each row's CDF over its texels (by luminance times the scale's, times sin theta) into
+ * s->env_cond_cdf, each row's sum into row_sum; returns the sum of all. */
+static double conditional_cdfs(rs_scene *s, const rs_image *im, double *row_sum)
+{
+    uint32_t w = im->width, h = im->height, i, j;
+    double total = 0;
+    /* the scale's luminance weights the distribution as it weights the radiance */
+    const float sc[3] = {s->env_scale.x, s->env_scale.y, s->env_scale.z};
+    for (j = 0; j < h; ++j) {
+        double sin_t = sin(PI * (j + 0.5) / h), acc = 0;
+        float *cdf = &s->env_cond_cdf[(size_t)j * (w + 1)];
+        for (i = 0; i < w; ++i) {
+            const float *t = &im->rgb[3 * ((size_t)j * w + i)];
+            float rgb[3];
+            rgb[0] = t[0] * sc[0], rgb[1] = t[1] * sc[1], rgb[2] = t[2] * sc[2];
+            cdf[i] = (float)acc;
+            acc += (double)luminance(rgb) * sin_t;
+        }
+        row_sum[j] = acc;
+        total += acc;
+        /* a black row is never picked; its CDF is made uniform so that it is well formed */
+        for (i = 0; i <= w; ++i)
+            cdf[i] = acc > 0 ? (i == w ? 1.0f : (float)(cdf[i] / acc)) : (float)i / (float)w;
+        cdf[w] = 1.0f;
+    }
+    return total;
+}
+
 rs_status rs_scene_env_build(rs_scene *s, double *power)
 {
     const rs_image *im;
@@ -84,19 +129,7 @@ rs_status rs_scene_env_build(rs_scene *s, double *power)
     s->env_uniform = 0;
     s->env_uniform_le = rs_v3_splat(0.0f);
     if (s->env_image == RS_NO_TEXTURE) {
-        /* a constant background colour is a uniform sky: light-sampled as one (over the sphere,
-         * MIS-weighted against BSDF rays that escape), as pbrt's and Mitsuba's constant
-         * emitters are; before, only BSDF rays that escaped saw it.  The RTIOW gradient
-         * (background_sky) is not sampled. */
-        const rs_vec3 b = s->background;
-        const float rgb[3] = {b.x, b.y, b.z};
-        if (!s->background_sky && isfinite(b.x) && isfinite(b.y) && isfinite(b.z) && b.x >= 0 &&
-            b.y >= 0 && b.z >= 0 && luminance(rgb) > 0) {
-            double r = rs_scene_bound_radius(s);
-            s->env_uniform = 1;
-            s->env_uniform_le = b;
-            *power = PI * r * r * (double)luminance(rgb) * 4.0 * PI;
-        }
+        constant_background(s, power);
         return RS_OK;
     }
     if (s->env_image >= s->n_images)
@@ -128,27 +161,7 @@ rs_status rs_scene_env_build(rs_scene *s, double *power)
         s->env_marg_cdf = s->env_cond_cdf = NULL;
         return rs_error_set(RS_ERR_NOMEM, "out of memory for a %ux%u environment map", w, h);
     }
-    {
-        /* the scale's luminance weights the distribution as it weights the radiance */
-        const float sc[3] = {s->env_scale.x, s->env_scale.y, s->env_scale.z};
-        for (j = 0; j < h; ++j) {
-            double sin_t = sin(PI * (j + 0.5) / h), acc = 0;
-            float *cdf = &s->env_cond_cdf[(size_t)j * (w + 1)];
-            for (i = 0; i < w; ++i) {
-                const float *t = &im->rgb[3 * ((size_t)j * w + i)];
-                float rgb[3];
-                rgb[0] = t[0] * sc[0], rgb[1] = t[1] * sc[1], rgb[2] = t[2] * sc[2];
-                cdf[i] = (float)acc;
-                acc += (double)luminance(rgb) * sin_t;
-            }
-            row_sum[j] = acc;
-            total += acc;
-            /* a black row is never picked; its CDF is made uniform so that it is well formed */
-            for (i = 0; i <= w; ++i)
-                cdf[i] = acc > 0 ? (i == w ? 1.0f : (float)(cdf[i] / acc)) : (float)i / (float)w;
-            cdf[w] = 1.0f;
-        }
-    }
+    total = conditional_cdfs(s, im, row_sum);
     {
         double acc = 0;
         for (j = 0; j < h; ++j) {

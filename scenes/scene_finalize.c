@@ -316,6 +316,18 @@ static rs_status build_masks(rs_scene *s)
  * lights, each picked in proportion to its power: s->lights, light_cdf, n_area_lights (n_lights
  * is set by the caller from *n_lights); *total, their summed power.  s->prim_light (allocated by
  * the caller) maps a primitive to its light or -1. */
+/* A punctual light's power: 4 pi I for a point, the cone's solid angle (to the middle of the
+ * falloff) times I for a spot, pi R^2 E for a directional light over a scene of radius R. */
+static double punctual_power(const rs_punctual *p, double radius)
+{
+    double lum = luminance(p->intensity);
+    if (p->type == RS_PUNCTUAL_POINT)
+        return 4.0 * 3.14159265358979 * lum;
+    if (p->type == RS_PUNCTUAL_SPOT)
+        return 2.0 * 3.14159265358979 * (1.0 - 0.5 * (p->cos_inner + p->cos_outer)) * lum;
+    return 3.14159265358979 * radius * radius * lum;
+}
+
 static rs_status build_lights(rs_scene *s, uint32_t n, uint32_t *n_lights, double *total)
 {
     uint32_t i, nl = 0;
@@ -348,17 +360,8 @@ static rs_status build_lights(rs_scene *s, uint32_t n, uint32_t *n_lights, doubl
         if (!s->lights || !s->light_cdf)
             return rs_error_set(RS_ERR_NOMEM, "out of memory preparing %u lights", nl);
         for (i = 0; i < s->n_punctuals; ++i) {
-            /* its power: 4 pi I for a point, the cone's solid angle (to the middle of the
-             * falloff) times I for a spot, pi R^2 E for a directional light over the scene */
-            const rs_punctual *p = &s->punctuals[i];
             rs_light *lt = &s->lights[s->n_area_lights + i];
-            double lum = luminance(p->intensity), pw;
-            if (p->type == RS_PUNCTUAL_POINT)
-                pw = 4.0 * 3.14159265358979 * lum;
-            else if (p->type == RS_PUNCTUAL_SPOT)
-                pw = 2.0 * 3.14159265358979 * (1.0 - 0.5 * (p->cos_inner + p->cos_outer)) * lum;
-            else
-                pw = 3.14159265358979 * radius * radius * lum;
+            double pw = punctual_power(&s->punctuals[i], radius);
             lt->prim = RS_LIGHT_PUNCTUAL | i;
             lt->area = 0.0f;
             lt->power = (float)pw;
