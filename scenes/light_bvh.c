@@ -191,6 +191,74 @@ static uint32_t new_node(builder *b)
     return b->n_nodes++;
 }
 
+/* Where recs[begin, end) splits (two or more lights): by a cost split over buckets along the
+ * centres' longest axis (a stable partition, the same order on every machine), else in halves by
+ * order. */
+static uint32_t split_at(builder *b, uint32_t begin, uint32_t end, int depth)
+{
+    uint32_t i, mid = begin + (end - begin) / 2; /* by order, unless the buckets find better */
+    float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    int axis = 0, k;
+    for (i = begin; i < end; ++i)
+        for (k = 0; k < 3; ++k) {
+            clo[k] = fminf(clo[k], b->recs[i].c[k]);
+            chi[k] = fmaxf(chi[k], b->recs[i].c[k]);
+        }
+    for (k = 1; k < 3; ++k)
+        if (chi[k] - clo[k] > chi[axis] - clo[axis])
+            axis = k;
+    /* a cost split may leave all but one light on one side; it is taken only while that
+     * side could still be split in halves within the depth limit (halves: as deep as
+     * ceil(log2 n) more), so no leaf is ever deeper than the limit, whatever the lights */
+    if (depth + 1 + halving_levels(end - begin) <= g_depth_limit && chi[axis] > clo[axis]) {
+        bound bk[BUCKETS];
+        double best = INFINITY, scale = BUCKETS / ((double)chi[axis] - clo[axis]);
+        int split = -1, j;
+        for (j = 0; j < BUCKETS; ++j)
+            bound_empty(&bk[j]);
+        for (i = begin; i < end; ++i) {
+            int q = (int)(((double)b->recs[i].c[axis] - clo[axis]) * scale);
+            bound_add(&bk[q < BUCKETS ? q : BUCKETS - 1], &b->recs[i]);
+        }
+        for (j = 0; j < BUCKETS - 1; ++j) {
+            bound l, r;
+            double c;
+            int t;
+            bound_empty(&l);
+            bound_empty(&r);
+            for (t = 0; t <= j; ++t)
+                bound_merge(&l, &bk[t]);
+            for (t = j + 1; t < BUCKETS; ++t)
+                bound_merge(&r, &bk[t]);
+            if (l.empty || r.empty)
+                continue;
+            c = bound_cost(&l, axis) + bound_cost(&r, axis);
+            if (c < best) {
+                best = c;
+                split = j;
+            }
+        }
+        if (split >= 0) { /* a stable partition: the same order on every machine */
+            uint32_t nl = 0, nr = 0, n = end - begin;
+            for (i = begin; i < end; ++i) {
+                int q = (int)(((double)b->recs[i].c[axis] - clo[axis]) * scale);
+                q = q < BUCKETS ? q : BUCKETS - 1;
+                if (q <= split)
+                    b->tmp[nl++] = b->recs[i];
+            }
+            for (i = begin; i < end; ++i) {
+                int q = (int)(((double)b->recs[i].c[axis] - clo[axis]) * scale);
+                q = q < BUCKETS ? q : BUCKETS - 1;
+                if (q > split)
+                    b->tmp[nl + nr++] = b->recs[i];
+            }
+            memcpy(b->recs + begin, b->tmp, (size_t)n * sizeof *b->recs);
+            mid = begin + nl;
+        }
+    }
+    return mid;
+}
+
 /* Builds the subtree of recs[begin, end) at `depth` whose path is `bits`; its root's index in
  * *out.  0 when out of memory. */
 static int build(builder *b, uint32_t begin, uint32_t end, int depth, uint64_t bits, uint32_t *out)
@@ -219,68 +287,7 @@ static int build(builder *b, uint32_t begin, uint32_t end, int depth, uint64_t b
         b->trail[b->recs[begin].light] = bits | (1ull << depth);
         return 1;
     }
-    mid = begin + (end - begin) / 2; /* by order, unless the buckets find better */
-    {
-        float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        int axis = 0, k;
-        for (i = begin; i < end; ++i)
-            for (k = 0; k < 3; ++k) {
-                clo[k] = fminf(clo[k], b->recs[i].c[k]);
-                chi[k] = fmaxf(chi[k], b->recs[i].c[k]);
-            }
-        for (k = 1; k < 3; ++k)
-            if (chi[k] - clo[k] > chi[axis] - clo[axis])
-                axis = k;
-        /* a cost split may leave all but one light on one side; it is taken only while that
-         * side could still be split in halves within the depth limit (halves: as deep as
-         * ceil(log2 n) more), so no leaf is ever deeper than the limit, whatever the lights */
-        if (depth + 1 + halving_levels(end - begin) <= g_depth_limit && chi[axis] > clo[axis]) {
-            bound bk[BUCKETS];
-            double best = INFINITY, scale = BUCKETS / ((double)chi[axis] - clo[axis]);
-            int split = -1, j;
-            for (j = 0; j < BUCKETS; ++j)
-                bound_empty(&bk[j]);
-            for (i = begin; i < end; ++i) {
-                int q = (int)(((double)b->recs[i].c[axis] - clo[axis]) * scale);
-                bound_add(&bk[q < BUCKETS ? q : BUCKETS - 1], &b->recs[i]);
-            }
-            for (j = 0; j < BUCKETS - 1; ++j) {
-                bound l, r;
-                double c;
-                int t;
-                bound_empty(&l);
-                bound_empty(&r);
-                for (t = 0; t <= j; ++t)
-                    bound_merge(&l, &bk[t]);
-                for (t = j + 1; t < BUCKETS; ++t)
-                    bound_merge(&r, &bk[t]);
-                if (l.empty || r.empty)
-                    continue;
-                c = bound_cost(&l, axis) + bound_cost(&r, axis);
-                if (c < best) {
-                    best = c;
-                    split = j;
-                }
-            }
-            if (split >= 0) { /* a stable partition: the same order on every machine */
-                uint32_t nl = 0, nr = 0, n = end - begin;
-                for (i = begin; i < end; ++i) {
-                    int q = (int)(((double)b->recs[i].c[axis] - clo[axis]) * scale);
-                    q = q < BUCKETS ? q : BUCKETS - 1;
-                    if (q <= split)
-                        b->tmp[nl++] = b->recs[i];
-                }
-                for (i = begin; i < end; ++i) {
-                    int q = (int)(((double)b->recs[i].c[axis] - clo[axis]) * scale);
-                    q = q < BUCKETS ? q : BUCKETS - 1;
-                    if (q > split)
-                        b->tmp[nl + nr++] = b->recs[i];
-                }
-                memcpy(b->recs + begin, b->tmp, (size_t)n * sizeof *b->recs);
-                mid = begin + nl;
-            }
-        }
-    }
+    mid = split_at(b, begin, end, depth);
     {
         uint32_t left;
         if (!build(b, begin, mid, depth + 1, bits, &left) ||
