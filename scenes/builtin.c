@@ -91,6 +91,40 @@ static float rand_range(uint64_t *st, float lo, float hi)
     return lo + (hi - lo) * (float)scene_rand(st);
 }
 
+/* One of the small spheres at c: diffuse (moving up over the shutter with `bouncing`), metal or
+ * glass as `choose` says, its colour from *st. */
+static rs_status add_small_sphere(rs_scene *s, uint64_t *st, rs_vec3 c, float choose,
+                                  int bouncing)
+{
+    rs_material m;
+    uint32_t id;
+    if (choose < 0.8f) {
+        rs_vec3 c1 =
+            rs_v3((float)scene_rand(st), (float)scene_rand(st), (float)scene_rand(st));
+        rs_vec3 c2 =
+            rs_v3((float)scene_rand(st), (float)scene_rand(st), (float)scene_rand(st));
+        m = rs_mat_lambertian(rs_v3_mul(c1, c2));
+        RS_TRY(rs_scene_add_material(s, &m, &id));
+        if (bouncing)
+            RS_TRY(rs_scene_add_moving_sphere(
+                s, c, 0.0f, rs_v3_add(c, rs_v3(0, rand_range(st, 0, 0.5f), 0)), 1.0f, 0.2f,
+                id));
+        else
+            RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+    } else if (choose < 0.95f) {
+        m = rs_mat_metal(rs_v3(rand_range(st, .5f, 1), rand_range(st, .5f, 1),
+                               rand_range(st, .5f, 1)),
+                         rand_range(st, 0, .5f));
+        RS_TRY(rs_scene_add_material(s, &m, &id));
+        RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+    } else {
+        m = rs_mat_dielectric(1.5f);
+        RS_TRY(rs_scene_add_material(s, &m, &id));
+        RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
+    }
+    return RS_OK;
+}
+
 /* The random spheres of "Ray Tracing in One Weekend" (v4, §14) — the thesis's Fig. 6.9 scene.
  * With `bouncing`, RTNW's first scene instead: the diffuse spheres move up by up to 0.5 during
  * the shutter and the ground is a checker.  Same layout rules; our own fixed-seed numbers. */
@@ -123,30 +157,7 @@ static rs_status build_random_spheres(rs_scene *s, int bouncing)
                               (float)b + 0.9f * (float)scene_rand(&st));
             if (rs_v3_length(rs_v3_sub(c, rs_v3(4, 0.2f, 0))) <= 0.9f)
                 continue;
-            if (choose < 0.8f) {
-                rs_vec3 c1 =
-                    rs_v3((float)scene_rand(&st), (float)scene_rand(&st), (float)scene_rand(&st));
-                rs_vec3 c2 =
-                    rs_v3((float)scene_rand(&st), (float)scene_rand(&st), (float)scene_rand(&st));
-                m = rs_mat_lambertian(rs_v3_mul(c1, c2));
-                RS_TRY(rs_scene_add_material(s, &m, &id));
-                if (bouncing)
-                    RS_TRY(rs_scene_add_moving_sphere(
-                        s, c, 0.0f, rs_v3_add(c, rs_v3(0, rand_range(&st, 0, 0.5f), 0)), 1.0f, 0.2f,
-                        id));
-                else
-                    RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
-            } else if (choose < 0.95f) {
-                m = rs_mat_metal(rs_v3(rand_range(&st, .5f, 1), rand_range(&st, .5f, 1),
-                                       rand_range(&st, .5f, 1)),
-                                 rand_range(&st, 0, .5f));
-                RS_TRY(rs_scene_add_material(s, &m, &id));
-                RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
-            } else {
-                m = rs_mat_dielectric(1.5f);
-                RS_TRY(rs_scene_add_material(s, &m, &id));
-                RS_TRY(rs_scene_add_sphere(s, c, 0.2f, id));
-            }
+            RS_TRY(add_small_sphere(s, &st, c, choose, bouncing));
         }
     m = rs_mat_dielectric(1.5f);
     RS_TRY(rs_scene_add_material(s, &m, &id));
@@ -201,6 +212,34 @@ static rs_status add_uv_grid_image(rs_scene *s, uint32_t *id)
     return rs_scene_add_image(s, W, H, rgb, id);
 }
 
+/* The materials scene's textures: the floor's checker, a 3D checker, stripes and a UV grid. */
+static rs_status materials_textures(rs_scene *s, uint32_t *t_floor, uint32_t *t_checker,
+                                    uint32_t *t_stripes, uint32_t *t_image)
+{
+    rs_texture tex;
+    uint32_t image;
+    memset(&tex, 0, sizeof tex);
+    tex.type = RS_TEX_CHECKER;
+    tex.a = rs_v3(.75f, .75f, .75f);
+    tex.b = rs_v3(.25f, .25f, .28f);
+    tex.scale = 1.0f;
+    RS_TRY(rs_scene_add_texture(s, &tex, t_floor));
+    tex.a = rs_v3(.9f, .8f, .1f);
+    tex.b = rs_v3(.1f, .2f, .6f);
+    tex.scale = 0.3f;
+    RS_TRY(rs_scene_add_texture(s, &tex, t_checker));
+    tex.type = RS_TEX_STRIPES;
+    tex.a = rs_v3(.85f, .85f, .85f);
+    tex.b = rs_v3(.7f, .1f, .1f);
+    tex.scale = 12.0f;
+    RS_TRY(rs_scene_add_texture(s, &tex, t_stripes));
+    RS_TRY(add_uv_grid_image(s, &image));
+    tex.type = RS_TEX_IMAGE;
+    tex.image = image;
+    RS_TRY(rs_scene_add_texture(s, &tex, t_image));
+    return RS_OK;
+}
+
 /* Every material and texture side by side, on a checker floor under an area light and a sky:
  *   back row:   Disney diffuse at roughness 0, 0.5, 1; Lambertian; uniform-hemisphere diffuse
  *   middle row: Phong at exponents 10, 100, 1000; fuzzy metal; mirror
@@ -210,28 +249,9 @@ static rs_status build_materials(rs_scene *s)
     static const float phong_n[3] = {10.0f, 100.0f, 1000.0f};
     rs_vec3 warm = rs_v3(.8f, .45f, .25f);
     rs_material m;
-    rs_texture tex;
-    uint32_t id, t_floor, t_checker, t_stripes, t_image, image;
+    uint32_t id, t_floor, t_checker, t_stripes, t_image;
     int i;
-    memset(&tex, 0, sizeof tex);
-    tex.type = RS_TEX_CHECKER;
-    tex.a = rs_v3(.75f, .75f, .75f);
-    tex.b = rs_v3(.25f, .25f, .28f);
-    tex.scale = 1.0f;
-    RS_TRY(rs_scene_add_texture(s, &tex, &t_floor));
-    tex.a = rs_v3(.9f, .8f, .1f);
-    tex.b = rs_v3(.1f, .2f, .6f);
-    tex.scale = 0.3f;
-    RS_TRY(rs_scene_add_texture(s, &tex, &t_checker));
-    tex.type = RS_TEX_STRIPES;
-    tex.a = rs_v3(.85f, .85f, .85f);
-    tex.b = rs_v3(.7f, .1f, .1f);
-    tex.scale = 12.0f;
-    RS_TRY(rs_scene_add_texture(s, &tex, &t_stripes));
-    RS_TRY(add_uv_grid_image(s, &image));
-    tex.type = RS_TEX_IMAGE;
-    tex.image = image;
-    RS_TRY(rs_scene_add_texture(s, &tex, &t_image));
+    RS_TRY(materials_textures(s, &t_floor, &t_checker, &t_stripes, &t_image));
 
     m = rs_mat_lambertian(rs_v3_splat(1.0f));
     m.albedo_tex = t_floor;
