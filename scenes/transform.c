@@ -4,6 +4,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/try.h"
+
 #define DEG (3.14159265358979323846 / 180.0)
 
 rs_xform rs_xform_identity(void)
@@ -232,6 +234,41 @@ static rs_status out_of_range(void)
     return rs_error_set(RS_ERR_ARG, "the transform moves a coordinate beyond 1e30 (absurd scale?)");
 }
 
+/* Triangle i placed by x (cof: its cofactor matrix, for the vertex normals); a mirroring x
+ * swaps v1 and v2 (with their UVs and normals) so that the triangle keeps its side. */
+static rs_status transform_triangle(rs_scene *s, uint32_t i, const rs_xform *x,
+                                    const double cof[3][3], int mirror)
+{
+    rs_tri *t = &s->tris[i];
+    rs_vec3 a = rs_xform_point(x, t->v0), b = rs_xform_point(x, t->v1);
+    rs_vec3 c = rs_xform_point(x, t->v2);
+    if (!in_range(a) || !in_range(b) || !in_range(c))
+        return out_of_range();
+    t->v0 = a;
+    t->v1 = mirror ? c : b;
+    t->v2 = mirror ? b : c;
+    if (s->tri_uv && mirror) {
+        float *uv = &s->tri_uv[6 * (size_t)i], u1 = uv[2], v1 = uv[3];
+        uv[2] = uv[4];
+        uv[3] = uv[5];
+        uv[4] = u1;
+        uv[5] = v1;
+    }
+    if (s->tri_normal) {
+        float *vn = &s->tri_normal[9 * (size_t)i], out[9];
+        int k, j;
+        for (k = 0; k < 3; ++k)
+            normal_by(cof, mirror ? -1.0 : 1.0, &vn[3 * k], &out[3 * k]);
+        /* with v1 and v2 swapped, so are their normals */
+        for (j = 0; j < 3; ++j) {
+            vn[j] = out[j];
+            vn[3 + j] = out[(mirror ? 6 : 3) + j];
+            vn[6 + j] = out[(mirror ? 3 : 6) + j];
+        }
+    }
+    return RS_OK;
+}
+
 rs_status rs_scene_transform_since(rs_scene *s, const rs_scene_mark *from, const rs_xform *x)
 {
     const char *why = rs_xform_invalid(x);
@@ -272,35 +309,8 @@ rs_status rs_scene_transform_since(rs_scene *s, const rs_scene_mark *from, const
             return out_of_range();
         *qd = rs_quad_make(q, u, v);
     }
-    for (i = from->n_tris; i < s->n_tris; ++i) {
-        rs_tri *t = &s->tris[i];
-        rs_vec3 a = rs_xform_point(x, t->v0), b = rs_xform_point(x, t->v1);
-        rs_vec3 c = rs_xform_point(x, t->v2);
-        if (!in_range(a) || !in_range(b) || !in_range(c))
-            return out_of_range();
-        t->v0 = a;
-        t->v1 = mirror ? c : b;
-        t->v2 = mirror ? b : c;
-        if (s->tri_uv && mirror) {
-            float *uv = &s->tri_uv[6 * (size_t)i], u1 = uv[2], v1 = uv[3];
-            uv[2] = uv[4];
-            uv[3] = uv[5];
-            uv[4] = u1;
-            uv[5] = v1;
-        }
-        if (s->tri_normal) {
-            float *vn = &s->tri_normal[9 * (size_t)i], out[9];
-            int k, j;
-            for (k = 0; k < 3; ++k)
-                normal_by(cof, mirror ? -1.0 : 1.0, &vn[3 * k], &out[3 * k]);
-            /* with v1 and v2 swapped, so are their normals */
-            for (j = 0; j < 3; ++j) {
-                vn[j] = out[j];
-                vn[3 + j] = out[(mirror ? 6 : 3) + j];
-                vn[6 + j] = out[(mirror ? 3 : 6) + j];
-            }
-        }
-    }
+    for (i = from->n_tris; i < s->n_tris; ++i)
+        RS_TRY(transform_triangle(s, i, x, (const double(*)[3])cof, mirror));
     for (i = from->n_punctuals; i < s->n_punctuals; ++i) {
         rs_punctual *p = &s->punctuals[i];
         p->pos = rs_xform_point(x, p->pos);
