@@ -235,6 +235,30 @@ static rs_status ply_walk_chunk(ply_walk *w, const char *path, const char *buf, 
     return RS_OK;
 }
 
+/* The walk over the ascii data's lists, started with the elements and properties a strict
+ * parse of the header keeps (a header only the loose parse takes is left to Assimp as before:
+ * no elements to walk).  Returns the elements, for the caller to free. */
+static rs_ply_elem *walk_start(ply_walk *w, const char *path, const char *buf, size_t n,
+                               uint64_t size, size_t data_at)
+{
+    rs_ply_header strict;
+    rs_ply_elem *elems = (rs_ply_elem *)rs_alloc(RS_PLY_WALK_ELEMS, sizeof *elems);
+    memset(w, 0, sizeof *w);
+    memset(&strict, 0, sizeof strict);
+    strict.elems = elems;
+    strict.max_elems = elems ? RS_PLY_WALK_ELEMS : 0;
+    if (elems && rs_ply_parse_header(path, buf, n, size, 1, &strict) == RS_OK) {
+        w->elems = elems;
+        w->n_elems = strict.n_elems;
+        w->list_left = -1;
+        w->line = 1;
+        w->max_items = (size - data_at) / 2u + 1u;
+        ply_walk_settle(w);
+    }
+    rs_error_clear();
+    return elems;
+}
+
 /* Checks a file that says it is PLY (*is_ply set: 1, or 2 for one of triangle strips, which
  * Assimp does not read: a stripped model came out as one triangle; scenes/ply_strips.h does);
  * any other file passes. */
@@ -245,7 +269,7 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
     char *buf;
     size_t n, i;
     int last_nl;
-    rs_ply_header h, strict;
+    rs_ply_header h;
     rs_ply_elem *elems;
     ply_walk w;
     rs_status st = rs_file_open(path, RS_FILE_MAX_MESH_BYTES, &f, &size);
@@ -275,22 +299,7 @@ static rs_status check_ply_header(const char *path, int *is_ply_out)
         rs_free(buf);
         return st;
     }
-    /* the elements and properties, to walk the lists (a header only the loose parse takes is
-     * left to Assimp as before) */
-    memset(&w, 0, sizeof w);
-    elems = (rs_ply_elem *)rs_alloc(RS_PLY_WALK_ELEMS, sizeof *elems);
-    memset(&strict, 0, sizeof strict);
-    strict.elems = elems;
-    strict.max_elems = elems ? RS_PLY_WALK_ELEMS : 0;
-    if (elems && rs_ply_parse_header(path, buf, n, size, 1, &strict) == RS_OK) {
-        w.elems = elems;
-        w.n_elems = strict.n_elems;
-        w.list_left = -1;
-        w.line = 1;
-        w.max_items = (size - h.data_at) / 2u + 1u;
-        ply_walk_settle(&w);
-    }
-    rs_error_clear();
+    elems = walk_start(&w, path, buf, n, size, h.data_at);
     /* the ascii data's lines: every newline, and a last line without one */
     for (i = h.data_at; i < n; ++i)
         lines += buf[i] == '\n';
