@@ -137,7 +137,7 @@ static rs_status gltf_node(gltf_ctx *g, const struct aiNode *nd, const rs_xform 
  * frames the model's bounding sphere from the front, a little above. */
 static void gltf_camera(gltf_ctx *g)
 {
-    rs_camera_desc *d = &g->s->camera;
+    rs_camera_desc cd = g->s->camera, *d = &cd;
     if (g->camera) {
         const struct aiCamera *c = g->camera;
         float aspect = c->mAspect > 0 ? c->mAspect : 1.0f;
@@ -150,8 +150,7 @@ static void gltf_camera(gltf_ctx *g)
         d->vfov_deg = fminf(fmaxf(yfov, 1.0f), 170.0f);
         if (c->mAspect > 0) {
             float w = roundf(512.0f * c->mAspect);
-            g->s->height = 512;
-            g->s->width = (uint32_t)fminf(fmaxf(w, 1.0f), 32768.0f);
+            rs_scene_set_image_size(g->s, (uint32_t)fminf(fmaxf(w, 1.0f), 32768.0f), 512);
         }
     } else {
         rs_aabb b = g->info.bounds;
@@ -165,6 +164,7 @@ static void gltf_camera(gltf_ctx *g)
     }
     d->aperture = 0;
     d->focus_dist = 0;
+    rs_scene_set_camera(g->s, d);
 }
 
 /* The materials the file's meshes use (in the file's order), or a default; *emissive counts
@@ -249,7 +249,7 @@ static rs_status gltf_finish(gltf_ctx *g, uint32_t emissive)
     }
     gltf_camera(g);
     if (g->lights == 0 && emissive == 0)
-        g->s->background = rs_v3_splat(1.0f); /* nothing lights it: a white sky does */
+        rs_scene_set_background(g->s, rs_v3_splat(1.0f)); /* nothing lights it: a white sky */
     st = rs_scene_finalize(g->s);
     if (st != RS_OK) {
         char msg[400];

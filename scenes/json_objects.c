@@ -395,10 +395,7 @@ static rs_status add_sphere(ctx *c, const cJSON *o, const char *path)
          * stored motion exactly) */
         rs_vec3 vel;
         RS_TRY(rs_json_get_vec3(c, o, path, "velocity", 1, center, &vel));
-        RS_TRY(
-            rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, vel), 1.0f, r, mat));
-        s->sphere_motion[s->n_spheres - 1] = vel;
-        return RS_OK;
+        return rs_scene_add_sphere_velocity(s, center, vel, r, mat);
     }
     return rs_scene_add_sphere(s, center, r, mat);
 }

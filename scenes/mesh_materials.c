@@ -348,13 +348,7 @@ static rs_status pbr_base_texture(rs_scene *s, const struct aiScene *as,
         return RS_ERR_ARG;
     if (t != RS_NO_TEXTURE) {
         /* glTF multiplies the texture by the factor: bake the factor into the texels */
-        rs_image *im = &s->images[s->textures[t].image];
-        size_t i, n = (size_t)im->width * im->height;
-        for (i = 0; i < n; ++i) {
-            im->rgb[3 * i] *= m->albedo.x;
-            im->rgb[3 * i + 1] *= m->albedo.y;
-            im->rgb[3 * i + 2] *= m->albedo.z;
-        }
+        RS_TRY(rs_scene_scale_image(s, s->textures[t].image, m->albedo));
         m->albedo_tex = t;
         m->albedo = rs_v3_splat(1.0f);
     }

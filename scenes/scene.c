@@ -194,6 +194,53 @@ rs_status rs_scene_add_moving_sphere(rs_scene *s, rs_vec3 c0, float t0, rs_vec3 
     return st;
 }
 
+rs_status rs_scene_add_sphere_velocity(rs_scene *s, rs_vec3 center, rs_vec3 velocity,
+                                       float radius, uint32_t mat)
+{
+    rs_status st = rs_scene_add_moving_sphere(s, center, 0.0f, rs_v3_add(center, velocity), 1.0f,
+                                              radius, mat);
+    if (st == RS_OK)
+        s->sphere_motion[s->n_spheres - 1] = velocity; /* exactly, not as c1 - c0 rounds it */
+    return st;
+}
+
+void rs_scene_set_camera(rs_scene *s, const rs_camera_desc *camera) { s->camera = *camera; }
+
+void rs_scene_set_image_size(rs_scene *s, uint32_t width, uint32_t height)
+{
+    s->width = width;
+    s->height = height;
+}
+
+void rs_scene_set_background(rs_scene *s, rs_vec3 color)
+{
+    s->background = color;
+    s->background_sky = 0;
+}
+
+void rs_scene_set_background_gradient(rs_scene *s, rs_vec3 horizon, rs_vec3 zenith)
+{
+    s->background = horizon;
+    s->background_top = zenith;
+    s->background_sky = 1;
+}
+
+rs_status rs_scene_scale_image(rs_scene *s, uint32_t image, rs_vec3 factor)
+{
+    rs_image *im;
+    size_t i, n;
+    if (image >= s->n_images)
+        return rs_error_set(RS_ERR_ARG, "no image %u to scale", image);
+    im = &s->images[image];
+    n = (size_t)im->width * im->height;
+    for (i = 0; i < n; ++i) {
+        im->rgb[3 * i] *= factor.x;
+        im->rgb[3 * i + 1] *= factor.y;
+        im->rgb[3 * i + 2] *= factor.z;
+    }
+    return RS_OK;
+}
+
 rs_status rs_scene_add_quad(rs_scene *s, rs_vec3 q, rs_vec3 u, rs_vec3 v, uint32_t mat)
 {
     rs_status st = check_mat(s, mat);

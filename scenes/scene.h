@@ -490,6 +490,10 @@ rs_status rs_scene_add_sphere(rs_scene *s, rs_vec3 center, float radius, uint32_
 /* A sphere at c0 at time t0 and at c1 at time t1, moving linearly (RTNW's moving sphere). */
 rs_status rs_scene_add_moving_sphere(rs_scene *s, rs_vec3 c0, float t0, rs_vec3 c1, float t1,
                                      float radius, uint32_t mat);
+/* A sphere whose centre at time t is center + t velocity, the velocity stored exactly (what
+ * `raystream export` writes and a scene file's "velocity" reads back). */
+rs_status rs_scene_add_sphere_velocity(rs_scene *s, rs_vec3 center, rs_vec3 velocity,
+                                       float radius, uint32_t mat);
 /* Parallelogram Q + a u + b v, a, b in [0, 1]; its normal is u x v. */
 rs_status rs_scene_add_quad(rs_scene *s, rs_vec3 q, rs_vec3 u, rs_vec3 v, uint32_t mat);
 rs_status rs_scene_add_triangle(rs_scene *s, rs_vec3 v0, rs_vec3 v1, rs_vec3 v2, uint32_t mat);
@@ -520,6 +524,18 @@ rs_status rs_scene_load_image_data(rs_scene *s, const char *path, uint32_t *id);
  * (through the origin) and then moved by `offset` (RTNW's box + rotate_y + translate). */
 rs_status rs_scene_add_box(rs_scene *s, rs_vec3 lo, rs_vec3 hi, float rot_y_deg, rs_vec3 offset,
                            uint32_t mat);
+
+/* The scene's camera (copied), its preferred image size, and its background: a constant colour
+ * (a uniform sky, light-sampled, where it is not black) or RTIOW's gradient from `horizon` to
+ * `zenith` by the direction's height.  What a loader knows of the scene besides its parts; the
+ * loaders set nothing in the struct themselves (scenes/json_*.c, gltf_scene.c, mesh*.c). */
+void rs_scene_set_camera(rs_scene *s, const rs_camera_desc *camera);
+void rs_scene_set_image_size(rs_scene *s, uint32_t width, uint32_t height);
+void rs_scene_set_background(rs_scene *s, rs_vec3 color);
+void rs_scene_set_background_gradient(rs_scene *s, rs_vec3 horizon, rs_vec3 zenith);
+/* Multiplies image `image`'s texels by `factor` (glTF's base colour factor baked into its
+ * texture).  RS_ERR_ARG for an image that is not there. */
+rs_status rs_scene_scale_image(rs_scene *s, uint32_t image, rs_vec3 factor);
 
 /* Lights the scene with image `image` (rs_scene_load_image) as an environment map, its texels
  * times `scale`, turned by `rot_world_to_map` (a rotation, row-major; NULL: none).  The map's

@@ -24,7 +24,7 @@ static rs_status read_camera(ctx *c, const cJSON *cam)
 {
     static const char *const keys[] = {"from",           "at",      "up", "vfov", "aperture",
                                        "focus_distance", "shutter", NULL};
-    rs_camera_desc *d = &c->scene->camera;
+    rs_camera_desc cd = c->scene->camera, *d = &cd;
     const cJSON *sh;
     if (!cJSON_IsObject(cam))
         return FAIL(c, "camera", "expected an object");
@@ -52,6 +52,7 @@ static rs_status read_camera(ctx *c, const cJSON *cam)
         if (!(d->shutter_close >= d->shutter_open))
             return FAIL(c, "camera.shutter", "close must not be before open");
     }
+    rs_scene_set_camera(c->scene, d);
     return RS_OK;
 }
 
@@ -66,8 +67,7 @@ static rs_status read_image_size(ctx *c, const cJSON *img)
     RS_TRY(rs_json_get_num(c, img, "image", "height", 0, 512, 1, 32768, &h));
     if (w != floorf(w) || h != floorf(h))
         return FAIL(c, "image", "width and height must be whole numbers");
-    c->scene->width = (uint32_t)w;
-    c->scene->height = (uint32_t)h;
+    rs_scene_set_image_size(c->scene, (uint32_t)w, (uint32_t)h);
     return RS_OK;
 }
 
@@ -155,23 +155,24 @@ static rs_status read_sky(ctx *c, const cJSON *bg)
 static rs_status read_background(ctx *c, const cJSON *bg)
 {
     static const char *const keys[] = {"horizon", "zenith", NULL};
-    rs_scene *s = c->scene;
+    rs_vec3 horizon, zenith;
     if (cJSON_IsObject(bg) && cJSON_GetObjectItemCaseSensitive(bg, "map"))
         return read_envmap(c, bg);
     if (cJSON_IsObject(bg) && cJSON_GetObjectItemCaseSensitive(bg, "sky"))
         return read_sky(c, bg);
     if (cJSON_IsArray(bg)) {
-        RS_TRY(rs_json_vec3_of(c, bg, "background", &s->background));
-        if (s->background.x < 0 || s->background.y < 0 || s->background.z < 0)
+        RS_TRY(rs_json_vec3_of(c, bg, "background", &horizon));
+        if (horizon.x < 0 || horizon.y < 0 || horizon.z < 0)
             return FAIL(c, "background", "colour components must be >= 0");
+        rs_scene_set_background(c->scene, horizon);
         return RS_OK;
     }
     if (!cJSON_IsObject(bg))
         return FAIL(c, "background", "expected [r, g, b] or {\"horizon\": .., \"zenith\": ..}");
     RS_TRY(rs_json_check_keys(c, bg, "background", keys));
-    RS_TRY(rs_json_get_color(c, bg, "background", "horizon", 1, rs_v3(0, 0, 0), &s->background));
-    RS_TRY(rs_json_get_color(c, bg, "background", "zenith", 1, rs_v3(0, 0, 0), &s->background_top));
-    s->background_sky = 1;
+    RS_TRY(rs_json_get_color(c, bg, "background", "horizon", 1, rs_v3(0, 0, 0), &horizon));
+    RS_TRY(rs_json_get_color(c, bg, "background", "zenith", 1, rs_v3(0, 0, 0), &zenith));
+    rs_scene_set_background_gradient(c->scene, horizon, zenith);
     return RS_OK;
 }
 /* Reads a name -> definition map (textures, materials) in file order. */
