@@ -1,6 +1,7 @@
 /* scenes/json_internal.h — what the JSON scene reader's files share (internal to scenes/, built
  * only with cJSON; scenes/scene_json_none.c stands in without it), along pbrt-v4's parser ->
- * scene line: the reader only calls rs_scene_add_* and never reaches into the scene.
+ * scene line: the reader only calls rs_scene_add_* and rs_scene_set_* and never writes into the
+ * scene struct itself.
  *
  *   json_values.c     fields: typed values with ranges, unknown keys with a suggestion, the
  *                     JSON paths messages name (objects[3].radius)
