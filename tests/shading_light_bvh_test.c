@@ -424,6 +424,46 @@ static void test_depth_bounded(void **state)
     rs_light_bvh_set_depth_limit(62);
 }
 
+/* The issue's case: a million equal lights on a line 0.01 apart (the cost splits peel them off
+ * one end at a time, depth 61 of the trail's 63 bits at 4 million before the bound): every light
+ * in the tree within the default depth limit, its trail a path the picker follows (a pick's
+ * probability is its pmf), and the pick probabilities at a point on the line summing to 1. */
+static void test_million_collinear(void **state)
+{
+    enum { N = 1000000 };
+    rs_scene *s = NULL;
+    rs_material m = rs_mat_light(rs_v3_splat(1.0f), 1);
+    uint32_t id, i, deepest;
+    double sum = 0.0;
+    rs_vec3 x = rs_v3(2500.0f, 1.0f, 0.0f);
+    int j;
+    (void)state;
+    assert_int_equal(rs_scene_create("collinear", &s), RS_OK);
+    assert_int_equal(rs_scene_add_material(s, &m, &id), RS_OK);
+    for (i = 0; i < N; ++i)
+        assert_int_equal(rs_scene_add_quad(s, rs_v3(0.01f * (float)i, 0, 0), rs_v3(0.001f, 0, 0),
+                                           rs_v3(0, 0, 0.001f), id),
+                         RS_OK);
+    if (rs_scene_finalize(s) != RS_OK)
+        fail_msg("finalize: %s", rs_error_message());
+    assert_non_null(s->light_trail);
+    deepest = deepest_light(s);
+    print_message("%u collinear lights: the deepest at depth %u (limit 62)\n", s->n_lights,
+                  deepest);
+    assert_true(deepest <= 62 && deepest >= 20); /* ceil(log2 10^6) = 20 */
+    for (i = 0; i < s->n_lights; ++i)
+        sum += rs_light_bvh_pmf(s, x, i);
+    if (!(fabs(sum - 1.0) < 1e-3))
+        fail_msg("the pick probabilities sum to %.6f", sum);
+    for (j = 0; j < 200; ++j) {
+        uint32_t got = 0;
+        float pm;
+        if (rs_light_bvh_pick(s, x, rnd(), &got, &pm))
+            assert_true(pm == rs_light_bvh_pmf(s, x, got));
+    }
+    rs_scene_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -433,6 +473,7 @@ int main(void)
         cmocka_unit_test(test_cone_union),
         cmocka_unit_test(test_depth_bounded),
         cmocka_unit_test(test_inverse_square),
+        cmocka_unit_test(test_million_collinear),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
