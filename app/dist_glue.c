@@ -215,31 +215,6 @@ static void on_dist_saved(void *user, const rs_film *film, const uint32_t (*done
     rs_path_ranges_free(&held);
 }
 
-/* Rank 0: the samples the film lacks (all of them, or the gaps of a --resume) as passes
- * {first sample, samples} into *todo (rs_free it).  RS_EXIT_OK, or an exit code after a
- * message. */
-static int dist_todo(render_run *r, uint32_t (**todo)[2], uint32_t *n_todo)
-{
-    uint64_t npix = (uint64_t)r->st.width * r->st.height;
-    rs_path_ranges lack;
-    uint32_t i;
-    memset(&lack, 0, sizeof lack);
-    *todo = rs_calloc((size_t)r->held.n + 1, sizeof **todo);
-    if (!*todo || !rs_path_ranges_complement(&r->held, npix * r->st.spp, &lack)) {
-        rs_free(*todo);
-        *todo = NULL;
-        rs_path_ranges_free(&lack);
-        return rs_app_fail(RS_EXIT_RUNTIME, "out of memory");
-    }
-    /* every range starts and ends on whole samples (checked at --resume) */
-    for (i = 0; i < lack.n; ++i) {
-        (*todo)[*n_todo][0] = (uint32_t)(lack.r[i][0] / npix);
-        (*todo)[(*n_todo)++][1] = (uint32_t)((lack.r[i][1] - lack.r[i][0]) / npix);
-    }
-    rs_path_ranges_free(&lack);
-    return RS_EXIT_OK;
-}
-
 /* Rank 0, after the job: its result as one render's statistics, the film's ranges for the
  * final checkpoint.  Returns an exit code. */
 static int dist_gathered(render_run *r, rs_status st)
@@ -339,7 +314,6 @@ static rs_status dist_round(void *user, const rs_work_plan *plan, const rs_rende
     render_run *r = dr->r;
     uint64_t np = plan->pixels ? plan->n_pixels : (uint64_t)r->st.width * r->st.height;
     uint64_t lo = plan->todo.n ? plan->todo.r[0][0] : 0, hi = plan->todo.n ? plan->todo.r[0][1] : 0;
-    uint32_t todo[1][2];
     rs_dist_job job = dr->job;
     rs_dist_result res;
     rs_status st;
@@ -348,10 +322,7 @@ static rs_status dist_round(void *user, const rs_work_plan *plan, const rs_rende
                                         "samples of its round only (resume it on one process)");
     if (lo == hi)
         return RS_OK;
-    todo[0][0] = (uint32_t)(lo / np);
-    todo[0][1] = (uint32_t)((hi - lo) / np);
-    job.todo = (const uint32_t(*)[2])todo;
-    job.n_todo = 1;
+    job.todo = &plan->todo;
     job.pixels = plan->pixels;
     job.n_pixels = plan->n_pixels;
     if (job.time_limit_s > 0) { /* what is left of it */
@@ -370,7 +341,7 @@ static rs_status dist_round(void *user, const rs_work_plan *plan, const rs_rende
         st = rs_error_set(RS_ERR_NOMEM, "out of memory");
     if (st == RS_OK && res.stopped) {
         /* resumable only if what the round finished is its first samples */
-        dr->uneven = !(res.n_done == 0 || (res.n_done == 1 && res.done[0][0] == todo[0][0]));
+        dr->uneven = !(res.n_done == 0 || (res.n_done == 1 && res.done[0][0] == lo / np));
         st = rs_error_set(RS_ERR_CANCELLED, "stopped");
     } else if (st == RS_OK && res.complete && hooks && hooks->film_ready) {
         rs_path_ranges done;
@@ -457,19 +428,24 @@ static int dist_run(const rs_cli_options *o, render_run *r)
 {
     rs_dist_job job;
     rs_status st;
-    uint32_t(*todo)[2] = NULL, n_todo = 0;
-    int code;
+    rs_path_ranges todo;
     rs_signals_install();
+    memset(&todo, 0, sizeof todo);
     dist_job_init(o, r, &job);
     if (o->adaptive > 0 && r->rank > 0)
         return dist_rounds_work(r, &job) == RS_OK ? RS_EXIT_OK
                                                   : rs_app_fail(RS_EXIT_RUNTIME, NULL);
     if (o->adaptive > 0)
         return dist_run_adaptive(o, r, &job);
-    if (r->rank == 0 && (code = dist_todo(r, &todo, &n_todo)) != RS_EXIT_OK)
-        return code;
-    job.todo = (const uint32_t(*)[2])todo;
-    job.n_todo = n_todo;
+    /* rank 0: the paths the film lacks (all of them, or the gaps of a --resume, which start and
+     * end on whole samples: checked at --resume) */
+    if (r->rank == 0 &&
+        !rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,
+                                   &todo)) {
+        rs_path_ranges_free(&todo);
+        return rs_app_fail(RS_EXIT_RUNTIME, "out of memory");
+    }
+    job.todo = &todo;
     if (r->ckpt_out) {
         job.flush_every_s = o->ckpt_every_s;
         job.saved = on_dist_saved;
@@ -479,7 +455,7 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     if (r->rank == 0)
         rs_progress_begin(&r->progress, !o->quiet);
     st = rs_dist_render(r->dist, &job, r->film, &r->dres);
-    rs_free(todo);
+    rs_path_ranges_free(&todo);
     if (r->rank == 0)
         rs_progress_end(&r->progress);
     if (r->rank > 0)

@@ -196,7 +196,7 @@ typedef struct passes {
 
 /* Samples per pass when the job leaves it to us (job->pass_spp 0). */
 uint32_t passes_auto_spp(const rs_dist_job *job, uint32_t npix, int ranks);
-/* The passes: each range of job->todo cut into pieces of t->pass_spp samples (state and owner
+/* The passes: each range of job->todo (whole samples) cut into pieces of t->pass_spp samples (state and owner
  * allocated, owners -1).  0 when out of memory. */
 int passes_make(passes *t, const rs_dist_job *job);
 void passes_free(passes *t);

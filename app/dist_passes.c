@@ -1,4 +1,5 @@
-/* app/dist_passes.c — rank 0's table of passes: job->todo cut into passes of pass_spp samples of
+/* app/dist_passes.c — rank 0's table of passes: job->todo (path ranges over the job's pixels, whole
+ * samples) cut into passes of pass_spp samples of
  * every pixel, each free, handed out to a rank, done there (not yet on the frame) or merged
  * into the frame.  Handed out lowest first; a rank lost frees its passes for the others. */
 #include <string.h>
@@ -11,10 +12,8 @@ uint32_t passes_auto_spp(const rs_dist_job *job, uint32_t npix, int ranks)
     /* about 8 passes a rank, so that a slow one costs little at the end, and at most about
      * 2^21 paths (1-2 s on one core), so that a stop, which drops the passes under way, loses
      * little */
-    uint32_t left = 0, i, most = (1u << 21) / npix, spp;
-    for (i = 0; i < job->n_todo; ++i)
-        left += job->todo[i][1];
-    spp = left / (8u * (uint32_t)ranks);
+    uint32_t left = (uint32_t)(rs_path_ranges_total(job->todo) / npix), most = (1u << 21) / npix;
+    uint32_t spp = left / (8u * (uint32_t)ranks);
     if (spp > most)
         spp = most;
     if (spp < 1)
@@ -22,22 +21,30 @@ uint32_t passes_auto_spp(const rs_dist_job *job, uint32_t npix, int ranks)
     return spp;
 }
 
+/* Range k of job->todo as samples: [*s0, *end) of every pixel of the job. */
+static void todo_samples(const passes *t, const rs_dist_job *job, uint32_t k, uint32_t *s0,
+                         uint32_t *end)
+{
+    *s0 = (uint32_t)(job->todo->r[k][0] / t->npix);
+    *end = (uint32_t)(job->todo->r[k][1] / t->npix);
+}
+
 int passes_make(passes *t, const rs_dist_job *job)
 {
-    uint32_t i, n = 0, total = 0;
-    for (i = 0; i < job->n_todo; ++i) {
-        n += (job->todo[i][1] + t->pass_spp - 1) / t->pass_spp;
-        total += job->todo[i][1];
+    uint32_t i, n = 0, s0, end;
+    for (i = 0; i < job->todo->n; ++i) {
+        todo_samples(t, job, i, &s0, &end);
+        n += (end - s0 + t->pass_spp - 1) / t->pass_spp;
     }
     t->n_passes = n;
     t->limit = n;
-    t->todo_paths = (uint64_t)total * t->npix;
+    t->todo_paths = rs_path_ranges_total(job->todo);
     t->ps0 = (uint32_t *)rs_calloc(n ? n : 1, sizeof *t->ps0);
     t->pn = (uint32_t *)rs_calloc(n ? n : 1, sizeof *t->pn);
     if (!t->ps0 || !t->pn)
         return 0;
-    for (i = 0, n = 0; i < job->n_todo; ++i) {
-        uint32_t s0 = job->todo[i][0], end = s0 + job->todo[i][1];
+    for (i = 0, n = 0; i < job->todo->n; ++i) {
+        todo_samples(t, job, i, &s0, &end);
         for (; s0 < end; s0 += t->pass_spp, ++n) {
             t->ps0[n] = s0;
             t->pn[n] = end - s0 < t->pass_spp ? end - s0 : t->pass_spp;

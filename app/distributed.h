@@ -94,10 +94,10 @@ typedef struct rs_dist_job {
                                    others with rs_dist_job_begin); NULL: every pixel */
     uint32_t n_pixels;
     int variance;               /* every rank: films keep squared-luminance sums (--adaptive) */
-    const uint32_t (*todo)[2];  /* rank 0: the samples to render, ranges [s0, s0 + n) of the
-                                   job's pixels (sorted, disjoint; what the film does not
-                                   hold) */
-    uint32_t n_todo;
+    const rs_path_ranges *todo; /* rank 0: the paths to render, in scheduler/plan.h's numbering
+                                   over the job's pixels (path i: sample i div n of pixel
+                                   i mod n), each range whole samples (what the film does not
+                                   hold; the passes are cut from it, dist_passes.c) */
     uint32_t pass_spp;          /* samples per pass; 0: auto (about 8 passes per rank, at
                                    most about 2^22 paths a pass) */
     double flush_every_s;       /* rank 0: > 0, every rank sends what it finished this often
@@ -147,7 +147,7 @@ typedef struct rs_dist_result {
 } rs_dist_result;
 
 /* Collective: renders `job` over every rank into `film` (rank 0: the frame, which may already
- * hold the samples outside job->todo; other ranks: scratch of the frame's size).  Rank 0 fills
+ * hold the paths outside job->todo; other ranks: scratch of the frame's size).  Rank 0 fills
  * *res.  RS_OK also when stopped early (res says so); an error when rank 0's own render failed
  * or every rank was lost. */
 rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_dist_result *res);
