@@ -63,7 +63,9 @@ static void mark_dead(coord *c, int r, const char *why)
 static void call_saved(coord *c)
 {
     local *l = &c->l;
-    uint32_t(*done)[2] = NULL, n_done, samples, i;
+    rs_path_ranges done;
+    uint32_t samples, i;
+    int ok;
     pthread_mutex_lock(&l->mu);
     for (i = 0; i < (uint32_t)l->done_len; ++i) {
         uint32_t q = passes_of(&c->pt, l->done_s0[i]);
@@ -71,13 +73,13 @@ static void call_saved(coord *c)
             c->pt.state[q] = P_MERGED;
     }
     l->done_len = 0;
-    n_done = passes_merged_ranges(&c->pt, &done, &samples);
+    ok = passes_merged_ranges(&c->pt, &done, &samples);
     pthread_mutex_lock(&c->film_mu);
-    if (done)
-        c->job->saved(c->job->user, c->film, (const uint32_t(*)[2])done, n_done);
+    if (ok)
+        c->job->saved(c->job->user, c->film, &done);
     pthread_mutex_unlock(&c->film_mu);
     pthread_mutex_unlock(&l->mu);
-    rs_free(done);
+    rs_path_ranges_free(&done);
 }
 
 /* ---- set-up and the end ------------------------------------------------------------------- */
@@ -165,7 +167,8 @@ static void finish(coord *c)
         res->rays_shadow += res->rank[r].rays_shadow;
     }
     /* which samples the frame holds */
-    res->n_done = passes_merged_ranges(&c->pt, &res->done, &res->samples_done);
+    if (!passes_merged_ranges(&c->pt, &res->done, &res->samples_done))
+        fprintf(stderr, "raystream: out of memory listing the passes done\n");
     res->complete = passes_count(&c->pt, P_MERGED, c->pt.n_passes) == c->pt.n_passes;
 }
 

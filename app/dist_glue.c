@@ -190,27 +190,19 @@ static void on_dist_progress(void *user, uint64_t done, uint64_t total)
     rs_progress_update(&((render_run *)user)->progress, done, total);
 }
 
-/* The film held r->held, plus the job's finished passes `done` (whole samples). */
-static int dist_held(render_run *r, const uint32_t (*done)[2], uint32_t n_done, rs_path_ranges *out)
+/* The film held r->held, plus the job's finished passes `done`. */
+static int dist_held(render_run *r, const rs_path_ranges *done, rs_path_ranges *out)
 {
-    uint64_t npix = (uint64_t)r->st.width * r->st.height;
-    uint32_t i;
     memset(out, 0, sizeof *out);
-    if (!rs_path_ranges_union(out, &r->held))
-        return 0;
-    for (i = 0; i < n_done; ++i)
-        if (!rs_path_ranges_add(out, npix * done[i][0], npix * (done[i][0] + done[i][1])))
-            return 0;
-    return 1;
+    return rs_path_ranges_union(out, &r->held) && rs_path_ranges_union(out, done);
 }
 
 /* rank 0, after each periodic flush of an MPI job: the --checkpoint */
-static void on_dist_saved(void *user, const rs_film *film, const uint32_t (*done)[2],
-                          uint32_t n_done)
+static void on_dist_saved(void *user, const rs_film *film, const rs_path_ranges *done)
 {
     render_run *r = (render_run *)user;
     rs_path_ranges held;
-    if (dist_held(r, done, n_done, &held))
+    if (dist_held(r, done, &held))
         (void)rs_checkpoint_write(r->ckpt_out->path, r->ckpt_out->staged, 1, &r->key, film, &held);
     rs_path_ranges_free(&held);
 }
@@ -232,7 +224,7 @@ static int dist_gathered(render_run *r, rs_status st)
     if (st != RS_OK)
         return rs_app_fail(RS_EXIT_RUNTIME, "render failed");
     /* what the film holds now, for the final checkpoint (app/checkpoint.h: any ranges) */
-    if (!dist_held(r, (const uint32_t(*)[2])r->dres.done, r->dres.n_done, &now)) {
+    if (!dist_held(r, &r->dres.done, &now)) {
         rs_path_ranges_free(&now);
         return rs_app_fail(RS_EXIT_RUNTIME, "out of memory");
     }
@@ -341,7 +333,7 @@ static rs_status dist_round(void *user, const rs_work_plan *plan, const rs_rende
         st = rs_error_set(RS_ERR_NOMEM, "out of memory");
     if (st == RS_OK && res.stopped) {
         /* resumable only if what the round finished is its first samples */
-        dr->uneven = !(res.n_done == 0 || (res.n_done == 1 && res.done[0][0] == lo / np));
+        dr->uneven = !(res.done.n == 0 || (res.done.n == 1 && res.done.r[0][0] == lo));
         st = rs_error_set(RS_ERR_CANCELLED, "stopped");
     } else if (st == RS_OK && res.complete && hooks && hooks->film_ready) {
         rs_path_ranges done;

@@ -210,8 +210,10 @@ void passes_assign(passes *t, uint32_t p, int r);
 void passes_release(passes *t, int r);
 /* paths of the passes done or merged */
 uint64_t passes_paths_done(const passes *t);
-/* The merged passes as sorted ranges of samples, into *out (rs_alloc'd); their count. */
-uint32_t passes_merged_ranges(const passes *t, uint32_t (**out)[2], uint32_t *samples);
+/* The merged passes as path ranges (as job->todo numbers them) into *out (emptied first; free
+ * with rs_path_ranges_free), their samples of every pixel into *samples.  0 when out of
+ * memory. */
+int passes_merged_ranges(const passes *t, rs_path_ranges *out, uint32_t *samples);
 /* The time limit: no pass above the last one begun (at least the first) is handed out.  1 when
  * that lowered the limit. */
 int passes_limit_to_begun(passes *t);

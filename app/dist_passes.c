@@ -124,26 +124,20 @@ uint64_t passes_paths_done(const passes *t)
     return done;
 }
 
-uint32_t passes_merged_ranges(const passes *t, uint32_t (**out)[2], uint32_t *samples)
+int passes_merged_ranges(const passes *t, rs_path_ranges *out, uint32_t *samples)
 {
-    uint32_t p, k = 0;
-    uint32_t(*r)[2] = (uint32_t(*)[2])rs_calloc(t->n_passes ? t->n_passes : 1, sizeof *r);
+    uint32_t p;
+    memset(out, 0, sizeof *out);
     *samples = 0;
-    *out = r;
-    if (!r)
-        return 0;
     for (p = 0; p < t->n_passes; ++p) {
         if (t->state[p] != P_MERGED)
             continue;
         *samples += t->pn[p];
-        if (k && r[k - 1][0] + r[k - 1][1] == t->ps0[p])
-            r[k - 1][1] += t->pn[p];
-        else {
-            r[k][0] = t->ps0[p];
-            r[k++][1] = t->pn[p];
-        }
+        if (!rs_path_ranges_add(out, (uint64_t)t->ps0[p] * t->npix,
+                                ((uint64_t)t->ps0[p] + t->pn[p]) * t->npix))
+            return 0;
     }
-    return k;
+    return 1;
 }
 
 int passes_limit_to_begun(passes *t)

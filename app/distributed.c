@@ -59,9 +59,8 @@ rs_status rs_dist_render(rs_dist *d, const rs_dist_job *job, rs_film *film, rs_d
 void rs_dist_result_free(rs_dist_result *res)
 {
     rs_free(res->rank);
-    rs_free(res->done);
+    rs_path_ranges_free(&res->done);
     res->rank = NULL;
-    res->done = NULL;
 }
 
 int rs_dist_result_add(rs_dist_result *total, const rs_dist_result *job)

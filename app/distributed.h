@@ -84,9 +84,8 @@ typedef rs_status (*rs_dist_render_fn)(void *user, const uint32_t *pixels, uint3
                                        const atomic_int *cancel, rs_render_stats *stats);
 
 /* rank 0, every `flush_every_s`: the film holds the samples it held before plus `done`
- * (n_done ranges [s0, s0 + n) of every pixel, sorted); it may be read, not written */
-typedef void (*rs_dist_saved_fn)(void *user, const rs_film *film, const uint32_t (*done)[2],
-                                 uint32_t n_done);
+ * (path ranges, as job->todo numbers them); it may be read, not written */
+typedef void (*rs_dist_saved_fn)(void *user, const rs_film *film, const rs_path_ranges *done);
 
 typedef struct rs_dist_job {
     uint32_t width, height, spp;
@@ -129,8 +128,7 @@ typedef struct rs_dist_result {
     int ranks;
     uint32_t pass_spp, passes_total;
     uint32_t samples_done;     /* samples of every pixel this job added to the film */
-    uint32_t (*done)[2];       /* which: n_done ranges [s0, s0 + n), sorted */
-    uint32_t n_done;
+    rs_path_ranges done;       /* which: path ranges, as job->todo numbers them */
     int complete;              /* every sample of `todo` is on the film */
     uint32_t flushes;          /* times every rank sent what it had finished */
     int time_limited, stopped; /* the time limit / a stop signal ended it early */
