@@ -432,42 +432,39 @@ static rs_status gc_lights_and_patches(rs_scene *s, const gc_tex *t)
     return RS_OK;
 }
 
-/* Two instances of a pyramid prototype, one placed obliquely, one mirrored and sheared. */
+/* Two instances of a pyramid prototype whose sides alternate a rough Schlick conductor and a
+ * normal-mapped pbr with UVs and vertex normals: one placed obliquely, one mirrored and
+ * sheared. */
 static rs_status gc_pyramids(rs_scene *s, const gc_tex *tex)
 {
+    static const double axis[3] = {1, 1, 0.3};
     rs_material m;
-    uint32_t proto_first, proto_count;
-    /* the instanced pyramid: sides alternating a rough Schlick conductor and a normal-mapped pbr
-     * with UVs and vertex normals */
-    {
-        uint32_t a, b;
-        static const double axis[3] = {1, 1, 0.3};
-        rs_xform r, sc, t, x, sh;
-        RS_TRY(add_mat(s, rs_mat_conductor_f0(rs_v3(.9f, .9f, .95f), 0.3f), &a));
-        m = rs_mat_pbr(rs_v3(.3f, .6f, .9f), 0.2f, 0.35f);
-        m.albedo_tex = tex->base;
-        m.normal_tex = tex->normal;
-        m.normal_scale = 1.0f;
-        RS_TRY(add_mat(s, m, &b));
-        RS_TRY(add_pyramid_prototype(s, a, b, &proto_first, &proto_count));
-        /* oblique rotation after a non-uniform scale */
-        sc = rs_xform_scale(0.9, 1.4, 0.7);
-        r = rs_xform_rotate_axis(axis, 35.0);
-        t = rs_xform_translate(2.9, 0.35, -0.4);
-        x = rs_xform_compose(&r, &sc);
-        x = rs_xform_compose(&t, &x);
-        RS_TRY(place(s, proto_first, proto_count, &x));
-        /* mirrored (det < 0) and sheared, turned about y */
-        sc = rs_xform_scale(-1.1, 1.0, 1.0);
-        sh = rs_xform_identity();
-        sh.m[0][1] = 0.3;
-        r = rs_xform_rotate_euler(0.0, 25.0, 0.0);
-        t = rs_xform_translate(-3.1, 0.0, 0.6);
-        x = rs_xform_compose(&sh, &sc);
-        x = rs_xform_compose(&r, &x);
-        x = rs_xform_compose(&t, &x);
-        RS_TRY(place(s, proto_first, proto_count, &x));
-    }
+    uint32_t proto_first, proto_count, a, b;
+    rs_xform r, sc, t, x, sh;
+    RS_TRY(add_mat(s, rs_mat_conductor_f0(rs_v3(.9f, .9f, .95f), 0.3f), &a));
+    m = rs_mat_pbr(rs_v3(.3f, .6f, .9f), 0.2f, 0.35f);
+    m.albedo_tex = tex->base;
+    m.normal_tex = tex->normal;
+    m.normal_scale = 1.0f;
+    RS_TRY(add_mat(s, m, &b));
+    RS_TRY(add_pyramid_prototype(s, a, b, &proto_first, &proto_count));
+    /* oblique rotation after a non-uniform scale */
+    sc = rs_xform_scale(0.9, 1.4, 0.7);
+    r = rs_xform_rotate_axis(axis, 35.0);
+    t = rs_xform_translate(2.9, 0.35, -0.4);
+    x = rs_xform_compose(&r, &sc);
+    x = rs_xform_compose(&t, &x);
+    RS_TRY(place(s, proto_first, proto_count, &x));
+    /* mirrored (det < 0) and sheared, turned about y */
+    sc = rs_xform_scale(-1.1, 1.0, 1.0);
+    sh = rs_xform_identity();
+    sh.m[0][1] = 0.3;
+    r = rs_xform_rotate_euler(0.0, 25.0, 0.0);
+    t = rs_xform_translate(-3.1, 0.0, 0.6);
+    x = rs_xform_compose(&sh, &sc);
+    x = rs_xform_compose(&r, &x);
+    x = rs_xform_compose(&t, &x);
+    RS_TRY(place(s, proto_first, proto_count, &x));
     return RS_OK;
 }
 
