@@ -381,6 +381,26 @@ static uint32_t deepest_light(const rs_scene *s)
     return deepest;
 }
 
+/* At point x: the pick probabilities of every light sum to 1 (within tol), and `picks` picks
+ * each have their light's pmf as their probability, bit for bit. */
+static void check_sum_and_picks(const rs_scene *s, rs_vec3 x, double tol, int picks)
+{
+    double sum = 0;
+    uint32_t l;
+    int j;
+    for (l = 0; l < s->n_lights; ++l)
+        sum += rs_light_bvh_pmf(s, x, l);
+    if (!(fabs(sum - 1.0) < tol))
+        fail_msg("at (%g %g %g) the pick probabilities sum to %.6f", (double)x.x, (double)x.y,
+                 (double)x.z, sum);
+    for (j = 0; j < picks; ++j) {
+        uint32_t got = 0;
+        float pm;
+        if (rs_light_bvh_pick(s, x, rnd(), &got, &pm))
+            assert_true(pm == rs_light_bvh_pmf(s, x, got));
+    }
+}
+
 /* The tree's depth stays within its limit whatever the lights (the 64-bit trails hold 62
  * levels): with the default limit, and with a limit of 14 that the lopsided scene's cost splits
  * alone would pass three times over; the pick probabilities the trails give still sum to 1 and
@@ -392,7 +412,7 @@ static void test_depth_bounded(void **state)
     (void)state;
     for (c = 0; c < sizeof limits / sizeof limits[0]; ++c) {
         rs_scene *s;
-        uint32_t deepest, l;
+        uint32_t deepest;
         int k;
         rs_light_bvh_set_depth_limit(limits[c]);
         s = deep_scene();
@@ -405,19 +425,7 @@ static void test_depth_bounded(void **state)
             assert_true(deepest > 40); /* the cost splits did go deep */
         for (k = 0; k < 20; ++k) {
             float along = 1e-3f * powf(1.1f, 285.0f * rnd());
-            rs_vec3 x = rs_v3(along, 1.0f + 5.0f * rnd(), rnd() - 0.5f);
-            double sum = 0;
-            int j;
-            for (l = 0; l < s->n_lights; ++l)
-                sum += rs_light_bvh_pmf(s, x, l);
-            if (!(fabs(sum - 1.0) < 1e-4))
-                fail_msg("point %d: the pick probabilities sum to %.6f", k, sum);
-            for (j = 0; j < 20; ++j) {
-                uint32_t got = 0;
-                float pm;
-                if (rs_light_bvh_pick(s, x, rnd(), &got, &pm))
-                    assert_true(pm == rs_light_bvh_pmf(s, x, got));
-            }
+            check_sum_and_picks(s, rs_v3(along, 1.0f + 5.0f * rnd(), rnd() - 0.5f), 1e-4, 20);
         }
         rs_scene_destroy(s);
     }
@@ -434,9 +442,6 @@ static void test_million_collinear(void **state)
     rs_scene *s = NULL;
     rs_material m = rs_mat_light(rs_v3_splat(1.0f), 1);
     uint32_t id, i, deepest;
-    double sum = 0.0;
-    rs_vec3 x = rs_v3(2500.0f, 1.0f, 0.0f);
-    int j;
     (void)state;
     assert_int_equal(rs_scene_create("collinear", &s), RS_OK);
     assert_int_equal(rs_scene_add_material(s, &m, &id), RS_OK);
@@ -451,16 +456,7 @@ static void test_million_collinear(void **state)
     print_message("%u collinear lights: the deepest at depth %u (limit 62)\n", s->n_lights,
                   deepest);
     assert_true(deepest <= 62 && deepest >= 20); /* ceil(log2 10^6) = 20 */
-    for (i = 0; i < s->n_lights; ++i)
-        sum += rs_light_bvh_pmf(s, x, i);
-    if (!(fabs(sum - 1.0) < 1e-3))
-        fail_msg("the pick probabilities sum to %.6f", sum);
-    for (j = 0; j < 200; ++j) {
-        uint32_t got = 0;
-        float pm;
-        if (rs_light_bvh_pick(s, x, rnd(), &got, &pm))
-            assert_true(pm == rs_light_bvh_pmf(s, x, got));
-    }
+    check_sum_and_picks(s, rs_v3(2500.0f, 1.0f, 0.0f), 1e-3, 200);
     rs_scene_destroy(s);
 }
 

@@ -32,24 +32,16 @@
 #include "core/intersect.h"
 #include "scenes/light_bvh.h"
 #include "shading/light_sampler.h"
+#include "test_rand.h"
 
 static uint64_t g_s = 0x11647u;
 
-static float rnd(void)
-{
-    g_s = g_s * 6364136223846793005ull + 1442695040888963407ull;
-    return (float)((g_s >> 40) * (1.0 / 16777216.0));
-}
+/* uniform in [0, 1) with 24 bits: never 1, as a sampler's numbers */
+static float rnd(void) { return (float)(splitmix64(&g_s) >> 40) * 0x1.0p-24f; }
 
 static rs_vec3 rnd_v(float lo, float hi)
 {
-    return rs_v3(lo + (hi - lo) * rnd(), lo + (hi - lo) * rnd(), lo + (hi - lo) * rnd());
-}
-
-static rs_vec3 rnd_dir(void)
-{
-    float z = 2.0f * rnd() - 1.0f, phi = 6.2831853f * rnd(), r = sqrtf(1.0f - z * z);
-    return rs_v3(r * cosf(phi), r * sinf(phi), z);
+    return rs_v3(rnd_range(&g_s, lo, hi), rnd_range(&g_s, lo, hi), rnd_range(&g_s, lo, hi));
 }
 
 static rs_scene *make_scene(void)
@@ -68,20 +60,20 @@ static rs_scene *make_scene(void)
     assert_int_equal(rs_scene_add_material(s, &m, &mats[2]), RS_OK);
     m = rs_mat_lambertian(rs_v3_splat(0.5f));
     assert_int_equal(rs_scene_add_material(s, &m, &diffuse), RS_OK);
-    assert_int_equal(rs_scene_add_quad(s, rs_v3(-20, -1, -20), rs_v3(40, 0, 0), rs_v3(0, 0, 40),
-                                       diffuse),
-                     RS_OK);
+    assert_int_equal(
+        rs_scene_add_quad(s, rs_v3(-20, -1, -20), rs_v3(40, 0, 0), rs_v3(0, 0, 40), diffuse),
+        RS_OK);
     for (i = 0; i < 12; ++i) {
         rs_vec3 q = rs_v3_add(rnd_v(-6, 6), rs_v3(0, 7, 0));
-        assert_int_equal(rs_scene_add_quad(s, q, rs_v3_scale(rnd_dir(), 0.3f + rnd()),
-                                           rs_v3_scale(rnd_dir(), 0.3f + rnd()), mats[i % 3]),
+        assert_int_equal(rs_scene_add_quad(s, q, rs_v3_scale(rnd_unit(&g_s), 0.3f + rnd()),
+                                           rs_v3_scale(rnd_unit(&g_s), 0.3f + rnd()), mats[i % 3]),
                          RS_OK);
     }
     for (i = 0; i < 12; ++i) {
         rs_vec3 a = rs_v3_add(rnd_v(-6, 6), rs_v3(0, 7, 0));
-        assert_int_equal(rs_scene_add_triangle(s, a, rs_v3_add(a, rs_v3_scale(rnd_dir(), 0.8f)),
-                                               rs_v3_add(a, rs_v3_scale(rnd_dir(), 0.8f)),
-                                               mats[(i + 1) % 3]),
+        assert_int_equal(rs_scene_add_triangle(
+                             s, a, rs_v3_add(a, rs_v3_scale(rnd_unit(&g_s), 0.8f)),
+                             rs_v3_add(a, rs_v3_scale(rnd_unit(&g_s), 0.8f)), mats[(i + 1) % 3]),
                          RS_OK);
     }
     memset(&p, 0, sizeof p);
