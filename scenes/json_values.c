@@ -114,16 +114,26 @@ void rs_json_subpath(char *out, size_t n, const char *path, const char *key)
     out[k] = '\0';
 }
 
+/* Field `key` of obj into *it (NULL: absent, an error when `required`), its JSON path into
+ * p[n]. */
+static rs_status field_of(const ctx *c, const cJSON *obj, const char *path, const char *key,
+                          int required, char *p, size_t n, const cJSON **it)
+{
+    *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    rs_json_subpath(p, n, path, key);
+    if (!*it && required)
+        return FAIL(c, path, "missing '%s'", key);
+    return RS_OK;
+}
+
 /* A number in [lo, hi]; `def` when absent and not required. */
 rs_status rs_json_get_num(const ctx *c, const cJSON *obj, const char *path, const char *key,
                           int required, double def, double lo, double hi, float *out)
 {
-    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    const cJSON *it;
     char p[256];
-    rs_json_subpath(p, sizeof p, path, key);
+    RS_TRY(field_of(c, obj, path, key, required, p, sizeof p, &it));
     if (!it) {
-        if (required)
-            return FAIL(c, path, "missing '%s'", key);
         *out = (float)def;
         return RS_OK;
     }
@@ -154,12 +164,10 @@ rs_status rs_json_vec3_of(const ctx *c, const cJSON *it, const char *p, rs_vec3 
 rs_status rs_json_get_vec3(const ctx *c, const cJSON *obj, const char *path, const char *key,
                            int required, rs_vec3 def, rs_vec3 *out)
 {
-    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    const cJSON *it;
     char p[256];
-    rs_json_subpath(p, sizeof p, path, key);
+    RS_TRY(field_of(c, obj, path, key, required, p, sizeof p, &it));
     if (!it) {
-        if (required)
-            return FAIL(c, path, "missing '%s'", key);
         *out = def;
         return RS_OK;
     }
@@ -193,9 +201,9 @@ rs_status rs_json_get_reflectance(const ctx *c, const cJSON *obj, const char *pa
 rs_status rs_json_get_bool(const ctx *c, const cJSON *obj, const char *path, const char *key,
                            int def, int *out)
 {
-    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    const cJSON *it;
     char p[256];
-    rs_json_subpath(p, sizeof p, path, key);
+    RS_TRY(field_of(c, obj, path, key, 0, p, sizeof p, &it));
     if (!it) {
         *out = def;
         return RS_OK;
@@ -209,11 +217,9 @@ rs_status rs_json_get_bool(const ctx *c, const cJSON *obj, const char *path, con
 rs_status rs_json_get_string(const ctx *c, const cJSON *obj, const char *path, const char *key,
                              const char **out)
 {
-    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    const cJSON *it;
     char p[256];
-    rs_json_subpath(p, sizeof p, path, key);
-    if (!it)
-        return FAIL(c, path, "missing '%s'", key);
+    RS_TRY(field_of(c, obj, path, key, 1, p, sizeof p, &it));
     if (!cJSON_IsString(it) || !*it->valuestring)
         return FAIL(c, p, "expected a non-empty string");
     *out = it->valuestring;
