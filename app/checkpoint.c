@@ -100,7 +100,7 @@ static size_t header_max(const rs_path_ranges *held)
 }
 
 static size_t make_header(unsigned char *h, const rs_checkpoint_key *key,
-                          const rs_path_ranges *held, uint64_t nonfinite)
+                          const rs_path_ranges *held, uint64_t nonfinite, int passes)
 {
     size_t name_len = strlen(key->scene), at;
     uint64_t paths = rs_path_ranges_total(held);
@@ -109,8 +109,9 @@ static size_t make_header(unsigned char *h, const rs_checkpoint_key *key,
     if (name_len >= NAME_MAX_BYTES)
         name_len = NAME_MAX_BYTES - 1;
     memcpy(h, k_magic, 8);
-    put32(h + 8,
-          key->adaptive_threshold > 0 ? RS_CHECKPOINT_VERSION_ADAPTIVE : RS_CHECKPOINT_VERSION);
+    put32(h + 8, key->adaptive_threshold > 0
+                     ? (passes ? RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES : RS_CHECKPOINT_VERSION_ADAPTIVE)
+                     : (passes ? RS_CHECKPOINT_VERSION_PASSES : RS_CHECKPOINT_VERSION));
     put32(h + 12, (uint32_t)(FIXED_HEADER + name_len + 8 + 16 * (size_t)held->n));
     put64(h + 16, key->scene_hash);
     put64(h + 24, key->seed);
@@ -188,11 +189,14 @@ static int write_file(const char *path, const char *staged, int rename_now,
         free(header);
         return 0;
     }
-    n = make_header(header, key, held, film->nonfinite);
+    n = make_header(header, key, held, film->nonfinite, film->pass != NULL);
     if (ad) /* no ranges: the paths held are the film's samples */
         put64(header + 32, rs_film_samples(film));
     ok = put(f, header, n, &sum) && put(f, film->sum, npix * 3 * sizeof *film->sum, &sum) &&
          put(f, film->count, npix * sizeof *film->count, &sum);
+    if (film->pass && ok)
+        ok = put(f, film->pass, npix * RS_FILM_PASSES * sizeof *film->pass, &sum) &&
+             put(f, film->pass_hits, npix * sizeof *film->pass_hits, &sum);
     if (ad && ok) {
         unsigned char q[ADAPTIVE_FIXED];
         make_adaptive(q, key, ad);
@@ -384,6 +388,7 @@ typedef struct reader {
     char name[NAME_MAX_BYTES];
     size_t hdr, name_len;
     uint32_t version, n_ranges;
+    int adaptive, passes; /* what the version says the file holds */
     uint64_t end; /* the last range's end */
 } reader;
 
@@ -400,11 +405,16 @@ static int read_header(reader *r)
     if (memcmp(r->h, k_magic, 8) != 0)
         return refuse(rc, r->path, "not a raystream checkpoint (no RSCKPT magic)%s%s", "", "");
     r->version = get32(r->h + 8);
-    if (r->version != RS_CHECKPOINT_VERSION && r->version != RS_CHECKPOINT_VERSION_ADAPTIVE) {
-        char v[16], want_v[16];
+    r->adaptive = r->version == RS_CHECKPOINT_VERSION_ADAPTIVE ||
+                  r->version == RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES;
+    r->passes = r->version == RS_CHECKPOINT_VERSION_PASSES ||
+                r->version == RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES;
+    if (r->version != RS_CHECKPOINT_VERSION && !r->adaptive && !r->passes) {
+        char v[16], want_v[24];
         snprintf(v, sizeof v, "%u", r->version);
-        snprintf(want_v, sizeof want_v, "%u and %u", RS_CHECKPOINT_VERSION,
-                 RS_CHECKPOINT_VERSION_ADAPTIVE);
+        snprintf(want_v, sizeof want_v, "%u, %u, %u and %u", RS_CHECKPOINT_VERSION,
+                 RS_CHECKPOINT_VERSION_ADAPTIVE, RS_CHECKPOINT_VERSION_PASSES,
+                 RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES);
         return refuse(rc, r->path, "checkpoint version %s; this raystream reads versions %s", v,
                       want_v);
     }
@@ -418,7 +428,7 @@ static int read_header(reader *r)
     r->name[r->name_len] = '\0';
     r->n_ranges = get32(r->h + FIXED_HEADER + r->name_len);
     if (r->n_ranges > RS_CHECKPOINT_MAX_RANGES ||
-        (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE && r->n_ranges != 0) ||
+        (r->adaptive && r->n_ranges != 0) ||
         r->hdr != FIXED_HEADER + r->name_len + 8 + 16 * (size_t)r->n_ranges ||
         fread(r->h + FIXED_HEADER + r->name_len + 8, 16, r->n_ranges, r->f) != r->n_ranges)
         return refuse(rc, r->path, "corrupt header (the list of paths held)%s%s", "", "");
@@ -442,10 +452,12 @@ static int check_size(const reader *r, const rs_checkpoint_key *want, size_t npi
     if (fw == 0 || fh == 0 || fw > 65536 || fh > 65536)
         return refuse(RS_EXIT_RUNTIME, r->path, "corrupt header (image size %s)%s", "out of range",
                       "");
-    if (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE)
+    if (r->adaptive)
         per_pixel += sizeof(rs_film_sq) + 1;
+    if (r->passes)
+        per_pixel += RS_FILM_PASSES * sizeof(rs_film_sum) + sizeof(uint32_t);
     expect = (uint64_t)r->hdr + (uint64_t)fw * fh * per_pixel + 8 +
-             (r->version == RS_CHECKPOINT_VERSION_ADAPTIVE ? ADAPTIVE_FIXED : 0);
+             (r->adaptive ? ADAPTIVE_FIXED : 0);
     if (r->size != expect) {
         char a[32], b[32];
         snprintf(a, sizeof a, "%llu", (unsigned long long)r->size);
@@ -471,8 +483,22 @@ static int take(reader *r, void *p, size_t n)
     return 1;
 }
 
-/* The film (and an adaptive section into q, ad and the film's squared luminance), then the
- * checksum. */
+/* n bytes read and folded into the checksum, not kept (a film's passes the render does not
+ * write); 0 when the file ends first. */
+static int skip(reader *r, uint64_t n)
+{
+    unsigned char buf[4096];
+    while (n > 0) {
+        size_t k = n < sizeof buf ? (size_t)n : sizeof buf;
+        if (!take(r, buf, k))
+            return 0;
+        n -= k;
+    }
+    return 1;
+}
+
+/* The film (its passes where it keeps them, and an adaptive section into q, ad and the film's
+ * squared luminance), then the checksum. */
 static int read_film(reader *r, rs_film *film, unsigned char *q, rs_adaptive_state *ad)
 {
     size_t npix = (size_t)film->width * film->height;
@@ -481,7 +507,12 @@ static int read_film(reader *r, rs_film *film, unsigned char *q, rs_adaptive_sta
     r->sum = fnv(FNV_OFFSET, r->h, r->hdr);
     ok = take(r, film->sum, npix * 3 * sizeof *film->sum) &&
          take(r, film->count, npix * sizeof *film->count);
-    if (ok && r->version == RS_CHECKPOINT_VERSION_ADAPTIVE)
+    if (ok && r->passes && film->pass)
+        ok = take(r, film->pass, npix * RS_FILM_PASSES * sizeof *film->pass) &&
+             take(r, film->pass_hits, npix * sizeof *film->pass_hits);
+    else if (ok && r->passes)
+        ok = skip(r, npix * (RS_FILM_PASSES * sizeof(rs_film_sum) + sizeof(uint32_t)));
+    if (ok && r->adaptive)
         ok = take(r, q, ADAPTIVE_FIXED) && take(r, film->sum_l2, npix * sizeof *film->sum_l2) &&
              take(r, ad->running, npix);
     if (!ok || fread(&stored, 1, sizeof stored, r->f) != sizeof stored)
@@ -540,10 +571,16 @@ static int take_adaptive(const reader *r, const unsigned char *q, const rs_check
     return RS_EXIT_OK;
 }
 
-/* Whether the file's kind (adaptive or not) is the render's; one line when not. */
-static int same_kind(const reader *r, const rs_checkpoint_key *want)
+/* Whether the file's kind (adaptive or not; with the passes where the render writes them) is
+ * the render's; one line when not. */
+static int same_kind(const reader *r, const rs_checkpoint_key *want, const rs_film *film)
 {
-    int file_adaptive = r->version == RS_CHECKPOINT_VERSION_ADAPTIVE;
+    int file_adaptive = r->adaptive;
+    if (film->pass && !r->passes)
+        return refuse(RS_EXIT_USAGE, r->path,
+                      "made without the passes --aov and --denoise read (%s%s); continue it "
+                      "without them, or start again",
+                      "albedo, normal, depth, direct emission", "");
     if (file_adaptive == (want->adaptive_threshold > 0))
         return RS_EXIT_OK;
     return refuse(RS_EXIT_USAGE, r->path,
@@ -574,7 +611,7 @@ static int read_any(const char *path, rs_checkpoint_key *want, rs_film *film, rs
         return RS_EXIT_USAGE;
     }
     if ((rc = read_header(&r)) == RS_EXIT_OK && (rc = check_size(&r, want, npix)) == RS_EXIT_OK &&
-        (rc = same_kind(&r, want)) == RS_EXIT_OK &&
+        (rc = same_kind(&r, want, film)) == RS_EXIT_OK &&
         (rc = read_film(&r, film, q, ad)) == RS_EXIT_OK &&
         (rc = check_header(path, r.h, r.name, r.end, want)) == RS_EXIT_OK) {
         if (ad && want->spp != get32(r.h + 56)) /* the last round's size depends on it */

@@ -40,6 +40,12 @@
  *        24*P  each pixel's sum of squared luminance (rs_film_sq: a 192-bit integer in units
  *              of 2^-64, three u64 from the lowest; version 3 had an f64 here and is refused)
  *           P  each pixel's running flag (0 or 1)
+ * Versions 5 and 6 are versions 2 and 4 of a film that keeps its passes (shading/film.h: what
+ * --aov and --denoise read), with the passes section after the counts:
+ *       160*P  the passes' sums, RS_FILM_PASSES signed 128-bit integers a pixel in film units
+ *         4*P  the samples whose camera ray hit something, u32 a pixel
+ * A render that writes passes resumes only from a file that holds them; one that does not
+ * skips them.
  * Everything that decides the image is in the header; the devices, threads, chunk and wave
  * sizes, the BVH builder and the integrator are not (they do not change the image).  spp matters
  * only to the zsobol sampler (its point set depends on it) and to adaptive sampling (its last
@@ -58,6 +64,8 @@
 #define RS_CHECKPOINT_VERSION          2u /* a render over every pixel */
 #define RS_CHECKPOINT_VERSION_ADAPTIVE 4u /* --adaptive: version 2 and an adaptive section
                                              (3 had inexact squared-luminance sums) */
+#define RS_CHECKPOINT_VERSION_PASSES   5u /* version 2 with the film's passes */
+#define RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES 6u /* version 4 with the film's passes */
 
 /* The paths a film holds (scheduler/plan.h): at most this many ranges in a file. */
 #define RS_CHECKPOINT_MAX_RANGES RS_PATH_RANGES_MAX

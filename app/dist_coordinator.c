@@ -109,7 +109,8 @@ static rs_status setup(coord *c)
         c->d->dead = (uint8_t *)rs_calloc((size_t)n, 1);
     if (!c->last_seen || !c->asked || !c->finished || !c->stopped || !c->flushing ||
         !res->rank || !c->d->dead || rs_film_create(job->width, job->height, &c->tmp) != RS_OK ||
-        (job->variance && rs_film_track_variance(c->tmp) != RS_OK))
+        (job->variance && rs_film_track_variance(c->tmp) != RS_OK) ||
+        (job->passes && rs_film_keep_passes(c->tmp) != RS_OK))
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the MPI coordinator");
     for (r = 0; r < n; ++r) {
         res->rank[r].alive = !c->d->dead[r]; /* found dead in an earlier job: not here */

@@ -32,7 +32,9 @@
  *                 GO    worst code, who      every rank is READY (or `who` is dead): go on
  *                                            when the code is 0, else stop
  * A film's data: FILM_SUMS chunks, FILM_COUNTS chunks, and, when its header's H_SQ says so,
- * FILM_SQ chunks (three uint64 a pixel: rs_film_sq). 
+ * FILM_SQ chunks (three uint64 a pixel: rs_film_sq), then, when H_PASS_DATA says so,
+ * FILM_PASSES chunks: the passes' sums (2 RS_FILM_PASSES uint64 a pixel, low words first), then
+ * the hit counts (uint32 a pixel).
  * Messages between two ranks arrive in the order they were sent, so a worker's DONEs precede
  * its film. */
 #ifndef RS_APP_DIST_INTERNAL_H
@@ -71,6 +73,7 @@ enum {
     T_JOB_PIXELS,
     T_READY,
     T_GO,
+    T_FILM_PASSES,
     T_COUNT /* one past the last tag */
 };
 
@@ -88,6 +91,7 @@ enum {
     H_FLUSH,     /* a periodic flush: the worker goes on */
     H_COMM_CPU,  /* double: CPU seconds of its messaging thread so far */
     H_SQ,        /* 1: FILM_SQ chunks follow the counts */
+    H_PASS_DATA, /* 1: FILM_PASSES chunks follow (the film's passes, shading/film.h) */
     H_COUNT
 };
 

@@ -109,7 +109,8 @@ rs_status local_start(local *l, const rs_dist_job *job, int rank, rs_film *acc,
     pthread_cond_init(&l->cv, NULL);
     if (rs_film_create(job->width, job->height, &l->scratch) != RS_OK)
         return RS_ERR_NOMEM;
-    if (job->variance && rs_film_track_variance(l->scratch) != RS_OK) {
+    if ((job->variance && rs_film_track_variance(l->scratch) != RS_OK) ||
+        (job->passes && rs_film_keep_passes(l->scratch) != RS_OK)) {
         rs_film_destroy(l->scratch);
         return RS_ERR_NOMEM;
     }

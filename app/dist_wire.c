@@ -139,7 +139,8 @@ int rs_dist_recv_chunks(void *data, size_t n, size_t elem, MPI_Datatype type, in
 
 int rs_dist_is_film_data(int tag)
 {
-    return tag == T_FILM_SUMS || tag == T_FILM_COUNTS || tag == T_FILM_SQ;
+    return tag == T_FILM_SUMS || tag == T_FILM_COUNTS || tag == T_FILM_SQ ||
+           tag == T_FILM_PASSES;
 }
 
 int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s)
@@ -152,6 +153,7 @@ int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s)
     h[H_ENC] = (uint64_t)enc;
     h[H_NONFINITE] = f->nonfinite;
     h[H_SQ] = f->sum_l2 != NULL;
+    h[H_PASS_DATA] = f->pass != NULL;
     /* this runs on the messaging thread */
     h[H_COMM_CPU] = rs_dist_dbits(rs_dist_thread_cpu_s() - rs_dist_cpu0);
     if (!rs_dist_send_small(h, H_COUNT, 0, T_FILM))
@@ -172,7 +174,12 @@ int rs_dist_send_film(const rs_film *f, uint64_t h[H_COUNT], double timeout_s)
          rs_dist_send_chunks(f->count, npix, sizeof *f->count, MPI_UINT32_T, 0, T_FILM_COUNTS,
                              timeout_s) &&
          (!f->sum_l2 || rs_dist_send_chunks(f->sum_l2, npix * 3, sizeof(uint64_t), MPI_UINT64_T,
-                                            0, T_FILM_SQ, timeout_s));
+                                            0, T_FILM_SQ, timeout_s)) &&
+         (!f->pass ||
+          (rs_dist_send_chunks(f->pass, npix * 2 * RS_FILM_PASSES, sizeof(uint64_t), MPI_UINT64_T,
+                               0, T_FILM_PASSES, timeout_s) &&
+           rs_dist_send_chunks(f->pass_hits, npix, sizeof *f->pass_hits, MPI_UINT32_T, 0,
+                               T_FILM_PASSES, timeout_s)));
     rs_free(wide);
     return ok;
 }
@@ -206,11 +213,19 @@ int rs_dist_recv_film(int r, const uint64_t *h, rs_film *tmp, double timeout_s,
     ok = ok && !h[H_SQ] == !tmp->sum_l2 &&
          (!h[H_SQ] || rs_dist_recv_chunks(tmp->sum_l2, npix * 3, sizeof(uint64_t), MPI_UINT64_T,
                                           r, T_FILM_SQ, timeout_s));
+    /* the passes likewise: when both films keep them (a job whose outputs read them) */
+    ok = ok && !h[H_PASS_DATA] == !tmp->pass &&
+         (!h[H_PASS_DATA] ||
+          (rs_dist_recv_chunks(tmp->pass, npix * 2 * RS_FILM_PASSES, sizeof(uint64_t),
+                               MPI_UINT64_T, r, T_FILM_PASSES, timeout_s) &&
+           rs_dist_recv_chunks(tmp->pass_hits, npix, sizeof *tmp->pass_hits, MPI_UINT32_T, r,
+                               T_FILM_PASSES, timeout_s)));
     rs_free(buf);
     if (!ok)
         return 0;
     tmp->nonfinite = h[H_NONFINITE];
-    *bytes = H_COUNT * 8 + n_sum * 8 + npix * 4 + (h[H_SQ] ? npix * 24 : 0);
+    *bytes = H_COUNT * 8 + n_sum * 8 + npix * 4 + (h[H_SQ] ? npix * 24 : 0) +
+             (h[H_PASS_DATA] ? npix * (16 * RS_FILM_PASSES + 4) : 0);
     return 1;
 }
 

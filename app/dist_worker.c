@@ -221,8 +221,10 @@ rs_status rs_dist_run_worker(rs_dist *d, const rs_dist_job *job, rs_film *film,
     rs_film_clear(film);
     if (rs_film_create(film->width, film->height, &w.spare) != RS_OK)
         return RS_ERR_NOMEM;
-    if (job->variance &&
-        (rs_film_track_variance(film) != RS_OK || rs_film_track_variance(w.spare) != RS_OK)) {
+    if ((job->variance &&
+         (rs_film_track_variance(film) != RS_OK || rs_film_track_variance(w.spare) != RS_OK)) ||
+        (job->passes &&
+         (rs_film_keep_passes(film) != RS_OK || rs_film_keep_passes(w.spare) != RS_OK))) {
         rs_film_destroy(w.spare);
         return RS_ERR_NOMEM;
     }

@@ -93,6 +93,7 @@ typedef struct rs_dist_job {
                                    others with rs_dist_job_begin); NULL: every pixel */
     uint32_t n_pixels;
     int variance;               /* every rank: films keep squared-luminance sums (--adaptive) */
+    int passes;                 /* every rank: films keep the passes (--aov, --denoise) */
     const rs_path_ranges *todo; /* rank 0: the paths to render, in scheduler/plan.h's numbering
                                    over the job's pixels (path i: sample i div n of pixel
                                    i mod n), each range whole samples (what the film does not

@@ -142,15 +142,15 @@ static int alloc_aovs(unsigned aovs, size_t npix, float **bufs)
              ((aovs & RS_AOV_DEPTH) && !bufs[2]) || ((aovs & RS_AOV_SAMPLES) && !bufs[3]));
 }
 
-/* The --aov layers of the finished render (shading/aov.h) into layers[], their buffers in
- * bufs[] (rs_free them); returns how many, or -1 after a message. */
+/* The --aov layers of the finished render (shading/aov.h: the film's passes, which the devices
+ * wrote as they rendered) into layers[], their buffers in bufs[] (rs_free them); returns how
+ * many, or -1 after a message. */
 static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_layer *layers,
                      float **bufs)
 {
     static const char *const names[4] = {"albedo", "normal", "depth", "samples"};
     static const char *const channels[4] = {"RGB", "XYZ", "Z", "Y"};
     size_t npix = (size_t)r->st.width * r->st.height;
-    rs_render_consts it;
     int n = 0, k;
     uint32_t i;
     bufs[0] = bufs[1] = bufs[2] = bufs[3] = NULL;
@@ -160,12 +160,8 @@ static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_laye
         rs_error_set(RS_ERR_NOMEM, "out of memory for the --aov layers");
         return -1;
     }
-    if (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH)) {
-        rs_bvh_view v = rs_bvh_view_of(r->bvh);
-        if (rs_render_constants(r->scene, &r->st, &it) != RS_OK)
-            return -1;
-        rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, bufs[0], bufs[1], bufs[2]);
-    }
+    if (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH))
+        rs_film_resolve_passes(r->film, bufs[0], bufs[1], NULL, bufs[2]);
     if (bufs[3])
         for (i = 0; i < npix; ++i)
             bufs[3][i] = (float)r->film->count[i];
@@ -196,13 +192,13 @@ static int used_gpu(const render_run *r)
     return 0;
 }
 
-/* --denoise: r->denoised from r->rgb with OIDN, guided by the first-hit albedo and normal
- * (averaged over the render's spp camera samples, so taken as clean: cleanAux; bench/
- * denoise_bench measures both), on OIDN's CUDA device when the render used a GPU.  Up to
- * RS_AOV_EMISSION_SPP spp, what the camera sees emitted is kept out of the denoiser and added
- * back, better estimated on its edges (rs_aov_emission, rs_denoise_split): beyond that the
- * render's own samples resolve a light's outline, and the pass would cost more.  0 after a
- * message. */
+/* --denoise: r->denoised from r->rgb with OIDN, guided by the first-hit albedo and normal (the
+ * film's passes: averaged over the render's own camera samples, so taken as clean: cleanAux;
+ * bench/denoise_bench measures both), on OIDN's CUDA device when the render used a GPU.  Up to
+ * RS_AOV_EMISSION_SPP spp, what the camera sees emitted (the film's emission pass) is kept out
+ * of the denoiser and added back, better estimated on its edges (rs_aov_refine,
+ * rs_denoise_split): beyond that the render's own samples resolve a light's outline, and the
+ * refinement would cost more.  0 after a message. */
 static int denoise(render_run *r)
 {
     size_t npix = (size_t)r->st.width * r->st.height;
@@ -218,10 +214,10 @@ static int denoise(render_run *r)
         rs_error_set(RS_ERR_NOMEM, "out of memory for --denoise (%ux%u)", r->st.width,
                      r->st.height);
     else if (rs_render_constants(r->scene, &r->st, &it) == RS_OK) {
-        rs_aov_render(&it, &v, &r->geom, r->st.spp, r->threads, albedo, normal, NULL);
+        rs_film_resolve_passes(r->film, albedo, normal, split ? direct : NULL, NULL);
         if (split)
-            rs_aov_emission(&it, &v, &r->geom, r->film->count, r->st.spp, r->threads, direct,
-                            direct + npix * 3);
+            rs_aov_refine(&it, &v, &r->geom, r->film->count, r->threads, direct,
+                          direct + npix * 3);
         ok = rs_denoise_split(r->rgb, direct, split ? direct + npix * 3 : NULL, albedo, normal,
                               r->st.width, r->st.height, 1, used_gpu(r), r->denoised,
                               r->denoise_device, sizeof r->denoise_device) == RS_OK;

@@ -82,6 +82,9 @@ int rs_run_load_scene(const rs_cli_options *o, render_run *r); /* under the load
 void rs_run_settings(const rs_cli_options *o, render_run *r);
 int rs_run_check_outputs(const rs_cli_options *o, render_run *r);
 int rs_run_make_film(const rs_cli_options *o, render_run *r);
+/* An empty film of the render's size, keeping the passes where the render writes them
+ * (r->st.passes). */
+rs_status rs_run_new_film(const render_run *r, rs_film **out);
 int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, const char *what);
 int rs_run_build_bvh(const rs_cli_options *o, render_run *r);
 int rs_run_start_devices(const rs_cli_options *o, render_run *r);

@@ -12,6 +12,7 @@
 #include "core/denoise.h"
 #include "core/image_io.h"
 #include "gpu/gpu_device.h"
+#include "shading/aov.h"
 
 /* The image size from the options and the scene's own size. */
 static void settings_size(const rs_cli_options *o, const rs_scene *scene, rs_render_settings *st)
@@ -42,6 +43,8 @@ void rs_run_settings(const rs_cli_options *o, render_run *r)
     st->filter = o->filter;
     st->texture_filter = o->texture_filter;
     st->light_sampler = o->light_sampler;
+    /* the devices write the passes the outputs read: the --aov layers, --denoise's guides */
+    st->passes = (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH)) || o->denoise;
     st->wave_paths = o->wave_paths;
     st->waves_in_flight = o->waves;
     r->threads = o->threads ? o->threads : rs_cpu_count();
@@ -159,6 +162,16 @@ static void make_key(const rs_cli_options *o, render_run *r)
     }
 }
 
+rs_status rs_run_new_film(const render_run *r, rs_film **out)
+{
+    rs_status st = rs_film_create(r->st.width, r->st.height, out);
+    if (st == RS_OK && r->st.passes && (st = rs_film_keep_passes(*out)) != RS_OK) {
+        rs_film_destroy(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
 /* The film: a fresh one, or with --resume the checkpoint's (app/checkpoint.h), checked against
  * these settings before any work; the render then starts at the first path it does not hold.
  * --resume without --spp continues to the spp the checkpoint was started with.  Returns an exit
@@ -167,7 +180,7 @@ int rs_run_make_film(const rs_cli_options *o, render_run *r)
 {
     int rc;
     make_key(o, r);
-    if (rs_film_create(r->st.width, r->st.height, &r->film) != RS_OK)
+    if (rs_run_new_film(r, &r->film) != RS_OK)
         return rs_app_fail(RS_EXIT_RUNTIME, "starting the render");
     if (!o->resume)
         return RS_EXIT_OK;

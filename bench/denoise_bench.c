@@ -71,9 +71,10 @@ static void settings_for(uint32_t size, uint32_t spp, rs_sampler sampler, int th
 }
 
 /* The stream engine on one CPU device with `threads` threads; rgb receives the image; *seconds
- * the render's time.  Returns 0 after printing why. */
+ * the render's time; with `albedo` (then normal and direct too), the film's passes as the
+ * devices wrote them (what --aov and --denoise read).  Returns 0 after printing why. */
 static int render(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
-                  float *rgb, double *seconds)
+                  float *rgb, double *seconds, float *albedo, float *normal, float *direct)
 {
     rs_device *dev = NULL;
     rs_sched *sched = NULL;
@@ -84,6 +85,7 @@ static int render(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sa
     rs_cores cores;
     int ok = 0;
     settings_for(size, spp, sampler, threads, &cores, &st);
+    st.passes = albedo != NULL;
     memset(&co, 0, sizeof co);
     co.threads = threads;
     co.cores = &cores;
@@ -91,8 +93,11 @@ static int render(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sa
         rs_device_upload(dev, &s->g, s->bvh) == RS_OK &&
         rs_sched_create(&dev, 1, NULL, &sched) == RS_OK &&
         rs_film_create(size, size, &film) == RS_OK &&
+        (!albedo || rs_film_keep_passes(film) == RS_OK) &&
         rs_render(s->scene, sched, &st, NULL, film, &stats) == RS_OK) {
         rs_film_resolve(film, rgb);
+        if (albedo)
+            rs_film_resolve_passes(film, albedo, normal, direct, NULL);
         *seconds = stats.seconds;
         ok = 1;
     } else {
@@ -104,25 +109,31 @@ static int render(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sa
     return ok;
 }
 
-/* The --aov albedo,normal layers of the spp render, as app/render_outputs.c makes them. */
-static int aovs(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
-                float *albedo, float *normal, float *direct, float *direct_fine, size_t *refined,
-                double *seconds)
+/* The direct emission refined on its edges, as app/render_outputs.c's --denoise does. */
+static int refine(const scene_ctx *s, uint32_t size, uint32_t spp, rs_sampler sampler, int threads,
+                  const float *direct, float *direct_fine, size_t *refined, double *seconds)
 {
     double t0;
     rs_render_settings st;
     rs_render_consts it;
     rs_cores cores;
     rs_bvh_view v = rs_bvh_view_of(s->bvh);
+    uint32_t *count = (uint32_t *)malloc((size_t)size * size * sizeof *count);
+    size_t i;
+    if (!count)
+        return 0;
+    for (i = 0; i < (size_t)size * size; ++i)
+        count[i] = spp;
     settings_for(size, spp, sampler, threads, &cores, &st);
     if (rs_render_constants(s->scene, &st, &it) != RS_OK) {
         fprintf(stderr, "denoise_bench: %s\n", rs_error_message());
+        free(count);
         return 0;
     }
     t0 = rs_now_s();
-    rs_aov_render(&it, &v, &s->g, spp, threads, albedo, normal, NULL);
-    *refined = rs_aov_emission(&it, &v, &s->g, NULL, spp, threads, direct, direct_fine);
+    *refined = rs_aov_refine(&it, &v, &s->g, count, threads, direct, direct_fine);
     *seconds = rs_now_s() - t0;
+    free(count);
     return 1;
 }
 
@@ -297,7 +308,8 @@ static int bench_scene(const char *spec, const opts *o)
                spec, o->size, o->size, o->spp, o->ref_spp, fd, o->threads,
                o->threads == 1 ? "" : "s");
     }
-    if (!render(&s, o->size, o->ref_spp, RS_SAMPLER_SOBOL, o->threads, ref, &t_ref))
+    if (!render(&s, o->size, o->ref_spp, RS_SAMPLER_SOBOL, o->threads, ref, &t_ref, NULL, NULL,
+                NULL))
         goto done;
     rc = 0;
     if (!all_finite(ref, n) || mean(ref, n) <= 0) {
@@ -309,9 +321,10 @@ static int bench_scene(const char *spec, const opts *o)
     for (j = 0; j < 2; ++j) {
         double floor;
         rc = -1;
-        if (!render(&s, o->size, o->spp, samplers[j], o->threads, noisy, &t_noisy) ||
-            !aovs(&s, o->size, o->spp, samplers[j], o->threads, albedo, normal, direct,
-                  direct_fine, &refined, &t_aov))
+        if (!render(&s, o->size, o->spp, samplers[j], o->threads, noisy, &t_noisy, albedo, normal,
+                    direct) ||
+            !refine(&s, o->size, o->spp, samplers[j], o->threads, direct, direct_fine, &refined,
+                    &t_aov))
             goto done;
         /* validate the inputs */
         rc = 0;
@@ -344,7 +357,8 @@ static int bench_scene(const char *spec, const opts *o)
             printf("; the reference's own RMSE is about %.5f (this RMSE x sqrt(%u/%u))", floor,
                    o->spp, o->ref_spp);
         printf("\n");
-        printf("  AOVs and direct emission in %.2f s, %zu pixels (%.1f%%) refined with %u samples\n",
+        printf("  AOVs and direct emission as passes of the render; its edges refined in %.2f s, "
+               "%zu pixels (%.1f%%) with %u samples\n",
                t_aov, refined, 100.0 * (double)refined / ((double)o->size * o->size),
                RS_AOV_EMISSION_SPP);
         rc = denoise_rows(spec, sampler_names[j], o, ref, noisy, albedo, normal, direct,

@@ -62,7 +62,7 @@ rs_status rs_denoise(const float *beauty, const float *albedo, const float *norm
  * light that arrived by reflection) is denoised, and direct_fine added back to the result.
  * direct: per pixel, the share of `beauty` that its camera rays' first hits emitted (an
  * emitter, the background), from the render's own samples; direct_fine: the same, estimated
- * better (shading/aov.h rs_aov_emission makes both).  A light seen at 16 samples a pixel has a
+ * better (the film's emission pass and shading/aov.h rs_aov_refine).  A light seen at 16 samples a pixel has a
  * noisy outline 15 times brighter than the wall beside it, which the denoiser cannot tell from
  * noise it should smooth; this way it never sees it.  direct or direct_fine NULL: rs_denoise.
  * Same arguments and results otherwise (`out` may be `beauty`). */

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "cpu/internal.h"
+#include "shading/aov.h"
 #include "shading/path_counts.h"
 
 typedef struct line_ctx {
@@ -43,9 +44,10 @@ static inline int occluded(const cpu_impl *c, rs_ray r)
     return rs_bvh_occluded(&c->bvh, &c->geom, r);
 }
 
-/* Path (pixel, sample) from the camera to its end; its rays counted in *n. */
+/* Path (pixel, sample) from the camera to its end; its rays counted in *n; where the render
+ * keeps passes, what its camera ray showed into *aux. */
 static inline rs_vec3 path_radiance(const rs_render_consts *it, const cpu_impl *c, uint32_t pixel,
-                                    uint32_t sample, rs_path_counts *n)
+                                    uint32_t sample, rs_path_counts *n, rs_path_aux *aux)
 {
     rs_path p;
     rs_path_start(it, pixel, sample, &p);
@@ -56,6 +58,8 @@ static inline rs_vec3 path_radiance(const rs_render_consts *it, const cpu_impl *
         ++n->closest;
         if (p.bounce > n->max_bounce)
             n->max_bounce = p.bounce;
+        if (p.bounce == 0 && it->passes)
+            *aux = rs_path_aux_at(it, &p.ray, &h, &p.ps);
         made = rs_path_step(it, &p, &h);
         if (made & RS_SHADE_SHADOW) {
             ++n->shadow;
@@ -92,8 +96,11 @@ static void render_lines(void *ctx, uint32_t lo, uint32_t hi)
                 goto out;
             }
             for (s = c->s0; s < c->s0 + c->n; ++s) {
-                rs_vec3 L = path_radiance(job->it, c->impl, pixel, s, &n);
+                rs_path_aux aux;
+                rs_vec3 L = path_radiance(job->it, c->impl, pixel, s, &n, &aux);
                 rs_film_add(job->film, pixel, L);
+                if (job->film->pass && job->it->passes)
+                    rs_film_add_pass(job->film, pixel, &aux);
             }
         }
         report(job, (uint64_t)len * c->n);

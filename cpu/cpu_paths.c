@@ -159,6 +159,8 @@ static void film_wave(const rs_paths_job *job, const rs_wave_buffers *b, uint64_
     for (i = 0; i < count; ++i) {
         uint32_t pixel = job->pixel_of ? job->pixel_of[k] : k;
         rs_film_add(job->film, pixel, rs_path_result(b->paths.radiance[i], b->paths.flags[i]));
+        if (job->film->pass)
+            rs_film_add_pass(job->film, pixel, &b->paths.aux[i]);
         if (++k == npix)
             k = 0;
     }

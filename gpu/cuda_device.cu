@@ -385,8 +385,9 @@ extern "C" int rs_gpu_count(const char **why)
 }
 
 /* Every kernel of the device, for their attributes: the trace kernel, the megakernel, the
- * wavefront's, the megakernel's bounds variant, the flat trace kernel. */
-#define RS_CUDA_KERNELS (4 + RS_CUDA_WF_ENTRIES)
+ * wavefront's, the megakernel's bounds variant, the flat trace kernel, the megakernel's
+ * passes. */
+#define RS_CUDA_KERNELS (5 + RS_CUDA_WF_ENTRIES)
 static void kernel_entries(const void **fn)
 {
     int k;
@@ -396,6 +397,7 @@ static void kernel_entries(const void **fn)
         fn[2 + k] = rs_cuda_wf_entry(k);
     fn[2 + RS_CUDA_WF_ENTRIES] = rs_cuda_megakernel_b2_entry();
     fn[3 + RS_CUDA_WF_ENTRIES] = (const void *)rs_trace_flat_kernel;
+    fn[4 + RS_CUDA_WF_ENTRIES] = rs_cuda_megakernel_aux_entry();
 }
 
 /* Raises device `index`'s stack limit (per thread; the device current) to the most local memory
@@ -406,7 +408,8 @@ static rs_status size_stack(int index)
     static const char *const names[RS_CUDA_KERNELS] = {
         "rs_trace_kernel",    "rs_megakernel_kernel", "rs_wf_raygen_kernel", "rs_wf_trace_kernel",
         "rs_wf_shade_kernel", "rs_wf_resolve_kernel", "rs_wf_film_kernel",
-        "rs_wf_trace_flat_kernel", "rs_megakernel_kernel_b2", "rs_trace_flat_kernel"};
+        "rs_wf_trace_flat_kernel", "rs_wf_passes_kernel", "rs_megakernel_kernel_b2",
+        "rs_trace_flat_kernel", "rs_megakernel_aux_kernel"};
     const void *fn[RS_CUDA_KERNELS];
     cudaFuncAttributes a;
     size_t need = 0, have = 0, local[RS_CUDA_KERNELS];

@@ -77,8 +77,22 @@ __global__ void __launch_bounds__(RS_CUDA_MK_BLOCK_MAX, 2)
     megakernel_body(it, tr, sample, nsamp, radiance, counts);
 }
 
+/* With it.passes: what the camera ray of each path of the launch (thread t as above) showed,
+ * at aux[t] (rs_gpu_path_aux: the megakernel's own camera ray and first hit), a kernel apart so
+ * that the megakernel does not carry the passes' code. */
+#define RS_MK_AUX_BLOCK 256
+__global__ void __launch_bounds__(RS_MK_AUX_BLOCK)
+    rs_megakernel_aux_kernel(rs_render_consts it, rs_path_tracer tr, uint32_t sample,
+                             uint32_t nsamp, rs_path_aux *aux)
+{
+    uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
+    if (t < it.npix * nsamp)
+        aux[t] = rs_gpu_path_aux(&it, &tr, t % it.npix, sample + t / it.npix);
+}
+
 const void *rs_cuda_megakernel_entry(void) { return (const void *)rs_megakernel_kernel; }
 const void *rs_cuda_megakernel_b2_entry(void) { return (const void *)rs_megakernel_kernel_b2; }
+const void *rs_cuda_megakernel_aux_entry(void) { return (const void *)rs_megakernel_aux_kernel; }
 
 /* The kernel this process runs: RS_MEGAKERNEL_BOUNDS=2 picks the two-blocks-per-SM build. */
 static const void *megakernel_fn(void)
@@ -97,9 +111,12 @@ void rs_cuda_scene_release(rs_cuda_impl *c)
         if (sl->done)
             (void)cudaEventSynchronize(sl->done);
         (void)cudaFree(sl->d_rad);
+        (void)cudaFree(sl->d_aux);
         (void)cudaFree(sl->d_cnt);
         if (sl->h_rad)
             (void)cudaFreeHost(sl->h_rad);
+        if (sl->h_aux)
+            (void)cudaFreeHost(sl->h_aux);
         if (sl->h_cnt)
             (void)cudaFreeHost(sl->h_cnt);
         if (sl->done)
@@ -131,6 +148,11 @@ static rs_status pass_make(rs_cuda_impl *c, const rs_scene *scene, const rs_rend
         CUDA_TRY(cudaMalloc((void **)&sl->d_rad, image));
         CUDA_TRY(cudaMalloc((void **)&sl->d_cnt, sizeof *sl->d_cnt));
         CUDA_TRY(cudaHostAlloc((void **)&sl->h_rad, image, cudaHostAllocPortable));
+        if (it->passes) {
+            size_t aux = (size_t)it->npix * RS_GPU_LAUNCH_SAMPLES * sizeof(rs_path_aux);
+            CUDA_TRY(cudaMalloc((void **)&sl->d_aux, aux));
+            CUDA_TRY(cudaHostAlloc((void **)&sl->h_aux, aux, cudaHostAllocPortable));
+        }
         CUDA_TRY(cudaHostAlloc((void **)&sl->h_cnt, sizeof *sl->h_cnt, cudaHostAllocPortable));
         CUDA_TRY(cudaEventCreateWithFlags(&sl->done, cudaEventDisableTiming));
     }
@@ -177,8 +199,17 @@ static rs_status launch_sample(rs_cuda_mk *mk, rs_cuda_mk_slot *sl, uint32_t s, 
     CUDA_TRY(cudaMemsetAsync(sl->d_cnt, 0, sizeof *sl->d_cnt, stream));
     CUDA_TRY(cudaLaunchKernel(megakernel_fn(), dim3((unsigned)grid), dim3(mk->block), args, 0,
                               stream));
+    if (sl->d_aux) {
+        args[4] = &sl->d_aux;
+        CUDA_TRY(cudaLaunchKernel(rs_cuda_megakernel_aux_entry(),
+                                  dim3((unsigned)((threads + RS_MK_AUX_BLOCK - 1) / RS_MK_AUX_BLOCK)),
+                                  dim3(RS_MK_AUX_BLOCK), args, 0, stream));
+    }
     CUDA_TRY(cudaMemcpyAsync(sl->h_rad, sl->d_rad, (size_t)threads * sizeof(rs_vec3),
                              cudaMemcpyDeviceToHost, stream));
+    if (sl->d_aux)
+        CUDA_TRY(cudaMemcpyAsync(sl->h_aux, sl->d_aux, (size_t)threads * sizeof(rs_path_aux),
+                                 cudaMemcpyDeviceToHost, stream));
     CUDA_TRY(
         cudaMemcpyAsync(sl->h_cnt, sl->d_cnt, sizeof *sl->h_cnt, cudaMemcpyDeviceToHost, stream));
     CUDA_TRY(cudaEventRecord(sl->done, stream));
@@ -203,13 +234,18 @@ static rs_status finish_sample(rs_device *d, rs_cuda_mk_slot *sl, const rs_pass_
         return RS_OK;
     /* the host is otherwise idle while the GPU runs the next samples: every core adds, each
      * pixel's samples in sample order */
-    for (j = 0; j < sl->nsamp; ++j)
+    for (j = 0; j < sl->nsamp; ++j) {
         rs_film_add_image(job->film, sl->h_rad + (size_t)j * npix, rs_cpu_count());
+        if (job->film->pass && sl->h_aux)
+            rs_film_add_pass_image(job->film, sl->h_aux + (size_t)j * npix, rs_cpu_count());
+    }
     counts->closest += sl->h_cnt->closest;
     counts->shadow += sl->h_cnt->shadow;
     if (sl->h_cnt->max_bounce > counts->max_bounce)
         counts->max_bounce = sl->h_cnt->max_bounce;
     d->stats.bytes_from_device += (uint64_t)npix * sl->nsamp * sizeof(rs_vec3) + sizeof *sl->h_cnt;
+    if (sl->h_aux)
+        d->stats.bytes_from_device += (uint64_t)npix * sl->nsamp * sizeof(rs_path_aux);
     if (job->progress)
         job->progress(job->user, (uint64_t)npix * sl->nsamp);
     return RS_OK;

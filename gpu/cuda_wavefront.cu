@@ -90,6 +90,17 @@ __global__ void __launch_bounds__(RS_CUDA_WF_BLOCK_MAX)
         rs_ray_soa_set(&next, k, &nr, p);
 }
 
+/* At the camera rays' hits, where the render keeps passes: what each showed (rs_wf_passes),
+ * before the shade kernel moves its path on. */
+__global__ void __launch_bounds__(RS_CUDA_WF_BLOCK_MAX)
+    rs_wf_passes_kernel(rs_render_consts it, rs_ray_soa queue, rs_hit_soa hits, rs_paths paths,
+                        const unsigned int *alive)
+{
+    uint32_t j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j < *alive)
+        rs_wf_passes(&it, j, &queue, &hits, &paths);
+}
+
 __global__ void __launch_bounds__(RS_CUDA_WF_BLOCK_MAX)
     rs_wf_resolve_kernel(rs_ray_soa shadow, const uint8_t *occluded, rs_paths paths,
                          const unsigned int *count)
@@ -116,6 +127,7 @@ const void *rs_cuda_wf_entry(int k)
     case 3: return (const void *)rs_wf_resolve_kernel;
     case 4: return (const void *)rs_wf_film_kernel;
     case 5: return (const void *)rs_wf_trace_flat_kernel;
+    case 6: return (const void *)rs_wf_passes_kernel;
     }
     return NULL;
 }
@@ -133,7 +145,7 @@ static size_t slot_layout(char *base, uint32_t cap, rs_cuda_wf_slot *s)
 #define RS_CUT_Q1(type, name)   RS_CUT(s->queue[1].name, type, cap)
 #define RS_CUT_SH(type, name)   RS_CUT(s->shadow.name, type, cap)
 #define RS_CUT_HIT(type, name)  RS_CUT(s->hits.name, type, cap)
-    RS_PATH_FIELDS(RS_CUT_PATH)
+    RS_PATH_ALL_FIELDS(RS_CUT_PATH)
     RS_RAY_FIELDS(RS_CUT_Q0)
     RS_RAY_FIELDS(RS_CUT_Q1)
     RS_RAY_FIELDS(RS_CUT_SH)
@@ -170,10 +182,14 @@ void rs_cuda_wf_release(rs_cuda_impl *c)
     (void)cudaFree(wf->film.count);
     (void)cudaFree(wf->film.sum_l2);
     (void)cudaFree(wf->film.nonfinite);
+    (void)cudaFree(wf->film.pass);
+    (void)cudaFree(wf->film.pass_hits);
     (void)cudaFree(wf->pixel_of);
     rs_free(wf->h_sum);
     rs_free(wf->h_count);
     rs_free(wf->h_sum_l2);
+    rs_free(wf->h_pass);
+    rs_free(wf->h_pass_hits);
     memset(wf, 0, sizeof *wf);
 }
 
@@ -211,7 +227,7 @@ static uint32_t resident_of(int ordinal, const void *fn, int block)
 
 /* Everything render_paths needs, made at its first call (the film's variance words when the
  * host film first keeps them); on failure the caller releases what was made. */
-static rs_status wf_make(rs_cuda_impl *c, int l2)
+static rs_status wf_make(rs_cuda_impl *c, int l2, int passes)
 {
     rs_cuda_wf *wf = &c->wf;
     size_t npix = c->mk.it.npix;
@@ -257,6 +273,17 @@ static rs_status wf_make(rs_cuda_impl *c, int l2)
         CUDA_TRY(cudaMemset(wf->film.sum_l2, 0, 3 * npix * sizeof(rs_wf_u64)));
         if (!(wf->h_sum_l2 = (rs_wf_u64 *)rs_alloc(3 * npix, sizeof(rs_wf_u64))))
             return rs_error_set(RS_ERR_NOMEM, "out of memory for the wavefront's film");
+    }
+    if (passes && !wf->film.pass) {
+        size_t words = 2 * RS_FILM_PASSES * npix;
+        CUDA_TRY(cudaMalloc((void **)&wf->film.pass, words * sizeof(rs_wf_u64)));
+        CUDA_TRY(cudaMalloc((void **)&wf->film.pass_hits, npix * sizeof(unsigned int)));
+        CUDA_TRY(cudaMemset(wf->film.pass, 0, words * sizeof(rs_wf_u64)));
+        CUDA_TRY(cudaMemset(wf->film.pass_hits, 0, npix * sizeof(unsigned int)));
+        wf->h_pass = (rs_wf_u64 *)rs_alloc(words, sizeof(rs_wf_u64));
+        wf->h_pass_hits = (unsigned int *)rs_alloc(npix, sizeof(unsigned int));
+        if (!wf->h_pass || !wf->h_pass_hits)
+            return rs_error_set(RS_ERR_NOMEM, "out of memory for the wavefront's passes");
     }
     CUDA_TRY(cudaDeviceSynchronize()); /* the memsets ran on the legacy stream */
     return RS_OK;
@@ -319,6 +346,16 @@ static rs_status wf_segment(rs_cuda_impl *c, rs_cuda_wf_slot *s, uint32_t upper)
                      s->stream)) != RS_OK)
         return st;
     CUDA_TRY(cudaMemsetAsync(counts, 0, 2 * sizeof(unsigned int), s->stream));
+    if (s->w.bounce == 0 && c->mk.it.passes) {
+        void *pargs[5];
+        pargs[0] = &c->mk.it;
+        pargs[1] = &s->queue[s->cur];
+        pargs[2] = &s->hits;
+        pargs[3] = &s->paths;
+        pargs[4] = &alive;
+        if ((st = launch(rs_cuda_wf_entry(6), upper, wf->block[6], pargs, s->stream)) != RS_OK)
+            return st;
+    }
     sargs[0] = &c->mk.it;
     sargs[1] = &s->w;
     sargs[2] = &s->queue[s->cur];
@@ -434,6 +471,8 @@ static rs_status wf_film_out(rs_device *d, rs_cuda_impl *c, rs_film *film)
     rs_wf_film host;
     rs_film view;
     int l2 = film->sum_l2 != NULL && wf->film.sum_l2 != NULL;
+    int passes = film->pass != NULL && wf->film.pass != NULL;
+    size_t pass_words = 2 * RS_FILM_PASSES * npix;
     CUDA_TRY(cudaDeviceSynchronize());
     CUDA_TRY(cudaMemcpy(wf->h_sum, wf->film.sum, 6 * npix * sizeof(rs_wf_u64),
                         cudaMemcpyDeviceToHost));
@@ -443,6 +482,13 @@ static rs_status wf_film_out(rs_device *d, rs_cuda_impl *c, rs_film *film)
     if (l2)
         CUDA_TRY(cudaMemcpy(wf->h_sum_l2, wf->film.sum_l2, 3 * npix * sizeof(rs_wf_u64),
                             cudaMemcpyDeviceToHost));
+    if (passes) {
+        CUDA_TRY(cudaMemcpy(wf->h_pass, wf->film.pass, pass_words * sizeof(rs_wf_u64),
+                            cudaMemcpyDeviceToHost));
+        CUDA_TRY(cudaMemcpy(wf->h_pass_hits, wf->film.pass_hits, npix * sizeof(unsigned int),
+                            cudaMemcpyDeviceToHost));
+        d->stats.bytes_from_device += pass_words * sizeof(rs_wf_u64) + npix * sizeof(unsigned int);
+    }
     d->stats.bytes_from_device += npix * (6 * sizeof(rs_wf_u64) + sizeof(unsigned int)) +
                                   (l2 ? 3 * npix * sizeof(rs_wf_u64) : 0);
     CUDA_TRY(cudaMemset(wf->film.sum, 0, 6 * npix * sizeof(rs_wf_u64)));
@@ -450,11 +496,18 @@ static rs_status wf_film_out(rs_device *d, rs_cuda_impl *c, rs_film *film)
     CUDA_TRY(cudaMemset(wf->film.nonfinite, 0, sizeof(rs_wf_u64)));
     if (wf->film.sum_l2)
         CUDA_TRY(cudaMemset(wf->film.sum_l2, 0, 3 * npix * sizeof(rs_wf_u64)));
+    if (wf->film.pass) {
+        CUDA_TRY(cudaMemset(wf->film.pass, 0, pass_words * sizeof(rs_wf_u64)));
+        CUDA_TRY(cudaMemset(wf->film.pass_hits, 0, npix * sizeof(unsigned int)));
+    }
     CUDA_TRY(cudaDeviceSynchronize());
+    memset(&host, 0, sizeof host);
     host.sum = wf->h_sum;
     host.count = wf->h_count;
     host.sum_l2 = l2 ? wf->h_sum_l2 : NULL;
     host.nonfinite = &nonfinite;
+    host.pass = passes ? wf->h_pass : NULL;
+    host.pass_hits = passes ? wf->h_pass_hits : NULL;
     view = rs_wf_film_view(&host, film->width, film->height);
     return rs_film_merge(film, &view);
 }
@@ -474,7 +527,8 @@ rs_status rs_cuda_render_paths(rs_device *d, const rs_paths_job *job, uint64_t p
         return rs_error_set(RS_ERR_ARG, "device %s: the film is not the upload_scene's image size",
                             d->name);
     CUDA_TRY(cudaSetDevice(c->ordinal));
-    if ((st = wf_make(c, job->film->sum_l2 != NULL)) != RS_OK ||
+    if ((st = wf_make(c, job->film->sum_l2 != NULL, job->film->pass != NULL && c->mk.it.passes)) !=
+            RS_OK ||
         (st = wf_pixels(c, job)) != RS_OK) {
         rs_cuda_wf_release(c);
         return st;

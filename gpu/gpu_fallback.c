@@ -56,6 +56,7 @@ typedef struct fallback_impl {
     rs_device_scene scene; /* its own copy of the scene */
     rs_render_consts it;   /* the render's constants, it.scene = scene.scene */
     rs_vec3 *radiance;     /* it.npix: one pass */
+    rs_path_aux *aux;      /* it.npix: one pass's passes (it.passes), or NULL */
     int pass_ready;
     /* render_paths: the wavefront's buffers (RS_WF_FALLBACK_WAVE paths, made at the first call)
      * and its film (it.npix pixels) */
@@ -135,6 +136,8 @@ static void release_wavefront(fallback_impl *f)
     rs_free(f->film.count);
     rs_free(f->film.sum_l2);
     rs_free(f->film.nonfinite);
+    rs_free(f->film.pass);
+    rs_free(f->film.pass_hits);
     memset(&f->film, 0, sizeof f->film);
 }
 
@@ -143,7 +146,9 @@ static void release_pass(fallback_impl *f)
     release_wavefront(f);
     rs_device_scene_release(&f->scene, &rs_device_copy_host_ops);
     rs_free(f->radiance);
+    rs_free(f->aux);
     f->radiance = NULL;
+    f->aux = NULL;
     f->pass_ready = 0;
 }
 
@@ -222,7 +227,9 @@ static rs_status fallback_upload_scene(rs_device *d, const rs_scene *scene,
     f->it = *it;
     f->it.scene = f->scene.scene;
     f->radiance = (rs_vec3 *)rs_alloc(it->npix, sizeof *f->radiance);
-    if (!f->radiance) {
+    if (it->passes)
+        f->aux = (rs_path_aux *)rs_alloc(it->npix, sizeof *f->aux);
+    if (!f->radiance || (it->passes && !f->aux)) {
         release_pass(f);
         return rs_error_set(RS_ERR_NOMEM, "device %s: out of memory for a %u-pixel pass", d->name,
                             it->npix);
@@ -255,6 +262,8 @@ static void pass_pixels(void *ctx, uint32_t lo, uint32_t hi)
             break;
         }
         p->f->radiance[pixel] = rs_gpu_path_radiance(it, &p->f->scene.tracer, pixel, p->sample, &n);
+        if (p->f->aux)
+            p->f->aux[pixel] = rs_gpu_path_aux(it, &p->f->scene.tracer, pixel, p->sample);
     }
     rs_path_counts_atomic_add(&p->counts, &n);
 }
@@ -285,6 +294,8 @@ static rs_status fallback_render_pass(rs_device *d, const rs_pass_job *job, uint
         if (atomic_load(&p.stopped))
             break; /* a partial pass is left out: the film holds whole samples */
         rs_film_add_image(job->film, f->radiance, threads);
+        if (job->film->pass && f->aux)
+            rs_film_add_pass_image(job->film, f->aux, threads);
         if (job->progress)
             job->progress(job->user, npix);
     }
@@ -294,8 +305,8 @@ static rs_status fallback_render_pass(rs_device *d, const rs_pass_job *job, uint
 }
 
 /* The wavefront's buffers and film, made at the first render_paths (the film's variance words
- * when the host film first keeps them). */
-static rs_status wavefront_ready(rs_device *d, fallback_impl *f, int l2)
+ * and passes when the host film first keeps them). */
+static rs_status wavefront_ready(rs_device *d, fallback_impl *f, int l2, int passes)
 {
     size_t npix = f->it.npix;
     rs_status st;
@@ -318,6 +329,12 @@ static rs_status wavefront_ready(rs_device *d, fallback_impl *f, int l2)
     if (l2 && !f->film.sum_l2 &&
         !(f->film.sum_l2 = (rs_wf_u64 *)rs_calloc(3 * npix, sizeof *f->film.sum_l2)))
         goto nomem;
+    if (passes && !f->film.pass) {
+        f->film.pass = (rs_wf_u64 *)rs_calloc(2 * RS_FILM_PASSES * npix, sizeof *f->film.pass);
+        f->film.pass_hits = (unsigned int *)rs_calloc(npix, sizeof *f->film.pass_hits);
+        if (!f->film.pass || !f->film.pass_hits)
+            goto nomem;
+    }
     return RS_OK;
 nomem:
     st = rs_error_set(RS_ERR_NOMEM, "device %s: out of memory for the wavefront", d->name);
@@ -352,6 +369,11 @@ static void run_wave(fallback_impl *f, int threads, rs_wf_wave *w, rs_path_count
         counts->closest += alive;
         if (w->bounce > counts->max_bounce)
             counts->max_bounce = w->bounce;
+        if (w->bounce == 0 && it->passes) {
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && alive >= RS_WF_FALLBACK_PAR_MIN)
+            for (i = 0; i < (long)alive; ++i)
+                rs_wf_passes(it, (uint32_t)i, &f->queue[cur], &f->wf_hits, &f->paths);
+        }
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256) if (threads > 1 && alive >= RS_WF_FALLBACK_PAR_MIN)
         for (i = 0; i < (long)alive; ++i) {
             rs_ray nr, sr;
@@ -398,7 +420,8 @@ static rs_status fallback_render_paths(rs_device *d, const rs_paths_job *job, ui
     if (job->film->width * job->film->height != f->it.npix)
         return rs_error_set(RS_ERR_ARG, "device %s: the film is not the upload_scene's image size",
                             d->name);
-    if ((st = wavefront_ready(d, f, job->film->sum_l2 != NULL)) != RS_OK)
+    if ((st = wavefront_ready(d, f, job->film->sum_l2 != NULL,
+                              job->film->pass != NULL && f->it.passes)) != RS_OK)
         return st;
     memset(&w, 0, sizeof w);
     w.pixel_of = job->pixel_of; /* host memory is the fallback's own */
@@ -417,11 +440,17 @@ static rs_status fallback_render_paths(rs_device *d, const rs_paths_job *job, ui
     view = rs_wf_film_view(&f->film, job->film->width, job->film->height);
     if (!job->film->sum_l2)
         view.sum_l2 = NULL;
+    if (!job->film->pass)
+        view.pass = NULL;
     st = rs_film_merge(job->film, &view);
     memset(f->film.sum, 0, 6 * (size_t)f->it.npix * sizeof *f->film.sum);
     memset(f->film.count, 0, (size_t)f->it.npix * sizeof *f->film.count);
     if (f->film.sum_l2)
         memset(f->film.sum_l2, 0, 3 * (size_t)f->it.npix * sizeof *f->film.sum_l2);
+    if (f->film.pass) {
+        memset(f->film.pass, 0, 2 * RS_FILM_PASSES * (size_t)f->it.npix * sizeof *f->film.pass);
+        memset(f->film.pass_hits, 0, (size_t)f->it.npix * sizeof *f->film.pass_hits);
+    }
     *f->film.nonfinite = 0;
     return st;
 }

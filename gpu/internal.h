@@ -37,8 +37,9 @@
  * to ptxas (no minimum of blocks per SM). */
 #define RS_CUDA_WF_BLOCK_MAX 256
 /* The wavefront's kernels: 0 raygen, 1 trace, 2 shade, 3 resolve, 4 film, 5 the trace kernel
- * for geometry without instances (accel/trace.h rs_trace_one_flat). */
-#define RS_CUDA_WF_ENTRIES 6
+ * for geometry without instances (accel/trace.h rs_trace_one_flat), 6 the film's passes at the
+ * camera rays' hits. */
+#define RS_CUDA_WF_ENTRIES 7
 
 /* Cuts `count` elements of `type` for `ptr` at byte `off` of the block at `base` (NULL: only
  * measures), each array 256-byte aligned: the staging sets' and the wavefront slots' layouts. */
@@ -72,10 +73,11 @@ typedef struct rs_cuda_mk_counts {
     unsigned int max_bounce;
 } rs_cuda_mk_counts;
 
-/* One slot of the megakernel's double buffer: sample `sample` is traced into d_rad, copied to
- * h_rad with its counters, and `done` is recorded after the copies. */
+/* One slot of the megakernel's double buffer: sample `sample` is traced into d_rad (and d_aux),
+ * copied to h_rad (h_aux) with its counters, and `done` is recorded after the copies. */
 typedef struct rs_cuda_mk_slot {
     rs_vec3 *d_rad, *h_rad;
+    rs_path_aux *d_aux, *h_aux; /* with it.passes: what each path's camera ray showed */
     rs_cuda_mk_counts *d_cnt, *h_cnt;
     cudaEvent_t done;
     uint32_t sample, nsamp; /* samples [sample, sample + nsamp) */
@@ -114,6 +116,8 @@ typedef struct rs_cuda_wf {
     int block[RS_CUDA_WF_ENTRIES]; /* threads per block of each kernel (rs_cuda_wf_entry order) */
     rs_wf_film film;
     rs_wf_u64 *h_sum, *h_sum_l2; /* the film copied back */
+    rs_wf_u64 *h_pass;           /* its passes copied back (with film.pass) */
+    unsigned int *h_pass_hits;
     unsigned int *h_count;
     uint32_t *pixel_of, pixel_cap; /* the plan's pixels on the device */
     uint64_t plan_id;
@@ -143,7 +147,7 @@ rs_status rs_cuda_render_pass(rs_device *d, const rs_pass_job *job, uint32_t s0,
                               rs_path_counts *counts);
 void rs_cuda_scene_release(rs_cuda_impl *c);
 /* gpu/cuda_wavefront.cu: render_paths (scheduler/device.h), the release of what it made, and its
- * kernels' entry points (0 raygen, 1 trace, 2 shade, 3 resolve, 4 film; NULL past them). */
+ * kernels' entry points (RS_CUDA_WF_ENTRIES' order; NULL past them). */
 rs_status rs_cuda_render_paths(rs_device *d, const rs_paths_job *job, uint64_t p0, uint64_t p1,
                                uint64_t *done, rs_path_counts *counts);
 void rs_cuda_wf_release(rs_cuda_impl *c);
@@ -152,5 +156,6 @@ const void *rs_cuda_wf_entry(int k);
  * from it and the trace kernel). */
 const void *rs_cuda_megakernel_entry(void);
 const void *rs_cuda_megakernel_b2_entry(void); /* the two-blocks-per-SM build of it */
+const void *rs_cuda_megakernel_aux_entry(void); /* its passes' kernel */
 
 #endif

@@ -13,6 +13,7 @@
 
 #include "accel/bvh_traverse.h"
 #include "scheduler/device_copy.h"
+#include "shading/aov.h"
 #include "shading/path.h"
 
 /* Path (pixel, sample) traced on `tr` (device pointers on the GPU); its rays added to *n. */
@@ -37,6 +38,20 @@ RS_HD rs_vec3 rs_gpu_path_radiance(const rs_render_consts *it, const rs_path_tra
         if (!(made & RS_SHADE_NEXT))
             return rs_path_result(p.ps.radiance, p.ps.flags);
     }
+}
+
+/* What path (pixel, sample)'s camera ray shows at its first hit, for the film's passes: the
+ * camera ray and its closest hit as rs_gpu_path_radiance traces them (the same bits), then
+ * rs_path_aux_at.  Its own kernel on the GPU, so that the megakernel does not carry the
+ * passes' code. */
+RS_HD rs_path_aux rs_gpu_path_aux(const rs_render_consts *it, const rs_path_tracer *tr,
+                                  uint32_t pixel, uint32_t sample)
+{
+    rs_path p;
+    rs_hit h;
+    rs_path_start(it, pixel, sample, &p);
+    rs_bvh_closest(&tr->bvh, &tr->geom, p.ray, &h);
+    return rs_path_aux_at(it, &p.ray, &h, &p.ps);
 }
 
 #endif

@@ -10,6 +10,7 @@
  *   raygen (once)   rs_wf_raygen: the camera ray of slot i into queue[0][i]
  *   trace-closest   rs_trace_one over the current queue (accel/trace.h, the trace kernel's body;
  *                   rs_trace_one_flat where the scene has no instances)
+ *   passes          rs_wf_passes, at the camera rays' hits where the render keeps passes
  *   shade           rs_wf_shade: shading/path.h's rs_path_shade_at, the very code the CPU stream
  *                   engine's shade stage and every megakernel run; the caller appends the next
  *                   ray to the other queue and the shadow ray to the shadow queue (an atomic
@@ -18,12 +19,15 @@
  *   trace-shadow    rs_trace_one over the shadow queue
  *   resolve         rs_wf_resolve: an unoccluded shadow ray's pending light onto its path
  *   (compaction is the appending: the next queue holds only live paths)
- *   film (once)     rs_wf_film_add of each slot's rs_path_result into the device's film
+ *   film (once)     rs_wf_film_add of each slot's rs_path_result into the device's film (and,
+ *                   where the render keeps passes, rs_wf_film_add_pass of what rs_wf_passes
+ *                   recorded)
  *
  * The film (rs_wf_film) keeps shading/film.c's exact sums in the same bytes: per channel a
  * 128-bit two's complement integer of film units as two 64-bit words (low first, the layout of
  * rs_film_sum), per pixel a 32-bit count and, when the host film tracks variance, the 192-bit sum
- * of squared luminances (rs_film_sq), and the non-finite count.  Samples are added with 64-bit
+ * of squared luminances (rs_film_sq), when it keeps passes their sums and hit counts, and the
+ * non-finite count.  Samples are added with 64-bit
  * atomic adds that carry into the next word: integer addition is associative, so the sums do not
  * depend on the order the threads add in, and the film merges into the host's with
  * rs_film_merge as any film does — the CPU stream engine's image, bit for bit. */
@@ -33,6 +37,7 @@
 #include <math.h>
 
 #include "accel/trace.h"
+#include "shading/aov.h"
 #include "shading/film.h"
 #include "shading/path.h"
 #include "streams/paths.h"
@@ -46,6 +51,9 @@ typedef struct rs_wf_film {
     unsigned int *count;  /* per pixel */
     rs_wf_u64 *sum_l2;    /* 3 per pixel (rs_film_sq's words), or NULL */
     rs_wf_u64 *nonfinite; /* one */
+    rs_wf_u64 *pass;      /* 2 RS_FILM_PASSES per pixel (rs_film's passes: channel c's low word at
+                             2 (RS_FILM_PASSES p + c)), or NULL */
+    unsigned int *pass_hits; /* per pixel, with `pass` */
 } rs_wf_film;
 
 /* The plan's map and the wave's place in it. */
@@ -140,6 +148,36 @@ RS_HD void rs_wf_film_add(const rs_wf_film *f, uint32_t pixel, rs_vec3 c)
     }
 }
 
+/* One component of a pass onto its sum: shading/film.c's pass_fixed (zero where not finite or
+ * beyond RS_FILM_MAX_SAMPLE). */
+RS_HD void rs_wf_pass_add(rs_wf_u64 *s, float x)
+{
+    rs_wf_u64 lo, hi;
+    if (!(fabsf(x) <= (float)RS_FILM_MAX_SAMPLE))
+        return;
+    rs_wf_fixed(x, &lo, &hi);
+    rs_wf_add128(s, lo, hi);
+}
+
+/* shading/film.c's rs_film_add_pass onto the device's film. */
+RS_HD void rs_wf_film_add_pass(const rs_wf_film *f, uint32_t pixel, const rs_path_aux *a)
+{
+    rs_wf_u64 *s = &f->pass[2 * RS_FILM_PASSES * (size_t)pixel];
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_ALBEDO], a->albedo.x);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_ALBEDO + 2], a->albedo.y);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_ALBEDO + 4], a->albedo.z);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_NORMAL], a->normal.x);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_NORMAL + 2], a->normal.y);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_NORMAL + 4], a->normal.z);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_EMISSION], a->emission.x);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_EMISSION + 2], a->emission.y);
+    rs_wf_pass_add(&s[2 * RS_FILM_PASS_EMISSION + 4], a->emission.z);
+    if (fabsf(a->depth) <= (float)RS_FILM_MAX_SAMPLE) {
+        rs_wf_pass_add(&s[2 * RS_FILM_PASS_DEPTH], a->depth);
+        (void)RS_ATOMIC_ADD_U32(&f->pass_hits[pixel], 1u);
+    }
+}
+
 /* Slot i of the wave: its camera ray into queue[i] (path i), its state reset. */
 RS_HD void rs_wf_raygen(const rs_render_consts *it, const rs_wf_wave *w, uint32_t i,
                         const rs_paths *paths, const rs_ray_soa *queue)
@@ -149,6 +187,19 @@ RS_HD void rs_wf_raygen(const rs_render_consts *it, const rs_wf_wave *w, uint32_
     rs_ray ray = rs_path_begin_at(it, rs_wf_pixel(w, g), (uint32_t)(g / w->n_active), NULL, &ps);
     rs_ray_soa_set(queue, i, &ray, i);
     rs_paths_store(paths, i, &ps);
+}
+
+/* Entry j of the first queue at its camera ray's hit (before rs_wf_shade moves it on): what the
+ * ray showed, for the film's passes (it->passes), into its path's aux record.  A stage of its own
+ * (a kernel on the GPU), so that the shade kernel does not carry the passes' code. */
+RS_HD void rs_wf_passes(const rs_render_consts *it, uint32_t j, const rs_ray_soa *queue,
+                        const rs_hit_soa *hits, const rs_paths *paths)
+{
+    uint32_t p = queue->path[j];
+    rs_ray r = rs_ray_soa_get(queue, j);
+    rs_hit h = rs_hit_soa_get(hits, j);
+    rs_path_state ps = rs_paths_load(paths, p);
+    paths->aux[p] = rs_path_aux_at(it, &r, &h, &ps);
 }
 
 /* Entry j of the current queue shaded at its hit (segment w->bounce): the path's state stored
@@ -183,8 +234,10 @@ RS_HD void rs_wf_resolve(uint32_t k, const rs_ray_soa *shadow, const uint8_t *oc
 /* Slot i's finished path onto the film. */
 RS_HD void rs_wf_film_path(const rs_wf_wave *w, uint32_t i, const rs_paths *paths, const rs_wf_film *f)
 {
-    rs_wf_film_add(f, rs_wf_pixel(w, w->start + i),
-                   rs_path_result(paths->radiance[i], paths->flags[i]));
+    uint32_t pixel = rs_wf_pixel(w, w->start + i);
+    rs_wf_film_add(f, pixel, rs_path_result(paths->radiance[i], paths->flags[i]));
+    if (f->pass)
+        rs_wf_film_add_pass(f, pixel, &paths->aux[i]);
 }
 
 /* The device film as an rs_film over the same bytes (host memory), for rs_film_merge. */
@@ -197,6 +250,8 @@ static inline rs_film rs_wf_film_view(const rs_wf_film *f, uint32_t width, uint3
     v.count = (uint32_t *)f->count;
     v.sum_l2 = (rs_film_sq *)(void *)f->sum_l2;
     v.nonfinite = *f->nonfinite;
+    v.pass = (rs_film_sum *)(void *)f->pass;
+    v.pass_hits = (uint32_t *)f->pass_hits;
     return v;
 }
 

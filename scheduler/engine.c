@@ -62,6 +62,7 @@ rs_status rs_render_constants(const rs_scene *scene, const rs_render_settings *s
     it->sampling = (uint32_t)st->sampling;
     it->sampler = (uint32_t)st->sampler;
     it->light_sampler = st->light_sampler;
+    it->passes = st->passes ? 1u : 0u;
     if (st->filter.width > 0.0f)
         it->filter = st->filter;
     else if (!rs_filter_make(RS_FILTER_BOX, 1.0f, &it->filter))
@@ -173,6 +174,11 @@ static rs_status check_plan(const rs_engine *e, const rs_work_plan *p, const rs_
     if (film->width != e->st.width || film->height != e->st.height)
         return rs_error_set(RS_ERR_ARG, "film is %ux%u but the render is %ux%u", film->width,
                             film->height, e->st.width, e->st.height);
+    if (!e->it.passes != !film->pass)
+        return rs_error_set(RS_ERR_ARG, e->it.passes ? "the render writes passes the film does "
+                                                       "not keep (rs_film_keep_passes)"
+                                                     : "the film keeps passes the render does "
+                                                       "not write (settings.passes)");
     if (p->pixels && (p->n_pixels == 0 || p->n_pixels > e->it.npix))
         return rs_error_set(RS_ERR_ARG, "a plan over %u of %u pixels", p->n_pixels, e->it.npix);
     if (p->todo.n && p->todo.r[p->todo.n - 1][1] > n * e->st.spp)

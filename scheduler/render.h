@@ -63,6 +63,8 @@ typedef struct rs_render_settings {
                                  pixel */
     uint32_t texture_filter;  /* rs_texture_filter (shading/texture.h); zeroed: trilinear */
     uint32_t light_sampler;   /* rs_light_sampler (shading/light_sampler.h); zeroed: by power */
+    uint32_t passes;          /* 1: the devices write the film's passes (shading/film.h; the
+                                 film must keep them: rs_film_keep_passes) */
     uint32_t wave_paths;      /* paths in flight; 0: auto (one CPU device: RS_RENDER_HOST_WAVE
                                  per thread on one core, RS_RENDER_HOST_WAVE_FREE per thread
                                  on more; RS_RENDER_DEFAULT_WAVE with a GPU or several

@@ -123,10 +123,14 @@ static void flush_range(void *ctx, uint32_t begin, uint32_t end)
 {
     const flush_ctx *f = (const flush_ctx *)ctx;
     uint32_t k, i;
+    const rs_paths *ps = &f->sl->b.paths;
     for (k = begin; k < end; ++k)
-        for (i = k; i < f->sl->count; i += f->npix)
-            rs_film_add(f->film, rs_path_map_pixel(f->map, f->sl->start + i),
-                        rs_path_result(f->sl->b.paths.radiance[i], f->sl->b.paths.flags[i]));
+        for (i = k; i < f->sl->count; i += f->npix) {
+            uint32_t pixel = rs_path_map_pixel(f->map, f->sl->start + i);
+            rs_film_add(f->film, pixel, rs_path_result(ps->radiance[i], ps->flags[i]));
+            if (f->film->pass)
+                rs_film_add_pass(f->film, pixel, &ps->aux[i]);
+        }
 }
 
 /* The wave onto the film in path order (run only for the next wave in wave order). */

@@ -78,9 +78,11 @@ static void pdev_loop(pdev_ctx *p)
     job.film = own;
     job.cancelled = paths_cancelled;
     job.user = c;
-    /* the device's film keeps the variance sums when the run's does */
+    /* the device's film keeps the variance sums and the passes when the run's does */
     if (own != c->film && c->film->sum_l2 && !own->sum_l2)
         p->status = rs_film_track_variance(own);
+    if (p->status == RS_OK && own != c->film && c->film->pass && !own->pass)
+        p->status = rs_film_keep_passes(own);
     while (p->status == RS_OK && rs_run_take(c, p->k, per, &lo, &n)) {
         uint64_t done = 0;
         double t0 = rs_now_s(), t1;

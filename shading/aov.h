@@ -1,13 +1,14 @@
 /* shading/aov.h — the auxiliary images (AOVs) written beside the beauty image as EXR layers:
- * the first hit's albedo, shading normal and distance, averaged over the pixel's first samples
- * (the very camera rays the render traced first), and the samples each pixel got.  What a
- * denoiser (Intel Open Image Denoise, OptiX) takes with the beauty image, and what a compositor
- * wants for depth.
+ * the first hit's albedo, shading normal and distance, what the camera sees emitted, averaged
+ * over the pixel's samples, and the samples each pixel got.  What a denoiser (Intel Open Image
+ * Denoise, OptiX) takes with the beauty image, and what a compositor wants for depth.
  *
- * They are made in a pass of their own after the render, on host threads, with the host BVH:
- * camera rays and their first hits only, so a few percent of one sample's work.  Being a
- * function of the scene, the settings and the seed only, they are the same for any device set,
- * and for a render resumed from a checkpoint. */
+ * They are written by the devices as they render, as Cycles' denoising passes: each path's
+ * first vertex (rs_path_aux_at, on every device: the host's stages, the CPU's and the GPU's
+ * wavefronts, the megakernels) records what its camera ray showed, and the film adds it to its
+ * passes (shading/film.h) with the path's sample, in exact sums.  So they are the render's own
+ * samples, the same bits on any device set, under mpirun and for a render resumed from a
+ * checkpoint. */
 #ifndef RS_SHADING_AOV_H
 #define RS_SHADING_AOV_H
 
@@ -19,9 +20,6 @@
 #define RS_AOV_DEPTH   4u /* "depth" (Z): distance from the camera to the first hit; inf: none */
 #define RS_AOV_SAMPLES 8u /* "samples" (Y): the samples the pixel got */
 #define RS_AOV_ALL     15u
-
-/* Samples per pixel the albedo, normal and depth average over (at most the render's spp). */
-#define RS_AOV_SPP 16u
 
 /* What the first hit of camera ray r (hit h) gives: the material's albedo there (an emitter's
  * emission held to [0, 1]; the background's radiance, held likewise, for a miss), the shading
@@ -95,38 +93,40 @@ RS_HD rs_vec3 rs_path_first_emission(const rs_render_consts *it, const rs_ray *r
     return rs_path_result(rs_v3_mul(ps->throughput, le), ps->flags);
 }
 
-/* Camera samples per pixel for rs_aov_emission's better estimate where the direct emission has
+/* What the camera ray r of a path (its state ps as rs_path_begin_at left it) showed at its first
+ * hit h, for the film's passes: rs_path_aov and rs_path_first_emission together.  Every path
+ * step's first vertex calls it where the render keeps passes (it->passes), on every device,
+ * before shading moves the path on. */
+RS_HD rs_path_aux rs_path_aux_at(const rs_render_consts *it, const rs_ray *r, const rs_hit *h,
+                                 const rs_path_state *ps)
+{
+    rs_path_aux a;
+    rs_path_aov(it, r, h, &a.albedo, &a.normal, &a.depth);
+    a.emission = rs_path_first_emission(it, r, h, ps);
+    return a;
+}
+
+/* Camera samples per pixel for rs_aov_refine's better estimate where the direct emission has
  * an edge (an emitter's outline, the horizon against a sky). */
 #define RS_AOV_EMISSION_SPP 256u
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-/* The AOVs `which` (RS_AOV_* but SAMPLES) of the render whose constants are `it`, traced through
- * `bvh` over `g` (host arrays, attached: rs_bvh_attach) on `threads` host threads: each pixel's
- * first min(spp, RS_AOV_SPP) camera rays.  albedo and normal: 3 floats a pixel, depth: 1 (each
- * may be NULL when not asked for); row-major from the top-left. */
-void rs_aov_render(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
-                   uint32_t spp, int threads, float *albedo, float *normal, float *depth);
-
-/* The direct emission of a render (rs_path_first_emission: what the camera sees emitted, the
- * background included), per pixel, two ways (w*h*3 floats each, row-major from the top-left):
- *   e_render: the mean over the very samples the render took: samples 0 .. count[p]-1 of pixel p
- *     (count: the film's per-pixel counts; NULL: spp for every pixel).  Up to rounding, the share
- *     of the beauty image its camera rays' first hits added, so beauty - e_render is the light
- *     that arrived by reflection.
- *   e_fine: the same integral estimated better: where the direct emission has an edge within
- *     the filter's reach (a pixel's neighbourhood of radius ceil(width/2) + 1 holds samples that
- *     differ by more than 5% of its brightest), from RS_AOV_EMISSION_SPP Sobol camera samples of
- *     its own (fewer when edges cover much of the image: at most 64 a pixel on average; none
- *     when the render took as many); elsewhere e_render (a flat emitter, an empty background,
- *     geometry that emits nothing: the render's samples already agree).
- * Only camera rays and their first hits (with the host BVH, on `threads` host threads), as
- * rs_aov_render.  Returns how many pixels got the better estimate.  --denoise keeps both out of
- * the denoiser: core/denoise.h rs_denoise_split. */
-size_t rs_aov_emission(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
-                       const uint32_t *count, uint32_t spp, int threads, float *e_render,
-                       float *e_fine);
+/* The direct emission's better estimate (--denoise keeps it out of the denoiser and adds this
+ * back: core/denoise.h rs_denoise_split).  e_render: the emission pass of the render's film
+ * (rs_film_resolve_passes: the mean over the very samples the render took, w*h*3 floats); into
+ * e_fine (the same size) the same integral estimated better where the direct emission has an
+ * edge within the filter's reach (a pixel's neighbourhood of radius ceil(width/2) + 1 whose
+ * means differ by more than 5% of its brightest): from RS_AOV_EMISSION_SPP Sobol camera samples
+ * of its own (fewer when edges cover much of the image: at most 64 a pixel on average; none
+ * where the render took as many, count[p]); elsewhere e_render (a flat emitter, an empty
+ * background, geometry that emits nothing: the render's samples already agree).  Camera rays
+ * and their first hits only, through `bvh` over `g` (host arrays, attached: rs_bvh_attach) on
+ * `threads` host threads: an estimate of its own, with numbers of its own, so the same for any
+ * device set.  Returns how many pixels got the better estimate. */
+size_t rs_aov_refine(const rs_render_consts *it, const rs_bvh_view *bvh, const rs_geom *g,
+                     const uint32_t *count, int threads, const float *e_render, float *e_fine);
 #ifdef __cplusplus
 }
 #endif

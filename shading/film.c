@@ -36,6 +36,8 @@ void rs_film_destroy(rs_film *f)
     rs_free(f->sum);
     rs_free(f->count);
     rs_free(f->sum_l2);
+    rs_free(f->pass);
+    rs_free(f->pass_hits);
     rs_free(f);
 }
 
@@ -112,12 +114,105 @@ rs_status rs_film_track_variance(rs_film *f)
     return RS_OK;
 }
 
+rs_status rs_film_keep_passes(rs_film *f)
+{
+    size_t n = (size_t)f->width * f->height;
+    if (f->pass)
+        return RS_OK;
+    f->pass = (rs_film_sum *)rs_calloc(n * RS_FILM_PASSES, sizeof *f->pass);
+    f->pass_hits = (uint32_t *)rs_calloc(n, sizeof *f->pass_hits);
+    if (!f->pass || !f->pass_hits) {
+        rs_free(f->pass);
+        rs_free(f->pass_hits);
+        f->pass = NULL;
+        f->pass_hits = NULL;
+        return rs_error_set(RS_ERR_NOMEM, "out of memory for the film's passes (%ux%u)", f->width,
+                            f->height);
+    }
+    return RS_OK;
+}
+
+/* x in film units, or zero where it is not finite or beyond RS_FILM_MAX_SAMPLE. */
+static inline rs_film_sum pass_fixed(float x)
+{
+    return fabsf(x) <= (float)RS_FILM_MAX_SAMPLE ? to_fixed(x) : 0;
+}
+
+void rs_film_add_pass(rs_film *f, uint32_t pixel, const rs_path_aux *a)
+{
+    rs_film_sum *s = &f->pass[RS_FILM_PASSES * (size_t)pixel];
+    s[RS_FILM_PASS_ALBEDO] += pass_fixed(a->albedo.x);
+    s[RS_FILM_PASS_ALBEDO + 1] += pass_fixed(a->albedo.y);
+    s[RS_FILM_PASS_ALBEDO + 2] += pass_fixed(a->albedo.z);
+    s[RS_FILM_PASS_NORMAL] += pass_fixed(a->normal.x);
+    s[RS_FILM_PASS_NORMAL + 1] += pass_fixed(a->normal.y);
+    s[RS_FILM_PASS_NORMAL + 2] += pass_fixed(a->normal.z);
+    s[RS_FILM_PASS_EMISSION] += pass_fixed(a->emission.x);
+    s[RS_FILM_PASS_EMISSION + 1] += pass_fixed(a->emission.y);
+    s[RS_FILM_PASS_EMISSION + 2] += pass_fixed(a->emission.z);
+    if (fabsf(a->depth) <= (float)RS_FILM_MAX_SAMPLE) {
+        s[RS_FILM_PASS_DEPTH] += to_fixed(a->depth);
+        f->pass_hits[pixel]++;
+    }
+}
+
+typedef struct add_pass_ctx {
+    rs_film *film;
+    const rs_path_aux *aux;
+} add_pass_ctx;
+
+static void add_pass_range(void *ctx, uint32_t lo, uint32_t hi)
+{
+    const add_pass_ctx *a = (const add_pass_ctx *)ctx;
+    uint32_t i;
+    for (i = lo; i < hi; ++i)
+        rs_film_add_pass(a->film, i, &a->aux[i]);
+}
+
+void rs_film_add_pass_image(rs_film *f, const rs_path_aux *aux, int threads)
+{
+    add_pass_ctx a;
+    a.film = f;
+    a.aux = aux;
+    rs_parallel_range(RS_PAR_FOR_DYNAMIC, threads, 0, f->width * f->height, 16384, add_pass_range,
+                      &a);
+}
+
+void rs_film_resolve_passes(const rs_film *f, float *albedo, float *normal, float *emission,
+                            float *depth)
+{
+    size_t i, c, n = (size_t)f->width * f->height;
+    for (i = 0; i < n; ++i) {
+        const rs_film_sum *s = f->pass ? &f->pass[RS_FILM_PASSES * i] : NULL;
+        double inv = f->count[i] ? 1.0 / f->count[i] : 0.0, v[3], l;
+        for (c = 0; c < 3; ++c) {
+            if (albedo)
+                albedo[3 * i + c] = s ? (float)(from_fixed(s[RS_FILM_PASS_ALBEDO + c]) * inv) : 0.0f;
+            if (emission)
+                emission[3 * i + c] =
+                    s ? (float)(from_fixed(s[RS_FILM_PASS_EMISSION + c]) * inv) : 0.0f;
+            v[c] = s ? from_fixed(s[RS_FILM_PASS_NORMAL + c]) : 0.0;
+        }
+        if (normal) { /* the mean's direction: the sum's */
+            l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            for (c = 0; c < 3; ++c)
+                normal[3 * i + c] = l > 0.0 ? (float)(v[c] / l) : 0.0f;
+        }
+        if (depth)
+            depth[i] = s && f->pass_hits[i]
+                           ? (float)(from_fixed(s[RS_FILM_PASS_DEPTH]) / f->pass_hits[i])
+                           : INFINITY;
+    }
+}
+
 rs_status rs_film_merge(rs_film *dst, const rs_film *src)
 {
     size_t i, n = (size_t)dst->width * dst->height;
     if (src->width != dst->width || src->height != dst->height)
         return rs_error_set(RS_ERR_ARG, "merging a %ux%u film into a %ux%u one", src->width,
                             src->height, dst->width, dst->height);
+    if (dst->pass && !src->pass) /* its samples would lack their passes */
+        return rs_error_set(RS_ERR_ARG, "merging a film without passes into one that keeps them");
     for (i = 0; i < 3 * n; ++i)
         dst->sum[i] += src->sum[i];
     for (i = 0; i < n; ++i)
@@ -125,6 +220,12 @@ rs_status rs_film_merge(rs_film *dst, const rs_film *src)
     if (dst->sum_l2 && src->sum_l2)
         for (i = 0; i < n; ++i)
             sq_add(&dst->sum_l2[i], &src->sum_l2[i]);
+    if (dst->pass && src->pass) {
+        for (i = 0; i < RS_FILM_PASSES * n; ++i)
+            dst->pass[i] += src->pass[i];
+        for (i = 0; i < n; ++i)
+            dst->pass_hits[i] += src->pass_hits[i];
+    }
     dst->nonfinite += src->nonfinite;
     return RS_OK;
 }
@@ -136,6 +237,10 @@ void rs_film_clear(rs_film *f)
     memset(f->count, 0, n * sizeof *f->count);
     if (f->sum_l2)
         memset(f->sum_l2, 0, n * sizeof *f->sum_l2);
+    if (f->pass) {
+        memset(f->pass, 0, RS_FILM_PASSES * n * sizeof *f->pass);
+        memset(f->pass_hits, 0, n * sizeof *f->pass_hits);
+    }
     f->nonfinite = 0;
 }
 

@@ -17,6 +17,7 @@
 
 #include "core/status.h"
 #include "core/vec3.h"
+#include "streams/paths.h"
 
 #define RS_FILM_SCALE      0x1p40 /* film units per unit of radiance (2^40) */
 #define RS_FILM_MAX_SAMPLE 0x1p48 /* larger radiances count as non-finite */
@@ -43,7 +44,22 @@ typedef struct rs_film {
                            rs_film_track_variance asked for it */
     uint64_t nonfinite; /* samples that were NaN, infinite or beyond RS_FILM_MAX_SAMPLE:
                            counted, contributed zero */
+    /* The passes (NULL unless rs_film_keep_passes asked for them): what each sample's camera
+     * ray showed at its first hit (streams/paths.h rs_path_aux), written by the devices as they
+     * render, exact sums as `sum` is, so that they merge in any order too.  RS_FILM_PASSES per
+     * pixel: albedo (RS_FILM_PASS_ALBEDO, 3), shading normal (RS_FILM_PASS_NORMAL, 3), the
+     * direct emission (RS_FILM_PASS_EMISSION, 3: rs_path_first_emission, its share of the
+     * pixel) and the distance (RS_FILM_PASS_DEPTH, 1; misses add nothing); pass_hits: per
+     * pixel, the samples whose camera ray hit something (the distance's divisor). */
+    rs_film_sum *pass;
+    uint32_t *pass_hits;
 } rs_film;
+
+#define RS_FILM_PASS_ALBEDO   0
+#define RS_FILM_PASS_NORMAL   3
+#define RS_FILM_PASS_EMISSION 6
+#define RS_FILM_PASS_DEPTH    9
+#define RS_FILM_PASSES        10
 
 #ifdef __cplusplus
 extern "C" {
@@ -57,9 +73,10 @@ void rs_film_add(rs_film *f, uint32_t pixel, rs_vec3 radiance);
 void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads);
 /* Adds every sample of `src` (the same size) to `dst`: sums, counts and the non-finite count;
  * the squared-luminance sums only where both films keep them.  RS_ERR_ARG on a size mismatch.
- * Exact: merging films in any order gives the same film. */
+ * The passes likewise where both films keep them; RS_ERR_ARG where only `dst` does.  Exact: merging films in any order gives the
+ * same film. */
 rs_status rs_film_merge(rs_film *dst, const rs_film *src);
-/* Clears every sum and count (and the non-finite count). */
+/* Clears every sum and count (and the non-finite count), the passes too. */
 void rs_film_clear(rs_film *f);
 /* Pixel `pixel`'s channel sums as doubles (rounded once). */
 void rs_film_pixel_sum(const rs_film *f, uint32_t pixel, double out[3]);
@@ -76,6 +93,20 @@ double rs_film_rel_error(const rs_film *f, uint32_t pixel);
 /* Pixel `pixel`'s sum of squared luminances as a double (rounded; 0 without
  * rs_film_track_variance). */
 double rs_film_pixel_sq(const rs_film *f, uint32_t pixel);
+/* From now on keep the passes (`pass`, `pass_hits`): on an empty film. */
+rs_status rs_film_keep_passes(rs_film *f);
+/* Adds one sample's passes to pixel `pixel` (a film that keeps them; the sample itself is added
+ * by rs_film_add): components beyond +-RS_FILM_MAX_SAMPLE or not finite add zero, a depth that
+ * is not finite (a miss) adds nothing. */
+void rs_film_add_pass(rs_film *f, uint32_t pixel, const rs_path_aux *a);
+/* rs_film_add_pass for every pixel, aux[pixel] (the megakernel's pass), on `threads` threads. */
+void rs_film_add_pass_image(rs_film *f, const rs_path_aux *aux, int threads);
+/* The passes as images (each NULL when not wanted; a film without passes writes zeros):
+ * albedo, normal and emission 3 floats a pixel, depth 1; row-major from the top-left.  Each the
+ * mean over the pixel's samples, but the normal: the mean's direction (zero where every sample
+ * missed), and the depth: the mean over the samples that hit (infinity where none did). */
+void rs_film_resolve_passes(const rs_film *f, float *albedo, float *normal, float *emission,
+                            float *depth);
 /* Fewest samples any pixel has. */
 uint32_t rs_film_min_count(const rs_film *f);
 /* The samples on the film, every pixel's together. */

@@ -2,6 +2,7 @@
  * integrator.h); the
  * estimators themselves are shading/path.h's. */
 #include "shading/integrator.h"
+#include "shading/aov.h"
 #include "shading/shade_wide.h"
 
 #include <string.h>
@@ -150,6 +151,20 @@ typedef struct shade_ctx {
 
 #define RS_NO_WIDE 0xffffffffu
 
+/* Entries [b, b + n) at the camera rays' hits: what each showed, for the film's passes, before
+ * shading moves the paths on. */
+static void record_passes(const shade_ctx *c, uint32_t b, uint32_t n)
+{
+    uint32_t j;
+    for (j = b; j < b + n; ++j) {
+        uint32_t p = c->rays->path[j];
+        rs_ray r = rs_ray_soa_get(c->rays, j);
+        rs_hit h = rs_hit_soa_get(c->hits, j);
+        rs_path_state ps = rs_paths_load(c->paths, p);
+        c->paths->aux[p] = rs_path_aux_at(c->it, &r, &h, &ps);
+    }
+}
+
 /* Shades the entries [begin, end) in order; their next rays go packed to next[begin ...] and
  * their shadow rays to shadow[begin ...], the counts to the range's run record. */
 static void shade_range(void *ctx, uint32_t begin, uint32_t end)
@@ -165,6 +180,8 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
         rs_ray wide_next[BATCH], wide_shadow[BATCH];
         uint8_t wide_made[BATCH];
         locate(c->map, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
+        if (c->bounce == 0 && c->it->passes)
+            record_passes(c, b, n);
         if (draws) {
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_BSDF, n, rb);
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);

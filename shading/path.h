@@ -87,6 +87,8 @@ typedef struct rs_render_consts {
                            distance, for image textures' level of detail (rs_texture_footprint);
                            0: bilinear textures on level 0 (--texture-filter bilinear) */
     uint32_t light_sampler; /* rs_light_sampler: how MIS's next-event estimation picks a light */
+    uint32_t passes; /* 1: each path's first vertex records what its camera ray showed for the
+                        film's passes (shading/aov.h rs_path_aux_at, shading/film.h) */
 } rs_render_consts;
 
 /* The Sobol samplers' numbers of group `group` in the order the decisions take them: the

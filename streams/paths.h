@@ -25,6 +25,21 @@
     X(uint8_t, flags)      /* RS_PATH_* (shading/path.h) */
 /* clang-format on */
 
+/* What a path's camera ray showed at its first hit, for the film's passes (shading/film.h;
+ * made by shading/aov.h rs_path_aux_at): kept beside the path's state, not in RS_PATH_FIELDS,
+ * since it is written once (at the first hit, when the render keeps passes) and read once (by
+ * the film), so the per-vertex loads and stores do not carry it. */
+typedef struct rs_path_aux {
+    rs_vec3 albedo;   /* the material's reflectance there, textured (held to [0, 1]) */
+    rs_vec3 normal;   /* the shading normal, world space, toward the eye; zero for a miss */
+    rs_vec3 emission; /* what the pixel's sample took there unweighted: the direct emission */
+    float depth;      /* distance from the camera; infinity for a miss */
+} rs_path_aux;
+
+/* The arrays every wave's paths hold: the state, then the passes' record (one rs_path_aux a
+ * path).  Allocation and the device copies' layouts go over this list. */
+#define RS_PATH_ALL_FIELDS(X) RS_PATH_FIELDS(X) X(rs_path_aux, aux)
+
 #define RS_PATH_DECLARE_FIELD(type, name) type name;
 #define RS_PATH_DECLARE_ARRAY(type, name) type *name;
 
@@ -35,7 +50,7 @@ typedef struct rs_path_state {
 
 /* The state of a wave's paths (SoA, indexed by path slot). */
 typedef struct rs_paths {
-    RS_PATH_FIELDS(RS_PATH_DECLARE_ARRAY)
+    RS_PATH_ALL_FIELDS(RS_PATH_DECLARE_ARRAY)
     uint32_t capacity;
 } rs_paths;
 

@@ -62,7 +62,7 @@ void rs_host_free(const rs_host_allocator *a, void *p)
 RS_DEFINE_SOA(ray_soa, rs_ray_soa, RS_RAY_FIELDS, "rays")
 RS_DEFINE_SOA(hit_soa, rs_hit_soa, RS_HIT_FIELDS, "hits")
 /* path state: rs_paths_init_in / rs_paths_free_in are internal, the plain pair is paths.h's */
-RS_DEFINE_SOA(paths, rs_paths, RS_PATH_FIELDS, "paths")
+RS_DEFINE_SOA(paths, rs_paths, RS_PATH_ALL_FIELDS, "paths")
 
 void rs_ray_soa_copy(rs_ray_soa *dst, uint32_t to, const rs_ray_soa *src, uint32_t from)
 {

@@ -1,10 +1,10 @@
 /* streams/wave.h — every buffer one wave of paths needs, allocated once per render (nothing per
  * chunk or per bounce).  Per path slot: two extension-ray streams (current and next, ping-pong),
  * the shadow rays, the hits, the occlusion byte, the shade stage's run records (three words,
- * streams/stream.h) and the path state: 40 + 40 + 40 + 16 + 1 + 12 + 45 = 194 B.  The streams a
- * device reads and writes (the extension rays, the shadow rays, the hits and the occlusion
- * bytes) come from the allocator given (a GPU's page-locked host memory); the rest from
- * rs_alloc. */
+ * streams/stream.h), the path state and the passes' record (streams/paths.h rs_path_aux):
+ * 40 + 40 + 40 + 16 + 1 + 12 + 45 + 40 = 234 B.  The streams a device reads and writes (the
+ * extension rays, the shadow rays, the hits and the occlusion bytes) come from the allocator
+ * given (a GPU's page-locked host memory); the rest from rs_alloc. */
 #ifndef RS_STREAMS_WAVE_H
 #define RS_STREAMS_WAVE_H
 

@@ -1662,6 +1662,73 @@ static void test_aov_layers(void **state)
     }
 }
 
+/* The --aov layers with --checkpoint and --resume: the film's passes travel in the checkpoint, so
+ * a 3-spp render resumed to 8 (on the CPU, and on CPU + GPU, the fallback here) has every layer
+ * of the uninterrupted 8-spp render bit for bit; a checkpoint made without --aov cannot give
+ * them (one line, a usage error, no image), and one made with them resumes without --aov to the
+ * plain image. */
+static void test_aov_resume(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+#define AOV "--width", "40", "--height", "30", "-q", "--aov", "all"
+    static const char *const full[] = {"render", AOV, "--spp", "8", "-o", "full.exr", NULL};
+    static const char *const part[] = {"render", AOV, "--spp", "3", "--checkpoint", "a.ckpt",
+                                       "-o", "part.exr", NULL};
+    static const char *const cpu[] = {"render", AOV, "--resume", "a.ckpt", "--spp", "8",
+                                      "--devices", "cpu", "-o", "r1.exr", NULL};
+    static const char *const mixed[] = {"render", AOV, "--resume", "a.ckpt", "--spp", "8",
+                                        "--devices", "cpu:1,gpu", "-o", "r2.exr", NULL};
+    static const char *const plain_part[] = {"render", "--width", "40", "--height", "30", "-q",
+                                             "--spp", "3", "--checkpoint", "p.ckpt", "-o",
+                                             "pp.exr", NULL};
+    static const char *const want_aov[] = {"render", AOV, "--resume", "p.ckpt", "--spp", "8",
+                                           "-o", "no.exr", NULL};
+    static const char *const plain_full[] = {"render", "--width", "40", "--height", "30", "-q",
+                                             "--spp", "8", "-o", "pf.exr", NULL};
+    static const char *const no_aov[] = {"render", "--width", "40", "--height", "30", "-q",
+                                         "--resume", "a.ckpt", "--spp", "8", "-o", "r3.exr", NULL};
+#undef AOV
+    static const char *const chans[] = {"R",        "G",        "B",        "albedo.R",
+                                        "albedo.G", "albedo.B", "normal.X", "normal.Y",
+                                        "normal.Z", "depth.Z",  "samples.Y"};
+    static const char *const outs[] = {"r1.exr", "r2.exr"};
+    char path[256];
+    uint32_t w, h;
+    size_t k, o;
+    proc p;
+    run_expect(f, full, 0, &p);
+    proc_free(&p);
+    run_expect(f, part, 0, &p);
+    proc_free(&p);
+    run_expect(f, cpu, 0, &p);
+    proc_free(&p);
+    run_expect(f, mixed, 0, &p);
+    for (o = 0; o < 2; ++o)
+        for (k = 0; k < sizeof chans / sizeof chans[0]; ++k) {
+            float *a = read_channel(&p, f, "full.exr", chans[k], &w, &h);
+            float *b = read_channel(&p, f, outs[o], chans[k], &w, &h);
+            EXPECT(&p, memcmp(a, b, 40 * 30 * sizeof(float)) == 0,
+                   "%s of the render resumed to %s is not the uninterrupted render's", chans[k],
+                   outs[o]);
+            rs_free(a);
+            rs_free(b);
+        }
+    proc_free(&p);
+    run_expect(f, plain_part, 0, &p);
+    proc_free(&p);
+    run(&p, f->dir, DEFAULT_TIMEOUT_S, want_aov);
+    path_in(f, "no.exr", path, sizeof path);
+    EXPECT(&p, exited_with(&p, 2) && one_line(&p.err) && strstr(p.err.data, "without the passes"),
+           "--aov resumed from a checkpoint without passes: one usage line");
+    EXPECT(&p, !file_exists(path), "the refused resume wrote an image");
+    proc_free(&p);
+    run_expect(f, plain_full, 0, &p);
+    proc_free(&p);
+    run_expect(f, no_aov, 0, &p);
+    expect_same_image(&p, f, "pf.exr", "r3.exr");
+    proc_free(&p);
+}
+
 /* --adaptive: pixels stop at different sample counts (the samples layer shows them, from 16 to
  * the --spp), the summary says so, and the image is the same on cpu:1,gpu. */
 static void test_adaptive(void **state)
@@ -1965,6 +2032,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_checkpoint_refused, setup, teardown),
         cmocka_unit_test_setup_teardown(test_exr_metadata, setup, teardown),
         cmocka_unit_test_setup_teardown(test_aov_layers, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_aov_resume, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive_resume, setup, teardown),
         cmocka_unit_test_setup_teardown(test_resume_flattened, setup, teardown),

@@ -24,8 +24,11 @@
  *   - --adaptive (rank 0 decides each round from the merged film) with 2 and 3 ranks and odd
  *     pass sizes, after a rank died in an early round, and stopped by the time limit with a
  *     checkpoint resumed on one process and under mpirun: the one-process adaptive image;
- *   - options the job cannot honour (--aov) and a bad RS_MPI_FAULT are refused by rank 0
- *     alone, in one line. */
+ *   - --aov all --denoise under 2 ranks (the film's passes written on every rank, sent with
+ *     its film): every channel of the EXR (the denoised beauty, the raw one, albedo, normal,
+ *     depth, samples) is the one-process file's bit for bit (--aov all alone where OIDN is
+ *     missing);
+ *   - a bad RS_MPI_FAULT is refused by rank 0 alone, in one line. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -562,34 +565,89 @@ static void test_adaptive_stop_keeps_checkpoint(void **state)
     proc_free(&p);
 }
 
-static void test_unsupported_options(void **state)
+/* Channel `ch` of `a` and of `b` (files in f's folder) the same, bit for bit. */
+static void expect_same_channel(const proc *p, const fixture *f, const char *a, const char *b,
+                                const char *ch)
+{
+    char pa[256], pb[256];
+    float *da = NULL, *db = NULL;
+    uint32_t wa = 0, ha = 0, wb = 0, hb = 0;
+    path_in(f, a, pa, sizeof pa);
+    path_in(f, b, pb, sizeof pb);
+    EXPECT(p, rs_image_read_channel(pa, ch, &wa, &ha, &da) == RS_OK, "%s has no channel %s", a,
+           ch);
+    EXPECT(p, rs_image_read_channel(pb, ch, &wb, &hb, &db) == RS_OK, "%s has no channel %s", b,
+           ch);
+    EXPECT(p, wa == wb && ha == hb && memcmp(da, db, (size_t)wa * ha * sizeof(float)) == 0,
+           "channel %s of %s is not the one-process render's", ch, b);
+    rs_free(da);
+    rs_free(db);
+}
+
+static void test_aov_denoise_same_image(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const args[] = {"render", "builtin:cornell", "--aov", "albedo", "-q",
+    static const char *const chans[] = {"R",        "G",        "B",        "albedo.R",
+                                        "albedo.G", "albedo.B", "normal.X", "normal.Y",
+                                        "normal.Z", "depth.Z",  "samples.Y", "noisy.R",
+                                        "noisy.G",  "noisy.B"};
+    static const char *const with[] = {"render", "builtin:cornell", "--width", SIZE, "--height",
+                                       SIZE, "--spp", "8", "--aov", "all", "--denoise", "-q",
                                        NULL};
+    static const char *const without[] = {"render", "builtin:cornell", "--width", SIZE,
+                                          "--height", SIZE, "--spp", "8", "--aov", "all", "-q",
+                                          NULL};
+    const char *const *args = with;
+    const char *argv[MAX_ARGS + 1];
+    size_t n_chans = sizeof chans / sizeof chans[0], k;
+    int i;
+    proc p;
+    for (i = 0; with[i]; ++i)
+        argv[i] = with[i];
+    argv[i++] = "-o";
+    argv[i++] = "one.exr";
+    argv[i] = NULL;
+    run(&p, f->dir, TIMEOUT_S, argv);
+    if (exited_with(&p, 1) && strstr(p.err.data, "raystream: --denoise: ")) {
+        printf("  no OIDN here (%.*s): --aov all alone\n", (int)strcspn(p.err.data, "\n"),
+               p.err.data);
+        args = without;
+        n_chans -= 3; /* no raw layer beside a denoised beauty */
+        one_process(f, without, "one.exr");
+    } else {
+        EXPECT(&p, exited_with(&p, 0), "the one-process render with --aov all --denoise failed");
+    }
+    proc_free(&p);
+    for (i = 0; args[i]; ++i)
+        argv[i] = args[i];
+    argv[i++] = "-o";
+    argv[i++] = "many.exr";
+    argv[i] = NULL;
+    mpirun(&p, f, 2, 0, argv);
+    EXPECT(&p, exited_with(&p, 0), "mpirun -n 2 with --aov all%s failed",
+           args == with ? " --denoise" : "");
+    for (k = 0; k < n_chans; ++k)
+        expect_same_channel(&p, f, "one.exr", "many.exr", chans[k]);
+    printf("  --aov all%s under 2 ranks: %zu channels the one-process render's\n",
+           args == with ? " --denoise" : "", n_chans);
+    proc_free(&p);
+}
+
+static void test_bad_fault(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const plain[] = {"render", "builtin:cornell", "-q", NULL};
     proc p;
     const char *s;
     int lines = 0;
-    mpirun(&p, f, 2, 0, args);
-    EXPECT(&p, !exited_with(&p, 0), "--aov under mpirun was not refused");
+    setenv("RS_MPI_FAULT", "die:0:x", 1);
+    mpirun(&p, f, 2, 0, plain);
+    setenv("RS_MPI_FAULT", "", 1);
     for (s = strstr(p.err.data, "raystream:"); s; s = strstr(s + 1, "raystream:"))
         ++lines;
-    EXPECT(&p, lines == 1 && strstr(p.err.data, "--aov"),
-           "not one line from rank 0 naming --aov (%d lines)", lines);
+    EXPECT(&p, !exited_with(&p, 0) && lines == 1 && strstr(p.err.data, "RS_MPI_FAULT"),
+           "a bad RS_MPI_FAULT is not one line (%d lines)", lines);
     proc_free(&p);
-    /* a bad fault spec: one line too */
-    {
-        static const char *const plain[] = {"render", "builtin:cornell", "-q", NULL};
-        setenv("RS_MPI_FAULT", "die:0:x", 1);
-        mpirun(&p, f, 2, 0, plain);
-        setenv("RS_MPI_FAULT", "", 1);
-        lines = 0;
-        for (s = strstr(p.err.data, "raystream:"); s; s = strstr(s + 1, "raystream:"))
-            ++lines;
-        EXPECT(&p, !exited_with(&p, 0) && lines == 1 && strstr(p.err.data, "RS_MPI_FAULT"),
-               "a bad RS_MPI_FAULT is not one line (%d lines)", lines);
-        proc_free(&p);
-    }
 }
 
 static void asan_full_unwind(void)
@@ -632,7 +690,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_time_limit_whole_passes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_ctrl_c_stops_every_rank, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive_stop_keeps_checkpoint, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_unsupported_options, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_aov_denoise_same_image, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_bad_fault, setup, teardown),
     };
     find_mpi();
     if (g_skip[0]) {

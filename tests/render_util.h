@@ -43,6 +43,9 @@ typedef struct rt_args {
     rs_adaptive adaptive;            /* threshold > 0: rs_render_adaptive (the stream integrator) */
     rs_adaptive_stats *adaptive_out; /* its statistics, where not NULL */
     uint32_t *counts_out;            /* where not NULL: each pixel's samples (width * height) */
+    float *passes_out; /* where not NULL: the render writes the film's passes, resolved here as
+                          four planes of n = width * height pixels: albedo [0, 3n), normal
+                          [3n, 6n), emission [6n, 9n) (3 floats a pixel), depth [9n, 10n) */
     const rs_filter *filter;         /* the pixel filter; NULL: box, 1 pixel */
     uint32_t light_sampler;          /* rs_light_sampler; zeroed: by power */
     int wavefront; /* the GPU device (fallback_only: alone; with_fallback: beside the CPU device,
@@ -170,9 +173,11 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     cfg.chunk_size = a->chunk_size;
     /* with the wavefront beside it, the scheduler has the CPU device alone */
     if (rs_sched_create(devs, a->wavefront && n == 2 ? 1 : n, &cfg, &sched) != RS_OK ||
-        rs_film_create(a->width, a->height, &film) != RS_OK)
+        rs_film_create(a->width, a->height, &film) != RS_OK ||
+        (a->passes_out && rs_film_keep_passes(film) != RS_OK))
         goto out;
     st = rt_settings(a);
+    st.passes = a->passes_out != NULL;
     st.waves_in_flight = a->waves;
     st.threads = a->threads;
     st.cores = budget;
@@ -222,6 +227,11 @@ static inline float *rt_render_scene(const rs_scene *scene, const rt_args *a,
     rs_film_resolve(film, rgb);
     if (a->counts_out)
         memcpy(a->counts_out, film->count, (size_t)a->width * a->height * sizeof *film->count);
+    if (a->passes_out) {
+        size_t np = (size_t)a->width * a->height;
+        rs_film_resolve_passes(film, a->passes_out, a->passes_out + 3 * np,
+                               a->passes_out + 6 * np, a->passes_out + 9 * np);
+    }
     if (stats_out)
         *stats_out = stats;
     ok = 1;
