@@ -12,11 +12,16 @@
 #include "core/file.h"
 #include "core/intersect.h"
 #include "shading/integrator.h"
+#include "shading/light_sampler.h"
+#include "shading/texture.h"
 
 static const char k_magic[8] = {'R', 'S', 'C', 'K', 'P', 'T', '\r', '\n'};
 
 #define FIXED_HEADER   92u /* up to and including the scene name's length */
 #define NAME_MAX_BYTES 4096u
+#define SETTINGS_MAX   8192u /* the settings block's bytes (version 7) */
+#define FLAG_ADAPTIVE  1u
+#define FLAG_PASSES    2u
 #define FNV_OFFSET     14695981039346656037ull
 #define FNV_PRIME      1099511628211ull
 
@@ -96,49 +101,63 @@ static uint64_t get64(const unsigned char *p)
  * header_max(held)). */
 static size_t header_max(const rs_path_ranges *held)
 {
-    return FIXED_HEADER + NAME_MAX_BYTES + 8 + 16 * (size_t)held->n;
+    return FIXED_HEADER + NAME_MAX_BYTES + 8 + 16 * (size_t)held->n + 8 + SETTINGS_MAX;
 }
 
+/* The filter word of versions 2 and 4 for the settings img. */
+static uint32_t filter_word(const rs_image_settings *img)
+{
+    return rs_checkpoint_filter_code(&img->filter, img->texture_filter == RS_TEXTURE_TRILINEAR) |
+           (img->light_sampler == RS_LIGHT_SAMPLER_BVH ? RS_CHECKPOINT_LIGHT_BVH : 0u);
+}
+
+/* The header (version 7) into h; its length, or 0 when the settings block does not fit. */
 static size_t make_header(unsigned char *h, const rs_checkpoint_key *key,
                           const rs_path_ranges *held, uint64_t nonfinite, int passes)
 {
-    size_t name_len = strlen(key->scene), at;
+    const rs_image_settings *img = &key->img;
+    size_t name_len = strlen(key->scene), at, block;
     uint64_t paths = rs_path_ranges_total(held);
     uint32_t u[10];
     int i;
     if (name_len >= NAME_MAX_BYTES)
         name_len = NAME_MAX_BYTES - 1;
     memcpy(h, k_magic, 8);
-    put32(h + 8, key->adaptive_threshold > 0
-                     ? (passes ? RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES : RS_CHECKPOINT_VERSION_ADAPTIVE)
-                     : (passes ? RS_CHECKPOINT_VERSION_PASSES : RS_CHECKPOINT_VERSION));
-    put32(h + 12, (uint32_t)(FIXED_HEADER + name_len + 8 + 16 * (size_t)held->n));
+    put32(h + 8, RS_CHECKPOINT_VERSION);
     put64(h + 16, key->scene_hash);
-    put64(h + 24, key->seed);
+    put64(h + 24, img->seed);
     put64(h + 32, paths);
     put64(h + 40, nonfinite);
-    u[0] = key->width;
-    u[1] = key->height;
-    u[2] = key->spp;
-    u[3] = key->max_depth;
-    u[4] = key->rr_depth;
-    u[5] = key->sampling;
-    u[6] = key->sampler;
-    u[7] = key->isect_sphere;
-    u[8] = key->isect_tri;
-    u[9] = key->isect_aabb;
+    u[0] = img->width;
+    u[1] = img->height;
+    u[2] = img->spp;
+    u[3] = img->max_depth;
+    u[4] = img->rr_depth;
+    u[5] = (uint32_t)img->sampling;
+    u[6] = (uint32_t)img->sampler;
+    u[7] = img->isect_sphere;
+    u[8] = img->isect_tri;
+    u[9] = img->isect_aabb;
     for (i = 0; i < 10; ++i)
         put32(h + 48 + 4 * i, u[i]);
     put32(h + 88, (uint32_t)name_len);
     memcpy(h + FIXED_HEADER, key->scene, name_len);
     at = FIXED_HEADER + name_len;
     put32(h + at, held->n);
-    put32(h + at + 4, key->filter);
+    put32(h + at + 4, filter_word(img));
     for (i = 0; i < (int)held->n; ++i) {
         put64(h + at + 8 + 16 * (size_t)i, held->r[i][0]);
         put64(h + at + 16 + 16 * (size_t)i, held->r[i][1]);
     }
-    return at + 8 + 16 * (size_t)held->n;
+    at += 8 + 16 * (size_t)held->n;
+    put32(h + at, (img->adaptive > 0 ? FLAG_ADAPTIVE : 0u) | (passes ? FLAG_PASSES : 0u));
+    block = rs_image_settings_block(img, (char *)h + at + 8, SETTINGS_MAX);
+    if (block == 0)
+        return 0;
+    put32(h + at + 4, (uint32_t)block);
+    at += 8 + block;
+    put32(h + 12, (uint32_t)at);
+    return at;
 }
 
 /* fwrite of n bytes, folded into the checksum. */
@@ -155,8 +174,8 @@ static void make_adaptive(unsigned char *q, const rs_checkpoint_key *key,
                           const rs_adaptive_state *ad)
 {
     memset(q, 0, ADAPTIVE_FIXED);
-    memcpy(q, &key->adaptive_threshold, 8);
-    put32(q + 8, key->adaptive_min_spp);
+    memcpy(q, &key->img.adaptive, 8);
+    put32(q + 8, key->img.adaptive_min_spp);
     put32(q + 12, ad->n);
     put32(q + 16, ad->step);
     put32(q + 20, ad->stats.rounds);
@@ -190,6 +209,13 @@ static int write_file(const char *path, const char *staged, int rename_now,
         return 0;
     }
     n = make_header(header, key, held, film->nonfinite, film->pass != NULL);
+    if (n == 0) {
+        fprintf(stderr, "raystream: --checkpoint %s: the settings do not fit its header\n", path);
+        fclose(f);
+        unlink(staged);
+        free(header);
+        return 0;
+    }
     if (ad) /* no ranges: the paths held are the film's samples */
         put64(header + 32, rs_film_samples(film));
     ok = put(f, header, n, &sum) && put(f, film->sum, npix * 3 * sizeof *film->sum, &sum) &&
@@ -293,39 +319,45 @@ static void filter_code_name(uint32_t code, char *buf, size_t n)
              code & RS_CHECKPOINT_LIGHT_BVH ? "bvh" : "power");
 }
 
-/* The header against `want`.  Returns RS_EXIT_OK or the exit code after one line. */
-static int check_header(const char *path, const unsigned char *h, const char *name, uint64_t end,
-                        rs_checkpoint_key *want)
+/* A checkpoint being read: its header and what the header says. */
+typedef struct reader {
+    const char *path;
+    FILE *f;
+    uint64_t size, sum; /* the file's size; the checksum of what was read */
+    unsigned char *h;   /* the header */
+    char name[NAME_MAX_BYTES];
+    size_t hdr, name_len;
+    uint32_t version, n_ranges;
+    int adaptive, passes; /* what the version (7: its flags) says the file holds */
+    const char *block;    /* version 7: the settings block (in h), block_len bytes */
+    size_t block_len;
+    uint64_t end; /* the last range's end */
+} reader;
+
+/* The settings of a file of version 2 or 4 (fixed fields and the filter word) against `want`.
+ * Returns RS_EXIT_OK or the exit code after one line. */
+static int check_legacy(const char *path, const unsigned char *h, const rs_image_settings *want)
 {
     uint32_t u[10];
     int i;
     for (i = 0; i < 10; ++i)
         u[i] = get32(h + 48 + 4 * i);
-    /* the size was compared before the film was read */
-    if (get64(h + 16) != want->scene_hash) {
-        fprintf(stderr,
-                "raystream: --resume %s: made for another scene (%s; its content hash %016llx, "
-                "this scene %s has %016llx)\n",
-                path, name, (unsigned long long)get64(h + 16), want->scene,
-                (unsigned long long)want->scene_hash);
-        return RS_EXIT_USAGE;
-    }
     if (get64(h + 24) != want->seed)
         return mismatch_u(path, "--seed", get64(h + 24), want->seed);
     if (u[3] != want->max_depth)
         return mismatch_u(path, "--max-depth", u[3], want->max_depth);
     if (u[4] != want->rr_depth)
         return mismatch_u(path, "Russian roulette depth", u[4], want->rr_depth);
-    if (u[5] != want->sampling)
+    if (u[5] != (uint32_t)want->sampling)
         return mismatch_s(path, "--sampling", rs_sampling_name((rs_sampling)u[5]),
-                          rs_sampling_name((rs_sampling)want->sampling));
-    if (u[6] != want->sampler)
+                          rs_sampling_name(want->sampling));
+    if (u[6] != (uint32_t)want->sampler)
         return mismatch_s(path, "--sampler", rs_sampler_name((rs_sampler)u[6]),
-                          rs_sampler_name((rs_sampler)want->sampler));
-    if (get32(h + FIXED_HEADER + get32(h + 88) + 4) != want->filter) {
+                          rs_sampler_name(want->sampler));
+    if (get32(h + FIXED_HEADER + get32(h + 88) + 4) != filter_word(want)) {
         char a[80], b[80];
         filter_code_name(get32(h + FIXED_HEADER + get32(h + 88) + 4), a, sizeof a);
-        filter_code_name(want->filter, b, sizeof b);
+        filter_code_name(filter_word(want), b, sizeof b);
         return mismatch_s(path, "--filter / --texture-filter / --light-sampler", a, b);
     }
     if (u[7] != want->isect_sphere)
@@ -337,16 +369,45 @@ static int check_header(const char *path, const unsigned char *h, const char *na
     if (u[9] != want->isect_aabb)
         return mismatch_s(path, "--isect-aabb", rs_isect_aabb_algo_name(u[9]),
                           rs_isect_aabb_algo_name(want->isect_aabb));
-    if (want->spp == 0)
-        want->spp = u[2];
+    return RS_EXIT_OK;
+}
+
+/* The header against `want`: the scene, the settings (version 7: its block, row for row), the
+ * spp.  Returns RS_EXIT_OK or the exit code after one line. */
+static int check_header(const reader *r, rs_checkpoint_key *want)
+{
+    const char *path = r->path;
+    const unsigned char *h = r->h;
+    uint32_t spp = get32(h + 56);
+    rs_image_settings *img = &want->img;
+    int rc;
+    /* the size was compared before the film was read */
+    if (get64(h + 16) != want->scene_hash) {
+        fprintf(stderr,
+                "raystream: --resume %s: made for another scene (%s; its content hash %016llx, "
+                "this scene %s has %016llx)\n",
+                path, r->name, (unsigned long long)get64(h + 16), want->scene,
+                (unsigned long long)want->scene_hash);
+        return RS_EXIT_USAGE;
+    }
+    if (r->version == RS_CHECKPOINT_VERSION) {
+        char option[64], a[RS_SETTING_TEXT + 48], b[RS_SETTING_TEXT + 48];
+        if (!rs_image_settings_match(img, r->block, r->block_len, option, sizeof option, a, b,
+                                     sizeof a))
+            return mismatch_s(path, option, a, b);
+    } else if ((rc = check_legacy(path, h, img)) != RS_EXIT_OK) {
+        return rc;
+    }
+    if (img->spp == 0)
+        img->spp = spp;
     /* zsobol's points depend on spp: its sequence cannot be continued to another count */
-    if (want->sampler == RS_SAMPLER_ZSOBOL && u[2] != want->spp)
-        return mismatch_u(path, "--spp (the zsobol sampler's points depend on it)", u[2],
-                          want->spp);
-    if (end > (uint64_t)want->width * want->height * want->spp) {
+    if (img->sampler == RS_SAMPLER_ZSOBOL && spp != img->spp)
+        return mismatch_u(path, "--spp (the zsobol sampler's points depend on it)", spp,
+                          img->spp);
+    if (r->end > (uint64_t)img->width * img->height * img->spp) {
         char a[48], b[48];
-        snprintf(a, sizeof a, "%llu", (unsigned long long)end);
-        snprintf(b, sizeof b, "%u", want->spp);
+        snprintf(a, sizeof a, "%llu", (unsigned long long)r->end);
+        snprintf(b, sizeof b, "%u", img->spp);
         return refuse(RS_EXIT_USAGE, path, "holds paths up to %s, more than --spp %s asks for", a,
                       b);
     }
@@ -379,42 +440,46 @@ static int counts_agree(const rs_film *film, const rs_path_ranges *held)
     return ok;
 }
 
-/* A checkpoint being read: its header and what the header says. */
-typedef struct reader {
-    const char *path;
-    FILE *f;
-    uint64_t size, sum; /* the file's size; the checksum of what was read */
-    unsigned char *h;   /* the header */
-    char name[NAME_MAX_BYTES];
-    size_t hdr, name_len;
-    uint32_t version, n_ranges;
-    int adaptive, passes; /* what the version says the file holds */
-    uint64_t end; /* the last range's end */
-} reader;
 
-/* The fixed header, the scene name and the ranges.  RS_EXIT_OK or RS_EXIT_RUNTIME after one
- * line. */
+/* Version 7's flags and settings block after the ranges (at r->h + at), read into r->h. */
+static int read_settings(reader *r, size_t at)
+{
+    uint32_t flags, len;
+    if (fread(r->h + at, 1, 8, r->f) != 8)
+        return 0;
+    flags = get32(r->h + at);
+    len = get32(r->h + at + 4);
+    if ((flags & ~(FLAG_ADAPTIVE | FLAG_PASSES)) || len >= SETTINGS_MAX ||
+        r->hdr != at + 8 + len || fread(r->h + at + 8, 1, len, r->f) != len)
+        return 0;
+    r->adaptive = (flags & FLAG_ADAPTIVE) != 0;
+    r->passes = (flags & FLAG_PASSES) != 0;
+    r->block = (const char *)r->h + at + 8;
+    r->block_len = len;
+    return 1;
+}
+
+/* The fixed header, the scene name, the ranges and (version 7) the settings.  RS_EXIT_OK or
+ * RS_EXIT_RUNTIME after one line. */
 static int read_header(reader *r)
 {
     const int rc = RS_EXIT_RUNTIME;
     uint64_t prev = 0;
     uint32_t k;
+    size_t at;
     if (r->size < FIXED_HEADER + 8 || fread(r->h, 1, FIXED_HEADER, r->f) != FIXED_HEADER)
         return refuse(rc, r->path, "truncated: not a raystream checkpoint (%s%s)",
                       r->size < FIXED_HEADER + 8 ? "too short" : "cannot read", "");
     if (memcmp(r->h, k_magic, 8) != 0)
         return refuse(rc, r->path, "not a raystream checkpoint (no RSCKPT magic)%s%s", "", "");
     r->version = get32(r->h + 8);
-    r->adaptive = r->version == RS_CHECKPOINT_VERSION_ADAPTIVE ||
-                  r->version == RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES;
-    r->passes = r->version == RS_CHECKPOINT_VERSION_PASSES ||
-                r->version == RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES;
-    if (r->version != RS_CHECKPOINT_VERSION && !r->adaptive && !r->passes) {
+    r->adaptive = r->version == RS_CHECKPOINT_VERSION_ADAPTIVE;
+    if (r->version != RS_CHECKPOINT_VERSION && r->version != RS_CHECKPOINT_VERSION_PLAIN &&
+        r->version != RS_CHECKPOINT_VERSION_ADAPTIVE) {
         char v[16], want_v[24];
         snprintf(v, sizeof v, "%u", r->version);
-        snprintf(want_v, sizeof want_v, "%u, %u, %u and %u", RS_CHECKPOINT_VERSION,
-                 RS_CHECKPOINT_VERSION_ADAPTIVE, RS_CHECKPOINT_VERSION_PASSES,
-                 RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES);
+        snprintf(want_v, sizeof want_v, "%u, %u and %u", RS_CHECKPOINT_VERSION_PLAIN,
+                 RS_CHECKPOINT_VERSION_ADAPTIVE, RS_CHECKPOINT_VERSION);
         return refuse(rc, r->path, "checkpoint version %s; this raystream reads versions %s", v,
                       want_v);
     }
@@ -427,10 +492,14 @@ static int read_header(reader *r)
     memcpy(r->name, r->h + FIXED_HEADER, r->name_len);
     r->name[r->name_len] = '\0';
     r->n_ranges = get32(r->h + FIXED_HEADER + r->name_len);
+    at = FIXED_HEADER + r->name_len + 8 + 16 * (size_t)r->n_ranges;
     if (r->n_ranges > RS_CHECKPOINT_MAX_RANGES ||
-        (r->adaptive && r->n_ranges != 0) ||
-        r->hdr != FIXED_HEADER + r->name_len + 8 + 16 * (size_t)r->n_ranges ||
+        (r->version == RS_CHECKPOINT_VERSION ? r->hdr < at + 8 : r->hdr != at) ||
         fread(r->h + FIXED_HEADER + r->name_len + 8, 16, r->n_ranges, r->f) != r->n_ranges)
+        return refuse(rc, r->path, "corrupt header (the list of paths held)%s%s", "", "");
+    if (r->version == RS_CHECKPOINT_VERSION && !read_settings(r, at))
+        return refuse(rc, r->path, "corrupt header (its settings)%s%s", "", "");
+    if (r->adaptive && r->n_ranges != 0)
         return refuse(rc, r->path, "corrupt header (the list of paths held)%s%s", "", "");
     for (k = 0; k < r->n_ranges; ++k) {
         const unsigned char *q = r->h + FIXED_HEADER + r->name_len + 8 + 16 * (size_t)k;
@@ -465,10 +534,10 @@ static int check_size(const reader *r, const rs_checkpoint_key *want, size_t npi
         return refuse(RS_EXIT_RUNTIME, r->path,
                       "%s bytes where its header makes %s: truncated or corrupt", a, b);
     }
-    if ((uint64_t)fw * fh != npix || fw != want->width) {
+    if ((uint64_t)fw * fh != npix || fw != want->img.width) {
         char a[32], b[32];
         snprintf(a, sizeof a, "%ux%u", fw, fh);
-        snprintf(b, sizeof b, "%ux%u", want->width, want->height);
+        snprintf(b, sizeof b, "%ux%u", want->img.width, want->img.height);
         return mismatch_s(r->path, "size", a, b);
     }
     return RS_EXIT_OK;
@@ -548,11 +617,11 @@ static int take_adaptive(const reader *r, const unsigned char *q, const rs_check
     size_t i, npix = (size_t)film->width * film->height;
     double t;
     memcpy(&t, q, 8);
-    if (t != want->adaptive_threshold || get32(q + 8) != want->adaptive_min_spp) {
+    if (t != want->img.adaptive || get32(q + 8) != want->img.adaptive_min_spp) {
         char a[48], b[48];
         snprintf(a, sizeof a, "%g and --adaptive-min-spp %u", t, get32(q + 8));
-        snprintf(b, sizeof b, "%g and --adaptive-min-spp %u", want->adaptive_threshold,
-                 want->adaptive_min_spp);
+        snprintf(b, sizeof b, "%g and --adaptive-min-spp %u", want->img.adaptive,
+                 want->img.adaptive_min_spp);
         return mismatch_s(r->path, "--adaptive", a, b);
     }
     ad->n = get32(q + 12);
@@ -565,7 +634,7 @@ static int take_adaptive(const reader *r, const unsigned char *q, const rs_check
         if (!(rs_film_pixel_sq(film, (uint32_t)i) <= (double)film->count[i] * 0x1p96))
             break;
     if (i < npix || rs_film_samples(film) != get64(r->h + 32) ||
-        !rs_adaptive_state_fits(ad, film->count, (uint32_t)npix, want->spp))
+        !rs_adaptive_state_fits(ad, film->count, (uint32_t)npix, want->img.spp))
         return refuse(RS_EXIT_RUNTIME, r->path,
                       "corrupt: the sample counts do not match its adaptive state%s%s", "", "");
     return RS_EXIT_OK;
@@ -581,7 +650,7 @@ static int same_kind(const reader *r, const rs_checkpoint_key *want, const rs_fi
                       "made without the passes --aov and --denoise read (%s%s); continue it "
                       "without them, or start again",
                       "albedo, normal, depth, direct emission", "");
-    if (file_adaptive == (want->adaptive_threshold > 0))
+    if (file_adaptive == (want->img.adaptive > 0))
         return RS_EXIT_OK;
     return refuse(RS_EXIT_USAGE, r->path,
                   "made %s --adaptive, but this render is %s (the same "
@@ -599,7 +668,7 @@ static int read_any(const char *path, rs_checkpoint_key *want, rs_film *film, rs
     memset(&r, 0, sizeof r);
     r.path = path;
     r.h = (unsigned char *)malloc(FIXED_HEADER + NAME_MAX_BYTES + 8 +
-                                  16 * (size_t)RS_CHECKPOINT_MAX_RANGES);
+                                  16 * (size_t)RS_CHECKPOINT_MAX_RANGES + 8 + SETTINGS_MAX);
     if (!r.h) {
         fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
         return RS_EXIT_RUNTIME;
@@ -613,10 +682,10 @@ static int read_any(const char *path, rs_checkpoint_key *want, rs_film *film, rs
     if ((rc = read_header(&r)) == RS_EXIT_OK && (rc = check_size(&r, want, npix)) == RS_EXIT_OK &&
         (rc = same_kind(&r, want, film)) == RS_EXIT_OK &&
         (rc = read_film(&r, film, q, ad)) == RS_EXIT_OK &&
-        (rc = check_header(path, r.h, r.name, r.end, want)) == RS_EXIT_OK) {
-        if (ad && want->spp != get32(r.h + 56)) /* the last round's size depends on it */
+        (rc = check_header(&r, want)) == RS_EXIT_OK) {
+        if (ad && want->img.spp != get32(r.h + 56)) /* the last round's size depends on it */
             rc = mismatch_u(path, "--spp (adaptive sampling's rounds depend on it)",
-                            get32(r.h + 56), want->spp);
+                            get32(r.h + 56), want->img.spp);
         else
             rc = ad ? take_adaptive(&r, q, want, film, ad) : take_ranges(&r, film, held);
     }

@@ -1,5 +1,6 @@
 /* app/checkpoint.h — a render's film saved to a file (--checkpoint FILE) and read back
  * (--resume FILE), so that a render continued from it ends bit for bit as the uninterrupted one.
+ * Version 7 below; versions 2 and 4, written before it, are read.
  *
  * Why that holds: each path's radiance depends only on its number (paths are numbered
  * sample-major, scheduler/render.h), on every device set, and the film's sums are exact integers
@@ -40,8 +41,14 @@
  *        24*P  each pixel's sum of squared luminance (rs_film_sq: a 192-bit integer in units
  *              of 2^-64, three u64 from the lowest; version 3 had an f64 here and is refused)
  *           P  each pixel's running flag (0 or 1)
- * Versions 5 and 6 are versions 2 and 4 of a film that keeps its passes (shading/film.h: what
- * --aov and --denoise read), with the passes section after the counts:
+ * Version 7, what this raystream writes, is version 2 (or 4, adaptive) with, after the ranges,
+ *           4  flags: 1 adaptive (the adaptive section follows the film), 2 passes
+ *           4  settings bytes L (< 8192), then L bytes of the settings block: "NAME=VALUE\n" for
+ *              every image-defining setting (app/image_settings.h), which a resumed render
+ *              must match row for row (the fixed fields 24 and 48..87 and the filter word are
+ *              still written, and read only in files of versions 2 and 4)
+ *  and, with flag 2, between the counts and the adaptive section, the film's passes
+ *  (shading/film.h: what --aov and --denoise read):
  *       160*P  the passes' sums, RS_FILM_PASSES signed 128-bit integers a pixel in film units
  *         4*P  the samples whose camera ray hit something, u32 a pixel
  * A render that writes passes resumes only from a file that holds them; one that does not
@@ -55,31 +62,26 @@
 
 #include <stdint.h>
 
+#include "app/image_settings.h"
 #include "scenes/scene.h"
 #include "scheduler/adaptive.h"
 #include "scheduler/plan.h"
 #include "shading/film.h"
 #include "shading/filter.h"
 
-#define RS_CHECKPOINT_VERSION          2u /* a render over every pixel */
-#define RS_CHECKPOINT_VERSION_ADAPTIVE 4u /* --adaptive: version 2 and an adaptive section
-                                             (3 had inexact squared-luminance sums) */
-#define RS_CHECKPOINT_VERSION_PASSES   5u /* version 2 with the film's passes */
-#define RS_CHECKPOINT_VERSION_ADAPTIVE_PASSES 6u /* version 4 with the film's passes */
+#define RS_CHECKPOINT_VERSION          7u /* what is written: flags and the settings block */
+#define RS_CHECKPOINT_VERSION_PLAIN    2u /* read: a render over every pixel */
+#define RS_CHECKPOINT_VERSION_ADAPTIVE 4u /* read: --adaptive, version 2 and an adaptive
+                                             section (3 had inexact squared-luminance sums) */
 
 /* The paths a film holds (scheduler/plan.h): at most this many ranges in a file. */
 #define RS_CHECKPOINT_MAX_RANGES RS_PATH_RANGES_MAX
 
-/* What decides the image, as the checkpoint records it. */
+/* What decides the image, as the checkpoint records it: the scene's content and the image
+ * settings (img.spp 0 when reading: the file's). */
 typedef struct rs_checkpoint_key {
     uint64_t scene_hash;
-    uint64_t seed;
-    uint32_t width, height, spp, max_depth, rr_depth;
-    uint32_t sampling, sampler;
-    uint32_t filter; /* rs_checkpoint_filter_code */
-    uint32_t isect_sphere, isect_tri, isect_aabb;
-    double adaptive_threshold; /* --adaptive: > 0 (its min spp below); 0: not adaptive */
-    uint32_t adaptive_min_spp;
+    rs_image_settings img;
     const char *scene; /* the scene's name on the command line (messages only) */
 } rs_checkpoint_key;
 
@@ -101,20 +103,20 @@ uint64_t rs_checkpoint_scene_hash(const rs_scene *s);
 int rs_checkpoint_write(const char *path, const char *staged, int rename_now,
                         const rs_checkpoint_key *key, const rs_film *film,
                         const rs_path_ranges *held);
-/* The same for an adaptive render (key->adaptive_threshold > 0): `held` is not used (the film's
+/* The same for an adaptive render (key->img.adaptive > 0): `held` is not used (the film's
  * counts say what it holds), *ad and the film's squared-luminance sums are saved with it. */
 int rs_checkpoint_write_adaptive(const char *path, const char *staged, int rename_now,
                                  const rs_checkpoint_key *key, const rs_film *film,
                                  const rs_adaptive_state *ad);
 
 /* Reads checkpoint `path` for a render with settings `want` into `film` (want's size, fresh):
- * *held (empty) gets the paths it holds.  want->spp == 0 takes the file's spp into want->spp.
+ * *held (empty) gets the paths it holds.  want->img.spp == 0 takes the file's spp into it.
  * Returns 0 (RS_EXIT_OK); RS_EXIT_USAGE after one line naming the file when it is missing, not a
  * regular file or was made with other settings (the line names the field, its value in the
  * file and the one asked for); RS_EXIT_RUNTIME after one line when it is truncated or corrupt. */
 int rs_checkpoint_read(const char *path, rs_checkpoint_key *want, rs_film *film,
                        rs_path_ranges *held);
-/* The same for an adaptive render (want->adaptive_threshold > 0): the file must be an adaptive
+/* The same for an adaptive render (want->img.adaptive > 0): the file must be an adaptive
  * checkpoint with the same threshold and min spp; *ad (zeroed) gets its state, the film its
  * squared-luminance sums.  A file of the other kind is refused with one line. */
 int rs_checkpoint_read_adaptive(const char *path, rs_checkpoint_key *want, rs_film *film,

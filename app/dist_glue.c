@@ -240,7 +240,7 @@ static void dist_job_init(const rs_cli_options *o, render_run *r, rs_dist_job *j
     job->width = r->st.width;
     job->height = r->st.height;
     job->spp = r->st.spp;
-    job->variance = o->adaptive > 0;
+    job->variance = r->img.adaptive > 0;
     job->passes = r->st.passes != 0;
     job->pass_spp = o->mpi_pass_spp;
     job->time_limit_s = o->time_limit_s;
@@ -374,8 +374,8 @@ static int dist_run_adaptive(const rs_cli_options *o, render_run *r, const rs_di
     dr.job.user = &dr;
     dr.job.progress = round_progress;
     dr.t0 = rs_now_s();
-    a.threshold = o->adaptive;
-    a.min_spp = o->adaptive_min_spp;
+    a.threshold = r->img.adaptive;
+    a.min_spp = r->img.adaptive_min_spp;
     memset(&hooks, 0, sizeof hooks);
     hooks.progress = on_dist_progress;
     hooks.user = r;
@@ -418,10 +418,10 @@ static int dist_run(const rs_cli_options *o, render_run *r)
     rs_signals_install();
     memset(&todo, 0, sizeof todo);
     dist_job_init(o, r, &job);
-    if (o->adaptive > 0 && r->rank > 0)
+    if (r->img.adaptive > 0 && r->rank > 0)
         return dist_rounds_work(r, &job) == RS_OK ? RS_EXIT_OK
                                                   : rs_app_fail(RS_EXIT_RUNTIME, NULL);
-    if (o->adaptive > 0)
+    if (r->img.adaptive > 0)
         return dist_run_adaptive(o, r, &job);
     /* rank 0: the paths the film lacks (all of them, or the gaps of a --resume, which start and
      * end on whole samples: checked at --resume) */

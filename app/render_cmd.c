@@ -33,14 +33,14 @@ void rs_run_on_film_ready(void *user, const rs_film *film, const rs_path_ranges 
 
 /* The engine's run over what the film lacks: everything, or the gaps of a --resume; or the
  * rounds of --adaptive. */
-static rs_status engine_run(const rs_cli_options *o, render_run *r, const rs_render_hooks *hooks)
+static rs_status engine_run(render_run *r, const rs_render_hooks *hooks)
 {
     rs_work_plan plan;
     rs_status rst;
-    if (o->adaptive > 0) {
+    if (r->img.adaptive > 0) {
         rs_adaptive a;
-        a.threshold = o->adaptive;
-        a.min_spp = o->adaptive_min_spp;
+        a.threshold = r->img.adaptive;
+        a.min_spp = r->img.adaptive_min_spp;
         rst = rs_adaptive_run(r->engine, &a, &r->ad, hooks, r->film, &r->stats);
         r->adaptive = r->ad.stats;
         return rst;
@@ -74,7 +74,7 @@ static int run_render(const rs_cli_options *o, render_run *r)
         hooks.film_ready = rs_run_on_film_ready;
         rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
     }
-    rst = engine_run(o, r, &hooks);
+    rst = engine_run(r, &hooks);
     r->done = rs_engine_done(r->engine);
     rs_progress_end(&r->progress);
     if (rst == RS_ERR_CANCELLED) {

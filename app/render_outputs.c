@@ -68,23 +68,16 @@ static void make_report(const rs_cli_options *o, const render_run *r, rs_report 
     rep->height = r->st.height;
     rep->spp = r->st.spp;
     rep->spp_min = rs_film_min_count(r->film);
-    rep->max_depth = r->st.max_depth;
-    rep->seed = r->st.seed;
-    rep->sampling = r->st.sampling;
-    rep->sampler = r->st.sampler;
-    rs_filter_describe(&r->st.filter, rep->filter, sizeof rep->filter);
+    rep->img = &r->img;
     rep->lighting = r->lighting[0] ? r->lighting : NULL;
     rep->extensions = r->gltf_extensions[0] ? r->gltf_extensions : NULL;
-    rep->texture_filter = r->st.texture_filter == RS_TEXTURE_TRILINEAR ? "trilinear" : "bilinear";
-    rep->light_sampler = r->st.light_sampler == RS_LIGHT_SAMPLER_BVH ? "bvh" : "power";
     rep->denoised = r->denoised ? r->denoise_device : NULL;
-    rep->adaptive = o->adaptive > 0 ? o->adaptive : 0.0;
     rep->time_limit_s = o->time_limit_s;
     rep->interrupted = r->interrupted;
     rep->stats = r->stats;
     rep->adaptive_stats = r->adaptive;
     rep->resumed = r->resumed;
-    rep->checkpoint_samples = o->adaptive > 0 ? rs_film_samples(r->film)
+    rep->checkpoint_samples = r->img.adaptive > 0 ? rs_film_samples(r->film)
                                               : rs_path_ranges_total(&r->held) +
                                                     (r->done ? rs_path_ranges_total(r->done) : 0);
     rep->nonfinite = r->film->nonfinite;
@@ -263,7 +256,7 @@ static int write_image(const rs_cli_options *o, const render_run *r, const rs_re
     }
     if (ok && rs_image_write_view(r->out, r->st.width, r->st.height,
                                   r->denoised ? r->denoised : r->rgb, layers,
-                                  (size_t)n_layers, meta.meta, RS_REPORT_META_N, &view) != RS_OK) {
+                                  (size_t)n_layers, meta.meta, meta.n, &view) != RS_OK) {
         rs_app_fail(0, NULL);
         ok = 0;
     }

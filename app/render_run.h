@@ -47,7 +47,9 @@ typedef struct render_run {
     char denoise_device[160];    /* --denoise: the OIDN device that ran it */
     rs_cores cores;
     int threads;
-    rs_render_settings st;
+    rs_image_settings img;  /* what decides the image, made once from the options
+                               (rs_run_settings; --resume may take the file's spp) */
+    rs_render_settings st;  /* the engine's: img's, and how the render runs */
     rs_render_stats stats;
     rs_adaptive_stats adaptive; /* --adaptive: rounds, samples, pixels stopped */
     rs_adaptive_state ad;       /* --adaptive: where it stands (a checkpoint saves it) */

@@ -15,7 +15,7 @@
 #include "shading/aov.h"
 
 /* The image size from the options and the scene's own size. */
-static void settings_size(const rs_cli_options *o, const rs_scene *scene, rs_render_settings *st)
+static void settings_size(const rs_cli_options *o, const rs_scene *scene, rs_image_settings *st)
 {
     st->width = o->width ? o->width : scene->width;
     st->height = o->height ? o->height : scene->height;
@@ -29,20 +29,54 @@ static void settings_size(const rs_cli_options *o, const rs_scene *scene, rs_ren
         st->height = 1;
 }
 
+/* What decides the image, once, from the options and the scene's own size (the one place an
+ * image-defining option is read; app/image_settings.h). */
+static void image_settings(const rs_cli_options *o, render_run *r)
+{
+    rs_image_settings *img = &r->img;
+    memset(img, 0, sizeof *img);
+    settings_size(o, r->scene, img);
+    img->spp = o->spp;
+    img->max_depth = o->max_depth;
+    img->rr_depth = 3;
+    img->seed = o->seed;
+    img->sampling = o->sampling;
+    img->sampler = o->sampler;
+    img->filter = o->filter;
+    img->texture_filter = o->texture_filter;
+    img->light_sampler = o->light_sampler;
+    img->isect_sphere = o->isect_sphere;
+    img->isect_tri = o->isect_tri;
+    img->isect_aabb = o->isect_aabb;
+    if (o->adaptive > 0) {
+        img->adaptive = o->adaptive;
+        img->adaptive_min_spp = o->adaptive_min_spp;
+    }
+}
+
+/* The engine's settings: the image's (r->img) and how it runs. */
+static void engine_settings(const rs_image_settings *img, rs_render_settings *st)
+{
+    st->width = img->width;
+    st->height = img->height;
+    st->spp = img->spp;
+    st->max_depth = img->max_depth;
+    st->rr_depth = img->rr_depth;
+    st->seed = img->seed;
+    st->sampling = img->sampling;
+    st->sampler = img->sampler;
+    st->filter = img->filter;
+    st->texture_filter = img->texture_filter;
+    st->light_sampler = img->light_sampler;
+}
+
 /* The render settings from the options and the scene's own size. */
 void rs_run_settings(const rs_cli_options *o, render_run *r)
 {
     rs_render_settings *st = &r->st;
     memset(st, 0, sizeof *st);
-    settings_size(o, r->scene, st);
-    st->spp = o->spp;
-    st->max_depth = o->max_depth;
-    st->seed = o->seed;
-    st->sampling = o->sampling;
-    st->sampler = o->sampler;
-    st->filter = o->filter;
-    st->texture_filter = o->texture_filter;
-    st->light_sampler = o->light_sampler;
+    image_settings(o, r);
+    engine_settings(&r->img, st);
     /* the devices write the passes the outputs read: the --aov layers, --denoise's guides */
     st->passes = (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH)) || o->denoise;
     st->wave_paths = o->wave_paths;
@@ -141,25 +175,8 @@ static void make_key(const rs_cli_options *o, render_run *r)
      * triangles and 5 MB of textures): only where a checkpoint is written or read */
     if (o->checkpoint || o->resume)
         k->scene_hash = r->scene_hash ? r->scene_hash : rs_checkpoint_scene_hash(r->scene);
-    k->seed = r->st.seed;
-    k->width = r->st.width;
-    k->height = r->st.height;
-    k->spp = r->st.spp;
-    k->max_depth = r->st.max_depth;
-    k->rr_depth = r->st.rr_depth ? r->st.rr_depth : 3;
-    k->sampling = (uint32_t)r->st.sampling;
-    k->sampler = (uint32_t)r->st.sampler;
-    k->filter = rs_checkpoint_filter_code(&r->st.filter,
-                                          r->st.texture_filter == RS_TEXTURE_TRILINEAR) |
-                (r->st.light_sampler == RS_LIGHT_SAMPLER_BVH ? RS_CHECKPOINT_LIGHT_BVH : 0u);
-    k->isect_sphere = o->isect_sphere;
-    k->isect_tri = o->isect_tri;
-    k->isect_aabb = o->isect_aabb;
+    k->img = r->img;
     k->scene = o->scene;
-    if (o->adaptive > 0) {
-        k->adaptive_threshold = o->adaptive;
-        k->adaptive_min_spp = o->adaptive_min_spp;
-    }
 }
 
 rs_status rs_run_new_film(const render_run *r, rs_film **out)
@@ -185,17 +202,17 @@ int rs_run_make_film(const rs_cli_options *o, render_run *r)
     if (!o->resume)
         return RS_EXIT_OK;
     if (!o->spp_given)
-        r->key.spp = 0;    /* the file's */
-    if (o->adaptive > 0) { /* the film's first samples, and where adaptive sampling stood */
+        r->key.img.spp = 0; /* the file's */
+    if (r->img.adaptive > 0) { /* the film's first samples, and where adaptive sampling stood */
         if ((rc = rs_checkpoint_read_adaptive(o->resume, &r->key, r->film, &r->ad)) != RS_EXIT_OK)
             return rc;
-        r->st.spp = r->key.spp;
+        r->img.spp = r->st.spp = r->key.img.spp;
         r->resumed = rs_film_samples(r->film);
         return RS_EXIT_OK;
     }
     if ((rc = rs_checkpoint_read(o->resume, &r->key, r->film, &r->held)) != RS_EXIT_OK)
         return rc;
-    r->st.spp = r->key.spp;
+    r->img.spp = r->st.spp = r->key.img.spp;
     r->resumed = rs_path_ranges_total(&r->held);
     if (o->megakernel)
         return rs_run_resume_whole_samples(o, r,
@@ -224,9 +241,9 @@ int rs_run_build_bvh(const rs_cli_options *o, render_run *r)
     rs_bvh_build_opts bo;
     double t0;
     r->geom = rs_scene_geom(r->scene);
-    r->geom.sphere_algo = o->isect_sphere;
-    r->geom.tri_algo = o->isect_tri;
-    r->geom.aabb_algo = o->isect_aabb;
+    r->geom.sphere_algo = r->img.isect_sphere;
+    r->geom.tri_algo = r->img.isect_tri;
+    r->geom.aabb_algo = r->img.isect_aabb;
     memset(&bo, 0, sizeof bo);
     bo.builder = o->bvh;
     bo.threads = (uint32_t)r->threads;
@@ -365,7 +382,7 @@ int rs_run_write_checkpoint(const render_run *r, int rename_now)
 {
     rs_path_ranges held;
     int ok;
-    if (r->key.adaptive_threshold > 0) /* the film's counts and the adaptive state */
+    if (r->key.img.adaptive > 0) /* the film's counts and the adaptive state */
         return r->ad.running && rs_checkpoint_write_adaptive(r->ckpt_out->path, r->ckpt_out->staged,
                                                              rename_now, &r->key, r->film, &r->ad);
     if (!film_ranges(r, &held))

@@ -8,6 +8,7 @@
 #include <strings.h>
 
 #include "app/signals.h"
+#include "shading/light_sampler.h"
 
 #ifndef RS_VERSION
 #  define RS_VERSION "0.0.0"
@@ -100,6 +101,20 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
+/* "settings": every image setting's row (app/image_settings.h), its value as text. */
+static void json_settings(FILE *f, const rs_image_settings *img)
+{
+    size_t i;
+    fprintf(f, "},\n  \"settings\": {");
+    for (i = 0; i < rs_image_settings_count(); ++i) {
+        const rs_setting_desc *d = rs_image_setting(i);
+        char v[RS_SETTING_TEXT];
+        d->text(img, v, sizeof v);
+        fprintf(f, "%s\"%s\": ", i ? ", " : "", d->name);
+        json_string(f, v);
+    }
+}
+
 static void json_devices(FILE *f, const rs_report *rep)
 {
     int i;
@@ -174,10 +189,11 @@ int rs_report_write_json(const rs_report *rep, const char *path, const char *sho
             s->seconds > 0 ? s->seconds : 1e-9, (unsigned long long)rep->dev_rays, rep->spp_min,
             rep->spp, (unsigned long long)(rep->resumed + s->paths_done),
             (unsigned long long)rep->resumed, s->time_limited ? "true" : "false",
-            rep->interrupted ? "true" : "false", rep->adaptive, rep->adaptive_stats.rounds,
+            rep->interrupted ? "true" : "false", rep->img->adaptive, rep->adaptive_stats.rounds,
             rep->adaptive_stats.stopped);
     for (i = 0; i < RS_STAGE_COUNT; ++i)
         fprintf(f, "%s\"%s\": %.9f", i ? ", " : "", rs_stage_name((rs_stage)i), s->stage_s[i]);
+    json_settings(f, rep->img);
     json_devices(f, rep);
     if (rep->dist)
         json_mpi(f, rep->dist);
@@ -195,13 +211,13 @@ int rs_report_write_json(const rs_report *rep, const char *path, const char *sho
 /* "64 spp", or how many an adaptive or time-limited render took. */
 static void summary_spp(const rs_report *rep, char *spp, size_t n)
 {
-    if (rep->adaptive > 0) {
+    if (rep->img->adaptive > 0) {
         size_t npix = (size_t)rep->width * rep->height;
         snprintf(spp, n,
                  "%.1f spp on average, %u to %u (adaptive to %g in %u rounds: %.1f%% of the "
                  "pixels stopped early%s)",
                  npix ? (double)rep->adaptive_stats.samples / (double)npix : 0.0, rep->spp_min,
-                 rep->spp, rep->adaptive, rep->adaptive_stats.rounds,
+                 rep->spp, rep->img->adaptive, rep->adaptive_stats.rounds,
                  npix ? 100.0 * rep->adaptive_stats.stopped / (double)npix : 0.0,
                  rep->stats.time_limited ? "; stopped at the --time-limit" : "");
     } else if (rep->stats.time_limited)
@@ -214,14 +230,16 @@ static void summary_spp(const rs_report *rep, char *spp, size_t n)
 /* The first sentences: what was rendered, how fast, the BVH. */
 static void summary_render(const rs_report *rep)
 {
-    char sps[32], rps[32], rays[32], spp[200], inst[160] = "";
+    char sps[32], rps[32], rays[32], spp[200], inst[160] = "", filter[RS_SETTING_TEXT];
     const rs_render_stats *s = &rep->stats;
+    const rs_image_settings *img = rep->img;
     double secs = s->seconds > 0 ? s->seconds : 1e-9;
     uint64_t rays_total = s->rays_closest + s->rays_shadow;
     human((double)s->paths_done / secs, sps, sizeof sps);
     human((double)rays_total / secs, rps, sizeof rps);
     human((double)rays_total, rays, sizeof rays);
     summary_spp(rep, spp, sizeof spp);
+    rs_filter_describe(&img->filter, filter, sizeof filter);
     if (rep->instances)
         snprintf(inst, sizeof inst,
                  " (%u of them instances placing %u triangles; bottom levels: %u nodes over %u "
@@ -233,10 +251,10 @@ static void summary_render(const rs_report *rep)
             "%ssamples/s, %srays/s (%srays: %llu camera/bounce + %llu shadow). "
             "BVH (%s, SAH cost %.1f): %u nodes over %u primitives%s, built in %.2f ms. ",
             rep->interrupted ? "Partial render (interrupted):" : "Rendered", rep->scene, rep->width,
-            rep->height, spp, rs_sampling_name(rep->sampling),
-            rep->light_sampler && strcmp(rep->light_sampler, "bvh") == 0 ? " with a light BVH" : "",
-            rs_sampler_name(rep->sampler),
-            rep->filter, rep->max_depth, (unsigned long long)rep->seed, s->seconds, sps, rps, rays,
+            rep->height, spp, rs_sampling_name(img->sampling),
+            img->light_sampler == RS_LIGHT_SAMPLER_BVH ? " with a light BVH" : "",
+            rs_sampler_name(img->sampler), filter, img->max_depth,
+            (unsigned long long)img->seed, s->seconds, sps, rps, rays,
             (unsigned long long)s->rays_closest, (unsigned long long)s->rays_shadow,
             rep->bvh_builder, rep->bvh_sah, rep->bvh_nodes, rep->bvh_prims, inst, rep->bvh_ms);
     if (rep->extensions)
@@ -332,49 +350,43 @@ void rs_report_print_summary(const rs_report *rep)
 
 void rs_report_image_meta(const rs_report *rep, rs_report_meta *m)
 {
-    static const char *const keys[RS_REPORT_META_N] = {
-        "raystream:scene",      "raystream:spp",     "raystream:spp_requested", "raystream:seed",
-        "raystream:sampling",   "raystream:sampler", "raystream:max_depth",     "raystream:devices",
-        "raystream:integrator", "raystream:version", "raystream:adaptive", "raystream:filter",
-        "raystream:lighting",   "raystream:denoised", "raystream:texture_filter",
-        "raystream:light_sampler"};
-    const char *values[RS_REPORT_META_N];
-    size_t used = 0;
-    int i;
+    static const char *const keys[RS_REPORT_META_FIXED] = {
+        "raystream:scene",      "raystream:spp",     "raystream:spp_requested",
+        "raystream:devices",    "raystream:integrator", "raystream:version",
+        "raystream:lighting",   "raystream:denoised"};
+    const char *values[RS_REPORT_META_FIXED];
+    size_t used = 0, i;
     snprintf(m->spp, sizeof m->spp, "%u", rep->spp_min);
     snprintf(m->spp_requested, sizeof m->spp_requested, "%u", rep->spp);
-    snprintf(m->seed, sizeof m->seed, "%llu", (unsigned long long)rep->seed);
-    snprintf(m->depth, sizeof m->depth, "%u", rep->max_depth);
     m->devices[0] = '\0';
-    for (i = 0; i < rep->n_dev; ++i) {
+    for (i = 0; i < (size_t)rep->n_dev; ++i) {
         int k = snprintf(m->devices + used, sizeof m->devices - used, "%s%s", i ? "," : "",
                          rep->dev[i].name);
         if (k < 0 || (size_t)k >= sizeof m->devices - used)
             break;
         used += (size_t)k;
     }
-    if (rep->adaptive > 0)
-        snprintf(m->adaptive, sizeof m->adaptive, "%g", rep->adaptive);
-    else
-        snprintf(m->adaptive, sizeof m->adaptive, "off");
     values[0] = rep->scene;
     values[1] = m->spp;
     values[2] = m->spp_requested;
-    values[3] = m->seed;
-    values[4] = rs_sampling_name(rep->sampling);
-    values[5] = rs_sampler_name(rep->sampler);
-    values[6] = m->depth;
-    values[7] = m->devices;
-    values[8] = rep->megakernel ? "megakernel" : "stream";
-    values[9] = RS_VERSION;
-    values[10] = m->adaptive;
-    values[11] = rep->filter;
-    values[12] = rep->lighting ? rep->lighting : "the scene's own";
-    values[13] = rep->denoised ? rep->denoised : "no";
-    values[14] = rep->texture_filter ? rep->texture_filter : "trilinear";
-    values[15] = rep->light_sampler ? rep->light_sampler : "power";
-    for (i = 0; i < RS_REPORT_META_N; ++i) {
+    values[3] = m->devices;
+    values[4] = rep->megakernel ? "megakernel" : "stream";
+    values[5] = RS_VERSION;
+    values[6] = rep->lighting ? rep->lighting : "the scene's own";
+    values[7] = rep->denoised ? rep->denoised : "no";
+    for (i = 0; i < RS_REPORT_META_FIXED; ++i) {
         m->meta[i].key = keys[i];
         m->meta[i].value = values[i];
+    }
+    m->n = RS_REPORT_META_FIXED;
+    /* then the image settings' rows, as the checkpoint and the JSON have them */
+    for (i = 0; i < rs_image_settings_count() && m->n < RS_REPORT_META_MAX; ++i) {
+        const rs_setting_desc *d = rs_image_setting(i);
+        size_t k = m->n - RS_REPORT_META_FIXED;
+        snprintf(m->keys[k], sizeof m->keys[k], "raystream:%s", d->name);
+        d->text(rep->img, m->values[k], sizeof m->values[k]);
+        m->meta[m->n].key = m->keys[k];
+        m->meta[m->n].value = m->values[k];
+        m->n++;
     }
 }

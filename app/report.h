@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "app/distributed.h"
+#include "app/image_settings.h"
 #include "app/options.h"
 #include "core/image_io.h"
 #include "scheduler/adaptive.h"
@@ -27,18 +28,13 @@ typedef struct rs_report {
     int quiet, megakernel, mk_gpu;                   /* mk_gpu: the megakernel ran on a GPU */
     int wavefront; /* some devices ran the stream integrator's paths whole (dev[i].paths) */
     const char *strategy;                            /* the megakernel's host thread split */
-    uint32_t width, height, spp, spp_min, max_depth; /* spp asked; spp_min every pixel has */
-    uint64_t seed;
-    rs_sampling sampling;
-    rs_sampler sampler;
-    char filter[40];       /* "blackman-harris:1.5" */
-    const char *texture_filter; /* "trilinear" or "bilinear" */
-    const char *light_sampler;  /* "power" or "bvh" */
+    uint32_t width, height, spp, spp_min; /* spp asked; spp_min every pixel has */
+    const rs_image_settings *img; /* what decided the image (its table: the header, the JSON) */
     const char *extensions;     /* a glTF file's extensions that were read, or NULL */
     const char *denoised;  /* --denoise: the OIDN device that ran it; NULL: not denoised */
     const char *lighting;  /* how the scene was lit when the file said nothing ("the default
                               sky: ..."), or NULL */
-    double adaptive, time_limit_s; /* --adaptive's threshold (0: off), --time-limit */
+    double time_limit_s; /* --time-limit */
     /* what happened */
     int interrupted; /* the stop signal, or 0 */
     rs_render_stats stats;
@@ -65,15 +61,17 @@ int rs_report_write_json(const rs_report *rep, const char *path, const char *sho
 void rs_report_print_summary(const rs_report *rep);
 
 /* The .exr header's attributes (core/image_io.h): the scene, the spp every pixel has and the
- * spp asked for, seed, sampling, sampler, max depth, devices, integrator, version, adaptive,
- * the pixel filter, the lighting when the scene's file gave none, the denoiser, the texture
- * filter;
- * their strings in the struct itself. */
-enum { RS_REPORT_META_N = 16 };
+ * spp asked for, devices, integrator, version, the lighting when the scene's file gave none,
+ * the denoiser, then every image setting's row ("raystream:NAME", app/image_settings.h: seed,
+ * sampling, sampler, max depth, the filters, adaptive, ...); their strings in the struct
+ * itself, n of them. */
+enum { RS_REPORT_META_FIXED = 8, RS_REPORT_META_MAX = 40 };
 typedef struct rs_report_meta {
-    rs_image_meta meta[RS_REPORT_META_N];
-    char spp[16], spp_requested[16], seed[24], depth[16], devices[RS_MAX_DEVICES * 48];
-    char adaptive[32];
+    rs_image_meta meta[RS_REPORT_META_MAX];
+    size_t n;
+    char spp[16], spp_requested[16], devices[RS_MAX_DEVICES * 48];
+    char keys[RS_REPORT_META_MAX - RS_REPORT_META_FIXED][48];
+    char values[RS_REPORT_META_MAX - RS_REPORT_META_FIXED][RS_SETTING_TEXT];
 } rs_report_meta;
 void rs_report_image_meta(const rs_report *rep, rs_report_meta *m);
 

@@ -128,8 +128,9 @@ static void test_filter_in_checkpoint(void **state)
            "the resume with another filter does not name both filters");
     proc_free(&p);
     run_expect(f, other_tex, 2, &p);
-    EXPECT(&p, strstr(p.err.data, "trilinear textures") && strstr(p.err.data, "bilinear textures"),
-           "the resume with another texture filter does not name both");
+    EXPECT(&p, strstr(p.err.data, "--texture-filter trilinear") &&
+                   strstr(p.err.data, "--texture-filter bilinear"),
+           "the resume with another texture filter does not name it with both values");
     proc_free(&p);
     run_expect(f, same, 0, &p);
     proc_free(&p);
