@@ -90,8 +90,9 @@ static rs_status setup(coord *c)
     rs_dist_result *res = c->res;
     const char *kill_after = getenv("OMPI_MCA_odls_base_sigkill_timeout");
     int r, n = c->n;
-    c->pt.npix = job->pixels ? job->n_pixels : job->width * job->height;
-    c->pt.pass_spp = job->pass_spp ? job->pass_spp : passes_auto_spp(job, c->pt.npix, n);
+    c->pt.npix = job->plan.pixels ? job->plan.n_pixels : job->width * job->height;
+    c->pt.pass_spp = job->plan.pass_samples ? job->plan.pass_samples
+                                            : passes_auto_spp(job, c->pt.npix, n);
     c->pt.reissued = &res->reissued;
     if (!passes_make(&c->pt, job))
         return rs_error_set(RS_ERR_NOMEM, "out of memory for the MPI coordinator");
@@ -316,10 +317,15 @@ static void check_stops(coord *c, double now)
                                 "stop (it may be dead); its passes are left out\n",
                         r, c->res->rank[r].desc, c->grace_s);
             }
-    /* no new pass: those begun (or handed out again later) still finish */
-    if (!c->signalled && !c->res->time_limited && c->job->time_limit_s > 0 &&
-        now - c->t0 >= c->job->time_limit_s && passes_limit_to_begun(&c->pt))
-        c->res->time_limited = 1;
+    /* past the budget no new pass: those begun (or handed out again later) still finish */
+    if (!c->signalled && !c->res->time_limited) {
+        double t0 = c->job->t_start > 0 ? c->job->t_start : c->t0;
+        uint64_t end = rs_work_plan_time_cut(&c->job->plan,
+                                             (uint64_t)c->job->width * c->job->height, now - t0,
+                                             passes_begun_end(&c->pt), 0);
+        if (end != UINT64_MAX && passes_limit_to(&c->pt, end))
+            c->res->time_limited = 1;
+    }
 }
 
 /* Rank 0's own passes: the finished ones are on the frame, and one more when it has room.

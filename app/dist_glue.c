@@ -242,8 +242,9 @@ static void dist_job_init(const rs_cli_options *o, render_run *r, rs_dist_job *j
     job->spp = r->st.spp;
     job->variance = r->img.adaptive > 0;
     job->passes = r->st.passes != 0;
-    job->pass_spp = o->mpi_pass_spp;
-    job->time_limit_s = o->time_limit_s;
+    job->plan.pass_samples = o->mpi_pass_spp;
+    job->plan.time_limit_s = o->time_limit_s;
+    job->t_start = rs_now_s();
     job->timeout_s = o->mpi_timeout_s > 0 ? o->mpi_timeout_s : 60.0;
     job->cancel = rs_signals_cancel();
     job->render = dist_render_pass;
@@ -308,14 +309,11 @@ static rs_status dist_round(void *user, const rs_work_plan *plan, const rs_rende
                                         "samples of its round only (resume it on one process)");
     if (lo == hi)
         return RS_OK;
-    job.todo = &plan->todo;
-    job.pixels = plan->pixels;
-    job.n_pixels = plan->n_pixels;
-    if (job.time_limit_s > 0) { /* what is left of it */
-        job.time_limit_s -= rs_now_s() - dr->t0;
-        if (job.time_limit_s < 1e-6)
-            job.time_limit_s = 1e-6;
-    }
+    job.plan.todo = plan->todo; /* the round's plan: its budget counts from dr->t0 */
+    job.plan.pixels = plan->pixels;
+    job.plan.n_pixels = plan->n_pixels;
+    job.plan.time_limit_s = plan->time_limit_s;
+    job.t_start = dr->t0;
     if (!rs_dist_job_begin(r->dist, plan->pixels, plan->n_pixels, job.timeout_s))
         return rs_error_set(RS_ERR_NOMEM, "out of memory");
     dr->hooks = hooks;
@@ -351,8 +349,8 @@ static rs_status dist_rounds_work(render_run *r, const rs_dist_job *base)
         int go = rs_dist_job_wait(r->dist, &pixels, &n_pixels, base->timeout_s);
         if (go <= 0)
             return go == 0 ? RS_OK : rs_error_set(RS_ERR_IO, "rank 0 is gone");
-        job.pixels = pixels;
-        job.n_pixels = n_pixels;
+        job.plan.pixels = pixels;
+        job.plan.n_pixels = n_pixels;
         st = rs_dist_render(r->dist, &job, r->film, &res);
         rs_free(pixels);
         if (st != RS_OK)
@@ -376,6 +374,7 @@ static int dist_run_adaptive(const rs_cli_options *o, render_run *r, const rs_di
     dr.t0 = rs_now_s();
     a.threshold = r->img.adaptive;
     a.min_spp = r->img.adaptive_min_spp;
+    a.time_limit_s = base->plan.time_limit_s;
     memset(&hooks, 0, sizeof hooks);
     hooks.progress = on_dist_progress;
     hooks.user = r;
@@ -431,7 +430,7 @@ static int dist_run(const rs_cli_options *o, render_run *r)
         rs_path_ranges_free(&todo);
         return rs_app_fail(RS_EXIT_RUNTIME, "out of memory");
     }
-    job.todo = &todo;
+    job.plan.todo = todo;
     if (r->ckpt_out) {
         job.flush_every_s = o->ckpt_every_s;
         job.saved = on_dist_saved;

@@ -214,13 +214,15 @@ void passes_assign(passes *t, uint32_t p, int r);
 void passes_release(passes *t, int r);
 /* paths of the passes done or merged */
 uint64_t passes_paths_done(const passes *t);
-/* The merged passes as path ranges (as job->todo numbers them) into *out (emptied first; free
+/* The merged passes as path ranges (as job->plan.todo numbers them) into *out (emptied first; free
  * with rs_path_ranges_free), their samples of every pixel into *samples.  0 when out of
  * memory. */
 int passes_merged_ranges(const passes *t, rs_path_ranges *out, uint32_t *samples);
-/* The time limit: no pass above the last one begun (at least the first) is handed out.  1 when
- * that lowered the limit. */
-int passes_limit_to_begun(passes *t);
+/* Where the passes begun so far end (the last begun's end, in paths; 0: none begun): for the
+ * time limit's rule, scheduler/plan.h rs_work_plan_time_cut. */
+uint64_t passes_begun_end(const passes *t);
+/* No pass that starts at or past path `end` is handed out.  1 when that lowered the limit. */
+int passes_limit_to(passes *t, uint64_t end);
 
 /* ---- the roles --------------------------------------------------------------------------- */
 

@@ -85,7 +85,7 @@ static void *local_main(void *arg)
         rs_film_clear(l->scratch);
         memset(&rs, 0, sizeof rs);
         t0 = rs_now_s();
-        st = job->render(job->user, job->pixels, job->n_pixels, s0, n, l->scratch, &l->cancel,
+        st = job->render(job->user, job->plan.pixels, job->plan.n_pixels, s0, n, l->scratch, &l->cancel,
                          &rs);
         t1 = rs_now_s();
         if (st == RS_OK && job->fault.slow_factor > 1 && job->fault.slow_rank == l->rank)

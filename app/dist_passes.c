@@ -1,4 +1,4 @@
-/* app/dist_passes.c — rank 0's table of passes: job->todo (path ranges over the job's pixels, whole
+/* app/dist_passes.c — rank 0's table of passes: job->plan.todo (path ranges over the job's pixels, whole
  * samples) cut into passes of pass_spp samples of
  * every pixel, each free, handed out to a rank, done there (not yet on the frame) or merged
  * into the frame.  Handed out lowest first; a rank lost frees its passes for the others. */
@@ -12,7 +12,7 @@ uint32_t passes_auto_spp(const rs_dist_job *job, uint32_t npix, int ranks)
     /* about 8 passes a rank, so that a slow one costs little at the end, and at most about
      * 2^21 paths (1-2 s on one core), so that a stop, which drops the passes under way, loses
      * little */
-    uint32_t left = (uint32_t)(rs_path_ranges_total(job->todo) / npix), most = (1u << 21) / npix;
+    uint32_t left = (uint32_t)(rs_path_ranges_total(&job->plan.todo) / npix), most = (1u << 21) / npix;
     uint32_t spp = left / (8u * (uint32_t)ranks);
     if (spp > most)
         spp = most;
@@ -21,29 +21,29 @@ uint32_t passes_auto_spp(const rs_dist_job *job, uint32_t npix, int ranks)
     return spp;
 }
 
-/* Range k of job->todo as samples: [*s0, *end) of every pixel of the job. */
+/* Range k of job->plan.todo as samples: [*s0, *end) of every pixel of the job. */
 static void todo_samples(const passes *t, const rs_dist_job *job, uint32_t k, uint32_t *s0,
                          uint32_t *end)
 {
-    *s0 = (uint32_t)(job->todo->r[k][0] / t->npix);
-    *end = (uint32_t)(job->todo->r[k][1] / t->npix);
+    *s0 = (uint32_t)(job->plan.todo.r[k][0] / t->npix);
+    *end = (uint32_t)(job->plan.todo.r[k][1] / t->npix);
 }
 
 int passes_make(passes *t, const rs_dist_job *job)
 {
     uint32_t i, n = 0, s0, end;
-    for (i = 0; i < job->todo->n; ++i) {
+    for (i = 0; i < job->plan.todo.n; ++i) {
         todo_samples(t, job, i, &s0, &end);
         n += (end - s0 + t->pass_spp - 1) / t->pass_spp;
     }
     t->n_passes = n;
     t->limit = n;
-    t->todo_paths = rs_path_ranges_total(job->todo);
+    t->todo_paths = rs_path_ranges_total(&job->plan.todo);
     t->ps0 = (uint32_t *)rs_calloc(n ? n : 1, sizeof *t->ps0);
     t->pn = (uint32_t *)rs_calloc(n ? n : 1, sizeof *t->pn);
     if (!t->ps0 || !t->pn)
         return 0;
-    for (i = 0, n = 0; i < job->todo->n; ++i) {
+    for (i = 0, n = 0; i < job->plan.todo.n; ++i) {
         todo_samples(t, job, i, &s0, &end);
         for (; s0 < end; s0 += t->pass_spp, ++n) {
             t->ps0[n] = s0;
@@ -140,15 +140,22 @@ int passes_merged_ranges(const passes *t, rs_path_ranges *out, uint32_t *samples
     return 1;
 }
 
-int passes_limit_to_begun(passes *t)
+uint64_t passes_begun_end(const passes *t)
 {
-    /* those begun (or handed out again later) still finish */
-    uint32_t lim = 0, p;
-    for (p = 0; p < t->n_passes; ++p)
-        if (t->state[p] != P_FREE || t->owner[p] != -1)
-            lim = p + 1;
-    if (lim == 0)
-        lim = 1;
+    /* handed out lowest first: those below the last begun were all begun (or handed out again
+     * after a rank was lost) */
+    uint32_t p;
+    for (p = t->n_passes; p > 0; --p)
+        if (t->state[p - 1] != P_FREE || t->owner[p - 1] != -1)
+            return ((uint64_t)t->ps0[p - 1] + t->pn[p - 1]) * t->npix;
+    return 0;
+}
+
+int passes_limit_to(passes *t, uint64_t end)
+{
+    uint32_t lim = 0;
+    while (lim < t->n_passes && (uint64_t)t->ps0[lim] * t->npix < end)
+        ++lim;
     if (lim < t->limit) {
         t->limit = lim;
         return 1;

@@ -84,26 +84,25 @@ typedef rs_status (*rs_dist_render_fn)(void *user, const uint32_t *pixels, uint3
                                        const atomic_int *cancel, rs_render_stats *stats);
 
 /* rank 0, every `flush_every_s`: the film holds the samples it held before plus `done`
- * (path ranges, as job->todo numbers them); it may be read, not written */
+ * (path ranges, as job->plan.todo numbers them); it may be read, not written */
 typedef void (*rs_dist_saved_fn)(void *user, const rs_film *film, const rs_path_ranges *done);
 
 typedef struct rs_dist_job {
     uint32_t width, height, spp;
-    const uint32_t *pixels;     /* every rank: the job's pixels, increasing (rank 0 tells the
-                                   others with rs_dist_job_begin); NULL: every pixel */
-    uint32_t n_pixels;
+    /* The job's plan (scheduler/plan.h; not owned: its ranges are the caller's).  Every rank:
+     * plan.pixels, increasing (rank 0 tells the others with rs_dist_job_begin; NULL: every
+     * pixel), and plan.n_pixels.  Rank 0: plan.todo, the paths to render in the plan's
+     * numbering over the job's pixels, each range whole samples (what the film does not hold;
+     * the passes are cut from it, dist_passes.c); plan.pass_samples, samples per pass (0: auto,
+     * about 8 passes per rank, at most about 2^21 paths a pass); plan.time_limit_s, the
+     * render's budget from t_start (the one rule: rs_work_plan_time_cut, as the engine's). */
+    rs_work_plan plan;
+    double t_start;             /* rank 0: when the render began (rs_now_s); 0: the job's start */
     int variance;               /* every rank: films keep squared-luminance sums (--adaptive) */
     int passes;                 /* every rank: films keep the passes (--aov, --denoise) */
-    const rs_path_ranges *todo; /* rank 0: the paths to render, in scheduler/plan.h's numbering
-                                   over the job's pixels (path i: sample i div n of pixel
-                                   i mod n), each range whole samples (what the film does not
-                                   hold; the passes are cut from it, dist_passes.c) */
-    uint32_t pass_spp;          /* samples per pass; 0: auto (about 8 passes per rank, at
-                                   most about 2^22 paths a pass) */
     double flush_every_s;       /* rank 0: > 0, every rank sends what it finished this often
                                    (then `saved` is called); 0: only at the end */
     rs_dist_saved_fn saved;
-    double time_limit_s;        /* rank 0: > 0, no new pass after this many seconds */
     double timeout_s;           /* a rank silent this long is dead; 0: 60 */
     const atomic_int *cancel;   /* rank 0 and every rank: a stop signal */
     rs_dist_render_fn render;

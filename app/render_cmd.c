@@ -41,11 +41,13 @@ static rs_status engine_run(render_run *r, const rs_render_hooks *hooks)
         rs_adaptive a;
         a.threshold = r->img.adaptive;
         a.min_spp = r->img.adaptive_min_spp;
+        a.time_limit_s = r->st.time_limit_s;
         rst = rs_adaptive_run(r->engine, &a, &r->ad, hooks, r->film, &r->stats);
         r->adaptive = r->ad.stats;
         return rst;
     }
     memset(&plan, 0, sizeof plan);
+    plan.time_limit_s = r->st.time_limit_s;
     if (!rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,
                                    &plan.todo))
         rst = rs_error_set(RS_ERR_NOMEM, "out of memory");

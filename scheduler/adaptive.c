@@ -134,6 +134,7 @@ static rs_status run_round(adaptive_run *r, int *limited)
         if (s->running[p])
             r->list[count++] = p;
     memset(&plan, 0, sizeof plan);
+    plan.time_limit_s = r->a->time_limit_s;
     if (count < npix) { /* every pixel is the image's own numbering */
         plan.pixels = r->list;
         plan.n_pixels = count;

@@ -20,6 +20,8 @@
 typedef struct rs_adaptive {
     double threshold; /* > 0: a pixel stops once its relative error is at most this */
     uint32_t min_spp; /* every pixel's first samples, before any stops (at most spp; >= 2) */
+    double time_limit_s; /* > 0: the render's time budget, every round's plan's (scheduler/
+                            plan.h rs_work_plan.time_limit_s); 0: none */
 } rs_adaptive;
 
 typedef struct rs_adaptive_stats {
@@ -51,8 +53,8 @@ int rs_adaptive_state_fits(const rs_adaptive_state *s, const uint32_t *count, ui
  * engine `e`, from *state: a fresh one (running NULL: the film must be empty, and then tracks
  * its variance) or one saved with the film (a checkpoint: the film holds its squared-luminance
  * sums).  *state follows the render: whenever hooks->film_ready is called it describes the
- * film, so a checkpoint written there continues to the same image.  The engine's time limit
- * ends the rounds (the last one on a whole pass of its pixels); progress counts a stopped
+ * film, so a checkpoint written there continues to the same image.  The time limit (a's,
+ * on every round's plan) ends the rounds (the last one on a whole pass of its pixels); progress counts a stopped
  * pixel's remaining samples as done.  *stats sums the rounds' (seconds: the whole). */
 rs_status rs_adaptive_run(rs_engine *e, const rs_adaptive *a, rs_adaptive_state *state,
                           const rs_render_hooks *hooks, rs_film *film, rs_render_stats *stats);

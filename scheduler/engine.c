@@ -251,6 +251,7 @@ static rs_status render_once(const rs_scene *scene, rs_sched *sched, rs_device *
     if ((st = rs_engine_create(scene, settings, sched, mk, &e)) != RS_OK)
         return st;
     memset(&plan, 0, sizeof plan);
+    plan.time_limit_s = settings->time_limit_s;
     if (!rs_path_ranges_add(&plan.todo, settings->path_begin, all))
         st = rs_error_set(RS_ERR_NOMEM, "out of memory");
     else

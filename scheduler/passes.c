@@ -56,7 +56,7 @@ rs_status rs_passes_run(rs_run *c)
     rs_status status = RS_OK;
     uint32_t per, calls = 0;
     /* a time limit or a reader of the film needs the film on whole samples between calls */
-    int consistent = e->st.time_limit_s > 0 || (hooks && hooks->film_ready);
+    int consistent = c->plan->time_limit_s > 0 || (hooks && hooks->film_ready);
 
     p.c = c;
     /* the CPU's per-pixel loop (pass_samples 0) stops within a sample on a cancel: with

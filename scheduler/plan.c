@@ -89,6 +89,21 @@ int rs_work_plan_samples(rs_work_plan *p, uint64_t npix, uint32_t s0, uint32_t s
     return rs_path_ranges_add(&p->todo, npix * s0, npix * s1);
 }
 
+uint64_t rs_work_plan_time_cut(const rs_work_plan *p, uint64_t npix, double elapsed_s,
+                               uint64_t begun, int first_done)
+{
+    uint64_t n = p->pixels ? p->n_pixels : npix, end;
+    if (!(p->time_limit_s > 0) || elapsed_s < p->time_limit_s || n == 0)
+        return UINT64_MAX;
+    end = (begun + n - 1) / n * n;
+    if (!first_done && p->todo.n) { /* the render's first pass is always finished */
+        uint64_t first = (p->todo.r[0][0] / n + 1) * n;
+        if (end < first)
+            end = first;
+    }
+    return end;
+}
+
 void rs_work_plan_free(rs_work_plan *p)
 {
     rs_path_ranges_free(&p->todo);

@@ -12,7 +12,10 @@
  * order, so a render split into any plans is the one plan's bit for bit.
  *
  * Who makes plans: the plain render (one range), a resumed checkpoint (the gaps between what the
- * film holds), adaptive sampling (a pixel list per round), an MPI rank (its passes). */
+ * film holds), adaptive sampling (a pixel list per round), an MPI job (rank 0's plan, which the
+ * coordinator cuts into passes of pass_samples; each pass a plan of its own on a rank).  A plan
+ * also carries the render's time budget, decided by one rule (rs_work_plan_time_cut) wherever
+ * passes are begun. */
 #ifndef RS_SCHEDULER_PLAN_H
 #define RS_SCHEDULER_PLAN_H
 
@@ -41,7 +44,20 @@ typedef struct rs_work_plan {
     rs_path_ranges todo;    /* the paths to render, in the plan's numbering */
     const uint32_t *pixels; /* the plan's pixels (distinct); NULL: every pixel of the image */
     uint32_t n_pixels;      /* with pixels: how many (the pass size) */
+    uint32_t pass_samples;  /* samples of every pixel its driver deals out at once (an MPI job's
+                               passes, --mpi-pass); 0: the driver's own choice */
+    double time_limit_s;    /* > 0: the render's time budget (seconds since it began): past it
+                               no new pass is begun (rs_work_plan_time_cut); 0: none */
 } rs_work_plan;
+
+/* The time limit's one rule, for every driver of plans (the engine's runs, adaptive sampling's
+ * rounds, the MPI coordinator's passes): within p's budget (elapsed_s < p->time_limit_s, or no
+ * budget) UINT64_MAX; past it, where the plan ends: the first whole pass (a sample of every pixel
+ * of the plan, `npix` of them without a pixel list) at or after `begun` (the paths begun so far
+ * end there), and, unless `first_done`, not before the end of the plan's first pass.  So every
+ * pixel ends with the same samples, and a render always has one pass. */
+uint64_t rs_work_plan_time_cut(const rs_work_plan *p, uint64_t npix, double elapsed_s,
+                               uint64_t begun, int first_done);
 
 /* A plan over every pixel: samples [s0, s1) of a render of `npix` pixels (0 when out of
  * memory).  Free with rs_work_plan_free. */

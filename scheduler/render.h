@@ -75,11 +75,12 @@ typedef struct rs_render_settings {
     rs_par_strategy strategy; /* how the shade stage splits a wave among threads */
     rs_timeline *timeline;    /* stage spans on lane `timeline_lane`; NULL: none */
     uint16_t timeline_lane;   /* the render thread's lane: the number of devices */
-    /* > 0: once this many seconds have passed since rs_engine_create, no new pass is begun
-     * (a pass: every pixel of the plan once): the paths up to the end of the pass under way are
-     * finished, so every pixel has the same number of samples, the rest of the plan is dropped
-     * and the run returns RS_OK with stats->time_limited set; later runs do nothing.  At least
-     * one pass of the render is always finished. */
+    /* rs_render and rs_render_passes only: their plan's time budget (scheduler/plan.h
+     * rs_work_plan.time_limit_s; the engine reads a plan's, counted from rs_engine_create:
+     * past it no new pass is begun (a pass: every pixel of the plan once), the paths up to the
+     * end of the pass under way are finished, so every pixel has the same number of samples,
+     * the rest of the plan is dropped and the run returns RS_OK with stats->time_limited set.
+     * At least one pass of the render is always finished). */
     double time_limit_s;
     uint64_t path_begin; /* rs_render and rs_render_passes only: the film already holds paths
                             [0, path_begin) of this render (a resumed checkpoint) */

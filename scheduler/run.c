@@ -20,15 +20,10 @@ uint64_t rs_run_time_cut(rs_run *c, uint64_t next)
 {
     const rs_engine *e = c->e;
     uint64_t n = c->map.n_active, end;
-    if (!(e->st.time_limit_s > 0) || rs_now_s() - e->t_start < e->st.time_limit_s)
-        return UINT64_MAX;
     uint32_t k;
-    end = (next + n - 1) / n * n;
-    if (!e->any_done && c->plan->todo.n) { /* the render's first pass is always finished */
-        uint64_t first = (c->plan->todo.r[0][0] / n + 1) * n;
-        if (end < first)
-            end = first;
-    }
+    end = rs_work_plan_time_cut(c->plan, e->it.npix, rs_now_s() - e->t_start, next, e->any_done);
+    if (end == UINT64_MAX)
+        return end;
     /* The paths between the plan's ranges are on the film already (a checkpoint's, which has
      * gaps where devices finished ranges out of order): where such paths lie past `end`, the
      * passes they are in are finished too, so that every pixel ends with the same samples.

@@ -14,7 +14,8 @@
  *     key is named with the file;
  *   - --denoise: without OIDN, one line saying how to get it and no image; with it, the EXR's
  *     layer "noisy" is the render without --denoise bit for bit, the header and summary name the
- *     device, and the denoised image is closer to a 1024-spp reference than the noisy one. */
+ *     device, and the denoised image is closer to a 1024-spp reference than the noisy one and
+ *     the same bit for bit on cpu:1,gpu (its guides the film's passes). */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -354,6 +355,21 @@ static void test_denoise(void **state)
     EXPECT(&p, rmse(&d, &q) < 0.7 * rmse(&n, &q) && first_bad_value(&d) < 0,
            "the denoised image (RMSE %g) is not closer to the reference than the noisy one (%g)",
            rmse(&d, &q), rmse(&n, &q));
+    {
+        /* on cpu + gpu (the fallback here) the same denoised image, bit for bit: its guides and
+         * its direct emission are the film's passes, the same bits on any device set */
+        static const char *const den2[] = {"render",    "builtin:cornell", "--width", "48",
+                                           "--height",  "48",              "--spp",   "16",
+                                           "--denoise", "--devices",       "cpu:1,gpu", "-q",
+                                           "-o",        "d2.exr",          NULL};
+        image d2;
+        proc p2;
+        run_expect(f, den2, 0, &p2);
+        d2 = read_image(&p2, f, "d2.exr");
+        EXPECT(&p2, same_image(&d, &d2), "--denoise on cpu:1,gpu is not the cpu's denoised image");
+        rs_free(d2.rgb);
+        proc_free(&p2);
+    }
     rs_free(d.rgb);
     rs_free(r.rgb);
     rs_free(q.rgb);

@@ -155,7 +155,7 @@ static void test_bad_settings(void **state)
     rs_film *film;
     rs_render_settings st;
     rs_render_stats stats;
-    rs_adaptive a = {0.01, 1}; /* too few first samples */
+    rs_adaptive a = {0.01, 1, 0.0}; /* too few first samples */
     rs_adaptive_stats as;
     (void)state;
     assert_int_equal(rs_film_create(8, 8, &film), RS_OK);
@@ -212,7 +212,7 @@ static rs_render_settings split_settings(void)
 static rs_film *render_split(int stop_at, rs_adaptive_stats *out, int *calls)
 {
     rs_render_settings st = split_settings();
-    rs_adaptive a = {0.08, 8};
+    rs_adaptive a = {0.08, 8, 0.0};
     rs_adaptive_state s;
     rs_render_hooks h;
     rs_render_stats stats;

@@ -587,6 +587,31 @@ static void test_bvh_independence(void **state)
 
 /* The comparison above could pass vacuously if the image ignored its inputs: a different seed
  * must change it, and the same seed twice must not. */
+/* The time limit's one rule (scheduler/plan.h rs_work_plan_time_cut), which the engine's runs
+ * and the MPI coordinator both apply: none within the budget or without one; past it the first
+ * whole pass at or after the paths begun, and at least the plan's first pass; over a pixel list
+ * its passes are the list's. */
+static void test_time_cut_rule(void **state)
+{
+    const uint32_t list[3] = {2, 5, 7};
+    rs_work_plan p;
+    (void)state;
+    memset(&p, 0, sizeof p);
+    assert_true(rs_path_ranges_add(&p.todo, 250, 1000)); /* resumed at sample 2 of 100 pixels */
+    assert_true(rs_work_plan_time_cut(&p, 100, 5.0, 300, 0) == UINT64_MAX); /* no budget */
+    p.time_limit_s = 2.0;
+    assert_true(rs_work_plan_time_cut(&p, 100, 1.9, 300, 0) == UINT64_MAX); /* within it */
+    assert_true(rs_work_plan_time_cut(&p, 100, 2.0, 301, 1) == 400);        /* the pass under way */
+    assert_true(rs_work_plan_time_cut(&p, 100, 2.0, 400, 1) == 400);        /* at a pass's end */
+    assert_true(rs_work_plan_time_cut(&p, 100, 9.0, 250, 0) == 300); /* the first pass, at least */
+    assert_true(rs_work_plan_time_cut(&p, 100, 9.0, 250, 1) == 300);
+    assert_true(rs_work_plan_time_cut(&p, 100, 9.0, 200, 1) == 200); /* nothing begun, one done */
+    p.pixels = list;
+    p.n_pixels = 3;
+    assert_true(rs_work_plan_time_cut(&p, 100, 9.0, 7, 1) == 9);
+    rs_work_plan_free(&p);
+}
+
 static void test_seed_matters(void **state)
 {
     rt_args a = rt_defaults("cornell", SIZE, SPP);
@@ -609,6 +634,7 @@ int main(void)
         cmocka_unit_test(test_wave_sizes),
         cmocka_unit_test(test_two_devices),
         cmocka_unit_test(test_seed_matters),
+        cmocka_unit_test(test_time_cut_rule),
         cmocka_unit_test(test_waves_in_flight),
         cmocka_unit_test(test_device_sets),
         cmocka_unit_test(test_strategies_and_megakernel),

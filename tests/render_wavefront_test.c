@@ -274,7 +274,7 @@ static void test_time_cut_over_gaps(void **state)
         } else { /* the rest, with the time limit already passed */
             assert_true(rs_path_ranges_add(&plan.todo, 0, 1000));
             assert_true(rs_path_ranges_add(&plan.todo, 3000, 4800));
-            st.time_limit_s = 1e-9;
+            plan.time_limit_s = 1e-9; /* the plan's budget (scheduler/plan.h) */
         }
         assert_int_equal(rs_engine_create_paths(scene, &st, NULL, &d, 1, &e), RS_OK);
         assert_int_equal(rs_engine_run(e, &plan, NULL, pass == 0 ? ref : film, &rs), RS_OK);
