@@ -22,9 +22,23 @@ static rs_material light(float r, float g, float b) { return rs_mat_light(rs_v3(
 /* The room of Shirley's Cornell box ("Ray Tracing: The Rest of Your Life" v4), exactly: quads
  * as corner Q and edges u, v; the light emits only downward (its u x v is -y).  Returns the
  * white material in *white_out. */
+/* A built-in scene's camera: from `from` looking at `at`, y up, a vertical field of view of
+ * `vfov` degrees, the lens and shutter the scene's defaults.  The builders set it (and the image
+ * size and background) through the scene's API, as the file loaders do. */
+static rs_camera_desc look(const rs_scene *s, rs_vec3 from, rs_vec3 at, float vfov)
+{
+    rs_camera_desc c = s->camera;
+    c.from = from;
+    c.at = at;
+    c.up = rs_v3(0, 1, 0);
+    c.vfov_deg = vfov;
+    return c;
+}
+
 static rs_status build_cornell_room(rs_scene *s, uint32_t *white_out)
 {
     rs_material m;
+    rs_camera_desc cam;
     uint32_t red, white, green, lit;
     m = lambertian(.65f, .05f, .05f);
     RS_TRY(rs_scene_add_material(s, &m, &red));
@@ -43,12 +57,10 @@ static rs_status build_cornell_room(rs_scene *s, uint32_t *white_out)
     RS_TRY(rs_scene_add_quad(s, rs_v3(555, 0, 555), rs_v3(-555, 0, 0), rs_v3(0, 555, 0), white));
     *white_out = white;
 
-    s->camera.from = rs_v3(278, 278, -800);
-    s->camera.at = rs_v3(278, 278, 0);
-    s->camera.up = rs_v3(0, 1, 0);
-    s->camera.vfov_deg = 40.0f;
-    s->background = rs_v3(0, 0, 0);
-    s->width = s->height = 600;
+    cam = look(s, rs_v3(278, 278, -800), rs_v3(278, 278, 0), 40.0f);
+    rs_scene_set_camera(s, &cam);
+    rs_scene_set_background(s, rs_v3(0, 0, 0));
+    rs_scene_set_image_size(s, 600, 600);
     return RS_OK;
 }
 
@@ -132,6 +144,7 @@ static rs_status build_random_spheres(rs_scene *s, int bouncing)
 {
     uint64_t st = 0x5eedULL;
     rs_material m;
+    rs_camera_desc cam;
     uint32_t id;
     int a, b;
     if (bouncing) {
@@ -169,23 +182,18 @@ static rs_status build_random_spheres(rs_scene *s, int bouncing)
     RS_TRY(rs_scene_add_material(s, &m, &id));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(4, 1, 0), 1.0f, id));
 
-    s->camera.from = rs_v3(13, 2, 3);
-    s->camera.at = rs_v3(0, 0, 0);
-    s->camera.up = rs_v3(0, 1, 0);
-    s->camera.vfov_deg = 20.0f;
+    cam = look(s, rs_v3(13, 2, 3), rs_v3(0, 0, 0), 20.0f);
     /* RTIOW v4's defocus angle 0.6 deg at focus distance 10 is a lens of diameter
      * 2 * 10 * tan(0.3 deg) = 0.105 */
-    s->camera.aperture = 0.105f;
-    s->camera.focus_dist = 10.0f;
+    cam.aperture = 0.105f;
+    cam.focus_dist = 10.0f;
     if (bouncing) {
-        s->camera.shutter_open = 0.0f;
-        s->camera.shutter_close = 1.0f;
+        cam.shutter_open = 0.0f;
+        cam.shutter_close = 1.0f;
     }
-    s->background = rs_v3(1, 1, 1);
-    s->background_top = rs_v3(.5f, .7f, 1.0f);
-    s->background_sky = 1;
-    s->width = 1200;
-    s->height = 675;
+    rs_scene_set_camera(s, &cam);
+    rs_scene_set_background_gradient(s, rs_v3(1, 1, 1), rs_v3(.5f, .7f, 1.0f));
+    rs_scene_set_image_size(s, 1200, 675);
     return RS_OK;
 }
 
@@ -249,6 +257,7 @@ static rs_status build_materials(rs_scene *s)
     static const float phong_n[3] = {10.0f, 100.0f, 1000.0f};
     rs_vec3 warm = rs_v3(.8f, .45f, .25f);
     rs_material m;
+    rs_camera_desc cam;
     uint32_t id, t_floor, t_checker, t_stripes, t_image;
     int i;
     RS_TRY(materials_textures(s, &t_floor, &t_checker, &t_stripes, &t_image));
@@ -303,15 +312,10 @@ static rs_status build_materials(rs_scene *s)
     RS_TRY(rs_scene_add_material(s, &m, &id));
     RS_TRY(rs_scene_add_quad(s, rs_v3(-3, 7, -3), rs_v3(6, 0, 0), rs_v3(0, 0, 6), id));
 
-    s->camera.from = rs_v3(0, 6.5f, 11);
-    s->camera.at = rs_v3(0, 0.5f, 0);
-    s->camera.up = rs_v3(0, 1, 0);
-    s->camera.vfov_deg = 38.0f;
-    s->background = rs_v3(.12f, .12f, .12f);
-    s->background_top = rs_v3(.25f, .35f, .5f);
-    s->background_sky = 1;
-    s->width = 960;
-    s->height = 540;
+    cam = look(s, rs_v3(0, 6.5f, 11), rs_v3(0, 0.5f, 0), 38.0f);
+    rs_scene_set_camera(s, &cam);
+    rs_scene_set_background_gradient(s, rs_v3(.12f, .12f, .12f), rs_v3(.25f, .35f, .5f));
+    rs_scene_set_image_size(s, 960, 540);
     return RS_OK;
 }
 
@@ -410,16 +414,15 @@ static rs_status build_cornell_mesh(rs_scene *s, const rs_builtin_opts *o)
 static rs_status build_furnace(rs_scene *s)
 {
     rs_material m = lambertian(0.5f, 0.5f, 0.5f);
+    rs_camera_desc cam;
     uint32_t grey;
     RS_TRY(rs_scene_add_material(s, &m, &grey));
     RS_TRY(rs_scene_add_sphere(s, rs_v3(0, 0, 0), 1.0f, grey));
-    s->camera.from = rs_v3(0, 0, 5);
-    s->camera.at = rs_v3(0, 0, 0);
-    s->camera.up = rs_v3(0, 1, 0);
     /* the sphere subtends asin(1/5) = 11.5 deg; a 14 deg frame's corners are 9.9 deg off axis */
-    s->camera.vfov_deg = 14.0f;
-    s->background = rs_v3(1, 1, 1);
-    s->width = s->height = 64;
+    cam = look(s, rs_v3(0, 0, 5), rs_v3(0, 0, 0), 14.0f);
+    rs_scene_set_camera(s, &cam);
+    rs_scene_set_background(s, rs_v3(1, 1, 1));
+    rs_scene_set_image_size(s, 64, 64);
     return RS_OK;
 }
 
@@ -440,6 +443,7 @@ static rs_status build_many_lights(rs_scene *s)
     rs_material floor_m = lambertian(0.6f, 0.6f, 0.6f), wall_m = lambertian(0.4f, 0.5f, 0.6f);
     uint32_t floor_id, wall_id, i, j;
     uint64_t r = 0x9e3779b97f4a7c15ull;
+    rs_camera_desc cam;
     RS_TRY(rs_scene_add_material(s, &floor_m, &floor_id));
     RS_TRY(rs_scene_add_material(s, &wall_m, &wall_id));
     RS_TRY(rs_scene_add_quad(s, rs_v3(-12, 0, -12), rs_v3(0, 0, 24), rs_v3(24, 0, 0), floor_id));
@@ -470,13 +474,10 @@ static rs_status build_many_lights(rs_scene *s)
         RS_TRY(rs_scene_add_material(s, &m, &id));
         RS_TRY(rs_scene_add_sphere(s, rs_v3(cx, cy, cz), 0.1f, id));
     }
-    s->camera.from = rs_v3(0, 9, 16);
-    s->camera.at = rs_v3(0, 0, -1);
-    s->camera.up = rs_v3(0, 1, 0);
-    s->camera.vfov_deg = 50.0f;
-    s->background = rs_v3(0, 0, 0);
-    s->width = 400;
-    s->height = 300;
+    cam = look(s, rs_v3(0, 9, 16), rs_v3(0, 0, -1), 50.0f);
+    rs_scene_set_camera(s, &cam);
+    rs_scene_set_background(s, rs_v3(0, 0, 0));
+    rs_scene_set_image_size(s, 400, 300);
     return RS_OK;
 }
 

@@ -471,6 +471,7 @@ static rs_status gc_pyramids(rs_scene *s, const gc_tex *tex)
 /* The punctual lights, the environment map and the camera. */
 static rs_status gc_lights_map_camera(rs_scene *s, uint32_t sky_image)
 {
+    rs_camera_desc cam;
     /* punctual lights */
     RS_TRY(add_punctual(s, RS_PUNCTUAL_POINT, rs_v3(1.5f, 2.5f, 2.5f), rs_v3(0, 0, 0),
                         rs_v3(6, 5, 4), 0, 0));
@@ -489,17 +490,18 @@ static rs_status gc_lights_map_camera(rs_scene *s, uint32_t sky_image)
         RS_TRY(rs_scene_set_environment(s, sky_image, rs_v3(1.0f, 0.95f, 0.9f), rot));
     }
 
-    s->camera.from = rs_v3(0.0f, 3.4f, 9.0f);
-    s->camera.at = rs_v3(0.0f, 0.5f, 0.0f);
-    s->camera.up = rs_v3(0, 1, 0);
-    s->camera.vfov_deg = 40.0f;
-    s->camera.aperture = 0.08f;
-    s->camera.focus_dist = 9.0f;
-    s->camera.shutter_open = 0.0f;
-    s->camera.shutter_close = 1.0f;
-    s->background = rs_v3(0, 0, 0); /* the map replaces it */
-    s->width = 96;
-    s->height = 64;
+    cam = s->camera; /* the scene's defaults, then the view, through the scene's API */
+    cam.from = rs_v3(0.0f, 3.4f, 9.0f);
+    cam.at = rs_v3(0.0f, 0.5f, 0.0f);
+    cam.up = rs_v3(0, 1, 0);
+    cam.vfov_deg = 40.0f;
+    cam.aperture = 0.08f;
+    cam.focus_dist = 9.0f;
+    cam.shutter_open = 0.0f;
+    cam.shutter_close = 1.0f;
+    rs_scene_set_camera(s, &cam);
+    rs_scene_set_background(s, rs_v3(0, 0, 0)); /* the map replaces it */
+    rs_scene_set_image_size(s, 96, 64);
     return RS_OK;
 }
 

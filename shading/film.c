@@ -156,28 +156,6 @@ void rs_film_add_pass(rs_film *f, uint32_t pixel, const rs_path_aux *a)
     }
 }
 
-typedef struct add_pass_ctx {
-    rs_film *film;
-    const rs_path_aux *aux;
-} add_pass_ctx;
-
-static void add_pass_range(void *ctx, uint32_t lo, uint32_t hi)
-{
-    const add_pass_ctx *a = (const add_pass_ctx *)ctx;
-    uint32_t i;
-    for (i = lo; i < hi; ++i)
-        rs_film_add_pass(a->film, i, &a->aux[i]);
-}
-
-void rs_film_add_pass_image(rs_film *f, const rs_path_aux *aux, int threads)
-{
-    add_pass_ctx a;
-    a.film = f;
-    a.aux = aux;
-    rs_parallel_range(RS_PAR_FOR_DYNAMIC, threads, 0, f->width * f->height, 16384, add_pass_range,
-                      &a);
-}
-
 void rs_film_resolve_passes(const rs_film *f, float *albedo, float *normal, float *emission,
                             float *depth)
 {
@@ -272,26 +250,44 @@ double rs_film_rel_error(const rs_film *f, uint32_t pixel)
     return sqrt(var / n) / (mean > 1e-3 ? mean : 1e-3);
 }
 
+/* One image of samples (radiance, or aux: the passes) onto the film, a pixel each, the pixels
+ * split among `threads` host threads. */
 typedef struct add_image_ctx {
     rs_film *film;
     const rs_vec3 *radiance;
+    const rs_path_aux *aux;
 } add_image_ctx;
 
 static void add_image_range(void *ctx, uint32_t lo, uint32_t hi)
 {
     const add_image_ctx *a = (const add_image_ctx *)ctx;
     uint32_t i;
-    for (i = lo; i < hi; ++i)
-        rs_film_add(a->film, i, a->radiance[i]);
+    for (i = lo; i < hi; ++i) {
+        if (a->radiance)
+            rs_film_add(a->film, i, a->radiance[i]);
+        if (a->aux)
+            rs_film_add_pass(a->film, i, &a->aux[i]);
+    }
 }
 
-void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads)
+static void add_image(rs_film *f, const rs_vec3 *radiance, const rs_path_aux *aux, int threads)
 {
     add_image_ctx a;
     a.film = f;
     a.radiance = radiance;
+    a.aux = aux;
     rs_parallel_range(RS_PAR_FOR_DYNAMIC, threads, 0, f->width * f->height, 16384, add_image_range,
                       &a);
+}
+
+void rs_film_add_image(rs_film *f, const rs_vec3 *radiance, int threads)
+{
+    add_image(f, radiance, NULL, threads);
+}
+
+void rs_film_add_pass_image(rs_film *f, const rs_path_aux *aux, int threads)
+{
+    add_image(f, NULL, aux, threads);
 }
 
 void rs_film_resolve(const rs_film *f, float *rgb)

@@ -613,7 +613,7 @@ static void test_aov_denoise_same_image(void **state)
                p.err.data);
         args = without;
         n_chans -= 3; /* no raw layer beside a denoised beauty */
-        one_process(f, without, "one.exr");
+        rs_free(one_process(f, without, "one.exr").rgb);
     } else {
         EXPECT(&p, exited_with(&p, 0), "the one-process render with --aov all --denoise failed");
     }

@@ -120,62 +120,90 @@ static void test_block_and_match(void **state)
     }
 }
 
-static void test_checkpoint_follows(void **state)
-{
-    char dir[] = "/tmp/rs_settings_test_XXXXXX", path[256], staged[256], errpath[256];
+/* A checkpoint written for the tests: a folder, a film of 8x4 pixels with one sample each, the
+ * key it was written with. */
+typedef struct ck {
+    char dir[64], path[256], err[256];
     rs_checkpoint_key key;
-    rs_path_ranges held = {NULL, 0, 0}, back = {NULL, 0, 0};
-    rs_film *film = NULL, *read = NULL;
-    rs_vec3 c = rs_v3(0.25f, 0.5f, 2.0f);
+    rs_film *film;
+} ck;
+
+static void ck_make(ck *c, uint64_t scene_hash)
+{
+    char staged[256];
+    rs_path_ranges held = {NULL, 0, 0};
     uint32_t i;
-    int rc, saved;
-    char *err;
-    (void)state;
-    assert_non_null(mkdtemp(dir));
-    snprintf(path, sizeof path, "%s/c.ckpt", dir);
-    snprintf(staged, sizeof staged, "%s/c.ckpt.tmp", dir);
-    snprintf(errpath, sizeof errpath, "%s/err.txt", dir);
-    memset(&key, 0, sizeof key);
-    key.scene_hash = 0x1234;
-    key.img = settings();
-    key.scene = "builtin:test";
-    assert_int_equal(rs_film_create(8, 4, &film), RS_OK);
+    memset(c, 0, sizeof *c);
+    snprintf(c->dir, sizeof c->dir, "/tmp/rs_settings_test_XXXXXX");
+    assert_non_null(mkdtemp(c->dir));
+    snprintf(c->path, sizeof c->path, "%s/c.ckpt", c->dir);
+    snprintf(staged, sizeof staged, "%s/c.ckpt.tmp", c->dir);
+    snprintf(c->err, sizeof c->err, "%s/err.txt", c->dir);
+    c->key.scene_hash = scene_hash;
+    c->key.img = settings();
+    c->key.scene = "builtin:test";
+    assert_int_equal(rs_film_create(8, 4, &c->film), RS_OK);
     for (i = 0; i < 32; ++i)
-        rs_film_add(film, i, c);
+        rs_film_add(c->film, i, rs_v3(0.1f * (float)i, 0.5f, 2.0f));
     assert_true(rs_path_ranges_add(&held, 0, 32));
-    assert_int_equal(rs_checkpoint_write(path, staged, 1, &key, film, &held), 1);
-    /* resumed with dummy off: refused, the line naming it */
-    g_dummy = "off";
+    assert_int_equal(rs_checkpoint_write(c->path, staged, 1, &c->key, c->film, &held), 1);
+    rs_path_ranges_free(&held);
+}
+
+/* rs_checkpoint_read of `file` with c's key into a fresh film, stderr caught: the status, the
+ * film's sums the checkpoint's (when read), *err what it printed (free it). */
+static int ck_read(ck *c, const char *file, char **err)
+{
+    rs_path_ranges back = {NULL, 0, 0};
+    rs_film *read = NULL;
+    int rc, saved;
     assert_int_equal(rs_film_create(8, 4, &read), RS_OK);
     fflush(stderr);
     saved = dup(2);
-    assert_non_null(freopen(errpath, "w", stderr));
-    rc = rs_checkpoint_read(path, &key, read, &back);
+    assert_non_null(freopen(c->err, "w", stderr));
+    rc = rs_checkpoint_read(file, &c->key, read, &back);
     fflush(stderr);
     dup2(saved, 2);
     close(saved);
-    err = slurp(errpath);
-    printf("  resumed with --dummy off: status %d, \"%.*s\"\n", rc, (int)strcspn(err, "\n"), err);
-    assert_int_equal(rc, 2);
+    *err = slurp(c->err);
+    if (rc == 0) {
+        assert_int_equal(rs_path_ranges_total(&back), 32);
+        assert_memory_equal(read->sum, c->film->sum, 32 * 3 * sizeof *read->sum);
+        assert_memory_equal(read->count, c->film->count, 32 * sizeof *read->count);
+    }
+    rs_path_ranges_free(&back);
+    rs_film_destroy(read);
+    return rc;
+}
+
+static void ck_free(ck *c, const char *other)
+{
+    rs_film_destroy(c->film);
+    unlink(c->path);
+    unlink(c->err);
+    if (other)
+        unlink(other);
+    rmdir(c->dir);
+}
+
+static void test_checkpoint_follows(void **state)
+{
+    ck c;
+    char *err;
+    (void)state;
+    ck_make(&c, 0x1234);
+    /* resumed with dummy off: refused, the line naming it */
+    g_dummy = "off";
+    assert_int_equal(ck_read(&c, c.path, &err), 2);
+    printf("  resumed with --dummy off: \"%.*s\"\n", (int)strcspn(err, "\n"), err);
     assert_non_null(strstr(err, "--dummy on"));
     assert_non_null(strstr(err, "--dummy off"));
     free(err);
     /* with dummy on: read back */
     g_dummy = "on";
-    rs_film_clear(read);
-    rs_path_ranges_free(&back);
-    rc = rs_checkpoint_read(path, &key, read, &back);
-    assert_int_equal(rc, 0);
-    assert_int_equal(rs_path_ranges_total(&back), 32);
-    assert_memory_equal(read->sum, film->sum, 32 * 3 * sizeof *film->sum);
-    assert_memory_equal(read->count, film->count, 32 * sizeof *film->count);
-    rs_film_destroy(film);
-    rs_film_destroy(read);
-    rs_path_ranges_free(&held);
-    rs_path_ranges_free(&back);
-    unlink(path);
-    unlink(errpath);
-    rmdir(dir);
+    assert_int_equal(ck_read(&c, c.path, &err), 0);
+    free(err);
+    ck_free(&c, NULL);
 }
 
 static uint32_t get32(const unsigned char *p)
@@ -225,57 +253,21 @@ static void to_version2(const char *from, const char *to)
 
 static void test_version2_read(void **state)
 {
-    char dir[] = "/tmp/rs_settings_test_XXXXXX", path[256], staged[256], old[256], errpath[256];
-    rs_checkpoint_key key;
-    rs_path_ranges held = {NULL, 0, 0}, back = {NULL, 0, 0};
-    rs_film *film = NULL, *read = NULL;
-    uint32_t i;
-    int rc, saved;
-    char *err;
+    ck c;
+    char old[256], *err;
     (void)state;
-    assert_non_null(mkdtemp(dir));
-    snprintf(path, sizeof path, "%s/c.ckpt", dir);
-    snprintf(staged, sizeof staged, "%s/c.ckpt.tmp", dir);
-    snprintf(old, sizeof old, "%s/v2.ckpt", dir);
-    snprintf(errpath, sizeof errpath, "%s/err.txt", dir);
-    memset(&key, 0, sizeof key);
-    key.scene_hash = 0x77;
-    key.img = settings();
-    key.scene = "builtin:test";
-    assert_int_equal(rs_film_create(8, 4, &film), RS_OK);
-    for (i = 0; i < 32; ++i)
-        rs_film_add(film, i, rs_v3(0.1f * (float)i, 1.0f, 0.0f));
-    assert_true(rs_path_ranges_add(&held, 0, 32));
-    assert_int_equal(rs_checkpoint_write(path, staged, 1, &key, film, &held), 1);
-    to_version2(path, old);
-    assert_int_equal(rs_film_create(8, 4, &read), RS_OK);
-    rc = rs_checkpoint_read(old, &key, read, &back);
-    assert_int_equal(rc, 0);
-    assert_memory_equal(read->sum, film->sum, 32 * 3 * sizeof *film->sum);
-    key.img.seed = 43;
-    rs_film_clear(read);
-    rs_path_ranges_free(&back);
-    fflush(stderr);
-    saved = dup(2);
-    assert_non_null(freopen(errpath, "w", stderr));
-    rc = rs_checkpoint_read(old, &key, read, &back);
-    fflush(stderr);
-    dup2(saved, 2);
-    close(saved);
-    err = slurp(errpath);
+    ck_make(&c, 0x77);
+    snprintf(old, sizeof old, "%s/v2.ckpt", c.dir);
+    to_version2(c.path, old);
+    assert_int_equal(ck_read(&c, old, &err), 0);
+    free(err);
+    c.key.img.seed = 43;
+    assert_int_equal(ck_read(&c, old, &err), 2);
     printf("  a version-2 file read back; with --seed 43: \"%.*s\"\n", (int)strcspn(err, "\n"),
            err);
-    assert_int_equal(rc, 2);
     assert_non_null(strstr(err, "--seed 42"));
     free(err);
-    rs_film_destroy(film);
-    rs_film_destroy(read);
-    rs_path_ranges_free(&held);
-    rs_path_ranges_free(&back);
-    unlink(path);
-    unlink(old);
-    unlink(errpath);
-    rmdir(dir);
+    ck_free(&c, old);
 }
 
 static void test_header_and_json_follow(void **state)

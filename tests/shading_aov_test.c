@@ -48,6 +48,17 @@ static float *render_passes(rt_args *a, float *passes)
     return rgb;
 }
 
+/* The tests' renders: Sobol, the CLI's pixel filter (into *f), two threads. */
+static rt_args sobol_args(const char *scene, uint32_t size, uint32_t spp, rs_filter *f)
+{
+    rt_args a = rt_defaults(scene, size, spp);
+    rs_filter_default(f);
+    a.sampler = RS_SAMPLER_SOBOL;
+    a.filter = f;
+    a.threads = 2;
+    return a;
+}
+
 /* max |a - b| relative to max(1, |b|) */
 static double max_rel_diff(const float *a, const float *b, size_t n)
 {
@@ -111,14 +122,10 @@ static void check_brute(const char *scene)
     float *passes = malloc(npix * 10 * sizeof(float)), *ref = malloc(npix * 7 * sizeof(float));
     float *rgb;
     rs_filter f;
-    rt_args a = rt_defaults(scene, SIZE, 8);
+    rt_args a = sobol_args(scene, SIZE, 8, &f);
     double da, dn, dd = 0;
     size_t hits = 0, misses = 0, tilted = 0;
     assert_true(passes && ref);
-    rs_filter_default(&f);
-    a.sampler = RS_SAMPLER_SOBOL;
-    a.filter = &f;
-    a.threads = 2;
     rgb = render_passes(&a, passes);
     brute_passes(&a, ref, ref + 3 * npix, ref + 6 * npix);
     da = max_rel_diff(passes, ref, 3 * npix);
@@ -226,12 +233,8 @@ static void check_devices(const char *scene)
     float *ref = malloc(npix * 10 * sizeof(float)), *got = malloc(npix * 10 * sizeof(float));
     float *rgb_ref, *rgb;
     rs_filter f;
-    rt_args a = rt_defaults(scene, SIZE, 4);
+    rt_args a = sobol_args(scene, SIZE, 4, &f);
     assert_true(ref && got);
-    rs_filter_default(&f);
-    a.sampler = RS_SAMPLER_SOBOL;
-    a.filter = &f;
-    a.threads = 2;
     rgb_ref = render_passes(&a, ref);
     for (k = 0; k < sizeof sets / sizeof sets[0]; ++k) {
         rt_args b = a;
@@ -269,7 +272,7 @@ static void test_fine_where_refined(void **state)
     uint32_t *counts = calloc(npix, sizeof(uint32_t));
     double se_r = 0, se_f = 0, worst_else = 0;
     rs_filter f;
-    rt_args a = rt_defaults("cornell", size, 16);
+    rt_args a = sobol_args("cornell", size, 16, &f);
     rs_render_settings st;
     rs_render_consts it;
     rs_scene *scene = NULL;
@@ -279,10 +282,6 @@ static void test_fine_where_refined(void **state)
     const float *er;
     (void)state;
     assert_true(passes && ef && counts);
-    rs_filter_default(&f);
-    a.sampler = RS_SAMPLER_SOBOL;
-    a.filter = &f;
-    a.threads = 2;
     a.counts_out = counts;
     rgb = render_passes(&a, passes);
     er = passes + 6 * npix;
