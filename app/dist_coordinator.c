@@ -318,7 +318,7 @@ static void check_stops(coord *c, double now)
                         r, c->res->rank[r].desc, c->grace_s);
             }
     /* past the budget no new pass: those begun (or handed out again later) still finish */
-    if (!c->signalled && !c->res->time_limited) {
+    if (!c->signalled && !c->res->time_limited && c->job->plan.time_limit_s > 0) {
         double t0 = c->job->t_start > 0 ? c->job->t_start : c->t0;
         uint64_t end = rs_work_plan_time_cut(&c->job->plan,
                                              (uint64_t)c->job->width * c->job->height, now - t0,

@@ -570,6 +570,51 @@ static void test_gpucheck_wavefront_bit_exact(void **state)
     wavefront_same("cornell, adaptive", a);
 }
 
+/* The film's passes (shading/film.h: what --aov and --denoise read) written on the GPU: the CUDA
+ * wavefront's rs_wf_passes_kernel and the megakernel's rs_megakernel_aux_kernel give the CPU
+ * stream engine's passes, all ten planes, bit for bit (builtin:gpucheck: textures, normal maps,
+ * instances, an environment map, a thin lens; the Cornell box). */
+static void passes_same(const char *what, rt_args a)
+{
+    size_t n = (size_t)a.width * a.height * 10;
+    float *cpu = malloc(n * sizeof(float)), *gpu = malloc(n * sizeof(float)), *img;
+    int k;
+    assert_true(cpu && gpu);
+    a.passes_out = cpu;
+    img = rt_render(&a, NULL);
+    assert_non_null(img);
+    free(img);
+    for (k = 0; k < 2; ++k) {
+        rt_args b = a;
+        size_t i, differ = 0;
+        b.passes_out = gpu;
+        b.fallback_only = b.real_gpu = 1;
+        b.wavefront = k == 0;
+        b.megakernel = k == 1;
+        img = rt_render(&b, NULL);
+        assert_non_null(img);
+        free(img);
+        for (i = 0; i < n; ++i)
+            differ += memcmp(&cpu[i], &gpu[i], sizeof(float)) != 0;
+        print_message("%s: passes on the cuda %s: %zu of %zu values differ in any bit\n", what,
+                      k == 0 ? "wavefront" : "megakernel", differ, n);
+        assert_int_equal(differ, 0);
+    }
+    free(cpu);
+    free(gpu);
+}
+
+static void test_passes_cuda_bit_exact(void **state)
+{
+    rt_args a;
+    (void)state;
+    passes_same("gpucheck", gc_args(&gc_cases[0]));
+    a = rt_defaults("cornell", 64, 8);
+    a.threads = 4;
+    a.sampler = RS_SAMPLER_SOBOL;
+    passes_same("cornell", a);
+}
+
 /* A render of 2.6 million paths: two waves of RS_CUDA_WF_WAVE in flight at once, the second
  * partial (left out of scripts/gpu-check.sh's memcheck run, where it would take minutes). */
 static void test_wavefront_two_waves(void **state)
@@ -657,6 +702,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_gpucheck_megakernel_vs_cpu),
         cmocka_unit_test(test_gpucheck_wavefront_bit_exact),
         cmocka_unit_test(test_wavefront_two_waves),
+        cmocka_unit_test(test_passes_cuda_bit_exact),
     };
     if (rs_gpu_count(&why) == 0) {
         printf("SKIP: no CUDA device: %s\n", why);
