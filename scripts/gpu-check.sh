@@ -36,8 +36,8 @@
 #        samples/s and time to RMSE 0.01 for the CPU, the GPU wavefront, CPU + GPU, the GPU with
 #        host shading and the megakernel; docs/gpu.md);
 #     5. compute-sanitizer --tool memcheck over gpu_trace_test's gpucheck tests (the trace kernel,
-#        the megakernel and the wavefront's kernels, pinned DMA batches), where compute-sanitizer
-#        exists and supports the device (a refusal, as under gVisor, is reported, not failed; a
+#        the megakernel and the wavefront's kernels, the film passes' two, pinned DMA batches),
+#        where compute-sanitizer exists and supports the device (a refusal, as under gVisor, is reported, not failed; a
 #        memory error fails);
 #     6. the whole test suite of this build (ctest), unless --no-suite.
 # Logs go to gpu-results/ (or, on the lent machine, /tmp/gpu-check, and then into $OUT, which

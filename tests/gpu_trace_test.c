@@ -604,7 +604,7 @@ static void passes_same(const char *what, rt_args a)
     free(gpu);
 }
 
-static void test_passes_cuda_bit_exact(void **state)
+static void test_gpucheck_passes_bit_exact(void **state)
 {
     rt_args a;
     (void)state;
@@ -702,7 +702,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_gpucheck_megakernel_vs_cpu),
         cmocka_unit_test(test_gpucheck_wavefront_bit_exact),
         cmocka_unit_test(test_wavefront_two_waves),
-        cmocka_unit_test(test_passes_cuda_bit_exact),
+        cmocka_unit_test(test_gpucheck_passes_bit_exact),
     };
     if (rs_gpu_count(&why) == 0) {
         printf("SKIP: no CUDA device: %s\n", why);
