@@ -1,5 +1,6 @@
 /* app/checkpoint.c — see checkpoint.h. */
 #include "app/checkpoint.h"
+#include "app/fail.h"
 
 #include <errno.h>
 #include <math.h>
@@ -194,7 +195,7 @@ static int write_file(const char *path, const char *staged, int rename_now,
     FILE *f;
     int ok;
     if (!little_endian()) {
-        fprintf(stderr,
+        rs_app_print(
                 "raystream: --checkpoint %s: checkpoints are written on little-endian "
                 "machines only\n",
                 path);
@@ -203,14 +204,14 @@ static int write_file(const char *path, const char *staged, int rename_now,
     header = (unsigned char *)malloc(header_max(held));
     f = header ? fopen(staged, "wb") : NULL;
     if (!f) {
-        fprintf(stderr, "raystream: --checkpoint %s: cannot write %s (%s)\n", path, staged,
+        rs_app_print("raystream: --checkpoint %s: cannot write %s (%s)\n", path, staged,
                 header ? strerror(errno) : "out of memory");
         free(header);
         return 0;
     }
     n = make_header(header, key, held, film->nonfinite, film->pass != NULL);
     if (n == 0) {
-        fprintf(stderr, "raystream: --checkpoint %s: the settings do not fit its header\n", path);
+        rs_app_print("raystream: --checkpoint %s: the settings do not fit its header\n", path);
         fclose(f);
         unlink(staged);
         free(header);
@@ -237,7 +238,7 @@ static int write_file(const char *path, const char *staged, int rename_now,
     free(header);
     if (ok && (!rename_now || rename(staged, path) == 0))
         return 1;
-    fprintf(stderr, "raystream: --checkpoint %s: cannot write the checkpoint (%s)\n", path,
+    rs_app_print("raystream: --checkpoint %s: cannot write the checkpoint (%s)\n", path,
             strerror(errno));
     unlink(staged);
     return 0;
@@ -256,7 +257,7 @@ int rs_checkpoint_write_adaptive(const char *path, const char *staged, int renam
 {
     static const rs_path_ranges none = {NULL, 0, 0};
     if (!film->sum_l2) {
-        fprintf(stderr, "raystream: --checkpoint %s: the film keeps no variance\n", path);
+        rs_app_print("raystream: --checkpoint %s: the film keeps no variance\n", path);
         return 0;
     }
     return write_file(path, staged, rename_now, key, film, &none, ad);
@@ -265,9 +266,9 @@ int rs_checkpoint_write_adaptive(const char *path, const char *staged, int renam
 /* One line "raystream: --resume PATH: ..." and `code`. */
 static int refuse(int code, const char *path, const char *fmt, const char *a, const char *b)
 {
-    fprintf(stderr, "raystream: --resume %s: ", path);
-    fprintf(stderr, fmt, a, b);
-    fputc('\n', stderr);
+    rs_app_print("raystream: --resume %s: ", path);
+    rs_app_print(fmt, a, b);
+    rs_app_print("\n");
     return code;
 }
 
@@ -276,7 +277,7 @@ static int mismatch_u(const char *path, const char *field, uint64_t in_file, uin
     char a[32], b[32];
     snprintf(a, sizeof a, "%llu", (unsigned long long)in_file);
     snprintf(b, sizeof b, "%llu", (unsigned long long)asked);
-    fprintf(stderr,
+    rs_app_print(
             "raystream: --resume %s: made with %s %s, but this render has %s %s (the same "
             "settings are needed to continue it)\n",
             path, field, a, field, b);
@@ -285,7 +286,7 @@ static int mismatch_u(const char *path, const char *field, uint64_t in_file, uin
 
 static int mismatch_s(const char *path, const char *field, const char *in_file, const char *asked)
 {
-    fprintf(stderr,
+    rs_app_print(
             "raystream: --resume %s: made with %s %s, but this render has %s %s (the same "
             "settings are needed to continue it)\n",
             path, field, in_file, field, asked);
@@ -383,7 +384,7 @@ static int check_header(const reader *r, rs_checkpoint_key *want)
     int rc;
     /* the size was compared before the film was read */
     if (get64(h + 16) != want->scene_hash) {
-        fprintf(stderr,
+        rs_app_print(
                 "raystream: --resume %s: made for another scene (%s; its content hash %016llx, "
                 "this scene %s has %016llx)\n",
                 path, r->name, (unsigned long long)get64(h + 16), want->scene,
@@ -670,11 +671,11 @@ static int read_any(const char *path, rs_checkpoint_key *want, rs_film *film, rs
     r.h = (unsigned char *)malloc(FIXED_HEADER + NAME_MAX_BYTES + 8 +
                                   16 * (size_t)RS_CHECKPOINT_MAX_RANGES + 8 + SETTINGS_MAX);
     if (!r.h) {
-        fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
+        rs_app_print("raystream: --resume %s: out of memory\n", path);
         return RS_EXIT_RUNTIME;
     }
     if (rs_file_open(path, (uint64_t)1 << 46, &r.f, &r.size) != RS_OK) {
-        fprintf(stderr, "raystream: --resume %s\n", rs_error_message());
+        rs_app_print("raystream: --resume %s\n", rs_error_message());
         rs_error_clear();
         free(r.h);
         return RS_EXIT_USAGE;
@@ -714,7 +715,7 @@ int rs_checkpoint_read_adaptive(const char *path, rs_checkpoint_key *want, rs_fi
     memset(ad, 0, sizeof *ad);
     if (rs_film_track_variance(film) != RS_OK ||
         rs_adaptive_state_init(ad, film->width * film->height) != RS_OK) {
-        fprintf(stderr, "raystream: --resume %s: out of memory\n", path);
+        rs_app_print("raystream: --resume %s: out of memory\n", path);
         rs_error_clear();
         return RS_EXIT_RUNTIME;
     }

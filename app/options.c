@@ -1,5 +1,7 @@
 /* app/options.c — parsing and help text for the command line. */
 #include "app/options.h"
+#include "app/fail.h"
+#include "app/tev.h"
 
 #include "shading/aov.h"
 #include "scenes/gltf.h"
@@ -16,9 +18,9 @@
 
 static int usage_error(const char *fmt, const char *a, const char *b)
 {
-    fprintf(stderr, "raystream: ");
-    fprintf(stderr, fmt, a, b);
-    fprintf(stderr, " (see 'raystream --help')\n");
+    char what[1024];
+    snprintf(what, sizeof what, fmt, a, b);
+    rs_app_print("raystream: %s (see 'raystream --help')\n", what);
     return RS_EXIT_USAGE;
 }
 
@@ -38,14 +40,14 @@ static int parse_u64(const char *opt, const char *text, uint64_t lo, uint64_t hi
         goto bad;
     if (v < lo || v > hi) {
         snprintf(range, sizeof range, " must be between %" PRIu64 " and %" PRIu64, lo, hi);
-        fprintf(stderr, "raystream: %s %s:%s (see 'raystream --help')\n", opt, text, range);
+        rs_app_print("raystream: %s %s:%s (see 'raystream --help')\n", opt, text, range);
         return RS_EXIT_USAGE;
     }
     *out = v;
     return RS_EXIT_OK;
 bad:
     if (text[0] == '-' && strspn(text + 1, "0123456789") == strlen(text + 1) && text[1]) {
-        fprintf(stderr,
+        rs_app_print(
                 "raystream: %s %s: must be a positive whole number (see 'raystream --help')\n", opt,
                 text);
         return RS_EXIT_USAGE;
@@ -70,7 +72,7 @@ static int parse_seconds(const char *opt, const char *text, double *out)
     if (*end != '\0' || end == text)
         return usage_error("%s: '%s' is not a number of seconds", opt, text);
     if (errno || !(v > 0.0) || v > 1e9) {
-        fprintf(stderr,
+        rs_app_print(
                 "raystream: %s %s: must be a number of seconds above 0 and at most 1e9 (see "
                 "'raystream --help')\n",
                 opt, text);
@@ -285,7 +287,10 @@ static void help_render_engine(void)
 /* 4/5: timeline, time limit, checkpoints, MPI, quiet, help. */
 static void help_render_long(void)
 {
-    fputs("  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
+    fputs("  --tev [HOST:]PORT   show the image in a running tev viewer as it converges (tev's\n"
+          "                      port, 14158 by default; HOST 127.0.0.1): a few updates a\n"
+          "                      second; without tev the render goes on after one warning\n"
+          "  --timeline FILE.svg draw the render: a lane per device and one for shading, busy\n"
           "                      spans coloured by stage, idle gaps, waves labelled\n"
           "  --time-limit S      stop after S seconds (a decimal number > 0), at the end of\n"
           "                      the sample pass under way: every pixel gets the same\n"
@@ -673,11 +678,22 @@ static int opt_bvh(const char *name, const char *v, rs_cli_options *o)
 {
     (void)name;
     if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
-        fprintf(stderr, "raystream: --bvh: %s (see 'raystream render --help')\n",
+        rs_app_print("raystream: --bvh: %s (see 'raystream render --help')\n",
                 rs_error_message());
         rs_error_clear();
         return RS_EXIT_USAGE;
     }
+    return RS_EXIT_OK;
+}
+
+/* --tev [HOST:]PORT */
+static int opt_tev(const char *name, const char *v, rs_cli_options *o)
+{
+    char host[128], why[200];
+    int port;
+    if (!rs_tev_parse(v, host, sizeof host, &port, why, sizeof why))
+        return usage_error("%s: %s", name, why);
+    o->tev = v;
     return RS_EXIT_OK;
 }
 
@@ -772,6 +788,7 @@ static const opt_row options[] = {
     ROW_NUM("--stats", OPT_FLAG, stats, 0, 0),
     ROW_TEXT("--stats-json", NULL, stats_json, "a file name"),
     ROW_CALL("--timeline", opt_timeline),
+    ROW_CALL("--tev", opt_tev),
     ROW_CALL("--adaptive", opt_adaptive),
     ROW_NUM("--adaptive-min-spp", OPT_U32, adaptive_min_spp, 2, 1u << 20),
     ROW_CALL("--aov", opt_aov),
@@ -799,6 +816,16 @@ static const opt_row options[] = {
 #undef ROW_TEXT
 #undef ROW_CALL
 #undef FIELD
+
+int rs_cli_option_value(const char *name)
+{
+    size_t k;
+    for (k = 0; k < sizeof options / sizeof options[0]; ++k)
+        if (strcmp(name, options[k].name) == 0 ||
+            (options[k].alias && strcmp(name, options[k].alias) == 0))
+            return options[k].kind != OPT_FLAG;
+    return -1;
+}
 
 /* The option argv[*i], named `name` (its "=value" part `eq`, or NULL): the value is the part
  * after '=', else the next argument.  Returns RS_EXIT_OK, RS_EXIT_USAGE after printing why, or

@@ -98,6 +98,7 @@ typedef struct rs_cli_options {
     unsigned aovs;            /* --aov LIST: RS_AOV_* layers in the EXR (shading/aov.h) */
     double adaptive;          /* --adaptive THRESHOLD; 0: every pixel gets spp */
     uint32_t adaptive_min_spp; /* --adaptive-min-spp N (default 16) */
+    const char *tev;          /* --tev [HOST:]PORT: live preview in tev (app/tev.h) */
     const char *checkpoint;   /* --checkpoint FILE */
     double ckpt_every_s;      /* --checkpoint-interval SECONDS (default 60) */
     const char *resume;       /* --resume FILE */
@@ -109,5 +110,8 @@ typedef struct rs_cli_options {
  * problem on stderr. */
 int rs_cli_parse(int argc, char **argv, rs_cli_options *o);
 void rs_cli_print_help(const char *command);
+/* Whether the render option `name` ("--spp") takes a value: 1, 0 for a flag (--denoise), -1 for
+ * no such option (-h and -q included). */
+int rs_cli_option_value(const char *name);
 
 #endif

@@ -1,5 +1,6 @@
 /* app/outputs.c — see outputs.h. */
 #include "app/outputs.h"
+#include "app/fail.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -41,7 +42,7 @@ void rs_outputs_remove_tracked(void)
 /* One line "raystream: OPTION PATH: what" and RS_EXIT_USAGE. */
 static int refuse(const rs_output *o, const char *what, const char *detail)
 {
-    fprintf(stderr, "raystream: %s %s: %s%s%s%s\n", o->option, o->path, what, detail ? " (" : "",
+    rs_app_print("raystream: %s %s: %s%s%s%s\n", o->option, o->path, what, detail ? " (" : "",
             detail ? detail : "", detail ? ")" : "");
     return RS_EXIT_USAGE;
 }
@@ -136,7 +137,7 @@ int rs_output_commit(const rs_output *o)
 {
     if (rename(o->staged, o->path) == 0)
         return 1;
-    fprintf(stderr, "raystream: %s: cannot put the finished file in place (%s)\n", o->path,
+    rs_app_print("raystream: %s: cannot put the finished file in place (%s)\n", o->path,
             strerror(errno));
     return 0;
 }

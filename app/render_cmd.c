@@ -21,40 +21,14 @@ void rs_run_on_film_ready(void *user, const rs_film *film, const rs_path_ranges 
 {
     render_run *r = (render_run *)user;
     double now;
-    (void)film;
     r->done = done;
+    rs_tev_film(r->tev, film, 0);
     if (!r->ckpt_out || (now = rs_now_s()) - r->last_ckpt < r->ckpt_every_s ||
         rs_path_ranges_total(&r->held) + rs_path_ranges_total(done) ==
             (uint64_t)r->st.width * r->st.height * r->st.spp)
         return; /* the last is written at the end */
     r->last_ckpt = now;
     (void)rs_run_write_checkpoint(r, 1);
-}
-
-/* The engine's run over what the film lacks: everything, or the gaps of a --resume; or the
- * rounds of --adaptive. */
-static rs_status engine_run(render_run *r, const rs_render_hooks *hooks)
-{
-    rs_work_plan plan;
-    rs_status rst;
-    if (r->img.adaptive > 0) {
-        rs_adaptive a;
-        a.threshold = r->img.adaptive;
-        a.min_spp = r->img.adaptive_min_spp;
-        a.time_limit_s = r->st.time_limit_s;
-        rst = rs_adaptive_run(r->engine, &a, &r->ad, hooks, r->film, &r->stats);
-        r->adaptive = r->ad.stats;
-        return rst;
-    }
-    memset(&plan, 0, sizeof plan);
-    plan.time_limit_s = r->st.time_limit_s;
-    if (!rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,
-                                   &plan.todo))
-        rst = rs_error_set(RS_ERR_NOMEM, "out of memory");
-    else
-        rst = rs_engine_run(r->engine, &plan, hooks, r->film, &r->stats);
-    rs_work_plan_free(&plan);
-    return rst;
 }
 
 /* The render itself, with the progress bar and the stop signals (which stay caught until the
@@ -76,7 +50,10 @@ static int run_render(const rs_cli_options *o, render_run *r)
         hooks.film_ready = rs_run_on_film_ready;
         rs_outputs_track(r->ckpt_out->staged); /* a second signal during a periodic write */
     }
-    rst = engine_run(r, &hooks);
+    if (o->tev && (r->tev = rs_tev_open(o->tev, r->name, r->st.width, r->st.height)))
+        hooks.film_ready = rs_run_on_film_ready;
+    rst = rs_run_engine(r, &hooks);
+    rs_tev_film(r->tev, r->film, 1);
     r->done = rs_engine_done(r->engine);
     rs_progress_end(&r->progress);
     if (rst == RS_ERR_CANCELLED) {

@@ -135,11 +135,9 @@ static int alloc_aovs(unsigned aovs, size_t npix, float **bufs)
              ((aovs & RS_AOV_DEPTH) && !bufs[2]) || ((aovs & RS_AOV_SAMPLES) && !bufs[3]));
 }
 
-/* The --aov layers of the finished render (shading/aov.h: the film's passes, which the devices
- * wrote as they rendered) into layers[], their buffers in bufs[] (rs_free them); returns how
- * many, or -1 after a message. */
-static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_layer *layers,
-                     float **bufs)
+/* The --aov layers come from the film's passes (shading/aov.h), which the devices wrote as they
+ * rendered. */
+int rs_run_make_aovs(unsigned aovs, const render_run *r, rs_image_layer *layers, float **bufs)
 {
     static const char *const names[4] = {"albedo", "normal", "depth", "samples"};
     static const char *const channels[4] = {"RGB", "XYZ", "Z", "Y"};
@@ -147,13 +145,13 @@ static int make_aovs(const rs_cli_options *o, const render_run *r, rs_image_laye
     int n = 0, k;
     uint32_t i;
     bufs[0] = bufs[1] = bufs[2] = bufs[3] = NULL;
-    if (!o->aovs)
+    if (!aovs)
         return 0;
-    if (!alloc_aovs(o->aovs, npix, bufs)) {
+    if (!alloc_aovs(aovs, npix, bufs)) {
         rs_error_set(RS_ERR_NOMEM, "out of memory for the --aov layers");
         return -1;
     }
-    if (o->aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH))
+    if (aovs & (RS_AOV_ALBEDO | RS_AOV_NORMAL | RS_AOV_DEPTH))
         rs_film_resolve_passes(r->film, bufs[0], bufs[1], NULL, bufs[2]);
     if (bufs[3])
         for (i = 0; i < npix; ++i)
@@ -192,7 +190,7 @@ static int used_gpu(const render_run *r)
  * of the denoiser and added back, better estimated on its edges (rs_aov_refine,
  * rs_denoise_split): beyond that the render's own samples resolve a light's outline, and the
  * refinement would cost more.  0 after a message. */
-static int denoise(render_run *r)
+int rs_run_denoise(render_run *r)
 {
     size_t npix = (size_t)r->st.width * r->st.height;
     int split = r->st.spp <= RS_AOV_EMISSION_SPP;
@@ -240,10 +238,10 @@ static int write_image(const rs_cli_options *o, const render_run *r, const rs_re
     /* --view and --exposure (checked when the options were read): an 8-bit image gets the
      * view's display values; an .exr stays linear and records the view (core/image_io.h) */
     if (!rs_view_from_name(o->view, o->exposure, &view, why, sizeof why)) {
-        fprintf(stderr, "raystream: %s\n", why);
+        rs_app_print("raystream: %s\n", why);
         return 0;
     }
-    n_layers = make_aovs(o, r, layers, bufs);
+    n_layers = rs_run_make_aovs(o->aovs, r, layers, bufs);
     if (n_layers < 0) {
         rs_app_fail(0, NULL);
         ok = 0;
@@ -296,7 +294,7 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
      * stop, not for seconds more of the denoiser on an image cut short */
     if (o->denoise && r->interrupted)
         skipped = 1;
-    else if (o->denoise && !denoise(r))
+    else if (o->denoise && !rs_run_denoise(r))
         undenoised = 1;
     make_report(o, r, &rep);
     if (o->stats)
@@ -319,16 +317,16 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
     rs_outputs_remove_tracked(); /* what was not renamed */
     rs_outputs_untrack();
     if (!ok) {
-        fprintf(stderr, "raystream: the run failed; %s\n",
+        rs_app_print("raystream: the run failed; %s\n",
                 replaced ? "some outputs were already replaced" : "no output was replaced");
         return RS_EXIT_RUNTIME;
     }
     rs_report_print_summary(&rep);
     if (skipped)
-        fprintf(stderr, "raystream: interrupted: %s was written as rendered, not denoised\n",
+        rs_app_print("raystream: interrupted: %s was written as rendered, not denoised\n",
                 r->out);
     if (undenoised) {
-        fprintf(stderr, "raystream: --denoise failed after the render: %s was written as "
+        rs_app_print("raystream: --denoise failed after the render: %s was written as "
                         "rendered, not denoised\n",
                 r->out);
         return RS_EXIT_RUNTIME;

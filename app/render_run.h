@@ -15,6 +15,8 @@
 #include "app/options.h"
 #include "app/outputs.h"
 #include "app/progress.h"
+#include "app/tev.h"
+#include "core/image_io.h"
 #include "scheduler/adaptive.h"
 #include "scheduler/fault.h"
 #include "scheduler/render.h"
@@ -77,6 +79,8 @@ typedef struct render_run {
     int local_ranks;          /* ranks on this machine: they share its cores */
     rs_dist_result dres;      /* rank 0: the job's result */
     rs_dist_fault dist_fault; /* RS_MPI_FAULT */
+    rs_tev *tev;              /* --tev: the preview, or NULL */
+    int library;              /* run by the C API (api/raystream.c): no load watchdog */
 } render_run;
 
 /* The steps (render_steps.c, scene_load.c, render_outputs.c); see the top of this file. */
@@ -90,6 +94,14 @@ rs_status rs_run_new_film(const render_run *r, rs_film **out);
 int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, const char *what);
 int rs_run_build_bvh(const rs_cli_options *o, render_run *r);
 int rs_run_start_devices(const rs_cli_options *o, render_run *r);
+/* The engine's run over what the film lacks: everything, or the gaps of a --resume; or the
+ * rounds of --adaptive. */
+rs_status rs_run_engine(render_run *r, const rs_render_hooks *hooks);
+/* --denoise: r->denoised from r->rgb (the film resolved); 0 after a message. */
+int rs_run_denoise(render_run *r);
+/* The --aov layers `aovs` (RS_AOV_*) of the finished render into layers[] (room for 4), their
+ * buffers in bufs[4] (rs_free them); returns how many, or -1 (out of memory, rs_error set). */
+int rs_run_make_aovs(unsigned aovs, const render_run *r, rs_image_layer *layers, float **bufs);
 /* The outputs, all or none, then the summary; returns `code` or RS_EXIT_RUNTIME. */
 int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code);
 /* The --checkpoint of the film as it is now; 0 after a message. */

@@ -141,7 +141,7 @@ int rs_run_check_outputs(const rs_cli_options *o, render_run *r)
                        * a library that cannot make a CPU device and its filter */
         char why[400];
         if (!rs_denoise_probe(why, sizeof why)) {
-            fprintf(stderr, "raystream: --denoise: %s\n", why);
+            rs_app_print("raystream: --denoise: %s\n", why);
             return RS_EXIT_RUNTIME;
         }
     }
@@ -156,7 +156,7 @@ int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, co
     uint32_t i;
     for (i = 0; i < r->held.n; ++i)
         if (r->held.r[i][1] % npix != 0) {
-            fprintf(stderr,
+            rs_app_print(
                     "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
                     "pixels); %s\n",
                     o->resume, (unsigned long long)r->held.r[i][1], r->st.width, r->st.height,
@@ -257,7 +257,7 @@ int rs_run_build_bvh(const rs_cli_options *o, render_run *r)
         if (rs_gpu_count(&why) > 0)
             bo.lbvh_sort = rs_gpu_lbvh_sort; /* device 0 */
         else
-            fprintf(stderr, "raystream: warning: %s; the lbvh is built on the CPU\n", why);
+            rs_app_print("raystream: warning: %s; the lbvh is built on the CPU\n", why);
     }
     t0 = rs_now_s();
     if (rs_bvh_build(&r->geom, &bo, &r->bvh) != RS_OK)
@@ -336,7 +336,7 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
     }
     r->rgb = (float *)rs_alloc((size_t)r->st.width * r->st.height * 3, sizeof *r->rgb);
     if (!r->rgb) {
-        fprintf(stderr, "raystream: out of memory for a %ux%u image\n", r->st.width, r->st.height);
+        rs_app_print("raystream: out of memory for a %ux%u image\n", r->st.width, r->st.height);
         return RS_EXIT_RUNTIME;
     }
     /* under mpirun the job's coordinator keeps the time (app/distributed.h) */
@@ -348,9 +348,34 @@ int rs_run_start_devices(const rs_cli_options *o, render_run *r)
     return RS_EXIT_OK;
 }
 
+rs_status rs_run_engine(render_run *r, const rs_render_hooks *hooks)
+{
+    rs_work_plan plan;
+    rs_status rst;
+    if (r->img.adaptive > 0) {
+        rs_adaptive a;
+        a.threshold = r->img.adaptive;
+        a.min_spp = r->img.adaptive_min_spp;
+        a.time_limit_s = r->st.time_limit_s;
+        rst = rs_adaptive_run(r->engine, &a, &r->ad, hooks, r->film, &r->stats);
+        r->adaptive = r->ad.stats;
+        return rst;
+    }
+    memset(&plan, 0, sizeof plan);
+    plan.time_limit_s = r->st.time_limit_s;
+    if (!rs_path_ranges_complement(&r->held, (uint64_t)r->st.width * r->st.height * r->st.spp,
+                                   &plan.todo))
+        rst = rs_error_set(RS_ERR_NOMEM, "out of memory");
+    else
+        rst = rs_engine_run(r->engine, &plan, hooks, r->film, &r->stats);
+    rs_work_plan_free(&plan);
+    return rst;
+}
+
 void rs_run_release(render_run *r)
 {
     int i;
+    rs_tev_close(r->tev);
     rs_engine_destroy(r->engine);
     rs_sched_destroy(r->sched);
     for (i = 0; i < r->n_devs; ++i)
@@ -373,7 +398,7 @@ static int film_ranges(const render_run *r, rs_path_ranges *out)
     memset(out, 0, sizeof *out);
     if (rs_path_ranges_union(out, &r->held) && (!r->done || rs_path_ranges_union(out, r->done)))
         return 1;
-    fprintf(stderr, "raystream: out of memory for the checkpoint's list of paths\n");
+    rs_app_print("raystream: out of memory for the checkpoint's list of paths\n");
     rs_path_ranges_free(out);
     return 0;
 }

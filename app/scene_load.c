@@ -30,12 +30,12 @@ static int load_builtin(const rs_cli_options *o, render_run *r)
     rs_status bst;
     struct stat sb;
     if (o->mesh && stat(o->mesh, &sb) == 0 && S_ISDIR(sb.st_mode)) {
-        fprintf(stderr, "raystream: --mesh %s: is a folder, not a mesh file\n", o->mesh);
+        rs_app_print("raystream: --mesh %s: is a folder, not a mesh file\n", o->mesh);
         return RS_EXIT_USAGE;
     }
     bo.models_dir = o->models;
     bo.mesh_file = o->mesh;
-    bo.log = o->quiet ? NULL : stderr;
+    bo.log = rs_app_log(o->quiet);
     bst = rs_builtin_create_ex(o->scene + 8, &bo, &r->scene);
     if (bst != RS_OK)
         return rs_app_fail(bst == RS_ERR_ARG && !o->mesh ? RS_EXIT_USAGE : RS_EXIT_RUNTIME, NULL);
@@ -54,25 +54,25 @@ static int load_scene(const rs_cli_options *o, render_run *r)
     if (strncmp(o->scene, "builtin:", 8) == 0)
         return load_builtin(o, r);
     if (stat(o->scene, &sb) != 0) {
-        fprintf(stderr,
+        rs_app_print(
                 "raystream: %s: no such scene file (built-in scenes are named "
                 "builtin:NAME; see 'raystream scenes')\n",
                 o->scene);
         return RS_EXIT_USAGE;
     }
     if (S_ISDIR(sb.st_mode)) {
-        fprintf(stderr, "raystream: %s: is a folder, not a scene file\n", o->scene);
+        rs_app_print("raystream: %s: is a folder, not a scene file\n", o->scene);
         return RS_EXIT_USAGE;
     }
     if (rs_is_gltf_path(o->scene)) {
         rs_gltf_opts go;
         go.camera = o->camera;
-        go.log = o->quiet ? NULL : stderr;
+        go.log = rs_app_log(o->quiet);
         go.extensions = r->gltf_extensions;
         go.extensions_n = sizeof r->gltf_extensions;
         if (rs_scene_load_gltf(o->scene, &go, &r->scene) != RS_OK)
             return rs_app_fail(RS_EXIT_RUNTIME, NULL);
-    } else if (rs_scene_load_json_ex(o->scene, o->quiet ? NULL : stderr, &r->scene) != RS_OK) {
+    } else if (rs_scene_load_json_ex(o->scene, rs_app_log(o->quiet), &r->scene) != RS_OK) {
         return rs_app_fail(RS_EXIT_RUNTIME, NULL);
     }
     if (o->flatten_instances && r->scene->n_instances) {
@@ -95,7 +95,7 @@ static int apply_sky(const rs_cli_options *o, render_run *r)
     char why[200];
     if (o->background_kind == RS_BG_SKY) {
         if (!rs_sky_parse(o->background + 3, &p, why, sizeof why)) {
-            fprintf(stderr, "raystream: --background %s: %s\n", o->background, why);
+            rs_app_print("raystream: --background %s: %s\n", o->background, why);
             return RS_EXIT_USAGE;
         }
     } else {
@@ -180,6 +180,8 @@ int rs_run_load_scene(const rs_cli_options *o, render_run *r)
      * trilinear textures (a large scene or texture spent gigabytes on them otherwise) */
     rs_scene_set_extras(o->light_sampler == RS_LIGHT_SAMPLER_BVH,
                         o->texture_filter == RS_TEXTURE_TRILINEAR);
+    if (r->library) /* a library never ends its program */
+        return load_and_light(&a);
     return rs_load_watch_run(o->mesh ? o->mesh : o->scene, load_and_light, &a);
 }
 
@@ -190,7 +192,7 @@ int rs_cmd_export(const rs_cli_options *o)
     int code;
     size_t n = o->output ? strlen(o->output) : 0;
     if (!o->output || n < 5 || strcmp(o->output + n - 5, ".json") != 0) {
-        fprintf(stderr, "raystream: export needs -o FILE.json\n");
+        rs_app_print("raystream: export needs -o FILE.json\n");
         return RS_EXIT_USAGE;
     }
     memset(&r, 0, sizeof r);
@@ -202,7 +204,7 @@ int rs_cmd_export(const rs_cli_options *o)
         else if (rs_scene_export_json(r.scene, o->output) != RS_OK)
             code = rs_app_fail(RS_EXIT_RUNTIME, NULL);
         else if (!o->quiet)
-            fprintf(stderr, "raystream: wrote %s (%u spheres, %u quads, %u triangles)\n", o->output,
+            rs_app_print("raystream: wrote %s (%u spheres, %u quads, %u triangles)\n", o->output,
                     r.scene->n_spheres, r.scene->n_quads, r.scene->n_tris);
     }
     rs_run_release(&r);

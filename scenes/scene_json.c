@@ -490,3 +490,27 @@ rs_status rs_scene_load_json_ex(const char *path, FILE *log, rs_scene **out)
     rs_free(text);
     return st;
 }
+
+rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label,
+                                     uint32_t *id)
+{
+    cJSON *m;
+    ctx *c;
+    rs_status st;
+    if (!text || !*text)
+        return rs_error_set(RS_ERR_ARG, "%s: expected a JSON object, not an empty text", label);
+    if (!(m = cJSON_Parse(text)))
+        return rs_error_set(RS_ERR_ARG, "%s: JSON syntax error", label);
+    if (!(c = (ctx *)rs_calloc(1, sizeof *c))) {
+        cJSON_Delete(m);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", label);
+    }
+    c->label = label;
+    c->scene = s;
+    st = rs_json_read_material(c, m, "material", "");
+    if (st == RS_OK)
+        *id = c->materials[0].id;
+    cJSON_Delete(m);
+    rs_free(c);
+    return st;
+}

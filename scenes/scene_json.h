@@ -28,6 +28,11 @@ rs_status rs_scene_parse_json(const char *text, size_t len, const char *label,
 rs_status rs_scene_load_json_ex(const char *path, FILE *log, rs_scene **out);
 rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label,
                                  const char *base_dir, FILE *log, rs_scene **out);
+/* Adds to `s` the material the JSON object `text` describes, as a scene file's "materials"
+ * entry does (docs/scene-format.md; a texture may be a colour, not the name of one), its id in
+ * *id.  `label` names it in messages.  RS_ERR_ARG with one line for a bad object. */
+rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label,
+                                     uint32_t *id);
 #ifdef __cplusplus
 }
 #endif

@@ -10,7 +10,9 @@
 
 # The allowed arrows, A=B,C: a file in A/ may include A/ itself and B/, C/.  Keep this table and
 # the target_link_libraries of the folder libraries in CMakeLists.txt the same.  cpu and gpu
-# never include each other; nothing includes app/, tests/ or bench/.
+# never include each other; nothing includes app/ but api/ (the C API over the command's steps)
+# and python/, nothing tests/ or bench/.  The public header include/raystream.h is included as
+# "raystream.h", without a folder.
 RS_LAYERS="core=
 streams=core
 accel=core,streams
@@ -19,8 +21,10 @@ shading=core,streams,accel,scenes
 scheduler=core,streams,accel,scenes,shading
 cpu=core,streams,accel,scenes,shading,scheduler
 gpu=core,streams,accel,scenes,shading,scheduler
-app=core,streams,accel,scenes,shading,scheduler,cpu,gpu"
-RS_FOLDERS="core accel streams scenes shading scheduler cpu gpu app"
+app=core,streams,accel,scenes,shading,scheduler,cpu,gpu
+api=core,streams,accel,scenes,shading,scheduler,cpu,gpu,app
+python=core,streams,accel,scenes,shading,scheduler,cpu,gpu,app"
+RS_FOLDERS="core accel streams scenes shading scheduler cpu gpu app api python"
 
 script="$0"
 

@@ -11,14 +11,15 @@
 #             finds it.  Benchmark only; the renderer and its tests never need it.
 set -eu
 
-# python3-pip: fetches the OIDN wheel (below)
+# python3-pip: fetches the OIDN wheel (below); python3-dev, -venv, -numpy, -pytest: the Python
+# module (python/) and its tests, including `pip install .` in a fresh venv
 # clang, its libFuzzer/sanitizer runtimes (libclang-rt-14-dev: bookworm's clang does not pull it
 # in) and its OpenMP (libomp-14-dev): scripts/fuzz.sh, which check-sanitizers.sh runs
 PACKAGES="gcc g++ make cmake pkg-config libc6-dev
 libopenimageio-dev libassimp-dev libcjson-dev libcmocka-dev gnuplot-nox
 clang libclang-rt-14-dev libomp-14-dev
 libopenmpi-dev openmpi-bin
-python3-pip"
+python3-pip python3-dev python3-venv python3-numpy python3-pytest"
 
 for arg in "$@"; do
     case "$arg" in

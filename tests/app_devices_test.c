@@ -6,7 +6,7 @@
  *     examples of `raystream render --help`;
  *   - rs_devices_local_rank reads the launchers' node-local rank and size (Open MPI, MPICH,
  *     MVAPICH, PMI, Slurm) and refuses an incomplete or inconsistent pair.
- * It links app/devices.c alone; rs_app_fail (app/render_cmd.c) is stubbed. */
+ * It links app/devices.c and the lines it prints through (app/fail.c). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,12 +17,6 @@
 
 #include "app/devices.h"
 #include "app/render_run.h"
-
-int rs_app_fail(int code, const char *what)
-{
-    (void)what;
-    return code;
-}
 
 #define MAX_GPUS 16
 
