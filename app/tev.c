@@ -31,6 +31,8 @@ struct rs_tev {
     int quit;
     int dead;    /* the viewer went away: nothing more is sent */
     double last; /* when the last update was handed over */
+    double resolve_s, send_s; /* what the last update cost: the film resolved, the image sent */
+    double interval;          /* between updates: RS_TEV_INTERVAL_S, or more (rs_tev_film) */
 };
 
 int rs_tev_parse(const char *spec, char *host, size_t host_n, int *port, char *why, size_t why_n)
@@ -215,6 +217,7 @@ static void *sender(void *arg)
     rs_tev *t = (rs_tev *)arg;
     pthread_mutex_lock(&t->lock);
     for (;;) {
+        double t0, t1;
         int ok;
         while (!t->pending && !t->quit)
             pthread_cond_wait(&t->cond, &t->lock);
@@ -223,8 +226,11 @@ static void *sender(void *arg)
         t->pending = 0;
         t->busy = 1;
         pthread_mutex_unlock(&t->lock);
+        t0 = rs_now_s();
         ok = send_image(t);
+        t1 = rs_now_s();
         pthread_mutex_lock(&t->lock);
+        t->send_s = t1 - t0;
         t->busy = 0;
         if (!ok) {
             t->dead = errno ? errno : EPIPE;
@@ -282,6 +288,7 @@ rs_tev *rs_tev_open(const char *spec, const char *name, uint32_t width, uint32_t
         return NULL;
     }
     t->last = rs_now_s();
+    t->interval = RS_TEV_INTERVAL_S;
     return t;
 }
 
@@ -308,10 +315,16 @@ void rs_tev_film(rs_tev *t, const rs_film *film, int final)
     now = rs_now_s();
     if (t->dead) {
         report_dead(t);
-    } else if (final || (!t->busy && !t->pending && now - t->last >= RS_TEV_INTERVAL_S)) {
+    } else if (final || (!t->busy && !t->pending && now - t->last >= t->interval)) {
         rs_film_resolve(film, t->rgb); /* the sender is idle: the buffer is free */
         t->pending = 1;
         t->last = now;
+        t->resolve_s = rs_now_s() - now;
+        /* what the last update cost (the resolve here, the send on the sender's thread, both
+         * taken from the render's cores) at most 1/RS_TEV_COST_SHARE of the time */
+        t->interval = RS_TEV_COST_SHARE * (t->resolve_s + t->send_s);
+        if (t->interval < RS_TEV_INTERVAL_S)
+            t->interval = RS_TEV_INTERVAL_S;
         pthread_cond_broadcast(&t->cond);
         if (final) {
             while ((t->busy || t->pending) && !t->dead)

@@ -3,9 +3,10 @@
  * uint32 length, a type byte, then the fields; CreateImage = 4, UpdateImage = 6 with per-channel
  * offsets and strides).  Internal to app/.
  *
- * The render thread only resolves the film into a buffer (rs_tev_film, at most 4 times a second,
- * and only when the last update has gone out); a thread of the preview's own sends it, in tiles
- * of 128 x 128, so a slow or stalled viewer never holds the render up.  A viewer that is not
+ * The render thread only resolves the film into a buffer (rs_tev_film: at most 4 times a second,
+ * only when the last update has gone out, and so that an update's cost, the resolve and the send,
+ * is at most 1/100 of the time between two); a thread of the preview's own sends it, in tiles of
+ * 128 x 128, so a slow or stalled viewer never holds the render up.  A viewer that is not
  * there, or goes away, costs one warning line and the render goes on. */
 #ifndef RS_APP_TEV_H
 #define RS_APP_TEV_H
@@ -16,7 +17,8 @@
 
 #define RS_TEV_DEFAULT_PORT 14158
 #define RS_TEV_TILE         128
-#define RS_TEV_INTERVAL_S   0.25
+#define RS_TEV_INTERVAL_S   0.25 /* the shortest time between two updates */
+#define RS_TEV_COST_SHARE   100  /* an update costs at most 1/100 of the time between two */
 
 typedef struct rs_tev rs_tev;
 

@@ -35,7 +35,7 @@ if [ "$which" = all ] || [ "$which" = thread ]; then
     # locks and threads are suppressed by the binary itself (app/distributed.c)
     # OpenImageIO's thread pool synchronises where TSan cannot see (scripts/tsan.supp)
     TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(pwd)/scripts/tsan.supp" \
-        ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli|app_mpi|app_timeline"
+        ctest --test-dir build-tsan --output-on-failure -R "scheduler|render|app_cli|app_mpi|app_timeline|app_tev|api_test"
 fi
 if [ "$which" = all ] || [ "$which" = fuzz ]; then
     # the scene reader, the mesh import and the option parser: no crash, hang, leak or
