@@ -304,6 +304,8 @@ static int parse_options(const raystream_options *o, const char *scene, char **a
 struct raystream_scene {
     rs_scene *s;
     atomic_int refs;
+    uint32_t (*protos)[2]; /* raystream_scene_add_prototype's: first, count (inst_tris) */
+    uint32_t n_protos, cap_protos;
     char name[64]; /* the default output name's stem */
     char lighting[160];
 };
@@ -406,6 +408,7 @@ void raystream_scene_release(raystream_scene *h)
     if (!h || atomic_fetch_sub(&h->refs, 1) != 1)
         return;
     rs_scene_destroy(h->s);
+    free(h->protos);
     free(h);
 }
 
@@ -515,6 +518,83 @@ raystream_status raystream_scene_add_mesh(raystream_scene *h, const float *posit
     return RAYSTREAM_OK;
 }
 
+raystream_status raystream_scene_add_light(raystream_scene *h, const char *json)
+{
+    rs_status st;
+    NEED_SCENE(h, "raystream_scene_add_light");
+    if (!json)
+        return fail(RAYSTREAM_ERROR_ARGUMENT, "raystream_scene_add_light: json is NULL");
+    st = rs_scene_add_light_json(h->s, json, "light");
+    return st == RS_OK ? RAYSTREAM_OK : fail_core(st);
+}
+
+raystream_status raystream_scene_add_prototype(raystream_scene *h, const float *positions,
+                                               size_t n_vertices, const uint32_t *indices,
+                                               size_t n_triangles, const float *normals,
+                                               const float *uvs, uint32_t material,
+                                               uint32_t *prototype)
+{
+    raystream_status st;
+    uint32_t from;
+    rs_status rst;
+    NEED_SCENE(h, "raystream_scene_add_prototype");
+    if (h->n_protos == h->cap_protos) {
+        uint32_t cap = h->cap_protos ? 2 * h->cap_protos : 8;
+        void *p = realloc(h->protos, cap * sizeof *h->protos);
+        if (!p)
+            return fail(RAYSTREAM_ERROR_MEMORY, "out of memory");
+        h->protos = (uint32_t(*)[2])p;
+        h->cap_protos = cap;
+    }
+    if (material < h->s->n_materials && rs_material_is_light(&h->s->materials[material]))
+        return fail(RAYSTREAM_ERROR_ARGUMENT,
+                    "prototype: material %u emits light, and placed triangles are not lights "
+                    "(add the mesh with raystream_scene_add_mesh)",
+                    material);
+    from = h->s->n_tris;
+    if ((st = raystream_scene_add_mesh(h, positions, n_vertices, indices, n_triangles, normals, uvs,
+                                       material)) != RAYSTREAM_OK)
+        return st;
+    rst =
+        rs_scene_make_prototype(h->s, from, &h->protos[h->n_protos][0], &h->protos[h->n_protos][1]);
+    if (rst != RS_OK) {
+        h->s->n_tris = from;
+        return fail_core(rst);
+    }
+    if (prototype)
+        *prototype = h->n_protos;
+    ++h->n_protos;
+    return RAYSTREAM_OK;
+}
+
+raystream_status raystream_scene_add_instance(raystream_scene *h, uint32_t prototype,
+                                              const double matrix[12])
+{
+    rs_status st;
+    int i;
+    NEED_SCENE(h, "raystream_scene_add_instance");
+    if (prototype >= h->n_protos)
+        return fail(RAYSTREAM_ERROR_ARGUMENT,
+                    "instance: prototype %u, but the scene has %u (raystream_scene_add_prototype)",
+                    prototype, h->n_protos);
+    for (i = 0; matrix && i < 12; ++i)
+        if (!isfinite(matrix[i]) || fabs(matrix[i]) > 1e30)
+            return fail(RAYSTREAM_ERROR_ARGUMENT, "instance: matrix[%d] is not a finite number", i);
+    if (!matrix)
+        return fail(RAYSTREAM_ERROR_ARGUMENT, "raystream_scene_add_instance: matrix is NULL");
+    if (h->protos[prototype][1] == 0)
+        return RAYSTREAM_OK; /* an empty prototype places nothing, as an empty group */
+    st = rs_scene_add_instance(h->s, h->protos[prototype][0], h->protos[prototype][1], matrix);
+    if (st != RS_OK) {
+        char msg[600];
+        snprintf(msg, sizeof msg, "instance: %s", rs_error_message());
+        rs_error_clear();
+        return fail(st == RS_ERR_NOMEM ? RAYSTREAM_ERROR_MEMORY : RAYSTREAM_ERROR_ARGUMENT, "%s",
+                    msg);
+    }
+    return RAYSTREAM_OK;
+}
+
 raystream_status raystream_scene_add_sphere(raystream_scene *h, const float center[3], float radius,
                                             uint32_t material)
 {
@@ -604,7 +684,7 @@ void raystream_scene_counts(const raystream_scene *h, uint32_t *spheres, uint32_
     if (quads)
         *quads = s ? s->n_quads : 0;
     if (triangles)
-        *triangles = s ? s->n_tris + s->n_inst_tris : 0;
+        *triangles = s ? s->n_tris + s->n_inst_prims : 0;
     if (materials)
         *materials = s ? s->n_materials : 0;
 }

@@ -72,8 +72,8 @@ RAYSTREAM_API raystream_status raystream_scene_load(const char *scene, raystream
  * are found from `base_dir` (NULL: the current folder). */
 RAYSTREAM_API raystream_status raystream_scene_from_json(const char *json, const char *base_dir,
                                                          raystream_scene **out);
-/* An empty scene: a camera at the origin looking down -z, 60 degrees, 400 x 300, black
- * background; add materials and shapes below. */
+/* An empty scene: a camera at (0, 0, 1) looking at the origin, 40 degrees, 512 x 512, a black
+ * background; add materials, shapes and lights below. */
 RAYSTREAM_API raystream_status raystream_scene_create(raystream_scene **out);
 RAYSTREAM_API raystream_scene *raystream_scene_retain(raystream_scene *scene);
 RAYSTREAM_API void raystream_scene_release(raystream_scene *scene);
@@ -98,6 +98,21 @@ RAYSTREAM_API raystream_status raystream_scene_add_sphere(raystream_scene *scene
 RAYSTREAM_API raystream_status raystream_scene_add_quad(raystream_scene *scene, const float q[3],
                                                         const float u[3], const float v[3],
                                                         uint32_t material);
+/* A point, spot or directional light, written as a scene file's object of that type, e.g.
+ * {"type": "point_light", "position": [0, 3, 0], "intensity": [10, 10, 10]}. */
+RAYSTREAM_API raystream_status raystream_scene_add_light(raystream_scene *scene, const char *json);
+/* A mesh, as raystream_scene_add_mesh, that is not placed itself but by instances (one copy in
+ * memory however often it is placed): its id in *prototype.  Its material may not emit light
+ * (placed triangles are not lights). */
+RAYSTREAM_API raystream_status
+raystream_scene_add_prototype(raystream_scene *scene, const float *positions, size_t n_vertices,
+                              const uint32_t *indices, size_t n_triangles, const float *normals,
+                              const float *uvs, uint32_t material, uint32_t *prototype);
+/* Places a prototype by an affine transform: the top three rows of a 4x4 matrix, row by row
+ * (x' = m[0] x + m[1] y + m[2] z + m[3], ...); invertible and finite. */
+RAYSTREAM_API raystream_status raystream_scene_add_instance(raystream_scene *scene,
+                                                            uint32_t prototype,
+                                                            const double matrix[12]);
 /* A pinhole (aperture 0) or thin-lens camera; focus_dist 0: |at - from|. */
 RAYSTREAM_API raystream_status raystream_scene_set_camera(raystream_scene *scene,
                                                           const float from[3], const float at[3],
@@ -109,7 +124,8 @@ RAYSTREAM_API raystream_status raystream_scene_set_background(raystream_scene *s
 /* The image size a render gets without "width"/"height" options. */
 RAYSTREAM_API raystream_status raystream_scene_set_image_size(raystream_scene *scene,
                                                               uint32_t width, uint32_t height);
-/* What the scene holds: spheres, quads, triangles, materials (any may be NULL). */
+/* What the scene holds: spheres, quads, triangles (placed ones included), materials (any may be
+ * NULL). */
 RAYSTREAM_API void raystream_scene_counts(const raystream_scene *scene, uint32_t *spheres,
                                           uint32_t *quads, uint32_t *triangles,
                                           uint32_t *materials);

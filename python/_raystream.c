@@ -131,6 +131,7 @@ static int bytes_of(PyObject *o, const char *name, size_t unit, const char **dat
     return 1;
 }
 
+/* scene_add_mesh(cap, pos, idx, nrm, uv, material, as_prototype) -> None or the prototype */
 static PyObject *py_scene_add_mesh(PyObject *self, PyObject *args)
 {
     PyObject *cap, *pos, *idx, *nrm, *uv;
@@ -138,8 +139,11 @@ static PyObject *py_scene_add_mesh(PyObject *self, PyObject *args)
     const char *p, *i, *n, *u;
     size_t np_, ni, nn, nu;
     raystream_status st;
+    uint32_t proto = 0;
+    int as_proto = 0;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OSSOOk", &cap, &pos, &idx, &nrm, &uv, &mat) || !scene_of(cap))
+    if (!PyArg_ParseTuple(args, "OSSOOk|p", &cap, &pos, &idx, &nrm, &uv, &mat, &as_proto) ||
+        !scene_of(cap))
         return NULL;
     if (!bytes_of(pos, "vertices", 12, &p, &np_) || !bytes_of(idx, "indices", 12, &i, &ni) ||
         !bytes_of(nrm, "normals", 12, &n, &nn) || !bytes_of(uv, "uvs", 8, &u, &nu))
@@ -147,10 +151,60 @@ static PyObject *py_scene_add_mesh(PyObject *self, PyObject *args)
     if ((n && nn != np_) || (u && nu != np_))
         return PyErr_Format(PyExc_ValueError, "%s: %zu rows for %zu vertices",
                             n && nn != np_ ? "normals" : "uvs", n && nn != np_ ? nn : nu, np_);
-    st = raystream_scene_add_mesh(
-        scene_of(cap), (const float *)(const void *)p, np_, (const uint32_t *)(const void *)i, ni,
-        (const float *)(const void *)n, (const float *)(const void *)u, (uint32_t)mat);
+    if (as_proto)
+        st = raystream_scene_add_prototype(scene_of(cap), (const float *)(const void *)p, np_,
+                                           (const uint32_t *)(const void *)i, ni,
+                                           (const float *)(const void *)n,
+                                           (const float *)(const void *)u, (uint32_t)mat, &proto);
+    else
+        st = raystream_scene_add_mesh(
+            scene_of(cap), (const float *)(const void *)p, np_, (const uint32_t *)(const void *)i,
+            ni, (const float *)(const void *)n, (const float *)(const void *)u, (uint32_t)mat);
     if (st != RAYSTREAM_OK)
+        return raise_status(st);
+    if (as_proto)
+        return PyLong_FromUnsignedLong(proto);
+    Py_RETURN_NONE;
+}
+
+static PyObject *py_scene_add_light(PyObject *self, PyObject *args)
+{
+    PyObject *cap;
+    const char *json;
+    raystream_status st;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "Os", &cap, &json) || !scene_of(cap))
+        return NULL;
+    if ((st = raystream_scene_add_light(scene_of(cap), json)) != RAYSTREAM_OK)
+        return raise_status(st);
+    Py_RETURN_NONE;
+}
+
+/* scene_add_instance(cap, prototype, 12 numbers) */
+static PyObject *py_scene_add_instance(PyObject *self, PyObject *args)
+{
+    PyObject *cap, *m;
+    unsigned long proto;
+    double mat[12];
+    Py_ssize_t k;
+    raystream_status st;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OkO", &cap, &proto, &m) || !scene_of(cap))
+        return NULL;
+    if (!PySequence_Check(m) || PySequence_Size(m) != 12) {
+        PyErr_Clear();
+        return PyErr_Format(PyExc_ValueError, "instance: expected a 3 x 4 or 4 x 4 matrix");
+    }
+    for (k = 0; k < 12; ++k) {
+        PyObject *it = PySequence_GetItem(m, k);
+        mat[k] = it ? PyFloat_AsDouble(it) : -1.0;
+        Py_XDECREF(it);
+        if (PyErr_Occurred()) {
+            PyErr_Clear();
+            return PyErr_Format(PyExc_ValueError, "instance: the matrix holds a non-number");
+        }
+    }
+    if ((st = raystream_scene_add_instance(scene_of(cap), (uint32_t)proto, mat)) != RAYSTREAM_OK)
         return raise_status(st);
     Py_RETURN_NONE;
 }
@@ -437,6 +491,8 @@ static PyMethodDef k_methods[] = {
     {"scene_create", py_scene_create, METH_NOARGS, "scene_create() -> capsule"},
     {"scene_add_material", py_scene_add_material, METH_VARARGS, "-> material id"},
     {"scene_add_mesh", py_scene_add_mesh, METH_VARARGS, "(cap, pos, idx, nrm, uv, material)"},
+    {"scene_add_light", py_scene_add_light, METH_VARARGS, "(cap, json)"},
+    {"scene_add_instance", py_scene_add_instance, METH_VARARGS, "(cap, prototype, 12 numbers)"},
     {"scene_add_sphere", py_scene_add_sphere, METH_VARARGS, "(cap, center, radius, material)"},
     {"scene_add_quad", py_scene_add_quad, METH_VARARGS, "(cap, q, u, v, material)"},
     {"scene_set_camera", py_scene_set_camera, METH_VARARGS, "(cap, from, at, up, vfov, ap, fd)"},

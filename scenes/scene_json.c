@@ -491,26 +491,56 @@ rs_status rs_scene_load_json_ex(const char *path, FILE *log, rs_scene **out)
     return st;
 }
 
+/* A context over `s` for one JSON value of the API's (a material, a light): rs_free it. */
+static rs_status one_value(rs_scene *s, const char *text, const char *label, cJSON **v, ctx **c)
+{
+    *c = NULL;
+    if (!text || !*text)
+        return rs_error_set(RS_ERR_ARG, "%s: expected a JSON object, not an empty text", label);
+    if (!(*v = cJSON_Parse(text)))
+        return rs_error_set(RS_ERR_ARG, "%s: JSON syntax error", label);
+    if (!(*c = (ctx *)rs_calloc(1, sizeof **c))) {
+        cJSON_Delete(*v);
+        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", label);
+    }
+    (*c)->label = label;
+    (*c)->scene = s;
+    return RS_OK;
+}
+
 rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label,
                                      uint32_t *id)
 {
-    cJSON *m;
+    cJSON *m = NULL;
     ctx *c;
-    rs_status st;
-    if (!text || !*text)
-        return rs_error_set(RS_ERR_ARG, "%s: expected a JSON object, not an empty text", label);
-    if (!(m = cJSON_Parse(text)))
-        return rs_error_set(RS_ERR_ARG, "%s: JSON syntax error", label);
-    if (!(c = (ctx *)rs_calloc(1, sizeof *c))) {
-        cJSON_Delete(m);
-        return rs_error_set(RS_ERR_NOMEM, "%s: out of memory", label);
-    }
-    c->label = label;
-    c->scene = s;
+    rs_status st = one_value(s, text, label, &m, &c);
+    if (st != RS_OK)
+        return st;
     st = rs_json_read_material(c, m, "material", "");
     if (st == RS_OK)
         *id = c->materials[0].id;
     cJSON_Delete(m);
+    rs_free(c);
+    return st;
+}
+
+rs_status rs_scene_add_light_json(rs_scene *s, const char *text, const char *label)
+{
+    static const char *const types[] = {"point_light", "spot_light", "directional_light", NULL};
+    const cJSON *type;
+    cJSON *o = NULL;
+    ctx *c;
+    rs_xform id = rs_xform_identity();
+    rs_status st = one_value(s, text, label, &o, &c);
+    int i, known = 0;
+    if (st != RS_OK)
+        return st;
+    type = cJSON_GetObjectItemCaseSensitive(o, "type");
+    for (i = 0; types[i] && cJSON_IsString(type); ++i)
+        known |= strcmp(type->valuestring, types[i]) == 0;
+    st = known ? rs_json_read_object(c, o, "light", &id)
+               : FAIL(c, "light.type", "expected point_light, spot_light or directional_light");
+    cJSON_Delete(o);
     rs_free(c);
     return st;
 }

@@ -33,6 +33,10 @@ rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label
  * *id.  `label` names it in messages.  RS_ERR_ARG with one line for a bad object. */
 rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label,
                                      uint32_t *id);
+/* Adds the punctual light the JSON object `text` describes, as a scene file's "objects" entry
+ * of type point_light, spot_light or directional_light (with its "transform" if any).
+ * RS_ERR_ARG with one line for a bad object or another type. */
+rs_status rs_scene_add_light_json(rs_scene *s, const char *text, const char *label);
 #ifdef __cplusplus
 }
 #endif

@@ -36,3 +36,9 @@ rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *
     return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no JSON materials",
                         label);
 }
+
+rs_status rs_scene_add_light_json(rs_scene *s, const char *text, const char *label)
+{
+    (void)s, (void)text;
+    return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no JSON lights", label);
+}

@@ -27,6 +27,9 @@
 
 /* ---- helpers ------------------------------------------------------------------------------ */
 
+/* Fails unless `got` is `want` with one line holding `needle` (below). */
+static void expect_error(raystream_status got, raystream_status want, const char *needle);
+
 /* Options from "name=value" strings (NULL-terminated). */
 static raystream_options *options(const char *const *kv)
 {
@@ -264,6 +267,107 @@ static void test_built_scene_equals_json(void **state)
     raystream_scene_release(file);
 }
 
+/* Instances of a prototype and punctual lights, against the file's groups, instances and lights:
+ * two placements that turn, scale unevenly and move it, a point and a spot light. */
+static const char k_inst_json[] =
+    "{\"camera\": {\"from\": [0.5, 2.5, 5], \"at\": [0, 0.5, 0], \"vfov\": 40},\n"
+    " \"image\": {\"width\": 64, \"height\": 48},\n"
+    " \"materials\": {\"grey\": {\"type\": \"lambertian\", \"albedo\": [0.6, 0.6, 0.6]},\n"
+    "               \"green\": {\"type\": \"lambertian\", \"albedo\": [0.2, 0.7, 0.3]}},\n"
+    " \"groups\": {\"tet\": [\n"
+    "  {\"type\": \"triangle\", \"vertices\": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], \"material\": "
+    "\"green\"},\n"
+    "  {\"type\": \"triangle\", \"vertices\": [[0, 0, 0], [0, 1, 0], [0, 0, 1]], \"material\": "
+    "\"green\"},\n"
+    "  {\"type\": \"triangle\", \"vertices\": [[0, 0, 0], [0, 0, 1], [1, 0, 0]], \"material\": "
+    "\"green\"},\n"
+    "  {\"type\": \"triangle\", \"vertices\": [[1, 0, 0], [0, 0, 1], [0, 1, 0]], \"material\": "
+    "\"green\"}]},\n"
+    " \"objects\": [\n"
+    "  {\"type\": \"triangle\", \"vertices\": [[-3, 0, -3], [3, 0, 3], [3, 0, -3]], \"material\": "
+    "\"grey\"},\n"
+    "  {\"type\": \"triangle\", \"vertices\": [[-3, 0, -3], [-3, 0, 3], [3, 0, 3]], \"material\": "
+    "\"grey\"},\n"
+    "  {\"type\": \"instance\", \"group\": \"tet\", \"transform\": [{\"matrix\": [0.8, -0.3, 0.1, "
+    "-1, 0.3, 0.9, 0, 0.2, -0.1, 0.05, 1.2, 0.3, 0, 0, 0, 1]}]},\n"
+    "  {\"type\": \"instance\", \"group\": \"tet\", \"transform\": [{\"matrix\": [0.5, 0, 0.6, "
+    "1.1, 0, 1.4, 0, 0, -0.6, 0, 0.5, -0.4, 0, 0, 0, 1]}]},\n"
+    "  {\"type\": \"point_light\", \"position\": [0.5, 3, 1], \"intensity\": [9, 8, 7]},\n"
+    "  {\"type\": \"spot_light\", \"position\": [-2, 3, 2], \"direction\": [0.5, -1, -0.4], "
+    "\"intensity\": [20, 20, 25], \"outer\": 30}]}\n";
+
+static void test_instances_and_lights_equal_json(void **state)
+{
+    static const float ground[] = {-3, 0, -3, 3, 0, 3, 3, 0, -3, -3, 0, 3};
+    static const uint32_t ground_idx[] = {0, 1, 2, 0, 3, 1};
+    static const float tet[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t tet_idx[] = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
+    static const double m1[12] = {0.8, -0.3, 0.1, -1, 0.3, 0.9, 0, 0.2, -0.1, 0.05, 1.2, 0.3};
+    static const double m2[12] = {0.5, 0, 0.6, 1.1, 0, 1.4, 0, 0, -0.6, 0, 0.5, -0.4};
+    static const double singular[12] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0};
+    static const char *const kv[] = {"spp=8", NULL};
+    const float from[3] = {0.5f, 2.5f, 5}, at[3] = {0, 0.5f, 0}, up[3] = {0, 1, 0};
+    raystream_scene *s = NULL, *file = NULL;
+    raystream_image *a, *b;
+    uint32_t grey, green, lamp, proto, tris;
+    (void)state;
+    assert_int_equal(raystream_scene_create(&s), RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_add_material(
+                         s, "{\"type\": \"lambertian\", \"albedo\": [0.6, 0.6, 0.6]}", &grey),
+                     RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_add_material(
+                         s, "{\"type\": \"lambertian\", \"albedo\": [0.2, 0.7, 0.3]}", &green),
+                     RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_add_mesh(s, ground, 4, ground_idx, 2, NULL, NULL, grey),
+                     RAYSTREAM_OK);
+    assert_int_equal(
+        raystream_scene_add_prototype(s, tet, 4, tet_idx, 4, NULL, NULL, green, &proto),
+        RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_add_instance(s, proto, m1), RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_add_instance(s, proto, m2), RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_add_light(s, "{\"type\": \"point_light\", \"position\": "
+                                                  "[0.5, 3, 1], \"intensity\": [9, 8, 7]}"),
+                     RAYSTREAM_OK);
+    assert_int_equal(
+        raystream_scene_add_light(s, "{\"type\": \"spot_light\", \"position\": [-2, 3, 2], "
+                                     "\"direction\": [0.5, -1, -0.4], \"intensity\": [20, 20, 25], "
+                                     "\"outer\": 30}"),
+        RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_set_camera(s, from, at, up, 40.0f, 0, 0), RAYSTREAM_OK);
+    assert_int_equal(raystream_scene_set_image_size(s, 64, 48), RAYSTREAM_OK);
+    /* refused: an unknown prototype, a singular matrix, an emitting prototype, a light that is
+     * not a punctual one; the scene as it was */
+    expect_error(raystream_scene_add_instance(s, 7, m1), RAYSTREAM_ERROR_ARGUMENT, "prototype 7");
+    expect_error(raystream_scene_add_instance(s, proto, singular), RAYSTREAM_ERROR_ARGUMENT,
+                 "instance");
+    assert_int_equal(
+        raystream_scene_add_material(s, "{\"type\": \"light\", \"emission\": [1, 1, 1]}", &lamp),
+        RAYSTREAM_OK);
+    expect_error(raystream_scene_add_prototype(s, tet, 4, tet_idx, 4, NULL, NULL, lamp, &proto),
+                 RAYSTREAM_ERROR_ARGUMENT, "emits light");
+    expect_error(raystream_scene_add_light(s, "{\"type\": \"sphere\"}"), RAYSTREAM_ERROR_ARGUMENT,
+                 "point_light");
+    expect_error(raystream_scene_add_light(s, "{\"type\": \"point_light\", \"intensity\": -1}"),
+                 RAYSTREAM_ERROR_ARGUMENT, "light");
+    raystream_scene_counts(s, NULL, NULL, &tris, NULL);
+    assert_int_equal(tris, 2 + 2 * 4);
+    assert_int_equal(raystream_scene_from_json(k_inst_json, NULL, &file), RAYSTREAM_OK);
+    a = render_built(s, kv);
+    b = render_built(file, kv);
+    assert_true(same_pixels(a, b));
+    {
+        double mean = 0.0;
+        size_t i;
+        for (i = 0; i < 64 * 48 * 3; ++i)
+            mean += raystream_image_pixels(a)[i];
+        assert_true(mean / (64 * 48 * 3) > 0.01); /* the lights light it */
+    }
+    raystream_image_release(a);
+    raystream_image_release(b);
+    raystream_scene_release(s);
+    raystream_scene_release(file);
+}
+
 /* ---- progress and cancelling -------------------------------------------------------------- */
 
 typedef struct progress_log {
@@ -477,6 +581,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_render_matches_cli, setup, teardown),
         cmocka_unit_test_setup_teardown(test_aov_matches_cli, setup, teardown),
         cmocka_unit_test_setup_teardown(test_built_scene_equals_json, setup, teardown),
+        cmocka_unit_test(test_instances_and_lights_equal_json),
         cmocka_unit_test(test_progress_and_cancel),
         cmocka_unit_test_setup_teardown(test_hostile_calls, setup, teardown),
         cmocka_unit_test_setup_teardown(test_write_errors, setup, teardown),

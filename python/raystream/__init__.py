@@ -164,6 +164,42 @@ class Scene:
         uv = None if uvs is None else _floats(uvs, "uvs", 2)[0]
         _c.scene_add_mesh(self._cap, pos, idx, nrm, uv, int(material))
 
+    def add_prototype(self, vertices, indices, normals=None, uvs=None, material=0):
+        """A mesh placed only by add_instance (one copy in memory however often it is placed);
+        returns its id.  Its material may not emit light."""
+        pos, n = _floats(vertices, "vertices", 3)
+        idx = _indices(indices, n)
+        nrm = None if normals is None else _floats(normals, "normals", 3)[0]
+        uv = None if uvs is None else _floats(uvs, "uvs", 2)[0]
+        return _c.scene_add_mesh(self._cap, pos, idx, nrm, uv, int(material), True)
+
+    def add_instance(self, prototype, matrix):
+        """Places a prototype by an affine transform: a 3 x 4 or 4 x 4 matrix (the last row
+        [0, 0, 0, 1]), x' = M [x, y, z, 1]."""
+        try:
+            rows = [[float(v) for v in r] for r in matrix]
+        except (TypeError, ValueError):
+            raise ValueError("instance: expected a 3 x 4 or 4 x 4 matrix of numbers") from None
+        if len(rows) == 4:
+            if rows[3] != [0.0, 0.0, 0.0, 1.0]:
+                raise ValueError("instance: the last row must be [0, 0, 0, 1] (affine)")
+            rows = rows[:3]
+        if len(rows) != 3 or any(len(r) != 4 for r in rows):
+            raise ValueError("instance: expected a 3 x 4 or 4 x 4 matrix")
+        _c.scene_add_instance(self._cap, int(prototype), [v for r in rows for v in r])
+
+    def add_light(self, light=None, **fields):
+        """A point, spot or directional light as a scene file writes it: a dict, its JSON text
+        or keywords, e.g. add_light(type="point_light", position=(0, 3, 0),
+        intensity=(10, 10, 10))."""
+        if light is None:
+            light = fields
+        elif fields:
+            raise ValueError("add_light: give a dict or keywords, not both")
+        if not isinstance(light, str):
+            light = _json.dumps(light)
+        _c.scene_add_light(self._cap, light)
+
     def add_sphere(self, center, radius, material=0):
         _c.scene_add_sphere(self._cap, center, float(radius), int(material))
 

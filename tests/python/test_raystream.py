@@ -107,6 +107,49 @@ def test_numpy_scene_equals_json(tmp_path):
     assert s2.counts == (0, 0, 2, 1)
 
 
+def test_instances_and_lights_equal_json():
+    tet = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    tet_faces = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+    m1 = [[0.8, -0.3, 0.1, -1], [0.3, 0.9, 0, 0.2], [-0.1, 0.05, 1.2, 0.3], [0, 0, 0, 1]]
+    m2 = [[0.5, 0, 0.6, 1.1], [0, 1.4, 0, 0], [-0.6, 0, 0.5, -0.4]]
+    light = {"type": "point_light", "position": [0.5, 3, 1], "intensity": [9, 8, 7]}
+    s = raystream.Scene()
+    s.add_material(type="lambertian", albedo=(0.6, 0.6, 0.6))
+    green = s.add_material(type="lambertian", albedo=(0.2, 0.7, 0.3))
+    s.add_mesh([[-3, 0, -3], [3, 0, 3], [3, 0, -3], [-3, 0, 3]], [[0, 1, 2], [0, 3, 1]])
+    proto = s.add_prototype(tet, tet_faces, material=green)
+    s.add_instance(proto, m1)
+    s.add_instance(proto, np.array(m2))
+    s.add_light(light)
+    s.set_camera((0.5, 2.5, 5), (0, 0.5, 0))
+    s.set_image_size(64, 48)
+    assert s.counts == (0, 0, 10, 2)
+    d = {"camera": {"from": [0.5, 2.5, 5], "at": [0, 0.5, 0]},
+         "image": {"width": 64, "height": 48},
+         "materials": {"grey": {"type": "lambertian", "albedo": [0.6, 0.6, 0.6]},
+                       "green": {"type": "lambertian", "albedo": [0.2, 0.7, 0.3]}},
+         "groups": {"tet": [{"type": "triangle", "vertices": tet[f].tolist(), "material": "green"}
+                            for f in tet_faces]},
+         "objects": [{"type": "triangle", "vertices": [[-3, 0, -3], [3, 0, 3], [3, 0, -3]],
+                      "material": "grey"},
+                     {"type": "triangle", "vertices": [[-3, 0, -3], [-3, 0, 3], [3, 0, 3]],
+                      "material": "grey"},
+                     {"type": "instance", "group": "tet",
+                      "transform": [{"matrix": sum(m1, [])}]},
+                     {"type": "instance", "group": "tet",
+                      "transform": [{"matrix": sum(m2, []) + [0, 0, 0, 1]}]},
+                     light]}
+    a = np.asarray(raystream.render(s, spp=8))
+    b = np.asarray(raystream.render(raystream.load_json(d), spp=8))
+    assert a.mean() > 0.01 and np.array_equal(bits(a), bits(b))
+    with pytest.raises(ValueError, match="prototype 5"):
+        s.add_instance(5, m2)
+    with pytest.raises(ValueError, match="affine"):
+        s.add_instance(proto, [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, 1]])
+    with pytest.raises(ValueError, match="point_light"):
+        s.add_light(type="sphere")
+
+
 def test_aov_layers_and_write(tmp_path):
     img = raystream.render("builtin:cornell", width=40, spp=2, aov=["albedo", "normal", "depth"])
     assert set(img.layers) == {"albedo", "normal", "depth"}
