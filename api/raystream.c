@@ -18,7 +18,6 @@
 #include "app/tev.h"
 #include "core/alloc.h"
 #include "core/clock.h"
-#include "core/denoise.h"
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/view.h"
@@ -882,17 +881,7 @@ static int run_steps(const rs_cli_options *co, render_run *r, api_progress *p, i
     rs_render_hooks hooks;
     rs_status rst;
     int code;
-    rs_run_settings(co, r);
-    if (co->denoise) {
-        char why[400];
-        if (!rs_denoise_probe(why, sizeof why)) {
-            rs_app_print("raystream: --denoise: %s\n", why);
-            return RS_EXIT_RUNTIME;
-        }
-    }
-    if ((code = rs_run_make_film(co, r)) != RS_EXIT_OK ||
-        (code = rs_run_build_bvh(co, r)) != RS_EXIT_OK ||
-        (code = rs_run_start_devices(co, r)) != RS_EXIT_OK)
+    if ((code = rs_run_prepare(co, r)) != RS_EXIT_OK)
         return code;
     memset(&hooks, 0, sizeof hooks);
     hooks.progress = on_progress;

@@ -77,16 +77,11 @@ int rs_cmd_render(const rs_cli_options *o, int *argc, char ***argv)
     /* RS_FAULT is input like the options: a bad value is a usage error, before any work */
     if (rs_fault_parse(getenv("RS_FAULT"), &r.fault) != RS_OK)
         return rs_app_fail(RS_EXIT_USAGE, NULL);
-    if ((code = rs_run_load_scene(o, &r)) == RS_EXIT_OK) {
-        rs_run_settings(o, &r);
-        if ((code = rs_run_check_outputs(o, &r)) == RS_EXIT_OK &&
-            (code = rs_run_make_film(o, &r)) == RS_EXIT_OK &&
-            (code = rs_run_build_bvh(o, &r)) == RS_EXIT_OK &&
-            (code = rs_run_start_devices(o, &r)) == RS_EXIT_OK) {
-            code = run_render(o, &r);
-            if (code == RS_EXIT_OK || r.interrupted)
-                code = rs_run_write_outputs(o, &r, code);
-        }
+    if ((code = rs_run_load_scene(o, &r)) == RS_EXIT_OK &&
+        (code = rs_run_prepare(o, &r)) == RS_EXIT_OK) {
+        code = run_render(o, &r);
+        if (code == RS_EXIT_OK || r.interrupted)
+            code = rs_run_write_outputs(o, &r, code);
     }
     rs_run_release(&r);
     return code;

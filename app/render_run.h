@@ -87,6 +87,8 @@ typedef struct render_run {
 int rs_run_load_scene(const rs_cli_options *o, render_run *r); /* under the load watchdog */
 void rs_run_settings(const rs_cli_options *o, render_run *r);
 int rs_run_check_outputs(const rs_cli_options *o, render_run *r);
+/* --denoise: OIDN loads and makes a device (rs_run_check_outputs's last check).  Exit code. */
+int rs_run_check_denoise(const rs_cli_options *o);
 int rs_run_make_film(const rs_cli_options *o, render_run *r);
 /* An empty film of the render's size, keeping the passes where the render writes them
  * (r->st.passes). */
@@ -94,6 +96,9 @@ rs_status rs_run_new_film(const render_run *r, rs_film **out);
 int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, const char *what);
 int rs_run_build_bvh(const rs_cli_options *o, render_run *r);
 int rs_run_start_devices(const rs_cli_options *o, render_run *r);
+/* After the scene: rs_run_settings, rs_run_check_outputs (the library: rs_run_check_denoise),
+ * rs_run_make_film, rs_run_build_bvh, rs_run_start_devices; the first failure's exit code. */
+int rs_run_prepare(const rs_cli_options *o, render_run *r);
 /* The engine's run over what the film lacks: everything, or the gaps of a --resume; or the
  * rounds of --adaptive. */
 rs_status rs_run_engine(render_run *r, const rs_render_hooks *hooks);

@@ -137,15 +137,32 @@ int rs_run_check_outputs(const rs_cli_options *o, render_run *r)
         return rc;
     if (rs_image_check_output(r->out) != RS_OK)
         return rs_app_fail(RS_EXIT_USAGE, NULL);
-    if (o->denoise) { /* OIDN is loaded at run time: its absence stops the run here, as does
-                       * a library that cannot make a CPU device and its filter */
-        char why[400];
-        if (!rs_denoise_probe(why, sizeof why)) {
-            rs_app_print("raystream: --denoise: %s\n", why);
-            return RS_EXIT_RUNTIME;
-        }
+    return rs_run_check_denoise(o);
+}
+
+int rs_run_check_denoise(const rs_cli_options *o)
+{
+    char why[400];
+    /* OIDN is loaded at run time: its absence stops the run here, as does a library that cannot
+     * make a CPU device and its filter */
+    if (o->denoise && !rs_denoise_probe(why, sizeof why)) {
+        rs_app_print("raystream: --denoise: %s\n", why);
+        return RS_EXIT_RUNTIME;
     }
     return RS_EXIT_OK;
+}
+
+int rs_run_prepare(const rs_cli_options *o, render_run *r)
+{
+    int code;
+    rs_run_settings(o, r);
+    /* the library writes no file of the command's: it checks the denoiser alone */
+    if ((code = r->library ? rs_run_check_denoise(o) : rs_run_check_outputs(o, r)) ==
+            RS_EXIT_OK &&
+        (code = rs_run_make_film(o, r)) == RS_EXIT_OK &&
+        (code = rs_run_build_bvh(o, r)) == RS_EXIT_OK)
+        code = rs_run_start_devices(o, r);
+    return code;
 }
 
 /* A --resume whose ranges all end on whole samples: RS_EXIT_OK, else one line ending in

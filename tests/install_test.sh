@@ -2,8 +2,8 @@
 # tests/install_test.sh BUILD SOURCE — `cmake --install BUILD --prefix TMP`, then the example
 # program (examples/render.c) compiled as an outside program would be, against the installed tree
 # only: with pkg-config (the shared library, and libraystream.a with --static) and with CMake
-# (find_package(raystream)); each renders builtin:cornell, and the three images are the
-# installed command's bit for bit.  The manual page and the header are where users look.
+# (find_package(raystream)); each renders builtin:cornell without LD_LIBRARY_PATH (the .pc file
+# carries an rpath), and the three images are the installed command's bit for bit.  The manual page and the header are where users look.
 set -eu
 build="$1"
 src="$2"
@@ -55,8 +55,9 @@ cmake -S proj -B proj/b -DCMAKE_PREFIX_PATH="$prefix" >cmake.log 2>&1 &&
 
 "$prefix/bin/raystream" render builtin:cornell --width 64 --spp 2 -q -o cli.pfm ||
     fail "the installed command failed"
+# no LD_LIBRARY_PATH: raystream.pc's rpath and CMake's find the library where it was installed
 for ex in ./ex-shared ./ex-static ./proj/b/ex-cmake; do
-    LD_LIBRARY_PATH="$libdir" "$ex" builtin:cornell out.pfm spp=2 width=64 >run.log 2>&1 ||
+    "$ex" builtin:cornell out.pfm spp=2 width=64 >run.log 2>&1 ||
         fail "$ex failed: $(tail -n 2 run.log)"
     cmp -s out.pfm cli.pfm || fail "$ex's image differs from the installed command's"
 done
