@@ -596,7 +596,8 @@ rs_status rs_scene_finalize(rs_scene *s);
  * bvh) and the image textures' mip pyramids (trilinear lookups, the default texture filter).
  * Both by default; the CLI leaves out what its render will not read (issue 39: a scene of 10^7
  * emitters spent 2.2 GB on a light BVH a power-sampled render never reads, a 16384^2 texture
- * its pyramid under --texture-filter bilinear).  Process-wide: set before scenes are loaded.
+ * its pyramid under --texture-filter bilinear).  Per thread: set before scenes are loaded or
+ * finalized on it.
  * Without them, a render that asks for them is refused by rs_render_constants. */
 void rs_scene_set_extras(int light_bvh, int pyramids);
 

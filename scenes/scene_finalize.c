@@ -171,9 +171,9 @@ static rs_status build_pyramid(rs_image *im)
     return RS_OK;
 }
 
-static struct {
+static _Thread_local struct {
     int light_bvh, pyramids;
-} g_extras = {1, 1};
+} g_extras = {1, 1}; /* per thread: the library's renders on several threads each set theirs */
 
 void rs_scene_set_extras(int light_bvh, int pyramids)
 {

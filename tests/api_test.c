@@ -544,6 +544,57 @@ static void test_write_errors(void **state)
     raystream_image_release(img);
 }
 
+/* ---- renders on several threads at once --------------------------------------------------- */
+
+typedef struct job {
+    const char *scene;
+    const char *const *kv;
+    raystream_image *img;
+} job;
+
+static void *render_job(void *arg)
+{
+    job *j = (job *)arg;
+    raystream_options *o = NULL;
+    const char *const *kv;
+    raystream_options_create(&o);
+    for (kv = j->kv; *kv; ++kv) {
+        char name[64];
+        const char *eq = strchr(*kv, '=');
+        snprintf(name, sizeof name, "%.*s", (int)(eq - *kv), *kv);
+        raystream_options_set(o, name, eq + 1);
+    }
+    if (raystream_render_scene(j->scene, o, &j->img) != RAYSTREAM_OK)
+        j->img = NULL;
+    raystream_options_release(o);
+    return NULL;
+}
+
+/* Two scenes with different options (the light BVH on one, not the other) rendered at once on
+ * two threads: each the image it has alone. */
+static void test_threads_at_once(void **state)
+{
+    static const char *const kv_a[] = {"width=48", "spp=4", "light-sampler=bvh", "threads=1", NULL};
+    static const char *const kv_b[] = {"width=40", "spp=3", "texture-filter=bilinear", "threads=1",
+                                       NULL};
+    job jobs[2] = {{"builtin:many-lights", kv_a, NULL}, {"builtin:materials", kv_b, NULL}};
+    raystream_image *alone[2];
+    pthread_t t[2];
+    int k;
+    (void)state;
+    for (k = 0; k < 2; ++k)
+        alone[k] = render_name(jobs[k].scene, jobs[k].kv);
+    for (k = 0; k < 2; ++k)
+        assert_int_equal(pthread_create(&t[k], NULL, render_job, &jobs[k]), 0);
+    for (k = 0; k < 2; ++k) {
+        pthread_join(t[k], NULL);
+        assert_non_null(jobs[k].img);
+        assert_true(same_pixels(jobs[k].img, alone[k]));
+        raystream_image_release(jobs[k].img);
+        raystream_image_release(alone[k]);
+    }
+}
+
 /* ---- the version and the thread's own error ----------------------------------------------- */
 
 static void *fail_in_thread(void *arg)
@@ -585,6 +636,7 @@ int main(void)
         cmocka_unit_test(test_progress_and_cancel),
         cmocka_unit_test_setup_teardown(test_hostile_calls, setup, teardown),
         cmocka_unit_test_setup_teardown(test_write_errors, setup, teardown),
+        cmocka_unit_test(test_threads_at_once),
         cmocka_unit_test(test_version_and_thread_errors),
     };
     return cmocka_run_group_tests(tests, group_setup, NULL);
