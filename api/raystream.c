@@ -7,6 +7,7 @@
 #include "raystream.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -115,18 +116,24 @@ static raystream_status from_exit(const api_sink *s, int code)
 
 int raystream_version(void) { return RAYSTREAM_VERSION; }
 
+static char g_version[160];
+
+static void make_version(void)
+{
+    const char *why = "";
+    snprintf(g_version, sizeof g_version, "%d.%d.%d (%s%s, %s)", RAYSTREAM_VERSION_MAJOR,
+             RAYSTREAM_VERSION_MINOR, RAYSTREAM_VERSION_PATCH,
+             !rs_gpu_compiled()       ? "CPU only"
+             : rs_gpu_count(&why) > 0 ? "CUDA"
+                                      : "CUDA built in, no GPU",
+             RS_HAVE_OPENMP ? ", OpenMP" : "", rs_image_library_version());
+}
+
 const char *raystream_version_string(void)
 {
-    static char text[160];
-    const char *why = "";
-    if (!text[0])
-        snprintf(text, sizeof text, "%d.%d.%d (%s%s, %s)", RAYSTREAM_VERSION_MAJOR,
-                 RAYSTREAM_VERSION_MINOR, RAYSTREAM_VERSION_PATCH,
-                 !rs_gpu_compiled()       ? "CPU only"
-                 : rs_gpu_count(&why) > 0 ? "CUDA"
-                                          : "CUDA built in, no GPU",
-                 RS_HAVE_OPENMP ? ", OpenMP" : "", rs_image_library_version());
-    return text;
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, make_version);
+    return g_version;
 }
 
 const char *raystream_last_error(void) { return g_error; }
@@ -303,6 +310,7 @@ static int parse_options(const raystream_options *o, const char *scene, char **a
 struct raystream_scene {
     rs_scene *s;
     atomic_int refs;
+    atomic_int busy;       /* a render of it is under way: no other, and no change */
     uint32_t (*protos)[2]; /* raystream_scene_add_prototype's: first, count (inst_tris) */
     uint32_t n_protos, cap_protos;
     char name[64]; /* the default output name's stem */
@@ -318,6 +326,7 @@ static raystream_status wrap_scene(rs_scene *s, const char *name, raystream_scen
     }
     h->s = s;
     atomic_init(&h->refs, 1);
+    atomic_init(&h->busy, 0);
     snprintf(h->name, sizeof h->name, "%s", name);
     *out = h;
     return RAYSTREAM_OK;
@@ -411,10 +420,13 @@ void raystream_scene_release(raystream_scene *h)
     free(h);
 }
 
+/* A scene to change: there, and not being rendered. */
 #define NEED_SCENE(h, fn)                                                                          \
   do {                                                                                             \
     if (!(h))                                                                                      \
       return fail(RAYSTREAM_ERROR_ARGUMENT, "%s: scene is NULL", fn);                              \
+    if (atomic_load(&(h)->busy))                                                                   \
+      return fail(RAYSTREAM_ERROR_ARGUMENT, "%s: the scene is being rendered", fn);                \
   } while (0)
 
 static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
@@ -843,6 +855,8 @@ static raystream_status make_image(const rs_cli_options *co, render_run *r, rays
     snprintf(img->view, sizeof img->view, "%s", co->view ? co->view : "");
     img->exposure = co->exposure;
     if ((n = rs_run_make_aovs(co->aovs, r, layers, bufs)) < 0) {
+        for (i = 0; i < 4; ++i)
+            rs_free(bufs[i]);
         free(img);
         return fail_core(RS_ERR_NOMEM);
     }
@@ -964,12 +978,17 @@ static raystream_status render(raystream_scene *h, const char *scene, const rays
 raystream_status raystream_render(raystream_scene *scene, const raystream_options *options,
                                   raystream_image **out)
 {
-    if (!scene) {
-        if (out)
-            *out = NULL;
+    raystream_status st;
+    if (out)
+        *out = NULL;
+    if (!scene)
         return fail(RAYSTREAM_ERROR_ARGUMENT, "raystream_render: scene is NULL");
-    }
-    return render(scene, NULL, options, out);
+    if (atomic_exchange(&scene->busy, 1))
+        return fail(RAYSTREAM_ERROR_ARGUMENT, "raystream_render: the scene is being rendered by "
+                                              "another call (one render at a time per scene)");
+    st = render(scene, NULL, options, out);
+    atomic_store(&scene->busy, 0);
+    return st;
 }
 
 raystream_status raystream_render_scene(const char *scene, const raystream_options *options,

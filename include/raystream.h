@@ -16,7 +16,8 @@
  *     lists them), given as text exactly as on its command line: a render through the library
  *     and `raystream render` with the same options make the same image, bit for bit.
  *   - Images are row-major, top row first, RGB float32, scene-linear.
- *   - One render at a time per scene handle; different scenes may render on different threads.
+ *   - One render at a time per scene handle (another is refused, as is a change to the scene while
+ *     it renders); different scenes may render on different threads at once.
  */
 #ifndef RAYSTREAM_H
 #define RAYSTREAM_H

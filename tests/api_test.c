@@ -29,6 +29,7 @@
 
 /* Fails unless `got` is `want` with one line holding `needle` (below). */
 static void expect_error(raystream_status got, raystream_status want, const char *needle);
+static int try_while_busy(void *user, double fraction);
 
 /* Options from "name=value" strings (NULL-terminated). */
 static raystream_options *options(const char *const *kv)
@@ -262,6 +263,13 @@ static void test_built_scene_equals_json(void **state)
     raystream_image_release(a);
     raystream_image_release(b);
     raystream_image_release(c);
+    { /* one render at a time */
+        raystream_options *o = options(kv);
+        raystream_options_set_progress(o, try_while_busy, built);
+        assert_int_equal(raystream_render(built, o, &b), RAYSTREAM_OK);
+        raystream_image_release(b);
+        raystream_options_release(o);
+    }
     raystream_scene_release(built);
     raystream_scene_release(text);
     raystream_scene_release(file);
@@ -376,6 +384,20 @@ typedef struct progress_log {
     int fell;
     int stop_after;
 } progress_log;
+
+/* While a scene renders, a second render of it and a change to it are refused. */
+static int try_while_busy(void *user, double fraction)
+{
+    raystream_scene *s = (raystream_scene *)user;
+    raystream_image *img = NULL;
+    const float c[3] = {0, 0, 0};
+    (void)fraction;
+    expect_error(raystream_render(s, NULL, &img), RAYSTREAM_ERROR_ARGUMENT, "being rendered");
+    assert_null(img);
+    expect_error(raystream_scene_add_sphere(s, c, 1.0f, 0), RAYSTREAM_ERROR_ARGUMENT,
+                 "being rendered");
+    return 0;
+}
 
 static int on_progress(void *user, double fraction)
 {
