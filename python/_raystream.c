@@ -12,6 +12,7 @@
 
 #include <string.h>
 
+#include "pixels.h"
 #include "raystream.h"
 
 #define SCENE_CAPSULE "raystream.scene"
@@ -514,4 +515,27 @@ static struct PyModuleDef k_module = {PyModuleDef_HEAD_INIT,
                                       NULL,
                                       NULL};
 
-PyMODINIT_FUNC PyInit__raystream(void) { return PyModule_Create(&k_module); }
+/* Whether the running Python is 3.11 or later (the buffer slots of the limited API). */
+static int python_3_11(void)
+{
+    int major = 0, minor = 0;
+    return sscanf(Py_GetVersion(), "%d.%d", &major, &minor) == 2 &&
+           (major > 3 || (major == 3 && minor >= 11));
+}
+
+PyMODINIT_FUNC PyInit__raystream(void)
+{
+    PyObject *m = PyModule_Create(&k_module), *pixels;
+    if (!m)
+        return NULL;
+    if (!(pixels = rs_pixels_type(python_3_11())) || PyModule_AddObject(m, "Pixels", pixels) != 0) {
+        Py_XDECREF(pixels);
+        Py_DECREF(m);
+        return NULL;
+    }
+    if (PyModule_AddIntConstant(m, "PIXELS_HAVE_BUFFER", python_3_11()) != 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}

@@ -26,23 +26,27 @@ __version__ = "%d.%d.%d" % (version_number // 10000, version_number // 100 % 100
                             version_number % 100)
 
 
-class _Planes:
-    """Floats of a width x height image, channels per pixel, as numpy sees them without a copy
-    (the array interface) and as a memoryview (`.view`, the buffer protocol)."""
+class _Planes(_c.Pixels):
+    """Floats of a width x height image, channels per pixel.  The buffer protocol (Python 3.11
+    and later: memoryview(img), numpy.asarray(img) take the image's own memory, format "f",
+    shape (height, width[, channels])); on 3.9 and 3.10 numpy takes it through the array
+    interface, also without a copy.  `.view` is a memoryview of it on every version."""
 
     def __init__(self, data, width, height, channels):
+        super().__init__(data, height, width, channels)
         self._data = data  # a bytearray
         self.width, self.height, self.channels = width, height, channels
         self.shape = (height, width, channels) if channels > 1 else (height, width)
-        self.view = memoryview(data).cast("B").cast("f", self.shape)
+        if _c.PIXELS_HAVE_BUFFER:
+            self.view = memoryview(self)
+        else:
+            self.view = memoryview(data).cast("B").cast("f", self.shape)
 
-    @property
-    def __array_interface__(self):
-        return {"version": 3, "shape": self.shape, "typestr": "<f4",
-                "data": self.view, "strides": None}
-
-    def __buffer__(self, flags):  # Python >= 3.12: memoryview(image), numpy via the protocol
-        return self.view
+    if not _c.PIXELS_HAVE_BUFFER:
+        @property
+        def __array_interface__(self):
+            return {"version": 3, "shape": self.shape, "typestr": "<f4",
+                    "data": self.view, "strides": None}
 
     def __len__(self):
         return self.height

@@ -13,6 +13,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 
@@ -34,12 +35,27 @@ def test_render_equals_cli_exr(tmp_path):
     a = np.asarray(img)
     assert a.shape == (600, 600, 3) and a.dtype == np.float32
     assert not a.flags.owndata  # a view of the image's memory, not a copy
+
     out = tmp_path / "cli.exr"
     subprocess.run([RS_BINARY, "render", "builtin:cornell", "--spp", "16", "-q", "-o", str(out)],
                    check=True)
     b = np.asarray(raystream.read_image(out))
     assert np.array_equal(bits(a), bits(b))
     assert a.mean() > 0.01
+
+
+def test_pixels_are_the_images_memory():
+    img = raystream.render("builtin:cornell", width=32, spp=1, aov=["depth"])
+    a = np.asarray(img)
+    a[0, 0, 0] = 1234.5  # numpy's array is the image's memory: the write shows everywhere
+    assert np.asarray(img)[0, 0, 0] == 1234.5 and img.view[0, 0, 0] == 1234.5
+    if sys.version_info >= (3, 11):  # the buffer protocol on the image itself
+        mv = memoryview(img)
+        assert mv.format == "f" and mv.shape == (32, 32, 3) and not mv.readonly
+        assert mv[0, 0, 0] == 1234.5
+        depth = memoryview(img.layers["depth"])
+        assert depth.shape == (32, 32) and depth.format == "f"
+    assert np.asarray(img.layers["depth"]).shape == (32, 32)
 
 
 @pytest.mark.skipif(not RS_BINARY, reason="RS_BINARY (the raystream command) is not set")
