@@ -315,6 +315,7 @@ struct raystream_scene {
     uint32_t n_protos, cap_protos;
     char name[64]; /* the default output name's stem */
     char lighting[160];
+    char source[512]; /* what it was loaded from (the EXR header's raystream:scene), or "scene" */
 };
 
 static raystream_status wrap_scene(rs_scene *s, const char *name, raystream_scene **out)
@@ -325,6 +326,7 @@ static raystream_status wrap_scene(rs_scene *s, const char *name, raystream_scen
         return fail(RAYSTREAM_ERROR_MEMORY, "out of memory");
     }
     h->s = s;
+    snprintf(h->source, sizeof h->source, "scene");
     atomic_init(&h->refs, 1);
     atomic_init(&h->busy, 0);
     snprintf(h->name, sizeof h->name, "%s", name);
@@ -372,8 +374,10 @@ raystream_status raystream_scene_load(const char *scene, raystream_scene **out)
         return st;
     }
     st = wrap_scene(r.scene, r.name, out);
-    if (st == RAYSTREAM_OK)
+    if (st == RAYSTREAM_OK) {
         snprintf((*out)->lighting, sizeof(*out)->lighting, "%s", r.lighting);
+        snprintf((*out)->source, sizeof(*out)->source, "%s", scene);
+    }
     return st;
 }
 
@@ -712,6 +716,8 @@ struct raystream_image {
     double spp;
     char view[64]; /* the render's --view ("" standard) and --exposure, for 8-bit files */
     float exposure;
+    rs_image_meta meta[RS_REPORT_META_MAX]; /* the command's EXR header: keys and values */
+    size_t n_meta;                          /* (strings of the image's own) */
 };
 
 void raystream_image_release(raystream_image *img)
@@ -722,6 +728,10 @@ void raystream_image_release(raystream_image *img)
     rs_free(img->rgb);
     for (i = 0; i < img->n_layers; ++i)
         rs_free(img->layer[i]);
+    for (i = 0; i < (int)img->n_meta; ++i) {
+        free((char *)img->meta[i].key);
+        free((char *)img->meta[i].value);
+    }
     free(img);
 }
 
@@ -784,8 +794,8 @@ raystream_status raystream_image_write(const raystream_image *img, const char *p
         i = 0;
     else
         i = img->n_layers;
-    st = rs_image_write_view(path, img->width, img->height, img->rgb, layers, (size_t)i, NULL, 0,
-                             &view);
+    st = rs_image_write_view(path, img->width, img->height, img->rgb, layers, (size_t)i, img->meta,
+                             img->n_meta, &view);
     return st == RS_OK ? RAYSTREAM_OK : fail_core(st == RS_ERR_NOMEM ? st : RS_ERR_IO);
 }
 
@@ -841,7 +851,29 @@ static void on_film_ready(void *user, const rs_film *film, const rs_path_ranges 
 }
 
 /* The image of the finished (or cancelled) render: r->rgb and the layers taken over. */
-static raystream_status make_image(const rs_cli_options *co, render_run *r, raystream_image **out)
+/* The command's EXR header for this render (app/report.c), copied into the image; 0 when out
+ * of memory. */
+static int image_meta(raystream_image *img, const rs_cli_options *co, const render_run *r,
+                      const char *scene)
+{
+    rs_report rep;
+    rs_report_meta m;
+    size_t i;
+    rs_run_report(co, r, &rep);
+    rep.scene = scene;
+    rs_report_image_meta(&rep, &m);
+    for (i = 0; i < m.n; ++i) {
+        img->meta[i].key = strdup(m.meta[i].key);
+        img->meta[i].value = strdup(m.meta[i].value);
+        img->n_meta = i + 1;
+        if (!img->meta[i].key || !img->meta[i].value)
+            return 0;
+    }
+    return 1;
+}
+
+static raystream_status make_image(const rs_cli_options *co, render_run *r, const char *scene,
+                                   raystream_image **out)
 {
     raystream_image *img = (raystream_image *)calloc(1, sizeof *img);
     rs_image_layer layers[4];
@@ -849,6 +881,10 @@ static raystream_status make_image(const rs_cli_options *co, render_run *r, rays
     int n, i;
     if (!img)
         return fail(RAYSTREAM_ERROR_MEMORY, "out of memory");
+    if (!image_meta(img, co, r, scene)) {
+        raystream_image_release(img);
+        return fail(RAYSTREAM_ERROR_MEMORY, "out of memory");
+    }
     img->width = r->st.width;
     img->height = r->st.height;
     img->spp = (double)rs_film_samples(r->film) / ((double)img->width * img->height);
@@ -857,7 +893,7 @@ static raystream_status make_image(const rs_cli_options *co, render_run *r, rays
     if ((n = rs_run_make_aovs(co->aovs, r, layers, bufs)) < 0) {
         for (i = 0; i < 4; ++i)
             rs_free(bufs[i]);
-        free(img);
+        raystream_image_release(img);
         return fail_core(RS_ERR_NOMEM);
     }
     for (i = 0; i < n; ++i) {
@@ -962,7 +998,7 @@ static raystream_status render(raystream_scene *h, const char *scene, const rays
         code = run_steps(&co, &r, &p, &cancelled);
     st = from_exit(&sink, code);
     if (st == RAYSTREAM_OK)
-        st = make_image(&co, &r, out);
+        st = make_image(&co, &r, h ? h->source : co.scene, out);
     if (st == RAYSTREAM_OK && cancelled) {
         st = RAYSTREAM_CANCELLED;
         snprintf(g_error, sizeof g_error, "the render was cancelled");

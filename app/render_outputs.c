@@ -54,8 +54,7 @@ static void report_devices(const render_run *r, rs_report *rep)
     }
 }
 
-/* The report of the render, once the film is final. */
-static void make_report(const rs_cli_options *o, const render_run *r, rs_report *rep)
+void rs_run_report(const rs_cli_options *o, const render_run *r, rs_report *rep)
 {
     memset(rep, 0, sizeof *rep);
     rep->scene = o->scene;
@@ -296,7 +295,7 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
         skipped = 1;
     else if (o->denoise && !rs_run_denoise(r))
         undenoised = 1;
-    make_report(o, r, &rep);
+    rs_run_report(o, r, &rep);
     if (o->stats)
         rs_report_print_table(&rep);
     track_outputs(r, timeline_inner, sizeof timeline_inner);

@@ -15,6 +15,7 @@
 #include "app/options.h"
 #include "app/outputs.h"
 #include "app/progress.h"
+#include "app/report.h"
 #include "app/tev.h"
 #include "core/image_io.h"
 #include "scheduler/adaptive.h"
@@ -107,6 +108,9 @@ int rs_run_denoise(render_run *r);
 /* The --aov layers `aovs` (RS_AOV_*) of the finished render into layers[] (room for 4), their
  * buffers in bufs[4] (rs_free them); returns how many, or -1 (out of memory, rs_error set). */
 int rs_run_make_aovs(unsigned aovs, const render_run *r, rs_image_layer *layers, float **bufs);
+/* The report of the render (the summary's, --stats-json's, the EXR header's), once the film is
+ * final. */
+void rs_run_report(const rs_cli_options *o, const render_run *r, rs_report *rep);
 /* The outputs, all or none, then the summary; returns `code` or RS_EXIT_RUNTIME. */
 int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code);
 /* The --checkpoint of the film as it is now; 0 after a message. */

@@ -171,6 +171,23 @@ static void test_aov_matches_cli(void **state)
                          (double)mine[i * ch + chans[k].c], (double)data[i]);
         rs_free(data);
     }
+    /* the header: every attribute of the command's (raystream:*) with the same value */
+    {
+        static const char *const keys[] = {"raystream:scene",     "raystream:spp",
+                                           "raystream:devices",   "raystream:integrator",
+                                           "raystream:version",   "raystream:seed",
+                                           "raystream:filter",    "raystream:sampler",
+                                           "raystream:max_depth", NULL};
+        char mine[512], theirs[512], api_path[512];
+        path_in(f, "api.exr", api_path, sizeof api_path);
+        assert_int_equal(raystream_image_write(api, api_path), RAYSTREAM_OK);
+        for (k = 0; keys[k]; ++k) {
+            assert_int_equal(rs_image_read_meta(api_path, keys[k], mine, sizeof mine), RS_OK);
+            assert_int_equal(rs_image_read_meta(path, keys[k], theirs, sizeof theirs), RS_OK);
+            if (strcmp(mine, theirs) != 0)
+                fail_msg("%s: library '%s', command '%s'", keys[k], mine, theirs);
+        }
+    }
     proc_free(&p);
     raystream_image_release(api);
 }
