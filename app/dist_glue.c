@@ -109,6 +109,9 @@ static int dist_setup_steps(const rs_cli_options *o, render_run *r)
     if (code == RS_EXIT_OK) {
         rs_run_settings(o, r);
         if (r->rank == 0) {
+            if (o->tev) /* the ranks' samples meet in rank 0's film only as passes end */
+                rs_app_print("raystream: warning: --tev: no live preview under mpirun; the render "
+                             "goes on without it\n");
             if ((code = rs_run_check_outputs(o, r)) == RS_EXIT_OK)
                 code = rs_run_make_film(o, r);
         } else if (rs_run_new_film(r, &r->film) != RS_OK) {

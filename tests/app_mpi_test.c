@@ -650,6 +650,20 @@ static void test_bad_fault(void **state)
     proc_free(&p);
 }
 
+/* --tev under mpirun: one warning (no live preview there), and the render goes on. */
+static void test_tev_warns(void **state)
+{
+    const fixture *f = (const fixture *)*state;
+    static const char *const args[] = {"render", "builtin:cornell", "--width", "32", "--spp", "2",
+                                       "--tev", "1", "-q", "-o", "out.pfm", NULL};
+    proc p;
+    mpirun(&p, f, 2, 0, args);
+    EXPECT(&p, exited_with(&p, 0) && one_line(&p.err) &&
+                   strstr(p.err.data, "warning: --tev: no live preview under mpirun"),
+           "--tev under mpirun: one warning line, then the render");
+    proc_free(&p);
+}
+
 static void asan_full_unwind(void)
 {
     const char *asan = getenv("ASAN_OPTIONS");
@@ -678,6 +692,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_same_image_any_ranks, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_tev_warns, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive_same_image, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive_checkpoint_resume, setup, teardown),
         cmocka_unit_test_setup_teardown(test_adaptive_killed_rank, setup, teardown),
