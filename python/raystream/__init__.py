@@ -141,6 +141,15 @@ def _indices(x, n_vertices):
     return _array("I", flat).tobytes()
 
 
+def _json_text(what, value, fields):
+    """A scene file's object given as a dict, its JSON text, or keywords: its JSON text."""
+    if value is None:
+        value = fields
+    elif fields:
+        raise ValueError("%s: give a dict or keywords, not both" % what)
+    return value if isinstance(value, str) else _json.dumps(value)
+
+
 class Scene:
     """A scene: raystream.load(...), raystream.load_json(...), or Scene() built here."""
 
@@ -151,13 +160,7 @@ class Scene:
         """A material as a scene file writes it (docs/scene-format.md): a dict, its JSON text,
         or keywords, e.g. add_material(type="lambertian", albedo=(0.7, 0.2, 0.2)).  Returns its
         id for the shapes."""
-        if material is None:
-            material = fields
-        elif fields:
-            raise ValueError("add_material: give a dict or keywords, not both")
-        if not isinstance(material, str):
-            material = _json.dumps(material)
-        return _c.scene_add_material(self._cap, material)
+        return _c.scene_add_material(self._cap, _json_text("add_material", material, fields))
 
     def add_mesh(self, vertices, indices, normals=None, uvs=None, material=0):
         """A triangle mesh: vertices N x 3, indices M x 3 (numpy arrays or sequences), optional
@@ -196,13 +199,7 @@ class Scene:
         """A point, spot or directional light as a scene file writes it: a dict, its JSON text
         or keywords, e.g. add_light(type="point_light", position=(0, 3, 0),
         intensity=(10, 10, 10))."""
-        if light is None:
-            light = fields
-        elif fields:
-            raise ValueError("add_light: give a dict or keywords, not both")
-        if not isinstance(light, str):
-            light = _json.dumps(light)
-        _c.scene_add_light(self._cap, light)
+        _c.scene_add_light(self._cap, _json_text("add_light", light, fields))
 
     def add_sphere(self, center, radius, material=0):
         _c.scene_add_sphere(self._cap, center, float(radius), int(material))
