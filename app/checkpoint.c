@@ -195,17 +195,16 @@ static int write_file(const char *path, const char *staged, int rename_now,
     FILE *f;
     int ok;
     if (!little_endian()) {
-        rs_app_print(
-                "raystream: --checkpoint %s: checkpoints are written on little-endian "
-                "machines only\n",
-                path);
+        rs_app_print("raystream: --checkpoint %s: checkpoints are written on little-endian "
+                     "machines only\n",
+                     path);
         return 0;
     }
     header = (unsigned char *)malloc(header_max(held));
     f = header ? fopen(staged, "wb") : NULL;
     if (!f) {
         rs_app_print("raystream: --checkpoint %s: cannot write %s (%s)\n", path, staged,
-                header ? strerror(errno) : "out of memory");
+                     header ? strerror(errno) : "out of memory");
         free(header);
         return 0;
     }
@@ -239,7 +238,7 @@ static int write_file(const char *path, const char *staged, int rename_now,
     if (ok && (!rename_now || rename(staged, path) == 0))
         return 1;
     rs_app_print("raystream: --checkpoint %s: cannot write the checkpoint (%s)\n", path,
-            strerror(errno));
+                 strerror(errno));
     unlink(staged);
     return 0;
 }
@@ -277,19 +276,17 @@ static int mismatch_u(const char *path, const char *field, uint64_t in_file, uin
     char a[32], b[32];
     snprintf(a, sizeof a, "%llu", (unsigned long long)in_file);
     snprintf(b, sizeof b, "%llu", (unsigned long long)asked);
-    rs_app_print(
-            "raystream: --resume %s: made with %s %s, but this render has %s %s (the same "
-            "settings are needed to continue it)\n",
-            path, field, a, field, b);
+    rs_app_print("raystream: --resume %s: made with %s %s, but this render has %s %s (the same "
+                 "settings are needed to continue it)\n",
+                 path, field, a, field, b);
     return RS_EXIT_USAGE;
 }
 
 static int mismatch_s(const char *path, const char *field, const char *in_file, const char *asked)
 {
-    rs_app_print(
-            "raystream: --resume %s: made with %s %s, but this render has %s %s (the same "
-            "settings are needed to continue it)\n",
-            path, field, in_file, field, asked);
+    rs_app_print("raystream: --resume %s: made with %s %s, but this render has %s %s (the same "
+                 "settings are needed to continue it)\n",
+                 path, field, in_file, field, asked);
     return RS_EXIT_USAGE;
 }
 
@@ -385,10 +382,10 @@ static int check_header(const reader *r, rs_checkpoint_key *want)
     /* the size was compared before the film was read */
     if (get64(h + 16) != want->scene_hash) {
         rs_app_print(
-                "raystream: --resume %s: made for another scene (%s; its content hash %016llx, "
-                "this scene %s has %016llx)\n",
-                path, r->name, (unsigned long long)get64(h + 16), want->scene,
-                (unsigned long long)want->scene_hash);
+            "raystream: --resume %s: made for another scene (%s; its content hash %016llx, "
+            "this scene %s has %016llx)\n",
+            path, r->name, (unsigned long long)get64(h + 16), want->scene,
+            (unsigned long long)want->scene_hash);
         return RS_EXIT_USAGE;
     }
     if (r->version == RS_CHECKPOINT_VERSION) {

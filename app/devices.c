@@ -180,8 +180,8 @@ static rs_status create_gpu(const device_plan *p, int i, int threads, rs_cores *
                             "--require-gpu: %sgpu:%d cannot be used (no CPU fallback): %s",
                             p->megakernel ? "the megakernel's " : "", index, reason);
     }
-    rs_app_print("raystream: warning: %s; %sgpu:%d runs on the CPU fallback (%d thread%s)\n",
-            why, p->megakernel ? "the megakernel for " : "", index, ft, ft == 1 ? "" : "s");
+    rs_app_print("raystream: warning: %s; %sgpu:%d runs on the CPU fallback (%d thread%s)\n", why,
+                 p->megakernel ? "the megakernel for " : "", index, ft, ft == 1 ? "" : "s");
     rs_error_clear();
     return rs_gpu_fallback_create(ft, index, cores, out);
 }
@@ -210,11 +210,10 @@ static int plan_check(const rs_cli_options *o, const device_plan *p)
             /* fewer GPUs than ranks: rank L + n_gpus (if any) has this one too */
             shared |= p->specs[i].index + p->n_gpus < p->local_size;
         }
-    rs_app_print(
-            "raystream: local rank %d of %d on this machine: --devices auto takes %s of %d "
-            "GPU%s%s\n",
-            p->local_rank, p->local_size, list, p->n_gpus, p->n_gpus == 1 ? "" : "s",
-            shared ? " (shared with other ranks)" : "");
+    rs_app_print("raystream: local rank %d of %d on this machine: --devices auto takes %s of %d "
+                 "GPU%s%s\n",
+                 p->local_rank, p->local_size, list, p->n_gpus, p->n_gpus == 1 ? "" : "s",
+                 shared ? " (shared with other ranks)" : "");
     return 1;
 }
 

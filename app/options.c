@@ -47,9 +47,8 @@ static int parse_u64(const char *opt, const char *text, uint64_t lo, uint64_t hi
     return RS_EXIT_OK;
 bad:
     if (text[0] == '-' && strspn(text + 1, "0123456789") == strlen(text + 1) && text[1]) {
-        rs_app_print(
-                "raystream: %s %s: must be a positive whole number (see 'raystream --help')\n", opt,
-                text);
+        rs_app_print("raystream: %s %s: must be a positive whole number (see 'raystream --help')\n",
+                     opt, text);
         return RS_EXIT_USAGE;
     }
     return usage_error("%s: '%s' is not a whole number", opt, text);
@@ -72,10 +71,9 @@ static int parse_seconds(const char *opt, const char *text, double *out)
     if (*end != '\0' || end == text)
         return usage_error("%s: '%s' is not a number of seconds", opt, text);
     if (errno || !(v > 0.0) || v > 1e9) {
-        rs_app_print(
-                "raystream: %s %s: must be a number of seconds above 0 and at most 1e9 (see "
-                "'raystream --help')\n",
-                opt, text);
+        rs_app_print("raystream: %s %s: must be a number of seconds above 0 and at most 1e9 (see "
+                     "'raystream --help')\n",
+                     opt, text);
         return RS_EXIT_USAGE;
     }
     *out = v;
@@ -678,8 +676,7 @@ static int opt_bvh(const char *name, const char *v, rs_cli_options *o)
 {
     (void)name;
     if (rs_bvh_builder_parse(v, &o->bvh) != RS_OK) {
-        rs_app_print("raystream: --bvh: %s (see 'raystream render --help')\n",
-                rs_error_message());
+        rs_app_print("raystream: --bvh: %s (see 'raystream render --help')\n", rs_error_message());
         rs_error_clear();
         return RS_EXIT_USAGE;
     }

@@ -98,7 +98,7 @@ typedef struct rs_cli_options {
     unsigned aovs;            /* --aov LIST: RS_AOV_* layers in the EXR (shading/aov.h) */
     double adaptive;          /* --adaptive THRESHOLD; 0: every pixel gets spp */
     uint32_t adaptive_min_spp; /* --adaptive-min-spp N (default 16) */
-    const char *tev;          /* --tev [HOST:]PORT: live preview in tev (app/tev.h) */
+    const char *tev;           /* --tev [HOST:]PORT: live preview in tev (app/tev.h) */
     const char *checkpoint;   /* --checkpoint FILE */
     double ckpt_every_s;      /* --checkpoint-interval SECONDS (default 60) */
     const char *resume;       /* --resume FILE */

@@ -43,7 +43,7 @@ void rs_outputs_remove_tracked(void)
 static int refuse(const rs_output *o, const char *what, const char *detail)
 {
     rs_app_print("raystream: %s %s: %s%s%s%s\n", o->option, o->path, what, detail ? " (" : "",
-            detail ? detail : "", detail ? ")" : "");
+                 detail ? detail : "", detail ? ")" : "");
     return RS_EXIT_USAGE;
 }
 
@@ -138,6 +138,6 @@ int rs_output_commit(const rs_output *o)
     if (rename(o->staged, o->path) == 0)
         return 1;
     rs_app_print("raystream: %s: cannot put the finished file in place (%s)\n", o->path,
-            strerror(errno));
+                 strerror(errno));
     return 0;
 }

@@ -317,17 +317,16 @@ int rs_run_write_outputs(const rs_cli_options *o, render_run *r, int code)
     rs_outputs_untrack();
     if (!ok) {
         rs_app_print("raystream: the run failed; %s\n",
-                replaced ? "some outputs were already replaced" : "no output was replaced");
+                     replaced ? "some outputs were already replaced" : "no output was replaced");
         return RS_EXIT_RUNTIME;
     }
     rs_report_print_summary(&rep);
     if (skipped)
-        rs_app_print("raystream: interrupted: %s was written as rendered, not denoised\n",
-                r->out);
+        rs_app_print("raystream: interrupted: %s was written as rendered, not denoised\n", r->out);
     if (undenoised) {
         rs_app_print("raystream: --denoise failed after the render: %s was written as "
-                        "rendered, not denoised\n",
-                r->out);
+                     "rendered, not denoised\n",
+                     r->out);
         return RS_EXIT_RUNTIME;
     }
     return code;

@@ -157,8 +157,7 @@ int rs_run_prepare(const rs_cli_options *o, render_run *r)
     int code;
     rs_run_settings(o, r);
     /* the library writes no file of the command's: it checks the denoiser alone */
-    if ((code = r->library ? rs_run_check_denoise(o) : rs_run_check_outputs(o, r)) ==
-            RS_EXIT_OK &&
+    if ((code = r->library ? rs_run_check_denoise(o) : rs_run_check_outputs(o, r)) == RS_EXIT_OK &&
         (code = rs_run_make_film(o, r)) == RS_EXIT_OK &&
         (code = rs_run_build_bvh(o, r)) == RS_EXIT_OK)
         code = rs_run_start_devices(o, r);
@@ -173,11 +172,10 @@ int rs_run_resume_whole_samples(const rs_cli_options *o, const render_run *r, co
     uint32_t i;
     for (i = 0; i < r->held.n; ++i)
         if (r->held.r[i][1] % npix != 0) {
-            rs_app_print(
-                    "raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
-                    "pixels); %s\n",
-                    o->resume, (unsigned long long)r->held.r[i][1], r->st.width, r->st.height,
-                    what);
+            rs_app_print("raystream: --resume %s: stopped within a sample (%llu paths of %ux%u "
+                         "pixels); %s\n",
+                         o->resume, (unsigned long long)r->held.r[i][1], r->st.width, r->st.height,
+                         what);
             return RS_EXIT_USAGE;
         }
     return RS_EXIT_OK;

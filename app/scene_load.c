@@ -54,10 +54,9 @@ static int load_scene(const rs_cli_options *o, render_run *r)
     if (strncmp(o->scene, "builtin:", 8) == 0)
         return load_builtin(o, r);
     if (stat(o->scene, &sb) != 0) {
-        rs_app_print(
-                "raystream: %s: no such scene file (built-in scenes are named "
-                "builtin:NAME; see 'raystream scenes')\n",
-                o->scene);
+        rs_app_print("raystream: %s: no such scene file (built-in scenes are named "
+                     "builtin:NAME; see 'raystream scenes')\n",
+                     o->scene);
         return RS_EXIT_USAGE;
     }
     if (S_ISDIR(sb.st_mode)) {
@@ -205,7 +204,7 @@ int rs_cmd_export(const rs_cli_options *o)
             code = rs_app_fail(RS_EXIT_RUNTIME, NULL);
         else if (!o->quiet)
             rs_app_print("raystream: wrote %s (%u spheres, %u quads, %u triangles)\n", o->output,
-                    r.scene->n_spheres, r.scene->n_quads, r.scene->n_tris);
+                         r.scene->n_spheres, r.scene->n_quads, r.scene->n_tris);
     }
     rs_run_release(&r);
     return code;

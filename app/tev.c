@@ -29,8 +29,8 @@ struct rs_tev {
     int pending; /* rgb holds an image to send */
     int busy;    /* the sender is sending it */
     int quit;
-    int dead;    /* the viewer went away: nothing more is sent */
-    double last; /* when the last update was handed over */
+    int dead;                 /* the viewer went away: nothing more is sent */
+    double last;              /* when the last update was handed over */
     double resolve_s, send_s; /* what the last update cost: the film resolved, the image sent */
     double interval;          /* between updates: RS_TEV_INTERVAL_S, or more (rs_tev_film) */
 };

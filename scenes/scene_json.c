@@ -508,8 +508,7 @@ static rs_status one_value(rs_scene *s, const char *text, const char *label, cJS
     return RS_OK;
 }
 
-rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label,
-                                     uint32_t *id)
+rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label, uint32_t *id)
 {
     cJSON *m = NULL;
     ctx *c;

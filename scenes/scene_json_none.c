@@ -29,8 +29,7 @@ rs_status rs_scene_parse_json_ex(const char *text, size_t len, const char *label
     return rs_scene_parse_json(text, len, label, base_dir, out);
 }
 
-rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label,
-                                     uint32_t *id)
+rs_status rs_scene_add_material_json(rs_scene *s, const char *text, const char *label, uint32_t *id)
 {
     (void)s, (void)text, (void)id;
     return rs_error_set(RS_ERR_ARG, "%s: this build has no cJSON and reads no JSON materials",

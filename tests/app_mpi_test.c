@@ -654,12 +654,14 @@ static void test_bad_fault(void **state)
 static void test_tev_warns(void **state)
 {
     const fixture *f = (const fixture *)*state;
-    static const char *const args[] = {"render", "builtin:cornell", "--width", "32", "--spp", "2",
-                                       "--tev", "1", "-q", "-o", "out.pfm", NULL};
+    static const char *const args[] = {
+        "render", "builtin:cornell", "--width", "32", "--spp", "2", "--tev", "1", "-q",
+        "-o",     "out.pfm",         NULL};
     proc p;
     mpirun(&p, f, 2, 0, args);
-    EXPECT(&p, exited_with(&p, 0) && one_line(&p.err) &&
-                   strstr(p.err.data, "warning: --tev: no live preview under mpirun"),
+    EXPECT(&p,
+           exited_with(&p, 0) && one_line(&p.err) &&
+               strstr(p.err.data, "warning: --tev: no live preview under mpirun"),
            "--tev under mpirun: one warning line, then the render");
     proc_free(&p);
 }
