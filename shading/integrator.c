@@ -165,6 +165,25 @@ static void record_passes(const shade_ctx *c, uint32_t b, uint32_t n)
     }
 }
 
+/* Asks for the scene data shading will read at these hits (a triangle's corners, its vertex
+ * normals and material number) while the batch's random numbers are made: in a scene larger than
+ * the caches each hit's triangle is a miss, the first load of the shading that followed stalled
+ * on it (perf on the living room: a quarter of shade8's samples).  Only the speed changes.
+ * Forced inline: out of line GCC finds the function without effects and drops its calls. */
+RS_HD_HOT void prefetch_hits(const rs_scene *sc, const uint32_t *prim, uint32_t n)
+{
+    uint32_t k;
+    for (k = 0; k < n; ++k) {
+        uint32_t t = prim[k] - sc->n_spheres - sc->n_quads;
+        if (prim[k] == RS_NO_HIT || prim[k] < sc->n_spheres + sc->n_quads || t >= sc->n_tris)
+            continue;
+        __builtin_prefetch(&sc->tris[t]);
+        __builtin_prefetch(&sc->tri_mat[t]);
+        if (sc->tri_normal)
+            __builtin_prefetch(&sc->tri_normal[9 * (size_t)t]);
+    }
+}
+
 /* Shades the entries [begin, end) in order; their next rays go packed to next[begin ...] and
  * their shadow rays to shadow[begin ...], the counts to the range's run record. */
 static void shade_range(void *ctx, uint32_t begin, uint32_t end)
@@ -180,6 +199,7 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
         rs_ray wide_next[BATCH], wide_shadow[BATCH];
         uint8_t wide_made[BATCH];
         locate(c->map, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
+        prefetch_hits(c->it->scene, c->hits->prim + b, n);
         if (c->bounce == 0 && c->it->passes)
             record_passes(c, b, n);
         if (draws) {
