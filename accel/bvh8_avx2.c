@@ -26,9 +26,9 @@ typedef struct ray8 {
 
 } ray8;
 
-static inline void walk8_ray_init(ray8 *r, rs_vec3 o, rs_vec3 d)
+/* The ray broadcast, with inv_d = rs_bvh_inv_dir(d) already made. */
+static inline void walk8_ray_init_inv(ray8 *r, rs_vec3 o, rs_vec3 d, rs_vec3 inv_d)
 {
-    rs_vec3 inv_d = rs_bvh_inv_dir(d);
     float iv[3], ov[3];
     int a;
     iv[0] = inv_d.x;
@@ -47,6 +47,11 @@ static inline void walk8_ray_init(ray8 *r, rs_vec3 o, rs_vec3 d)
         /* 1 / d finite and nonzero: no 0 * inf, and the planes order as the signs say */
         r->general |= !(iv[a] - iv[a] == 0.0f) || iv[a] == 0.0f;
     }
+}
+
+static inline void walk8_ray_init(ray8 *r, rs_vec3 o, rs_vec3 d)
+{
+    walk8_ray_init_inv(r, o, d, rs_bvh_inv_dir(d));
 }
 
 /* An instance's bottom level: its boxes widened by `margin` (lo - margin, hi + margin, as
@@ -593,12 +598,23 @@ static uint32_t pk8_occluded(const rs_bvh8 *b, const rs_geom *g, pk8 *p, uint32_
     return done;
 }
 
-/* Whether 1 / d has a component that is infinite or zero: such a ray is walked alone. */
-static inline int pk8_general(rs_vec3 d)
+/* Rays i .. i + n - 1 of the stream as eight lanes: v[0..2] the origins, v[3..5] the directions,
+ * v[6] tmin; lanes n .. 7 copies of lane 0. */
+static inline void pk8_load(const rs_ray_soa *r, uint32_t i, uint32_t n, __m256 v[7])
 {
-    rs_vec3 iv = rs_bvh_inv_dir(d);
-    return !(iv.x - iv.x == 0.0f) || iv.x == 0.0f || !(iv.y - iv.y == 0.0f) || iv.y == 0.0f ||
-           !(iv.z - iv.z == 0.0f) || iv.z == 0.0f;
+    const float *f[7] = {r->ox + i, r->oy + i, r->oz + i, r->dx + i, r->dy + i, r->dz + i,
+                         r->tmin + i};
+    uint32_t k, l;
+    for (k = 0; k < 7; ++k) {
+        float x[8];
+        if (n == 8) {
+            v[k] = _mm256_loadu_ps(f[k]);
+            continue;
+        }
+        for (l = 0; l < 8; ++l)
+            x[l] = f[k][l < n ? l : 0];
+        v[k] = _mm256_loadu_ps(x);
+    }
 }
 
 void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
@@ -610,62 +626,45 @@ void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_ba
         return;
     }
     for (i = begin; i < end; i += 8) {
-        uint32_t n = end - i < 8 ? end - i : 8, active = 0;
-        float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8], ix[8], iy[8], iz[8], tmin[8];
+        uint32_t n = end - i < 8 ? end - i : 8, active, neg[3], a;
+        __m256 v[7], ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1)), zero = _mm256_setzero_ps();
         pk8 p;
         rs_hit hit[8];
+        /* the eight rays' fields, straight from the stream (a short packet's missing lanes take
+         * its first ray, masked off) */
+        pk8_load(&batch->rays, i, n, v);
         for (l = 0; l < 8; ++l) {
-            uint32_t j = i + (l < n ? l : 0);
-            rs_vec3 inv;
-            p.ray[l] = rs_ray_soa_get(&batch->rays, j);
-            if (l < n && !pk8_general(p.ray[l].d))
-                active |= 1u << l;
-            inv = rs_bvh_inv_dir(p.ray[l].d);
-            ox[l] = p.ray[l].o.x;
-            oy[l] = p.ray[l].o.y;
-            oz[l] = p.ray[l].o.z;
-            dx[l] = p.ray[l].d.x;
-            dy[l] = p.ray[l].d.y;
-            dz[l] = p.ray[l].d.z;
-            ix[l] = inv.x;
-            iy[l] = inv.y;
-            iz[l] = inv.z;
-            tmin[l] = p.ray[l].tmin;
-            p.tmax[l] = p.ray[l].tmax;
+            p.ray[l] = rs_ray_soa_get(&batch->rays, i + (l < n ? l : 0));
             hit[l].prim = RS_NO_HIT;
             hit[l].t = p.ray[l].tmax;
             hit[l].u = hit[l].v = 0.0f;
+            p.tmax[l] = p.ray[l].tmax;
         }
+        for (a = 0; a < 3; ++a) {
+            /* rs_bvh_inv_dir, eight at once (a division rounds as the scalar one); a lane whose
+             * 1 / d is not finite or is zero is walked alone */
+            p.o[a] = v[a];
+            p.d[a] = v[3 + a];
+            p.inv[a] = _mm256_div_ps(_mm256_set1_ps(1.0f), v[3 + a]);
+            ok = AND(ok, AND(_mm256_cmp_ps(SUB(p.inv[a], p.inv[a]), zero, _CMP_EQ_OQ),
+                             _mm256_cmp_ps(p.inv[a], zero, _CMP_NEQ_UQ)));
+        }
+        p.tmin = v[6];
+        active = (uint32_t)_mm256_movemask_ps(ok) & ((1u << n) - 1u);
         if (__builtin_popcount(active) < 2) {
             rs_bvh8_trace(b, g, batch, i, i + n);
             continue;
         }
-        {
-            /* the signs of the packet's directions, where they agree */
-            uint32_t neg[3] = {0, 0, 0}, a;
-            for (l = 0; l < 8; ++l)
-                if (active & (1u << l)) {
-                    neg[0] |= 1u << (ix[l] < 0.0f);
-                    neg[1] |= 1u << (iy[l] < 0.0f);
-                    neg[2] |= 1u << (iz[l] < 0.0f);
-                }
-            p.octant = neg[0] != 3u && neg[1] != 3u && neg[2] != 3u;
-            for (a = 0; a < 3; ++a) {
-                p.near[a] = a + (neg[a] == 2u ? 3u : 0u);
-                p.far[a] = a + (neg[a] == 2u ? 0u : 3u);
-            }
+        /* the signs of the packet's directions, where they agree */
+        for (a = 0; a < 3; ++a) {
+            uint32_t below = (uint32_t)_mm256_movemask_ps(CMP_LT(p.inv[a], zero)) & active;
+            neg[a] = (below != active ? 1u : 0u) | (below ? 2u : 0u);
         }
-        /* lanes that are not in the packet take lane 0's ray, masked off */
-        p.o[0] = _mm256_loadu_ps(ox);
-        p.o[1] = _mm256_loadu_ps(oy);
-        p.o[2] = _mm256_loadu_ps(oz);
-        p.d[0] = _mm256_loadu_ps(dx);
-        p.d[1] = _mm256_loadu_ps(dy);
-        p.d[2] = _mm256_loadu_ps(dz);
-        p.inv[0] = _mm256_loadu_ps(ix);
-        p.inv[1] = _mm256_loadu_ps(iy);
-        p.inv[2] = _mm256_loadu_ps(iz);
-        p.tmin = _mm256_loadu_ps(tmin);
+        p.octant = neg[0] != 3u && neg[1] != 3u && neg[2] != 3u;
+        for (a = 0; a < 3; ++a) {
+            p.near[a] = a + (neg[a] == 2u ? 3u : 0u);
+            p.far[a] = a + (neg[a] == 2u ? 0u : 3u);
+        }
         if (batch->kind == RS_TRACE_CLOSEST) {
             pk8_closest(b, g, &p, hit, active);
             for (l = 0; l < n; ++l) {
@@ -689,15 +688,45 @@ void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_ba
 void rs_bvh8_trace(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
                    uint32_t begin, uint32_t end)
 {
-    uint32_t i;
-    for (i = begin; i < end; ++i) {
-        rs_ray r = rs_ray_soa_get(&batch->rays, i);
-        if (batch->kind == RS_TRACE_CLOSEST) {
+    uint32_t i, l;
+    if (b->n_nodes == 0) {
+        for (i = begin; i < end; ++i) {
             rs_hit h;
-            rs_bvh8_closest(b, g, r, &h);
-            rs_hit_soa_set(&batch->hits, i, &h);
-        } else {
-            batch->occluded[i] = (uint8_t)rs_bvh8_occluded(b, g, r);
+            rs_ray r = rs_ray_soa_get(&batch->rays, i);
+            if (batch->kind == RS_TRACE_CLOSEST) {
+                rs_bvh8_closest(b, g, r, &h);
+                rs_hit_soa_set(&batch->hits, i, &h);
+            } else {
+                batch->occluded[i] = 0;
+            }
+        }
+        return;
+    }
+    for (i = begin; i < end; i += 8) {
+        /* rs_bvh8_closest / rs_bvh8_occluded ray by ray, the eight rays' 1 / d made at once (a
+         * vector division rounds as the scalar one): three scalar divisions a ray were a
+         * tenth of the packet walk's setup */
+        uint32_t n = end - i < 8 ? end - i : 8;
+        float iv[3][8];
+        __m256 v[7];
+        pk8_load(&batch->rays, i, n, v);
+        _mm256_storeu_ps(iv[0], _mm256_div_ps(_mm256_set1_ps(1.0f), v[3]));
+        _mm256_storeu_ps(iv[1], _mm256_div_ps(_mm256_set1_ps(1.0f), v[4]));
+        _mm256_storeu_ps(iv[2], _mm256_div_ps(_mm256_set1_ps(1.0f), v[5]));
+        for (l = 0; l < n; ++l) {
+            rs_ray r = rs_ray_soa_get(&batch->rays, i + l);
+            ray8 r8;
+            walk8_ray_init_inv(&r8, r.o, r.d, rs_v3(iv[0][l], iv[1][l], iv[2][l]));
+            if (batch->kind == RS_TRACE_CLOSEST) {
+                rs_hit h;
+                h.prim = RS_NO_HIT;
+                h.t = r.tmax;
+                h.u = h.v = 0.0f;
+                walk8_walk_closest(b, g, 0, &r8, &r, &h, NULL);
+                rs_hit_soa_set(&batch->hits, i + l, &h);
+            } else {
+                batch->occluded[i + l] = (uint8_t)walk8_walk_occluded(b, g, 0, &r8, &r, NULL);
+            }
         }
     }
 }

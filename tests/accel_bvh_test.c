@@ -647,9 +647,10 @@ static rs_ray packet_ray(uint64_t *s, long i, const soup *sp, uint32_t grid, flo
     return mk_ray(*o, d, tmin, tmax);
 }
 
-/* rs_bvh8_trace_packets against rs_bvh8_trace (itself checked against brute force above): the
- * same closest hit, bit for bit, and the same occlusion, for rays cut into packets from offset 0
- * and from offset 3.  Returns the rays that hit. */
+/* rs_bvh8_trace_packets against rs_bvh8_trace, and rs_bvh8_trace (which makes eight rays' 1 / d
+ * at once) against rs_bvh8_closest and rs_bvh8_occluded ray by ray (checked against brute force
+ * above): the same closest hit, bit for bit, and the same occlusion, for rays cut into packets
+ * from offset 0 and from offset 3.  Returns the rays that hit. */
 static long expect_packets_match(const rs_bvh8 *b8, const rs_geom *g, const soup *sp,
                                  uint32_t grid, float extent, const char *what)
 {
@@ -692,6 +693,16 @@ static long expect_packets_match(const rs_bvh8 *b8, const rs_geom *g, const soup
                          a.v, one.occluded[i], ray);
             }
             hits += from == 0 && a.prim != RS_NO_HIT;
+            {
+                rs_hit c;
+                rs_ray r = rs_ray_soa_get(&one.rays, i);
+                rs_bvh8_closest(b8, g, r, &c);
+                if (memcmp(&a, &c, sizeof a) != 0 || one.occluded[i] != rs_bvh8_occluded(b8, g, r))
+                    fail_msg("%s, ray %u (from %u): rs_bvh8_trace prim %u t %.9g occluded %d, "
+                             "rs_bvh8_closest prim %u t %.9g, rs_bvh8_occluded %d",
+                             what, i, from, a.prim, a.t, one.occluded[i], c.prim, c.t,
+                             rs_bvh8_occluded(b8, g, r));
+            }
         }
     }
     free(one.occluded);
