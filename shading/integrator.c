@@ -200,10 +200,9 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
     uint32_t b, k, on = begin, os = begin;
     for (b = begin; b < end; b += BATCH) {
         uint32_t n = end - b < BATCH ? end - b : BATCH;
-        uint32_t pixel[BATCH], sample[BATCH], wide_at[BATCH], wide_j[BATCH], nw;
+        uint32_t pixel[BATCH], sample[BATCH], wide_j[BATCH], nw = 0;
         rs_rng_f4 rb[BATCH], rl[BATCH], pre[2], wide_rb[BATCH], wide_rl[BATCH];
-        rs_ray wide_next[BATCH], wide_shadow[BATCH];
-        uint8_t wide_made[BATCH];
+        uint8_t wide[BATCH];
         locate(c->map, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
         if (c->prefetch)
             prefetch_hits(c->it->scene, c->hits->prim + b, n);
@@ -214,12 +213,11 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
             path_rand_batch(c->it, pixel, sample, c->bounce, RS_DIM_LIGHT, n, rl);
         }
         if (c->wide) {
-            /* the common vertices eight at a time (shading/shade_wide.h), the rest below */
-            nw = 0;
+            /* the common vertices eight at a time (shading/shade_wide.h), their rays first in
+             * the streams (the order of a stream's rays changes no answer), the rest below */
             for (k = 0; k < n; ++k) {
-                wide_at[k] = RS_NO_WIDE;
-                if (rs_shade_wide_entry(c->it->scene, c->hits->prim[b + k])) {
-                    wide_at[k] = nw;
+                wide[k] = (uint8_t)rs_shade_wide_entry(c->it->scene, c->hits->prim[b + k]);
+                if (wide[k]) {
                     wide_j[nw] = b + k;
                     wide_rb[nw] = rb[k];
                     wide_rl[nw] = rl[k];
@@ -227,7 +225,7 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
                 }
             }
             rs_shade_wide(c->it, c->bounce, c->rays, c->hits, wide_j, nw, wide_rb, wide_rl,
-                          c->paths, wide_made, wide_next, wide_shadow);
+                          c->paths, c->next, &on, c->shadow, &os);
         }
         for (k = 0; k < n; ++k) {
             /* entry j: path p's state loaded from the SoA, shaded, stored back (rs_path_shade_at
@@ -236,14 +234,8 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
             rs_ray r, nr, sr;
             rs_hit h;
             rs_path_state ps;
-            if (c->wide && wide_at[k] != RS_NO_WIDE) {
-                uint32_t w = wide_at[k];
-                if (wide_made[w] & RS_SHADE_SHADOW)
-                    rs_ray_soa_set(c->shadow, os++, &wide_shadow[w], p);
-                if (wide_made[w] & RS_SHADE_NEXT)
-                    rs_ray_soa_set(c->next, on++, &wide_next[w], p);
+            if (nw && wide[k])
                 continue;
-            }
             r = rs_ray_soa_get(c->rays, j);
             h = rs_hit_soa_get(c->hits, j);
             ps = rs_paths_load(c->paths, p);

@@ -318,7 +318,7 @@ WIDE void prim_point(const lane_prims *lp, f8 s, f8 t, v3 *p, v3 *err, v3 *ng)
 __attribute__((target("avx2"))) static void
 shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
        const uint32_t *entry, uint32_t count, const rs_rng_f4 *rb, const rs_rng_f4 *rl,
-       rs_paths *paths, uint8_t *made, rs_ray *next, rs_ray *shadow)
+       rs_paths *paths, rs_ray_soa *next, uint32_t *on, rs_ray_soa *shadow, uint32_t *os)
 {
     const rs_scene *sc = it->scene;
     const int nee = rs_scene_has_lights(sc);
@@ -491,33 +491,40 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
             store8(envpdf_, splat(0.0f));
     }
 
-    /* ---- scatter ---- */
+    /* ---- scatter: the rays straight into the streams ---- */
     for (i = 0; i < count; ++i) {
         uint32_t p = path_[i], j = entry[i];
         float time = rays->time[j];
-        made[i] = 0;
         if (shadow_ok[i]) {
-            rs_ray *s = &shadow[i];
+            uint32_t k = (*os)++;
             paths->pending[p] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
-            s->o = rs_v3(out_o[0][i], out_o[1][i], out_o[2][i]);
-            s->d = rs_v3(sh_d[0][i], sh_d[1][i], sh_d[2][i]);
-            s->tmin = 0.0f;
-            s->tmax = sh_env[i] ? FLT_MAX : 1.0f - RS_SHADOW_EPS;
-            s->time = time;
-            made[i] |= RS_SHADE_SHADOW;
+            shadow->ox[k] = out_o[0][i];
+            shadow->oy[k] = out_o[1][i];
+            shadow->oz[k] = out_o[2][i];
+            shadow->dx[k] = sh_d[0][i];
+            shadow->dy[k] = sh_d[1][i];
+            shadow->dz[k] = sh_d[2][i];
+            shadow->tmin[k] = 0.0f;
+            shadow->tmax[k] = sh_env[i] ? FLT_MAX : 1.0f - RS_SHADOW_EPS;
+            shadow->time[k] = time;
+            shadow->path[k] = p;
         }
         if (next_ok[i]) {
-            rs_ray *r = &next[i];
-            r->o = rs_v3(out_o[0][i], out_o[1][i], out_o[2][i]);
-            r->d = rs_v3(out_d[0][i], out_d[1][i], out_d[2][i]);
-            r->tmin = 0.0f;
-            r->tmax = FLT_MAX;
-            r->time = time;
+            uint32_t k = (*on)++;
+            next->ox[k] = out_o[0][i];
+            next->oy[k] = out_o[1][i];
+            next->oz[k] = out_o[2][i];
+            next->dx[k] = out_d[0][i];
+            next->dy[k] = out_d[1][i];
+            next->dz[k] = out_d[2][i];
+            next->tmin[k] = 0.0f;
+            next->tmax[k] = FLT_MAX;
+            next->time[k] = time;
+            next->path[k] = p;
             paths->throughput[p] = rs_v3(beta_[0][i], beta_[1][i], beta_[2][i]);
             paths->bsdf_pdf[p] = pdf_[i];
             paths->env_pdf[p] = envpdf_[i];
             paths->flags[p] = (uint8_t)(paths->flags[p] & RS_PATH_NEGATIVE);
-            made[i] |= RS_SHADE_NEXT;
         }
     }
 }
@@ -526,8 +533,8 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
 
 void rs_shade_wide(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays,
                    const rs_hit_soa *hits, const uint32_t *entry, uint32_t n, const rs_rng_f4 *rb,
-                   const rs_rng_f4 *rl, rs_paths *paths, uint8_t *made, rs_ray *next,
-                   rs_ray *shadow)
+                   const rs_rng_f4 *rl, rs_paths *paths, rs_ray_soa *next, uint32_t *on,
+                   rs_ray_soa *shadow, uint32_t *os)
 {
 #if RS_WIDE_HAVE_AVX2
     uint32_t i;
@@ -535,9 +542,9 @@ void rs_shade_wide(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa
         atomic_fetch_add_explicit(&wide_count, n, memory_order_relaxed);
     for (i = 0; i < n; i += 8)
         shade8(it, bounce, rays, hits, entry + i, n - i < 8 ? n - i : 8, rb + i, rl + i, paths,
-               made + i, next + i, shadow + i);
+               next, on, shadow, os);
 #else
     (void)it, (void)bounce, (void)rays, (void)hits, (void)entry, (void)n, (void)rb, (void)rl;
-    (void)paths, (void)made, (void)next, (void)shadow;
+    (void)paths, (void)next, (void)on, (void)shadow, (void)os;
 #endif
 }

@@ -48,12 +48,13 @@ static inline int rs_shade_wide_entry(const rs_scene *sc, uint32_t prim)
 
 /* Shades entries entry[0..n) of the stream (rays, hits), segment `bounce`, as rs_path_shade_at
  * would with the numbers rb[i] (group RS_DIM_BSDF) and rl[i] (RS_DIM_LIGHT): each entry's path
- * state in `paths` is updated, made[i] gets its RS_SHADE_* flags and next[i], shadow[i] its rays
- * where those say.  Every entry must pass rs_shade_wide_entry, after rs_shade_wide_ready. */
+ * state in `paths` is updated, and the rays it makes are written to the streams, a next ray at
+ * next[*on] and a shadow ray at shadow[*os] (each count then advanced), in the entries' order.
+ * Every entry must pass rs_shade_wide_entry, after rs_shade_wide_ready. */
 void rs_shade_wide(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays,
                    const rs_hit_soa *hits, const uint32_t *entry, uint32_t n, const rs_rng_f4 *rb,
-                   const rs_rng_f4 *rl, rs_paths *paths, uint8_t *made, rs_ray *next,
-                   rs_ray *shadow);
+                   const rs_rng_f4 *rl, rs_paths *paths, rs_ray_soa *next, uint32_t *on,
+                   rs_ray_soa *shadow, uint32_t *os);
 
 #ifdef __cplusplus
 }
