@@ -1,6 +1,6 @@
-/* core/rand_batch.c — see rand_batch.h.  The AVX2 code is compiled for that target alone
- * (function attributes), so the build runs on any x86-64 and picks it at run time; other
- * machines build the scalar loop only. */
+/* core/rand_batch.c — see rand_batch.h.  The AVX2 code (and the Sobol points' GFNI variant) is
+ * compiled for that target alone (function attributes), so the build runs on any x86-64 and
+ * picks it at run time; other machines build the scalar loop only. */
 #include "core/rand_batch.h"
 
 #include <stdatomic.h>
@@ -26,12 +26,23 @@ static int cpu_has_avx2(void)
 #endif
 }
 
+static int cpu_has_gfni(void)
+{
+#if RS_RAND_HAVE_AVX2
+    return __builtin_cpu_supports("gfni");
+#else
+    return 0;
+#endif
+}
+
 static rs_rand_isa resolve(void)
 {
     int f = atomic_load_explicit(&forced, memory_order_relaxed);
-    if (f == RS_RAND_ISA_SCALAR)
+    if (f == RS_RAND_ISA_SCALAR || !cpu_has_avx2())
         return RS_RAND_ISA_SCALAR;
-    return cpu_has_avx2() ? RS_RAND_ISA_AVX2 : RS_RAND_ISA_SCALAR;
+    if (f != RS_RAND_ISA_AVX2 && cpu_has_gfni())
+        return RS_RAND_ISA_AVX2_GFNI;
+    return RS_RAND_ISA_AVX2;
 }
 
 rs_rand_isa rs_rand_batch_use(rs_rand_isa isa)
@@ -110,52 +121,27 @@ AVX2 static inline void store_f4x8(__m256 a, __m256 b, __m256 c, __m256 d, rs_rn
     _mm256_storeu_ps(o + 24, _mm256_permute2f128_ps(u2, u3, 0x31));
 }
 
-/* rs_sobol2 on eight lanes; rsample = rs_reverse_bits(sample) */
-AVX2 static inline void sobol2x8(__m256i seed, __m256i rsample, __m256 *x0, __m256 *x1)
+/* rs_reverse_bits with GFNI: each byte's bits reversed by one affine transform over GF(2) (the
+ * anti-diagonal bit matrix), then the bytes of each word reversed */
+#  define GFNI __attribute__((target("avx2,gfni")))
+GFNI static inline __m256i rev8_gfni(__m256i x)
 {
-    __m256i index = rev8(lk8(rsample, seed));
-    *x0 = tofloat8(rev8(lk8(index, hash8(_mm256_add_epi32(seed, k8(1u))))));
-    *x1 = tofloat8(rev8(lk8(superset8(index), hash8(_mm256_add_epi32(seed, k8(2u))))));
+    const __m256i bytes = _mm256_setr_epi8(3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3,
+                                           2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12);
+    x = _mm256_gf2p8affine_epi64_epi8(x, _mm256_set1_epi64x((long long)0x8040201008040201ull), 0);
+    return _mm256_shuffle_epi8(x, bytes);
 }
 
-AVX2 static void sobol_avx2(uint64_t seed, const uint32_t *pixel, const uint32_t *sample,
-                            uint32_t bounce, uint32_t group, uint32_t n, rs_rng_f4 *out)
-{
-    const __m256i lo = k8((uint32_t)seed), hi = k8((uint32_t)(seed >> 32));
-    const __m256i hb = k8(rs_hash_u32(bounce * 8u + group));
-    uint32_t i = 0;
-    for (;; i += 8) {
-        uint32_t pix[8], smp[8];
-        rs_rng_f4 tail[8];
-        const uint32_t *pp = pixel + i, *sp = sample + i;
-        uint32_t left = n - i;
-        __m256i s, rs;
-        __m256 a, b, c, d;
-        if (i >= n)
-            break;
-        if (left < 8) {
-            memset(pix, 0, sizeof pix);
-            memset(smp, 0, sizeof smp);
-            memcpy(pix, pp, left * sizeof *pix);
-            memcpy(smp, sp, left * sizeof *smp);
-            pp = pix;
-            sp = smp;
-        }
-        s = _mm256_loadu_si256((const __m256i *)pp);
-        s = hash8(_mm256_xor_si256(s, hb));
-        s = hash8(_mm256_xor_si256(hi, s));
-        s = hash8(_mm256_xor_si256(lo, s));
-        rs = rev8(_mm256_loadu_si256((const __m256i *)sp));
-        sobol2x8(hash8(_mm256_xor_si256(s, k8(0x5bd1e995u))), rs, &a, &b);
-        sobol2x8(hash8(_mm256_xor_si256(s, k8(0x27d4eb2fu))), rs, &c, &d);
-        if (left < 8) {
-            store_f4x8(a, b, c, d, tail);
-            memcpy(out + i, tail, left * sizeof *tail);
-            break;
-        }
-        store_f4x8(a, b, c, d, out + i);
-    }
-}
+/* The Sobol points twice: sobol_avx2 and, for CPUs with GFNI (a sixth fewer operations: the
+ * bit reversals, seven a group, are two instructions instead of eight), sobol_gfni. */
+#  define RS_SOBOL8_ATTR AVX2
+#  define RS_SOBOL8_FN(x) x##_avx2
+#  define RS_SOBOL8_REV(x) rev8(x)
+#  include "core/rand_sobol8.h"
+#  define RS_SOBOL8_ATTR GFNI
+#  define RS_SOBOL8_FN(x) x##_gfni
+#  define RS_SOBOL8_REV(x) rev8_gfni(x)
+#  include "core/rand_sobol8.h"
 
 /* rs_mulhilo32 of each lane of c by the constant m */
 AVX2 static inline void mulhilo8(__m256i m, __m256i c, __m256i *lo, __m256i *hi)
@@ -218,7 +204,12 @@ void rs_rand_batch_sobol(uint64_t seed, const uint32_t *pixel, const uint32_t *s
 {
     uint32_t i;
 #if RS_RAND_HAVE_AVX2
-    if (resolve() == RS_RAND_ISA_AVX2) {
+    rs_rand_isa isa = resolve();
+    if (isa == RS_RAND_ISA_AVX2_GFNI) {
+        sobol_gfni(seed, pixel, sample, bounce, group, n, out);
+        return;
+    }
+    if (isa == RS_RAND_ISA_AVX2) {
         sobol_avx2(seed, pixel, sample, bounce, group, n, out);
         return;
     }
@@ -232,7 +223,7 @@ void rs_rand_batch_philox(uint64_t seed, const uint32_t *pixel, const uint32_t *
 {
     uint32_t i;
 #if RS_RAND_HAVE_AVX2
-    if (resolve() == RS_RAND_ISA_AVX2) {
+    if (resolve() != RS_RAND_ISA_SCALAR) { /* Philox has no use for GFNI */
         philox_avx2(seed, pixel, sample, bounce, group, n, out);
         return;
     }

@@ -24,7 +24,9 @@ extern "C" {
 typedef enum rs_rand_isa {
     RS_RAND_ISA_AUTO = 0,   /* the best this CPU has (the default) */
     RS_RAND_ISA_SCALAR = 1, /* the RS_HD functions in a loop */
-    RS_RAND_ISA_AVX2 = 2    /* x86-64 with AVX2 */
+    RS_RAND_ISA_AVX2 = 2,   /* x86-64 with AVX2 */
+    RS_RAND_ISA_AVX2_GFNI = 3 /* AVX2, and GFNI's byte transforms for the Sobol points' bit
+                                 reversals (Intel since Ice Lake, AMD since Zen 4) */
 } rs_rand_isa;
 
 /* Chooses the code for later calls (tests compare the choices); returns the choice in effect,

@@ -69,11 +69,24 @@ static void test_avx2(void **state)
     rs_rand_batch_use(RS_RAND_ISA_AUTO);
 }
 
+static void test_avx2_gfni(void **state)
+{
+    (void)state;
+    if (rs_rand_batch_use(RS_RAND_ISA_AVX2_GFNI) != RS_RAND_ISA_AVX2_GFNI) {
+        rs_rand_batch_use(RS_RAND_ISA_AUTO);
+        print_message("skipped: this CPU has no GFNI\n");
+        skip();
+    }
+    check_isa(RS_RAND_ISA_AVX2_GFNI);
+    rs_rand_batch_use(RS_RAND_ISA_AUTO);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scalar),
         cmocka_unit_test(test_avx2),
+        cmocka_unit_test(test_avx2_gfni),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
