@@ -91,8 +91,8 @@ static int stage_resolve_shadows(rs_run *c, rs_slot *sl, rs_status *status)
     return 0;
 }
 
-/* The surviving paths' next rays, in slot order, become the current stream: the shade stage
- * wrote them in runs into the other buffer, packed here in place.  Empty: no path alive. */
+/* The surviving paths' next rays become the current stream: the shade stage wrote them in runs
+ * into the other buffer, packed here in place.  Empty: no path alive. */
 static int stage_compact(rs_run *c, rs_slot *sl, rs_status *status)
 {
     rs_wave_buffers *b = &sl->b;

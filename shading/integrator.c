@@ -190,8 +190,9 @@ RS_HD_HOT void prefetch_hits(const rs_scene *sc, const uint32_t *prim, uint32_t 
     }
 }
 
-/* Shades the entries [begin, end) in order; their next rays go packed to next[begin ...] and
- * their shadow rays to shadow[begin ...], the counts to the range's run record. */
+/* Shades the entries [begin, end); their next rays go packed to next[begin ...] and their shadow
+ * rays to shadow[begin ...] (each batch's eight-lane entries first), the counts to the range's
+ * run record. */
 static void shade_range(void *ctx, uint32_t begin, uint32_t end)
 {
     const shade_ctx *c = (const shade_ctx *)ctx;

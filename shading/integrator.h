@@ -64,9 +64,11 @@ void rs_stage_raygen(const rs_render_consts *it, const rs_path_map *map, const r
 /* Shades the hits of `rays` (segment number `bounce`): each path may make its next ray and a
  * shadow ray (its contribution in paths->pending).  The stream is split into ranges (by the
  * strategy); each range writes its next rays packed from its first slot in `next` and its
- * shadow rays likewise in `shadow`, in slot order, and records the counts in `runs`
- * (first: next rays, second: shadow rays); rs_stream_pack_runs then packs each stream (the
- * valid entries in slot order, whatever the split). */
+ * shadow rays likewise in `shadow` (within each batch of 64 entries those the eight-lane code
+ * shades first, then the others in slot order: the order of a stream's rays changes no answer,
+ * only which rays walk the tree together), and records the counts in `runs` (first: next rays,
+ * second: shadow rays); rs_stream_pack_runs then packs each stream (the ranges' rays in range
+ * order, whatever the split). */
 void rs_stage_shade(const rs_render_consts *it, const rs_path_map *map, const rs_stage_exec *ex,
                     uint64_t wave_start, uint32_t bounce, const rs_ray_soa *rays,
                     const rs_hit_soa *hits, uint32_t count, rs_paths *paths, rs_ray_soa *next,

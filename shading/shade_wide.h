@@ -9,8 +9,9 @@
  * and on the same operands, so each lane rounds exactly as the scalar code does and the image is
  * the scalar shading's bit for bit (tests/shading_wide_test.c compares every output of every
  * entry).  Whatever else a wave holds (misses, emitters, other materials, spheres, instances,
- * textures) is shaded by rs_path_shade_at as before; the stage (shading/integrator.c) keeps the
- * rays in slot order whichever code made them.
+ * textures) is shaded by rs_path_shade_at as before; the stage (shading/integrator.c) writes
+ * each batch's rays from this code first, straight into the streams, then the others' (a ray's
+ * place in a stream changes no answer).
  *
  * Host only: the CUDA device and the megakernels shade with rs_path_shade_at. */
 #ifndef RS_SHADING_SHADE_WIDE_H

@@ -5,7 +5,7 @@
  *
  * Scenes chosen to reach each branch: the Cornell box (parallelograms, one light, roulette),
  * its glass twin (a sphere and a glass material between the walls: lanes of a batch shaded by
- * either code, rays kept in slot order), and a scene built here: tilted vertex normals on a
+ * either code, their rays written to the streams in either order), and a scene built here: tilted vertex normals on a
  * curved triangle mesh (shading normals not along any axis, some facing away from the ray), a
  * one-sided triangle light and a two-sided parallelogram light (picked by power: the CDF), with
  * and without a uniform sky (light sampling's sky branch, the sky's pdf kept for MIS).  Each in
