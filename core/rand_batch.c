@@ -121,6 +121,38 @@ AVX2 static inline void store_f4x8(__m256 a, __m256 b, __m256 c, __m256 d, rs_rn
     _mm256_storeu_ps(o + 24, _mm256_permute2f128_ps(u2, u3, 0x31));
 }
 
+/* Lanes i .. i + 7 of pixel[] and sample[] as vectors; where fewer than eight are left (n - i)
+ * the missing lanes read zero. */
+AVX2 static inline void load_lanes8(const uint32_t *pixel, const uint32_t *sample, uint32_t i,
+                                    uint32_t n, __m256i *pix, __m256i *smp)
+{
+    uint32_t p[8], s[8], left = n - i;
+    if (left >= 8) {
+        *pix = _mm256_loadu_si256((const __m256i *)(pixel + i));
+        *smp = _mm256_loadu_si256((const __m256i *)(sample + i));
+        return;
+    }
+    memset(p, 0, sizeof p);
+    memset(s, 0, sizeof s);
+    memcpy(p, pixel + i, left * sizeof *p);
+    memcpy(s, sample + i, left * sizeof *s);
+    *pix = _mm256_loadu_si256((const __m256i *)p);
+    *smp = _mm256_loadu_si256((const __m256i *)s);
+}
+
+/* Eight lanes' four numbers (store_f4x8) into out[i ..], only the n - i entries that exist. */
+AVX2 static inline void store_lanes8(__m256 a, __m256 b, __m256 c, __m256 d, rs_rng_f4 *out,
+                                     uint32_t i, uint32_t n)
+{
+    rs_rng_f4 tail[8];
+    if (n - i >= 8) {
+        store_f4x8(a, b, c, d, out + i);
+        return;
+    }
+    store_f4x8(a, b, c, d, tail);
+    memcpy(out + i, tail, (n - i) * sizeof *tail);
+}
+
 /* rs_reverse_bits with GFNI: each byte's bits reversed by one affine transform over GF(2) (the
  * anti-diagonal bit matrix), then the bytes of each word reversed */
 #  define GFNI __attribute__((target("avx2,gfni")))
@@ -156,28 +188,12 @@ AVX2 static void philox_avx2(uint64_t seed, const uint32_t *pixel, const uint32_
                              uint32_t bounce, uint32_t group, uint32_t n, rs_rng_f4 *out)
 {
     const __m256i m0 = k8(0xD2511F53u), m1 = k8(0xCD9E8D57u);
-    uint32_t i = 0;
-    for (;; i += 8) {
-        uint32_t pix[8], smp[8];
-        rs_rng_f4 tail[8];
-        const uint32_t *pp = pixel + i, *sp = sample + i;
-        uint32_t left = n - i, k0 = (uint32_t)seed, k1 = (uint32_t)(seed >> 32);
-        __m256i c0, c1, c2, c3;
+    uint32_t i;
+    for (i = 0; i < n; i += 8) {
+        uint32_t k0 = (uint32_t)seed, k1 = (uint32_t)(seed >> 32);
+        __m256i c0, c1, c2 = k8(bounce), c3 = k8(group);
         int round;
-        if (i >= n)
-            break;
-        if (left < 8) {
-            memset(pix, 0, sizeof pix);
-            memset(smp, 0, sizeof smp);
-            memcpy(pix, pp, left * sizeof *pix);
-            memcpy(smp, sp, left * sizeof *smp);
-            pp = pix;
-            sp = smp;
-        }
-        c0 = _mm256_loadu_si256((const __m256i *)pp);
-        c1 = _mm256_loadu_si256((const __m256i *)sp);
-        c2 = k8(bounce);
-        c3 = k8(group);
+        load_lanes8(pixel, sample, i, n, &c0, &c1);
         for (round = 0; round < 10; ++round) { /* rs_philox4x32_10 */
             __m256i lo0, hi0, lo1, hi1;
             mulhilo8(m0, c0, &lo0, &hi0);
@@ -189,12 +205,7 @@ AVX2 static void philox_avx2(uint64_t seed, const uint32_t *pixel, const uint32_
             k0 += 0x9E3779B9u;
             k1 += 0xBB67AE85u;
         }
-        if (left < 8) {
-            store_f4x8(tofloat8(c0), tofloat8(c1), tofloat8(c2), tofloat8(c3), tail);
-            memcpy(out + i, tail, left * sizeof *tail);
-            break;
-        }
-        store_f4x8(tofloat8(c0), tofloat8(c1), tofloat8(c2), tofloat8(c3), out + i);
+        store_lanes8(tofloat8(c0), tofloat8(c1), tofloat8(c2), tofloat8(c3), out, i, n);
     }
 }
 #endif

@@ -4,8 +4,8 @@
  *   RS_SOBOL8_ATTR      the functions' target attribute
  *   RS_SOBOL8_FN(x)     their names (prefix ## x)
  *   RS_SOBOL8_REV(x)    rs_reverse_bits on eight lanes
- * and it undefines them.  The helpers it calls (hash8, lk8, superset8, tofloat8, store_f4x8)
- * are rand_batch.c's, compiled for AVX2, which either target includes. */
+ * and it undefines them.  The helpers it calls (hash8, lk8, superset8, tofloat8, load_lanes8,
+ * store_lanes8) are rand_batch.c's, compiled for AVX2, which either target includes. */
 
 /* rs_sobol2 on eight lanes; rsample = rs_reverse_bits(sample) */
 RS_SOBOL8_ATTR static inline void RS_SOBOL8_FN(sobol2x8)(__m256i seed, __m256i rsample, __m256 *x0,
@@ -23,37 +23,18 @@ RS_SOBOL8_ATTR static void RS_SOBOL8_FN(sobol)(uint64_t seed, const uint32_t *pi
 {
     const __m256i lo = k8((uint32_t)seed), hi = k8((uint32_t)(seed >> 32));
     const __m256i hb = k8(rs_hash_u32(bounce * 8u + group));
-    uint32_t i = 0;
-    for (;; i += 8) {
-        uint32_t pix[8], smp[8];
-        rs_rng_f4 tail[8];
-        const uint32_t *pp = pixel + i, *sp = sample + i;
-        uint32_t left = n - i;
+    uint32_t i;
+    for (i = 0; i < n; i += 8) {
         __m256i s, rs;
         __m256 a, b, c, d;
-        if (i >= n)
-            break;
-        if (left < 8) {
-            memset(pix, 0, sizeof pix);
-            memset(smp, 0, sizeof smp);
-            memcpy(pix, pp, left * sizeof *pix);
-            memcpy(smp, sp, left * sizeof *smp);
-            pp = pix;
-            sp = smp;
-        }
-        s = _mm256_loadu_si256((const __m256i *)pp);
+        load_lanes8(pixel, sample, i, n, &s, &rs);
         s = hash8(_mm256_xor_si256(s, hb));
         s = hash8(_mm256_xor_si256(hi, s));
         s = hash8(_mm256_xor_si256(lo, s));
-        rs = RS_SOBOL8_REV(_mm256_loadu_si256((const __m256i *)sp));
+        rs = RS_SOBOL8_REV(rs);
         RS_SOBOL8_FN(sobol2x8)(hash8(_mm256_xor_si256(s, k8(0x5bd1e995u))), rs, &a, &b);
         RS_SOBOL8_FN(sobol2x8)(hash8(_mm256_xor_si256(s, k8(0x27d4eb2fu))), rs, &c, &d);
-        if (left < 8) {
-            store_f4x8(a, b, c, d, tail);
-            memcpy(out + i, tail, left * sizeof *tail);
-            break;
-        }
-        store_f4x8(a, b, c, d, out + i);
+        store_lanes8(a, b, c, d, out, i, n);
     }
 }
 

@@ -495,32 +495,20 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     for (i = 0; i < count; ++i) {
         uint32_t p = path_[i], j = entry[i];
         float time = rays->time[j];
+        rs_ray r;
+        r.o = rs_v3(out_o[0][i], out_o[1][i], out_o[2][i]);
+        r.tmin = 0.0f;
+        r.time = time;
         if (shadow_ok[i]) {
-            uint32_t k = (*os)++;
             paths->pending[p] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
-            shadow->ox[k] = out_o[0][i];
-            shadow->oy[k] = out_o[1][i];
-            shadow->oz[k] = out_o[2][i];
-            shadow->dx[k] = sh_d[0][i];
-            shadow->dy[k] = sh_d[1][i];
-            shadow->dz[k] = sh_d[2][i];
-            shadow->tmin[k] = 0.0f;
-            shadow->tmax[k] = sh_env[i] ? FLT_MAX : 1.0f - RS_SHADOW_EPS;
-            shadow->time[k] = time;
-            shadow->path[k] = p;
+            r.d = rs_v3(sh_d[0][i], sh_d[1][i], sh_d[2][i]);
+            r.tmax = sh_env[i] ? FLT_MAX : 1.0f - RS_SHADOW_EPS;
+            rs_ray_soa_set(shadow, (*os)++, &r, p);
         }
         if (next_ok[i]) {
-            uint32_t k = (*on)++;
-            next->ox[k] = out_o[0][i];
-            next->oy[k] = out_o[1][i];
-            next->oz[k] = out_o[2][i];
-            next->dx[k] = out_d[0][i];
-            next->dy[k] = out_d[1][i];
-            next->dz[k] = out_d[2][i];
-            next->tmin[k] = 0.0f;
-            next->tmax[k] = FLT_MAX;
-            next->time[k] = time;
-            next->path[k] = p;
+            r.d = rs_v3(out_d[0][i], out_d[1][i], out_d[2][i]);
+            r.tmax = FLT_MAX;
+            rs_ray_soa_set(next, (*on)++, &r, p);
             paths->throughput[p] = rs_v3(beta_[0][i], beta_[1][i], beta_[2][i]);
             paths->bsdf_pdf[p] = pdf_[i];
             paths->env_pdf[p] = envpdf_[i];
