@@ -598,23 +598,28 @@ static uint32_t pk8_occluded(const rs_bvh8 *b, const rs_geom *g, pk8 *p, uint32_
     return done;
 }
 
+/* Eight lanes of one stream field from f (entries i .. i + n - 1 of it): lanes n .. 7 copies of
+ * lane 0. */
+static inline __m256 pk8_field(const float *f, uint32_t n)
+{
+    float x[8];
+    uint32_t l;
+    if (n == 8)
+        return _mm256_loadu_ps(f);
+    for (l = 0; l < 8; ++l)
+        x[l] = f[l < n ? l : 0];
+    return _mm256_loadu_ps(x);
+}
+
 /* Rays i .. i + n - 1 of the stream as eight lanes: v[0..2] the origins, v[3..5] the directions,
- * v[6] tmin; lanes n .. 7 copies of lane 0. */
+ * v[6] tmin (pk8_field). */
 static inline void pk8_load(const rs_ray_soa *r, uint32_t i, uint32_t n, __m256 v[7])
 {
     const float *f[7] = {r->ox + i, r->oy + i, r->oz + i, r->dx + i, r->dy + i, r->dz + i,
                          r->tmin + i};
-    uint32_t k, l;
-    for (k = 0; k < 7; ++k) {
-        float x[8];
-        if (n == 8) {
-            v[k] = _mm256_loadu_ps(f[k]);
-            continue;
-        }
-        for (l = 0; l < 8; ++l)
-            x[l] = f[k][l < n ? l : 0];
-        v[k] = _mm256_loadu_ps(x);
-    }
+    uint32_t k;
+    for (k = 0; k < 7; ++k)
+        v[k] = pk8_field(f[k], n);
 }
 
 void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *batch,
@@ -707,12 +712,11 @@ void rs_bvh8_trace(const rs_bvh8 *b, const rs_geom *g, const rs_trace_batch *bat
          * vector division rounds as the scalar one): three scalar divisions a ray were a
          * tenth of the packet walk's setup */
         uint32_t n = end - i < 8 ? end - i : 8;
+        const __m256 one = _mm256_set1_ps(1.0f);
         float iv[3][8];
-        __m256 v[7];
-        pk8_load(&batch->rays, i, n, v);
-        _mm256_storeu_ps(iv[0], _mm256_div_ps(_mm256_set1_ps(1.0f), v[3]));
-        _mm256_storeu_ps(iv[1], _mm256_div_ps(_mm256_set1_ps(1.0f), v[4]));
-        _mm256_storeu_ps(iv[2], _mm256_div_ps(_mm256_set1_ps(1.0f), v[5]));
+        _mm256_storeu_ps(iv[0], _mm256_div_ps(one, pk8_field(batch->rays.dx + i, n)));
+        _mm256_storeu_ps(iv[1], _mm256_div_ps(one, pk8_field(batch->rays.dy + i, n)));
+        _mm256_storeu_ps(iv[2], _mm256_div_ps(one, pk8_field(batch->rays.dz + i, n)));
         for (l = 0; l < n; ++l) {
             rs_ray r = rs_ray_soa_get(&batch->rays, i + l);
             ray8 r8;
