@@ -202,7 +202,7 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
     for (b = begin; b < end; b += BATCH) {
         uint32_t n = end - b < BATCH ? end - b : BATCH;
         uint32_t pixel[BATCH], sample[BATCH], wide_j[BATCH], nw = 0;
-        rs_rng_f4 rb[BATCH], rl[BATCH], pre[2], wide_rb[BATCH], wide_rl[BATCH];
+        rs_rng_f4 rb[BATCH], rl[BATCH], pre[2];
         uint8_t wide[BATCH];
         locate(c->map, c->wave_start, c->rays->path + b, 0, n, pixel, sample);
         if (c->prefetch)
@@ -218,15 +218,11 @@ static void shade_range(void *ctx, uint32_t begin, uint32_t end)
              * the streams (the order of a stream's rays changes no answer), the rest below */
             for (k = 0; k < n; ++k) {
                 wide[k] = (uint8_t)rs_shade_wide_entry(c->it->scene, c->hits->prim[b + k]);
-                if (wide[k]) {
-                    wide_j[nw] = b + k;
-                    wide_rb[nw] = rb[k];
-                    wide_rl[nw] = rl[k];
-                    nw++;
-                }
+                if (wide[k])
+                    wide_j[nw++] = b + k;
             }
-            rs_shade_wide(c->it, c->bounce, c->rays, c->hits, wide_j, nw, wide_rb, wide_rl,
-                          c->paths, c->next, &on, c->shadow, &os);
+            rs_shade_wide(c->it, c->bounce, c->rays, c->hits, wide_j, nw, rb, rl, b, c->paths,
+                          c->next, &on, c->shadow, &os);
         }
         for (k = 0; k < n; ++k) {
             /* entry j: path p's state loaded from the SoA, shaded, stored back (rs_path_shade_at

@@ -314,89 +314,197 @@ WIDE void prim_point(const lane_prims *lp, f8 s, f8 t, v3 *p, v3 *err, v3 *ng)
     surface_point(quad, o, a, b, w, s, t, p, err, ng);
 }
 
-/* Up to eight entries: rs_path_shade_at's path through a Lambertian vertex. */
+/* Gathers (AVX2): lane i of the result is f[idx[i]]. */
+WIDE f8 gatherf(const float *f, i8 idx) { return (f8)_mm256_i32gather_ps(f, (__m256i)idx, 4); }
+WIDE u8 gatheru(const uint32_t *f, i8 idx)
+{
+    return (u8)_mm256_i32gather_epi32((const int *)(const void *)f, (__m256i)idx, 4);
+}
+/* Vectors stored `stride` floats apart, number idx[i] in lane i. */
+WIDE v3 gather3(const float *base, i8 idx, int32_t stride)
+{
+    i8 k = idx * stride;
+    v3 r = {gatherf(base, k), gatherf(base + 1, k), gatherf(base + 2, k)};
+    return r;
+}
+/* A stream field at the lanes' entries j: one load where they are eight in a row (run). */
+WIDE f8 field8(const float *f, i8 j, int run) { return run ? load8(f + j[0]) : gatherf(f, j); }
+WIDE u8 ufield8(const uint32_t *f, i8 j, int run)
+{
+    return run ? (u8)_mm256_loadu_si256((const __m256i *)(const void *)(f + j[0])) : gatheru(f, j);
+}
+
+/* Four numbers each of eight lanes, r[k[i]] in lane i: eight 16-byte loads, one 4x8 transpose. */
+WIDE void rng8(const rs_rng_f4 *r, const uint32_t k[8], f8 out[4])
+{
+    __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[0]].v)),
+                                     _mm_loadu_ps(r[k[4]].v), 1);
+    __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[1]].v)),
+                                     _mm_loadu_ps(r[k[5]].v), 1);
+    __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[2]].v)),
+                                     _mm_loadu_ps(r[k[6]].v), 1);
+    __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[3]].v)),
+                                     _mm_loadu_ps(r[k[7]].v), 1);
+    __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
+    __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
+    out[0] = (f8)_mm256_shuffle_ps(t0, t1, 0x44);
+    out[1] = (f8)_mm256_shuffle_ps(t0, t1, 0xee);
+    out[2] = (f8)_mm256_shuffle_ps(t2, t3, 0x44);
+    out[3] = (f8)_mm256_shuffle_ps(t2, t3, 0xee);
+}
+
+WIDE int all8(u8 m) { return _mm256_movemask_ps((__m256)m) == 0xff; }
+WIDE int any8(u8 m) { return _mm256_movemask_ps((__m256)m) != 0; }
+
+/* Up to eight entries: rs_path_shade_at's path through a Lambertian vertex.  The lanes' data come
+ * in by vector loads where the entries are eight in a row, by gathers elsewhere, and the scene's
+ * primitives by gathers where the lanes' are all triangles or all parallelograms (one loop over
+ * the lanes for a mix); the rays go out by vector stores where all eight make one. */
 __attribute__((target("avx2"))) static void
 shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
        const uint32_t *entry, uint32_t count, const rs_rng_f4 *rb, const rs_rng_f4 *rl,
-       rs_paths *paths, rs_ray_soa *next, uint32_t *on, rs_ray_soa *shadow, uint32_t *os)
+       uint32_t rng_base, rs_paths *paths, rs_ray_soa *next, uint32_t *on, rs_ray_soa *shadow,
+       uint32_t *os)
 {
     const rs_scene *sc = it->scene;
     const int nee = rs_scene_has_lights(sc);
     const float env_pick = sc->env_pick;
+    const int32_t mat_stride = (int32_t)(sizeof(rs_material) / sizeof(float));
     lane_prims hp, lp;
-    float d_[3][8], thr_[3][8], alb_[3][8], vn_[9][8], hu_[8], hv_[8];
-    float rb_[4][8], rl_[3][8], pick_[8], area_[8], emi_[3][8];
-    uint32_t vn_on[8], env_[8], lok_[8], two_[8], path_[8];
-    float out_o[3][8], out_d[3][8], sh_d[3][8], pend_[3][8], beta_[3][8], pdf_[8], envpdf_[8];
-    uint32_t shadow_ok[8], next_ok[8], sh_env[8];
+    uint32_t env_[8], lok_[8], path_[8], k_[8], light_[8];
+    float pend_[3][8], beta_[3][8], pdf_[8], envpdf_[8], time_[8];
     uint32_t i, c;
-    v3 d, wo, x, err, ng, n_geo, n, origin, thr, alb, beta;
+    int run, one_light;
+    f8 rbv[4], rlv[4], hu, hv, timev, pickv, areav, sh_tmax;
+    u8 pathv, primv, quadv, lquad, twov, sh_okv, nx_okv;
+    i8 jv, pv;
+    v3 d, wo, x, err, ng, n_geo, n, origin, thr, alb, beta, po, pa, pb, pw, lo, la, lb, lw, emiv;
+    v3 sh_dv, pendv, nx_d;
     u8 front;
+    typedef char material_floats[sizeof(rs_material) % sizeof(float) == 0 ? 1 : -1];
+    (void)sizeof(material_floats);
 
     /* ---- gather ---- */
     for (i = 0; i < 8; ++i) {
-        uint32_t j = entry[i < count ? i : 0], prim = hits->prim[j], t;
-        const rs_material *m = rs_scene_prim_material(sc, prim);
-        uint32_t p = rays->path[j];
-        path_[i] = p;
-        d_[0][i] = rays->dx[j];
-        d_[1][i] = rays->dy[j];
-        d_[2][i] = rays->dz[j];
-        hu_[i] = hits->u[j];
-        hv_[i] = hits->v[j];
-        thr_[0][i] = paths->throughput[p].x;
-        thr_[1][i] = paths->throughput[p].y;
-        thr_[2][i] = paths->throughput[p].z;
-        alb_[0][i] = m->albedo.x;
-        alb_[1][i] = m->albedo.y;
-        alb_[2][i] = m->albedo.z;
-        for (c = 0; c < 4; ++c)
-            rb_[c][i] = rb[i < count ? i : 0].v[c];
-        for (c = 0; c < 3; ++c)
-            rl_[c][i] = rl[i < count ? i : 0].v[c];
-        gather_prim(sc, prim, &hp, (int)i);
-        /* rs_shading_normal: a triangle of the scene's own with vertex normals */
-        t = prim - sc->n_spheres - sc->n_quads;
-        vn_on[i] = 0u;
-        for (c = 0; c < 9; ++c)
-            vn_[c][i] = 0.0f;
-        if (prim >= sc->n_spheres + sc->n_quads && sc->tri_normal) {
-            vn_on[i] = 0xffffffffu;
-            for (c = 0; c < 9; ++c)
-                vn_[c][i] = sc->tri_normal[9 * (size_t)t + c];
-        }
+        uint32_t j = entry[i < count ? i : 0];
+        jv[i] = (int32_t)j;
+        k_[i] = j - rng_base;
     }
-    d = lane3(d_);
-    thr = lane3(thr_);
-    alb = lane3(alb_);
-    prim_point(&hp, load8(hu_), load8(hv_), &x, &err, &ng);
-    front = (u8)(dot3(ng, d) < 0.0f);
-    n_geo = sel3(front, ng, neg3(ng));
-    wo = neg3(d);
-    {
-        /* rs_shading_normal */
-        f8 hu = load8(hu_), hv = load8(hv_);
-        v3 n0 = {load8(vn_[0]), load8(vn_[1]), load8(vn_[2])};
-        v3 n1 = {load8(vn_[3]), load8(vn_[4]), load8(vn_[5])};
-        v3 n2 = {load8(vn_[6]), load8(vn_[7]), load8(vn_[8])};
-        v3 ns = add3(add3(scale3(n0, 1.0f - hu - hv), scale3(n1, hu)), scale3(n2, hv));
-        f8 len = len3(ns);
-        u8 ok = (u8)_mm256_loadu_si256((const __m256i *)vn_on) & (u8)(len > 1e-6f);
-        ns = scale3(ns, 1.0f / len);
-        ns = sel3((u8)(dot3(ns, n_geo) < 0.0f), neg3(ns), ns);
-        n = sel3(ok & (u8)(dot3(ns, wo) > 0.0f), ns, n_geo);
+    run = count == 8 && entry[7] - entry[0] == 7u; /* entries rise: eight in a row */
+    d.x = field8(rays->dx, jv, run);
+    d.y = field8(rays->dy, jv, run);
+    d.z = field8(rays->dz, jv, run);
+    timev = field8(rays->time, jv, run);
+    hu = field8(hits->u, jv, run);
+    hv = field8(hits->v, jv, run);
+    pathv = ufield8(rays->path, jv, run);
+    primv = ufield8(hits->prim, jv, run);
+    rng8(rb, k_, rbv);
+    rng8(rl, k_, rlv);
+    _mm256_storeu_si256((__m256i *)path_, (__m256i)pathv);
+    store8(time_, timev);
+    thr = gather3(&paths->throughput[0].x, (i8)pathv, 3);
+    pv = (i8)(primv - usplat(sc->n_spheres)); /* wide entries: never a sphere */
+    quadv = (u8)(pv < (i8)usplat(sc->n_quads));
+    if (!any8(quadv)) {
+        /* all triangles: corners, material numbers and vertex normals gathered */
+        i8 t = pv - (i8)usplat(sc->n_quads);
+        const float *tf = &sc->tris[0].v0.x;
+        v3 v1 = gather3(tf + 3, t, 9), v2 = gather3(tf + 6, t, 9);
+        po = gather3(tf, t, 9);
+        pa = sub3(v1, po);
+        pb = sub3(v2, po);
+        pw = cross3(pa, pb);
+        alb = gather3(&sc->materials[0].albedo.x, (i8)gatheru(sc->tri_mat, t), mat_stride);
+        if (sc->tri_normal) {
+            /* rs_shading_normal: a triangle of the scene's own with vertex normals */
+            v3 n0 = gather3(sc->tri_normal, t, 9), n1 = gather3(sc->tri_normal + 3, t, 9);
+            v3 n2 = gather3(sc->tri_normal + 6, t, 9);
+            {
+                v3 ns = add3(add3(scale3(n0, 1.0f - hu - hv), scale3(n1, hu)), scale3(n2, hv));
+                f8 len = len3(ns);
+                u8 ok = (u8)(len > 1e-6f);
+                surface_point(usplat(0u), po, pa, pb, pw, hu, hv, &x, &err, &ng);
+                front = (u8)(dot3(ng, d) < 0.0f);
+                n_geo = sel3(front, ng, neg3(ng));
+                wo = neg3(d);
+                ns = scale3(ns, 1.0f / len);
+                ns = sel3((u8)(dot3(ns, n_geo) < 0.0f), neg3(ns), ns);
+                n = sel3(ok & (u8)(dot3(ns, wo) > 0.0f), ns, n_geo);
+            }
+        } else {
+            surface_point(usplat(0u), po, pa, pb, pw, hu, hv, &x, &err, &ng);
+            front = (u8)(dot3(ng, d) < 0.0f);
+            n_geo = sel3(front, ng, neg3(ng));
+            wo = neg3(d);
+            n = n_geo;
+        }
+    } else if (all8(quadv)) {
+        /* all parallelograms: no vertex normals */
+        const float *qf = &sc->quads[0].q.x;
+        po = gather3(qf, pv, 12);
+        pa = gather3(qf + 3, pv, 12);
+        pb = gather3(qf + 6, pv, 12);
+        pw = gather3(qf + 9, pv, 12);
+        alb = gather3(&sc->materials[0].albedo.x, (i8)gatheru(sc->quad_mat, pv), mat_stride);
+        surface_point(quadv, po, pa, pb, pw, hu, hv, &x, &err, &ng);
+        front = (u8)(dot3(ng, d) < 0.0f);
+        n_geo = sel3(front, ng, neg3(ng));
+        wo = neg3(d);
+        n = n_geo;
+    } else {
+        /* a mix: one lane at a time */
+        float alb_[3][8], vn_[9][8];
+        uint32_t vn_on[8], any_vn = 0;
+        for (i = 0; i < 8; ++i) {
+            uint32_t prim = primv[i], t;
+            const rs_material *m = rs_scene_prim_material(sc, prim);
+            alb_[0][i] = m->albedo.x;
+            alb_[1][i] = m->albedo.y;
+            alb_[2][i] = m->albedo.z;
+            gather_prim(sc, prim, &hp, (int)i);
+            /* rs_shading_normal: a triangle of the scene's own with vertex normals */
+            t = prim - sc->n_spheres - sc->n_quads;
+            vn_on[i] = 0u;
+            for (c = 0; c < 9; ++c)
+                vn_[c][i] = 0.0f;
+            if (prim >= sc->n_spheres + sc->n_quads && sc->tri_normal) {
+                vn_on[i] = 0xffffffffu;
+                any_vn = 1;
+                for (c = 0; c < 9; ++c)
+                    vn_[c][i] = sc->tri_normal[9 * (size_t)t + c];
+            }
+        }
+        alb = lane3(alb_);
+        prim_point(&hp, hu, hv, &x, &err, &ng);
+        front = (u8)(dot3(ng, d) < 0.0f);
+        n_geo = sel3(front, ng, neg3(ng));
+        wo = neg3(d);
+        n = n_geo;
+        if (any_vn) {
+            /* rs_shading_normal */
+            v3 n0 = {load8(vn_[0]), load8(vn_[1]), load8(vn_[2])};
+            v3 n1 = {load8(vn_[3]), load8(vn_[4]), load8(vn_[5])};
+            v3 n2 = {load8(vn_[6]), load8(vn_[7]), load8(vn_[8])};
+            v3 ns = add3(add3(scale3(n0, 1.0f - hu - hv), scale3(n1, hu)), scale3(n2, hv));
+            f8 len = len3(ns);
+            u8 ok = (u8)_mm256_loadu_si256((const __m256i *)vn_on) & (u8)(len > 1e-6f);
+            ns = scale3(ns, 1.0f / len);
+            ns = sel3((u8)(dot3(ns, n_geo) < 0.0f), neg3(ns), ns);
+            n = sel3(ok & (u8)(dot3(ns, wo) > 0.0f), ns, n_geo);
+        }
     }
     origin = spawn_origin(x, err, n_geo);
     beta = thr;
 
     /* ---- next-event estimation: rs_shade_next_event, rs_light_sample_from ---- */
+    one_light = 1; /* every lane that samples a light samples the same one (light_[0] after) */
+    light_[0] = RS_NO_HIT;
     for (i = 0; i < 8; ++i) {
-        float u = rl_[0][i];
+        float u = rlv[0][i];
         env_[i] = 0u;
         lok_[i] = nee ? 0xffffffffu : 0u;
-        pick_[i] = area_[i] = 1.0f;
-        two_[i] = 0u;
-        emi_[0][i] = emi_[1][i] = emi_[2][i] = 0.0f;
+        light_[i] = RS_NO_HIT;
         if (nee && env_pick > 0.0f) {
             if (u < env_pick)
                 env_[i] = 0xffffffffu;
@@ -406,35 +514,80 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
         if (nee && !env_[i] && sc->n_lights == 0)
             lok_[i] = 0u;
         if (lok_[i] && !env_[i]) {
-            uint32_t l = rs_light_pick_n(sc, u, sc->n_lights), prim = sc->lights[l].prim;
-            const rs_material *lm = rs_scene_prim_material(sc, prim);
-            pick_[i] = sc->lights[l].pick_pdf;
-            area_[i] = sc->lights[l].area;
-            two_[i] = (lm->flags & RS_MAT_TWO_SIDED) ? 0xffffffffu : 0u;
-            emi_[0][i] = lm->emission.x;
-            emi_[1][i] = lm->emission.y;
-            emi_[2][i] = lm->emission.z;
-            gather_prim(sc, prim, &lp, (int)i);
-        } else {
-            gather_prim(sc, hits->prim[entry[0]], &lp, (int)i); /* a valid primitive, unused */
+            light_[i] = sc->n_lights == 1 ? 0u : rs_light_pick_n(sc, u, sc->n_lights);
+            if (light_[0] == RS_NO_HIT)
+                light_[0] = light_[i];
+            one_light &= light_[i] == light_[0];
         }
+    }
+    /* The lights' data, lanes without one (the sky, or no light) given any primitive: nothing
+     * of theirs is kept.  One light for all: its data once, splat into every lane. */
+    if (one_light) {
+        uint32_t prim = light_[0] != RS_NO_HIT ? sc->lights[light_[0]].prim : primv[0];
+        const rs_material *lm = rs_scene_prim_material(sc, prim);
+        gather_prim(sc, prim, &lp, 0);
+        lquad = usplat(lp.quad[0]);
+        lo = splat3(rs_v3(lp.o[0][0], lp.o[1][0], lp.o[2][0]));
+        la = splat3(rs_v3(lp.a[0][0], lp.a[1][0], lp.a[2][0]));
+        lb = splat3(rs_v3(lp.b[0][0], lp.b[1][0], lp.b[2][0]));
+        lw = splat3(rs_v3(lp.w[0][0], lp.w[1][0], lp.w[2][0]));
+        if (light_[0] != RS_NO_HIT) {
+            pickv = splat(sc->lights[light_[0]].pick_pdf);
+            areav = splat(sc->lights[light_[0]].area);
+            twov = usplat((lm->flags & RS_MAT_TWO_SIDED) ? 0xffffffffu : 0u);
+            emiv = splat3(lm->emission);
+        } else {
+            pickv = areav = splat(1.0f);
+            twov = usplat(0u);
+            emiv = splat3(rs_v3(0.0f, 0.0f, 0.0f));
+        }
+    } else {
+        float pick_[8], area_[8], emi_[3][8];
+        uint32_t two_[8];
+        for (i = 0; i < 8; ++i) {
+            uint32_t l = light_[i];
+            pick_[i] = area_[i] = 1.0f;
+            two_[i] = 0u;
+            emi_[0][i] = emi_[1][i] = emi_[2][i] = 0.0f;
+            if (l != RS_NO_HIT) {
+                uint32_t prim = sc->lights[l].prim;
+                const rs_material *lm = rs_scene_prim_material(sc, prim);
+                pick_[i] = sc->lights[l].pick_pdf;
+                area_[i] = sc->lights[l].area;
+                two_[i] = (lm->flags & RS_MAT_TWO_SIDED) ? 0xffffffffu : 0u;
+                emi_[0][i] = lm->emission.x;
+                emi_[1][i] = lm->emission.y;
+                emi_[2][i] = lm->emission.z;
+                gather_prim(sc, prim, &lp, (int)i);
+            } else {
+                gather_prim(sc, primv[0], &lp, (int)i); /* a valid primitive, unused */
+            }
+        }
+        lquad = (u8)_mm256_loadu_si256((const __m256i *)lp.quad);
+        lo = lane3(lp.o);
+        la = lane3(lp.a);
+        lb = lane3(lp.b);
+        lw = lane3(lp.w);
+        pickv = load8(pick_);
+        areav = load8(area_);
+        twov = (u8)_mm256_loadu_si256((const __m256i *)two_);
+        emiv = lane3(emi_);
     }
     {
         u8 env = (u8)_mm256_loadu_si256((const __m256i *)env_);
         u8 ok = (u8)_mm256_loadu_si256((const __m256i *)lok_);
-        u8 quad = (u8)_mm256_loadu_si256((const __m256i *)lp.quad);
-        f8 u1 = load8(rl_[1]), u2 = load8(rl_[2]), su = vsqrt(u1), pdf, cos_l, d2, dist, c_, w;
+        f8 u1 = rlv[1], u2 = rlv[2], su = vsqrt(u1), pdf, cos_l, d2, dist, c_, w;
         v3 lpnt, lerr, ln, to, wi, le, fl, end, sd;
         /* the light's point: a parallelogram at (u1, u2), a triangle at rs_sample_triangle's */
-        prim_point(&lp, sel(quad, u1, su * (1.0f - u2)), sel(quad, u2, su * u2), &lpnt, &lerr, &ln);
+        surface_point(lquad, lo, la, lb, sel3(lquad, lw, cross3(la, lb)),
+                      sel(lquad, u1, su * (1.0f - u2)), sel(lquad, u2, su * u2), &lpnt, &lerr, &ln);
         to = sub3(lpnt, x);
         d2 = dot3(to, to);
         dist = vsqrt(d2);
         wi = scale3(to, 1.0f / dist);
         cos_l = vabs(dot3(ln, wi));
-        pdf = load8(pick_) * d2 / (load8(area_) * cos_l);
-        le = sel3((u8)_mm256_loadu_si256((const __m256i *)two_) | (u8)(dot3(ln, wi) < 0.0f),
-                  lane3(emi_), splat3(rs_v3(0.0f, 0.0f, 0.0f)));
+        pdf = pickv * d2 / (areav * cos_l);
+        le = sel3(twov | (u8)(dot3(ln, wi) < 0.0f), emiv, splat3(rs_v3(0.0f, 0.0f, 0.0f)));
         ok &= env | ((u8)(d2 > 0.0f) & (u8)(cos_l > 1e-7f));
         if (_mm256_movemask_ps((__m256)env)) {
             /* rs_light_sample_env -> rs_env_sample_at, a uniform sky about n */
@@ -453,19 +606,20 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
                   splat3(rs_v3(0.0f, 0.0f, 0.0f)));
         ok &= ~zero3(fl);
         w = power_heuristic(pdf, lambert_pdf(c_, dot3(n, wo)));
-        store3(pend_, scale3(mul3(mul3(beta, fl), le), vabs(c_) * w / pdf));
+        pendv = scale3(mul3(mul3(beta, fl), le), vabs(c_) * w / pdf);
+        store3(pend_, pendv);
         /* rs_spawn_end toward the origin */
         end =
             spawn_origin(lpnt, lerr, sel3((u8)(dot3(ln, sub3(origin, lpnt)) < 0.0f), neg3(ln), ln));
         sd = sel3(env, wi, sub3(end, origin));
-        store3(sh_d, sd);
-        _mm256_storeu_si256((__m256i *)shadow_ok, (__m256i)ok);
-        _mm256_storeu_si256((__m256i *)sh_env, (__m256i)env);
+        sh_dv = sd;
+        sh_okv = ok;
+        sh_tmax = sel(env, splat(FLT_MAX), splat(1.0f - RS_SHADOW_EPS));
     }
 
     /* ---- the next direction: rs_shade_direction -> rs_bsdf_sample, then roulette ---- */
     {
-        v3 wi = onb_to_world(n, cosine_hemisphere(load8(rb_[0]), load8(rb_[1])));
+        v3 wi = onb_to_world(n, cosine_hemisphere(rbv[0], rbv[1]));
         f8 ci = dot3(n, wi), co = dot3(n, wo), pdf = lambert_pdf(ci, co);
         u8 ok = (u8)(ci > 0.0f) & (u8)(pdf > 0.0f);
         v3 f = sel3((u8)(ci > 0.0f) & (u8)(co > 0.0f), scale3(alb, splat(RS_INV_PI)),
@@ -476,38 +630,92 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
         if (bounce + 1 >= it->rr_depth) {
             /* rs_roulette_survival */
             f8 q = vmin(vmax(maxc3(mul3(thr, alb)), splat(0.05f)), splat(0.95f));
-            ok &= (u8)(load8(rb_[3]) < q);
+            ok &= (u8)(rbv[3] < q);
             beta = scale3(beta, 1.0f / q);
         }
         ok &= ~zero3(beta) & (u8)(maxc3(beta) > 0.0f);
-        store3(out_d, wi);
-        store3(out_o, origin);
+        nx_d = wi;
+        nx_okv = ok;
         store3(beta_, beta);
         store8(pdf_, pdf);
-        _mm256_storeu_si256((__m256i *)next_ok, (__m256i)ok);
         if (sc->env_uniform) /* rs_env_pdf_at about n, times the sky's pick */
             store8(envpdf_, env_pick * (vmax(splat(0.0f), dot3(n, wi) / len3(wi)) * RS_INV_PI));
         else
             store8(envpdf_, splat(0.0f));
     }
 
-    /* ---- scatter: the rays straight into the streams ---- */
-    for (i = 0; i < count; ++i) {
-        uint32_t p = path_[i], j = entry[i];
-        float time = rays->time[j];
-        rs_ray r;
-        r.o = rs_v3(out_o[0][i], out_o[1][i], out_o[2][i]);
-        r.tmin = 0.0f;
-        r.time = time;
-        if (shadow_ok[i]) {
-            paths->pending[p] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
-            r.d = rs_v3(sh_d[0][i], sh_d[1][i], sh_d[2][i]);
-            r.tmax = sh_env[i] ? FLT_MAX : 1.0f - RS_SHADOW_EPS;
-            rs_ray_soa_set(shadow, (*os)++, &r, p);
+    /* ---- scatter: the rays straight into the streams (eight at once where all make one) ---- */
+    if (count == 8 && all8(sh_okv)) {
+        uint32_t k = *os;
+        store8(shadow->ox + k, origin.x);
+        store8(shadow->oy + k, origin.y);
+        store8(shadow->oz + k, origin.z);
+        store8(shadow->dx + k, sh_dv.x);
+        store8(shadow->dy + k, sh_dv.y);
+        store8(shadow->dz + k, sh_dv.z);
+        store8(shadow->tmin + k, splat(0.0f));
+        store8(shadow->tmax + k, sh_tmax);
+        store8(shadow->time + k, timev);
+        _mm256_storeu_si256((__m256i *)(void *)(shadow->path + k), (__m256i)pathv);
+        *os = k + 8;
+        for (i = 0; i < 8; ++i)
+            paths->pending[path_[i]] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
+    } else if (any8(sh_okv)) {
+        float o_[3][8], d_[3][8], tmax_[8];
+        uint32_t ok_[8];
+        store3(o_, origin);
+        store3(d_, sh_dv);
+        store8(tmax_, sh_tmax);
+        _mm256_storeu_si256((__m256i *)ok_, (__m256i)sh_okv);
+        for (i = 0; i < count; ++i) {
+            rs_ray r;
+            if (!ok_[i])
+                continue;
+            r.o = rs_v3(o_[0][i], o_[1][i], o_[2][i]);
+            r.d = rs_v3(d_[0][i], d_[1][i], d_[2][i]);
+            r.tmin = 0.0f;
+            r.tmax = tmax_[i];
+            r.time = time_[i];
+            paths->pending[path_[i]] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
+            rs_ray_soa_set(shadow, (*os)++, &r, path_[i]);
         }
-        if (next_ok[i]) {
-            r.d = rs_v3(out_d[0][i], out_d[1][i], out_d[2][i]);
+    }
+    if (count == 8 && all8(nx_okv)) {
+        uint32_t k = *on;
+        store8(next->ox + k, origin.x);
+        store8(next->oy + k, origin.y);
+        store8(next->oz + k, origin.z);
+        store8(next->dx + k, nx_d.x);
+        store8(next->dy + k, nx_d.y);
+        store8(next->dz + k, nx_d.z);
+        store8(next->tmin + k, splat(0.0f));
+        store8(next->tmax + k, splat(FLT_MAX));
+        store8(next->time + k, timev);
+        _mm256_storeu_si256((__m256i *)(void *)(next->path + k), (__m256i)pathv);
+        *on = k + 8;
+        for (i = 0; i < 8; ++i) {
+            uint32_t p = path_[i];
+            paths->throughput[p] = rs_v3(beta_[0][i], beta_[1][i], beta_[2][i]);
+            paths->bsdf_pdf[p] = pdf_[i];
+            paths->env_pdf[p] = envpdf_[i];
+            paths->flags[p] = (uint8_t)(paths->flags[p] & RS_PATH_NEGATIVE);
+        }
+    } else if (any8(nx_okv)) {
+        float o_[3][8], d_[3][8];
+        uint32_t ok_[8];
+        store3(o_, origin);
+        store3(d_, nx_d);
+        _mm256_storeu_si256((__m256i *)ok_, (__m256i)nx_okv);
+        for (i = 0; i < count; ++i) {
+            uint32_t p = path_[i];
+            rs_ray r;
+            if (!ok_[i])
+                continue;
+            r.o = rs_v3(o_[0][i], o_[1][i], o_[2][i]);
+            r.d = rs_v3(d_[0][i], d_[1][i], d_[2][i]);
+            r.tmin = 0.0f;
             r.tmax = FLT_MAX;
+            r.time = time_[i];
             rs_ray_soa_set(next, (*on)++, &r, p);
             paths->throughput[p] = rs_v3(beta_[0][i], beta_[1][i], beta_[2][i]);
             paths->bsdf_pdf[p] = pdf_[i];
@@ -521,18 +729,19 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
 
 void rs_shade_wide(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays,
                    const rs_hit_soa *hits, const uint32_t *entry, uint32_t n, const rs_rng_f4 *rb,
-                   const rs_rng_f4 *rl, rs_paths *paths, rs_ray_soa *next, uint32_t *on,
-                   rs_ray_soa *shadow, uint32_t *os)
+                   const rs_rng_f4 *rl, uint32_t rng_base, rs_paths *paths, rs_ray_soa *next,
+                   uint32_t *on, rs_ray_soa *shadow, uint32_t *os)
 {
 #if RS_WIDE_HAVE_AVX2
     uint32_t i;
     if (n)
         atomic_fetch_add_explicit(&wide_count, n, memory_order_relaxed);
     for (i = 0; i < n; i += 8)
-        shade8(it, bounce, rays, hits, entry + i, n - i < 8 ? n - i : 8, rb + i, rl + i, paths,
+        shade8(it, bounce, rays, hits, entry + i, n - i < 8 ? n - i : 8, rb, rl, rng_base, paths,
                next, on, shadow, os);
 #else
     (void)it, (void)bounce, (void)rays, (void)hits, (void)entry, (void)n, (void)rb, (void)rl;
+    (void)rng_base;
     (void)paths, (void)next, (void)on, (void)shadow, (void)os;
 #endif
 }

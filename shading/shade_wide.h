@@ -48,14 +48,15 @@ static inline int rs_shade_wide_entry(const rs_scene *sc, uint32_t prim)
 }
 
 /* Shades entries entry[0..n) of the stream (rays, hits), segment `bounce`, as rs_path_shade_at
- * would with the numbers rb[i] (group RS_DIM_BSDF) and rl[i] (RS_DIM_LIGHT): each entry's path
+ * would with the numbers rb[k] (group RS_DIM_BSDF) and rl[k] (RS_DIM_LIGHT), k = entry[i] -
+ * rng_base: each entry's path
  * state in `paths` is updated, and the rays it makes are written to the streams, a next ray at
  * next[*on] and a shadow ray at shadow[*os] (each count then advanced), in the entries' order.
  * Every entry must pass rs_shade_wide_entry, after rs_shade_wide_ready. */
 void rs_shade_wide(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays,
                    const rs_hit_soa *hits, const uint32_t *entry, uint32_t n, const rs_rng_f4 *rb,
-                   const rs_rng_f4 *rl, rs_paths *paths, rs_ray_soa *next, uint32_t *on,
-                   rs_ray_soa *shadow, uint32_t *os);
+                   const rs_rng_f4 *rl, uint32_t rng_base, rs_paths *paths, rs_ray_soa *next,
+                   uint32_t *on, rs_ray_soa *shadow, uint32_t *os);
 
 #ifdef __cplusplus
 }
