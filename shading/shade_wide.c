@@ -11,6 +11,7 @@
 #include "shading/shade_wide.h"
 
 #include <float.h>
+#include <stddef.h>
 #include <stdatomic.h>
 
 static atomic_int wide_off;         /* forced off (rs_shade_wide_use(0)) */
@@ -334,23 +335,54 @@ WIDE u8 ufield8(const uint32_t *f, i8 j, int run)
     return run ? (u8)_mm256_loadu_si256((const __m256i *)(const void *)(f + j[0])) : gatheru(f, j);
 }
 
-/* Four numbers each of eight lanes, r[k[i]] in lane i: eight 16-byte loads, one 4x8 transpose. */
-WIDE void rng8(const rs_rng_f4 *r, const uint32_t k[8], f8 out[4])
+/* Four floats of each of eight lanes, p[i][0..3] in lane i: eight 16-byte loads, one 4x8
+ * transpose (out[c] lane i = p[i][c]). */
+WIDE void load8x4(const float *const p[8], f8 out[4])
 {
-    __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[0]].v)),
-                                     _mm_loadu_ps(r[k[4]].v), 1);
-    __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[1]].v)),
-                                     _mm_loadu_ps(r[k[5]].v), 1);
-    __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[2]].v)),
-                                     _mm_loadu_ps(r[k[6]].v), 1);
-    __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(r[k[3]].v)),
-                                     _mm_loadu_ps(r[k[7]].v), 1);
+    __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p[0])), _mm_loadu_ps(p[4]), 1);
+    __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p[1])), _mm_loadu_ps(p[5]), 1);
+    __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p[2])), _mm_loadu_ps(p[6]), 1);
+    __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p[3])), _mm_loadu_ps(p[7]), 1);
     __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
     __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
     out[0] = (f8)_mm256_shuffle_ps(t0, t1, 0x44);
     out[1] = (f8)_mm256_shuffle_ps(t0, t1, 0xee);
     out[2] = (f8)_mm256_shuffle_ps(t2, t3, 0x44);
     out[3] = (f8)_mm256_shuffle_ps(t2, t3, 0xee);
+}
+
+/* Floats `off` .. off + 3 of records `stride` floats long, record idx[i] in lane i. */
+WIDE void rec8x4(const float *base, i8 idx, uint32_t stride, uint32_t off, f8 out[4])
+{
+    const float *p[8];
+    int i;
+    for (i = 0; i < 8; ++i)
+        p[i] = base + (size_t)(uint32_t)idx[i] * stride + off;
+    load8x4(p, out);
+}
+
+/* Nine floats of records `stride` >= 9 floats long (triangles: three corners; vertex normals),
+ * record idx[i] in lane i, as three vectors: floats 0..3, 4..7 and 5..8 loaded, none past the
+ * ninth. */
+WIDE void rec8x9(const float *base, i8 idx, uint32_t stride, v3 *a, v3 *b, v3 *c)
+{
+    f8 x[4], y[4], z[4];
+    rec8x4(base, idx, stride, 0, x);
+    rec8x4(base, idx, stride, 4, y);
+    rec8x4(base, idx, stride, 5, z);
+    a->x = x[0], a->y = x[1], a->z = x[2];
+    b->x = x[3], b->y = y[0], b->z = y[1];
+    c->x = y[2], c->y = y[3], c->z = z[3];
+}
+
+/* A rs_vec3 (and the float after it, which is read too) of records `stride` floats long. */
+WIDE v3 rec8v3(const float *base, i8 idx, uint32_t stride)
+{
+    f8 x[4];
+    v3 r;
+    rec8x4(base, idx, stride, 0, x);
+    r.x = x[0], r.y = x[1], r.z = x[2];
+    return r;
 }
 
 WIDE int all8(u8 m) { return _mm256_movemask_ps((__m256)m) == 0xff; }
@@ -369,7 +401,7 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     const rs_scene *sc = it->scene;
     const int nee = rs_scene_has_lights(sc);
     const float env_pick = sc->env_pick;
-    const int32_t mat_stride = (int32_t)(sizeof(rs_material) / sizeof(float));
+    const uint32_t mat_stride = (uint32_t)(sizeof(rs_material) / sizeof(float));
     lane_prims hp, lp;
     uint32_t env_[8], lok_[8], path_[8], k_[8], light_[8];
     float pend_[3][8], beta_[3][8], pdf_[8], envpdf_[8], time_[8];
@@ -381,8 +413,14 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     v3 d, wo, x, err, ng, n_geo, n, origin, thr, alb, beta, po, pa, pb, pw, lo, la, lb, lw, emiv;
     v3 sh_dv, pendv, nx_d;
     u8 front;
-    typedef char material_floats[sizeof(rs_material) % sizeof(float) == 0 ? 1 : -1];
-    (void)sizeof(material_floats);
+    /* records read four floats at a time: a material's albedo and the float after it */
+    typedef char material_floats[sizeof(rs_material) % sizeof(float) == 0 &&
+                                         offsetof(rs_material, albedo) + 16 <= sizeof(rs_material)
+                                     ? 1
+                                     : -1];
+    typedef char quad_floats[sizeof(rs_quad) == 12 * sizeof(float) ? 1 : -1];
+    typedef char tri_floats[sizeof(rs_tri) == 9 * sizeof(float) ? 1 : -1];
+    (void)sizeof(material_floats), (void)sizeof(quad_floats), (void)sizeof(tri_floats);
 
     /* ---- gather ---- */
     for (i = 0; i < 8; ++i) {
@@ -399,8 +437,8 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     hv = field8(hits->v, jv, run);
     pathv = ufield8(rays->path, jv, run);
     primv = ufield8(hits->prim, jv, run);
-    rng8(rb, k_, rbv);
-    rng8(rl, k_, rlv);
+    rec8x4(rb[0].v, (i8)_mm256_loadu_si256((const __m256i *)k_), 4, 0, rbv);
+    rec8x4(rl[0].v, (i8)_mm256_loadu_si256((const __m256i *)k_), 4, 0, rlv);
     _mm256_storeu_si256((__m256i *)path_, (__m256i)pathv);
     store8(time_, timev);
     thr = gather3(&paths->throughput[0].x, (i8)pathv, 3);
@@ -409,17 +447,16 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     if (!any8(quadv)) {
         /* all triangles: corners, material numbers and vertex normals gathered */
         i8 t = pv - (i8)usplat(sc->n_quads);
-        const float *tf = &sc->tris[0].v0.x;
-        v3 v1 = gather3(tf + 3, t, 9), v2 = gather3(tf + 6, t, 9);
-        po = gather3(tf, t, 9);
+        v3 v1, v2;
+        rec8x9(&sc->tris[0].v0.x, t, 9, &po, &v1, &v2);
         pa = sub3(v1, po);
         pb = sub3(v2, po);
         pw = cross3(pa, pb);
-        alb = gather3(&sc->materials[0].albedo.x, (i8)gatheru(sc->tri_mat, t), mat_stride);
+        alb = rec8v3(&sc->materials[0].albedo.x, (i8)gatheru(sc->tri_mat, t), mat_stride);
         if (sc->tri_normal) {
             /* rs_shading_normal: a triangle of the scene's own with vertex normals */
-            v3 n0 = gather3(sc->tri_normal, t, 9), n1 = gather3(sc->tri_normal + 3, t, 9);
-            v3 n2 = gather3(sc->tri_normal + 6, t, 9);
+            v3 n0, n1, n2;
+            rec8x9(sc->tri_normal, t, 9, &n0, &n1, &n2);
             {
                 v3 ns = add3(add3(scale3(n0, 1.0f - hu - hv), scale3(n1, hu)), scale3(n2, hv));
                 f8 len = len3(ns);
@@ -442,11 +479,15 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     } else if (all8(quadv)) {
         /* all parallelograms: no vertex normals */
         const float *qf = &sc->quads[0].q.x;
-        po = gather3(qf, pv, 12);
-        pa = gather3(qf + 3, pv, 12);
-        pb = gather3(qf + 6, pv, 12);
-        pw = gather3(qf + 9, pv, 12);
-        alb = gather3(&sc->materials[0].albedo.x, (i8)gatheru(sc->quad_mat, pv), mat_stride);
+        f8 q0[4], q1[4], q2[4];
+        rec8x4(qf, pv, 12, 0, q0);
+        rec8x4(qf, pv, 12, 4, q1);
+        rec8x4(qf, pv, 12, 8, q2);
+        po.x = q0[0], po.y = q0[1], po.z = q0[2];
+        pa.x = q0[3], pa.y = q1[0], pa.z = q1[1];
+        pb.x = q1[2], pb.y = q1[3], pb.z = q2[0];
+        pw.x = q2[1], pw.y = q2[2], pw.z = q2[3];
+        alb = rec8v3(&sc->materials[0].albedo.x, (i8)gatheru(sc->quad_mat, pv), mat_stride);
         surface_point(quadv, po, pa, pb, pw, hu, hv, &x, &err, &ng);
         front = (u8)(dot3(ng, d) < 0.0f);
         n_geo = sel3(front, ng, neg3(ng));
