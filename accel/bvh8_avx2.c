@@ -324,7 +324,51 @@ typedef struct pk8 {
     uint32_t near[3], far[3]; /* then each axis's near and far plane's row of rs_bvh8_node.b */
     float tmax[8];            /* per lane, cut just past each hit (closest) */
     rs_ray ray[8];            /* each lane's ray, for the leaves walked one lane at a time */
+    /* closest hit: the lanes' best hits and tmax in registers while the packet walks (pk8_out
+     * puts them in hit[] and tmax[] for the steps that walk one lane at a time, pk8_in back) */
+    __m256 ht, hu, hv, tmaxv;
+    __m256i hprim;
 } pk8;
+
+/* The lanes' hits and tmax from registers to hit[] and p->tmax (an 8x4 transpose). */
+static inline void pk8_out(pk8 *p, rs_hit *hit)
+{
+    __m256 pr = _mm256_castsi256_ps(p->hprim);
+    __m256 t0 = _mm256_unpacklo_ps(p->ht, p->hu), t1 = _mm256_unpacklo_ps(p->hv, pr);
+    __m256 t2 = _mm256_unpackhi_ps(p->ht, p->hu), t3 = _mm256_unpackhi_ps(p->hv, pr);
+    __m256 r0 = _mm256_shuffle_ps(t0, t1, 0x44), r1 = _mm256_shuffle_ps(t0, t1, 0xee);
+    __m256 r2 = _mm256_shuffle_ps(t2, t3, 0x44), r3 = _mm256_shuffle_ps(t2, t3, 0xee);
+    float *h = &hit[0].t;
+    typedef char hit_floats[sizeof(rs_hit) == 16 ? 1 : -1];
+    (void)sizeof(hit_floats);
+    /* r0 = lanes 0 | 4, r1 = 1 | 5, r2 = 2 | 6, r3 = 3 | 7 */
+    _mm_storeu_ps(h + 0, _mm256_castps256_ps128(r0));
+    _mm_storeu_ps(h + 4, _mm256_castps256_ps128(r1));
+    _mm_storeu_ps(h + 8, _mm256_castps256_ps128(r2));
+    _mm_storeu_ps(h + 12, _mm256_castps256_ps128(r3));
+    _mm_storeu_ps(h + 16, _mm256_extractf128_ps(r0, 1));
+    _mm_storeu_ps(h + 20, _mm256_extractf128_ps(r1, 1));
+    _mm_storeu_ps(h + 24, _mm256_extractf128_ps(r2, 1));
+    _mm_storeu_ps(h + 28, _mm256_extractf128_ps(r3, 1));
+    _mm256_storeu_ps(p->tmax, p->tmaxv);
+}
+
+/* hit[] and p->tmax back into registers. */
+static inline void pk8_in(pk8 *p, const rs_hit *hit)
+{
+    const float *h = &hit[0].t;
+    __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(h)), _mm_loadu_ps(h + 16), 1);
+    __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(h + 4)), _mm_loadu_ps(h + 20), 1);
+    __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(h + 8)), _mm_loadu_ps(h + 24), 1);
+    __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(h + 12)), _mm_loadu_ps(h + 28), 1);
+    __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
+    __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
+    p->ht = _mm256_shuffle_ps(t0, t1, 0x44);
+    p->hu = _mm256_shuffle_ps(t0, t1, 0xee);
+    p->hv = _mm256_shuffle_ps(t2, t3, 0x44);
+    p->hprim = _mm256_castps_si256(_mm256_shuffle_ps(t2, t3, 0xee));
+    p->tmaxv = _mm256_loadu_ps(p->tmax);
+}
 
 /* Child c of node n against the packet's rays: the lanes whose ray enters the box inside
  * (tmin, tmax), and their entry distances. */
@@ -387,24 +431,35 @@ static inline uint32_t pk8_prim(const rs_bvh8 *b, uint32_t count, uint32_t block
                                  : pk8_tri(&b->tri8[block], k, p, tmaxv, t, u, v);
 }
 
-static inline void pk8_take(pk8 *p, rs_hit *hit, uint32_t m, __m256 tv, __m256 uv, __m256 vv,
-                            uint32_t prim)
+/* Lanes `m` of a primitive test's answers, each taken where better (rs_hit_better: nearer, or as
+ * near with a lower number), the lane's ray cut just past it (rs_float_next_up): lane by lane the
+ * scalar rules, all lanes at once. */
+static inline void pk8_take(pk8 *p, uint32_t m, __m256 tv, __m256 uv, __m256 vv, uint32_t prim)
 {
-    float t[8], u[8], v[8];
-    _mm256_storeu_ps(t, tv);
-    _mm256_storeu_ps(u, uv);
-    _mm256_storeu_ps(v, vv);
-    while (m) {
-        uint32_t l = (uint32_t)__builtin_ctz(m);
-        m &= m - 1;
-        if (rs_hit_better(t[l], prim, &hit[l])) {
-            p->tmax[l] = rs_float_next_up(t[l]);
-            hit[l].t = t[l];
-            hit[l].u = u[l];
-            hit[l].v = v[l];
-            hit[l].prim = prim;
-        }
-    }
+    const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    const __m256i sign = _mm256_set1_epi32((int)0x80000000u), one = _mm256_set1_epi32(1);
+    __m256i mv = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)m), bit), bit);
+    __m256i pv = _mm256_set1_epi32((int)prim);
+    __m256i lower = _mm256_cmpgt_epi32(_mm256_xor_si256(p->hprim, sign), _mm256_xor_si256(pv, sign));
+    __m256 better = _mm256_or_ps(_mm256_cmp_ps(tv, p->ht, _CMP_LT_OQ),
+                                 _mm256_and_ps(_mm256_cmp_ps(tv, p->ht, _CMP_EQ_OQ),
+                                               _mm256_castsi256_ps(lower)));
+    __m256i u = _mm256_castps_si256(tv), up;
+    __m256 zero = _mm256_setzero_ps();
+    better = _mm256_and_ps(better, _mm256_castsi256_ps(mv));
+    /* rs_float_next_up: 0 -> the smallest denormal, finite > 0 -> one up, < 0 -> one down */
+    up = _mm256_blendv_epi8(u, _mm256_add_epi32(u, one),
+                            _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps(tv, zero, _CMP_GT_OQ)),
+                                             _mm256_cmpgt_epi32(_mm256_set1_epi32(0x7f800000), u)));
+    up = _mm256_blendv_epi8(up, _mm256_sub_epi32(u, one),
+                            _mm256_castps_si256(_mm256_cmp_ps(tv, zero, _CMP_LT_OQ)));
+    up = _mm256_blendv_epi8(up, one, _mm256_castps_si256(_mm256_cmp_ps(tv, zero, _CMP_EQ_OQ)));
+    p->tmaxv = _mm256_blendv_ps(p->tmaxv, _mm256_castsi256_ps(up), better);
+    p->ht = _mm256_blendv_ps(p->ht, tv, better);
+    p->hu = _mm256_blendv_ps(p->hu, uv, better);
+    p->hv = _mm256_blendv_ps(p->hv, vv, better);
+    p->hprim = _mm256_castps_si256(
+        _mm256_blendv_ps(_mm256_castsi256_ps(p->hprim), _mm256_castsi256_ps(pv), better));
 }
 
 /* A leaf for closest hit, lanes `m` of the packet: packed triangles and parallelograms against
@@ -419,17 +474,18 @@ static void pk8_leaf_closest(const rs_bvh8 *b, const rs_geom *g, uint32_t first,
             const uint32_t *prim = count & RS_WIDE_QUADS ? b->quad8[first + i].prim
                                                          : b->tri8[first + i].prim;
             for (k = 0; k < 8; ++k) {
-                __m256 t, u, v, tmaxv = _mm256_loadu_ps(p->tmax);
+                __m256 t, u, v;
                 uint32_t got;
                 if (prim[k] == RS_NO_HIT)
                     continue;
-                got = pk8_prim(b, count, first + i, k, p, tmaxv, &t, &u, &v) & m;
+                got = pk8_prim(b, count, first + i, k, p, p->tmaxv, &t, &u, &v) & m;
                 if (got)
-                    pk8_take(p, hit, got, t, u, v, prim[k]);
+                    pk8_take(p, got, t, u, v, prim[k]);
             }
         }
         return;
     }
+    pk8_out(p, hit);
     while (m) {
         uint32_t l = (uint32_t)__builtin_ctz(m);
         rs_ray r = p->ray[l];
@@ -445,9 +501,11 @@ static void pk8_leaf_closest(const rs_bvh8 *b, const rs_geom *g, uint32_t first,
         }
         p->tmax[l] = r.tmax;
     }
+    pk8_in(p, hit);
 }
 
-/* The closest hits of the packet's lanes `active` (hit[] set up as walk8_closest does). */
+/* The closest hits of the packet's lanes `active` (hit[] set up as walk8_closest does, and
+ * loaded into the packet by pk8_in; pk8_out puts the answers back). */
 static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit, uint32_t active)
 {
     uint32_t stack[RS_BVH8_STACK];
@@ -459,7 +517,7 @@ static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit,
     stack_tn[0] = _mm256_set1_ps(-FLT_MAX);
     sp = 1;
     while (sp > 0) {
-        __m256 tmaxv = _mm256_loadu_ps(p->tmax);
+        __m256 tmaxv = p->tmaxv;
         uint32_t ref, m;
         --sp;
         ref = stack[sp];
@@ -471,6 +529,7 @@ static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit,
             continue;
         if (!(ref & RS_WIDE_LEAF) && __builtin_popcount(m) <= PK8_ALONE) {
             /* too few lanes left to share the walk: each walks this subtree alone */
+            pk8_out(p, hit);
             while (m) {
                 uint32_t l = (uint32_t)__builtin_ctz(m);
                 rs_ray r = p->ray[l];
@@ -481,6 +540,7 @@ static void pk8_closest(const rs_bvh8 *b, const rs_geom *g, pk8 *p, rs_hit *hit,
                 walk8_walk_closest(b, g, ref, &r8, &r, &hit[l], NULL);
                 p->tmax[l] = r.tmax;
             }
+            pk8_in(p, hit);
             continue;
         }
         if (!(ref & RS_WIDE_LEAF)) {
@@ -671,7 +731,9 @@ void rs_bvh8_trace_packets(const rs_bvh8 *b, const rs_geom *g, const rs_trace_ba
             p.far[a] = a + (neg[a] == 2u ? 0u : 3u);
         }
         if (batch->kind == RS_TRACE_CLOSEST) {
+            pk8_in(&p, hit);
             pk8_closest(b, g, &p, hit, active);
+            pk8_out(&p, hit);
             for (l = 0; l < n; ++l) {
                 if (active & (1u << l))
                     rs_hit_soa_set(&batch->hits, i + l, &hit[l]);
