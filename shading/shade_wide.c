@@ -5,9 +5,9 @@
  * run time); the comment names it.  Operations are written in the scalar code's order with its
  * operands (a * b + c as (a * b) + c, left to right; the build never contracts to FMA), min and
  * max with the host's rs_fminf / rs_fmaxf NaN rules, selects for the scalar code's branches.
- * Lanes past the entries are copies of the first and are never stored.  Loads and stores go
- * through small per-lane loops: the stream, path and scene arrays are gathered into lanes and
- * the results scattered back. */
+ * Lanes past the entries are copies of the first and are never stored.  The stream, path and
+ * scene arrays come into lanes by vector loads, gathers and transposed rows (shade8), and the
+ * results go back by vector stores where eight entries make eight rays, else lane by lane. */
 #include "shading/shade_wide.h"
 
 #include <float.h>
@@ -388,10 +388,13 @@ WIDE v3 rec8v3(const float *base, i8 idx, uint32_t stride)
 WIDE int all8(u8 m) { return _mm256_movemask_ps((__m256)m) == 0xff; }
 WIDE int any8(u8 m) { return _mm256_movemask_ps((__m256)m) != 0; }
 
-/* Up to eight entries: rs_path_shade_at's path through a Lambertian vertex.  The lanes' data come
- * in by vector loads where the entries are eight in a row, by gathers elsewhere, and the scene's
- * primitives by gathers where the lanes' are all triangles or all parallelograms (one loop over
- * the lanes for a mix); the rays go out by vector stores where all eight make one. */
+/* Up to eight entries: rs_path_shade_at's path through a Lambertian vertex.  The lanes' stream
+ * fields come in by vector loads where the entries are eight in a row, by gathers elsewhere; the
+ * scene's triangles or parallelograms (where the lanes' are all of one kind: one loop over the
+ * lanes for a mix), their albedos and the random numbers as rows of four floats turned into lanes
+ * (load8x4); the rays go out by vector stores where all eight make one.  No lane is written to a
+ * small array and read back as a vector: such a load waits for the eight stores to leave the
+ * store buffer (perf put two thirds of this function's time there). */
 __attribute__((target("avx2"))) static void
 shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, const rs_hit_soa *hits,
        const uint32_t *entry, uint32_t count, const rs_rng_f4 *rb, const rs_rng_f4 *rl,
@@ -428,7 +431,8 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
         jv[i] = (int32_t)j;
         k_[i] = j - rng_base;
     }
-    run = count == 8 && entry[7] - entry[0] == 7u; /* entries rise: eight in a row */
+    /* eight in a row: entry[i] = entry[0] + i */
+    run = count == 8 && all8((u8)(jv == (i8){0, 1, 2, 3, 4, 5, 6, 7} + (int32_t)entry[0]));
     d.x = field8(rays->dx, jv, run);
     d.y = field8(rays->dy, jv, run);
     d.z = field8(rays->dz, jv, run);
