@@ -386,6 +386,48 @@ WIDE v3 rec8v3(const float *base, i8 idx, uint32_t stride)
 }
 
 WIDE int all8(u8 m) { return _mm256_movemask_ps((__m256)m) == 0xff; }
+
+/* The rays of lanes `ok` among the first `count` (origin o, direction d, tmin 0) into stream s
+ * from *at on, in lane order: eight vector stores where all eight make one.  The lanes written,
+ * as bits. */
+WIDE uint32_t put_rays(rs_ray_soa *s, uint32_t *at, u8 ok, uint32_t count, v3 o, v3 d, f8 tmax,
+                       f8 time, u8 path)
+{
+    uint32_t m = (uint32_t)_mm256_movemask_ps((__m256)ok) & ((1u << count) - 1u), k = *at, i;
+    if (m == 0xffu) {
+        store8(s->ox + k, o.x);
+        store8(s->oy + k, o.y);
+        store8(s->oz + k, o.z);
+        store8(s->dx + k, d.x);
+        store8(s->dy + k, d.y);
+        store8(s->dz + k, d.z);
+        store8(s->tmin + k, splat(0.0f));
+        store8(s->tmax + k, tmax);
+        store8(s->time + k, time);
+        _mm256_storeu_si256((__m256i *)(void *)(s->path + k), (__m256i)path);
+        *at = k + 8;
+    } else if (m) {
+        float o_[3][8], d_[3][8], tmax_[8], time_[8];
+        uint32_t path_[8];
+        store3(o_, o);
+        store3(d_, d);
+        store8(tmax_, tmax);
+        store8(time_, time);
+        _mm256_storeu_si256((__m256i *)(void *)path_, (__m256i)path);
+        for (i = 0; i < count; ++i) {
+            rs_ray r;
+            if (!(m >> i & 1u))
+                continue;
+            r.o = rs_v3(o_[0][i], o_[1][i], o_[2][i]);
+            r.d = rs_v3(d_[0][i], d_[1][i], d_[2][i]);
+            r.tmin = 0.0f;
+            r.tmax = tmax_[i];
+            r.time = time_[i];
+            rs_ray_soa_set(s, (*at)++, &r, path_[i]);
+        }
+    }
+    return m;
+}
 WIDE int any8(u8 m) { return _mm256_movemask_ps((__m256)m) != 0; }
 
 /* Up to eight entries: rs_path_shade_at's path through a Lambertian vertex.  The lanes' stream
@@ -407,8 +449,8 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     const uint32_t mat_stride = (uint32_t)(sizeof(rs_material) / sizeof(float));
     lane_prims hp, lp;
     uint32_t env_[8], lok_[8], path_[8], k_[8], light_[8];
-    float pend_[3][8], beta_[3][8], pdf_[8], envpdf_[8], time_[8];
-    uint32_t i, c;
+    float pend_[3][8], beta_[3][8], pdf_[8], envpdf_[8];
+    uint32_t i, c, m;
     int run, one_light;
     f8 rbv[4], rlv[4], hu, hv, timev, pickv, areav, sh_tmax;
     u8 pathv, primv, quadv, lquad, twov, sh_okv, nx_okv;
@@ -444,7 +486,6 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
     rec8x4(rb[0].v, (i8)_mm256_loadu_si256((const __m256i *)k_), 4, 0, rbv);
     rec8x4(rl[0].v, (i8)_mm256_loadu_si256((const __m256i *)k_), 4, 0, rlv);
     _mm256_storeu_si256((__m256i *)path_, (__m256i)pathv);
-    store8(time_, timev);
     thr = gather3(&paths->throughput[0].x, (i8)pathv, 3);
     pv = (i8)(primv - usplat(sc->n_spheres)); /* wide entries: never a sphere */
     quadv = (u8)(pv < (i8)usplat(sc->n_quads));
@@ -689,85 +730,20 @@ shade8(const rs_render_consts *it, uint32_t bounce, const rs_ray_soa *rays, cons
             store8(envpdf_, splat(0.0f));
     }
 
-    /* ---- scatter: the rays straight into the streams (eight at once where all make one) ---- */
-    if (count == 8 && all8(sh_okv)) {
-        uint32_t k = *os;
-        store8(shadow->ox + k, origin.x);
-        store8(shadow->oy + k, origin.y);
-        store8(shadow->oz + k, origin.z);
-        store8(shadow->dx + k, sh_dv.x);
-        store8(shadow->dy + k, sh_dv.y);
-        store8(shadow->dz + k, sh_dv.z);
-        store8(shadow->tmin + k, splat(0.0f));
-        store8(shadow->tmax + k, sh_tmax);
-        store8(shadow->time + k, timev);
-        _mm256_storeu_si256((__m256i *)(void *)(shadow->path + k), (__m256i)pathv);
-        *os = k + 8;
-        for (i = 0; i < 8; ++i)
+    /* ---- scatter: the rays straight into the streams, the paths' state ---- */
+    m = put_rays(shadow, os, sh_okv, count, origin, sh_dv, sh_tmax, timev, pathv);
+    for (i = 0; i < count; ++i)
+        if (m >> i & 1u)
             paths->pending[path_[i]] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
-    } else if (any8(sh_okv)) {
-        float o_[3][8], d_[3][8], tmax_[8];
-        uint32_t ok_[8];
-        store3(o_, origin);
-        store3(d_, sh_dv);
-        store8(tmax_, sh_tmax);
-        _mm256_storeu_si256((__m256i *)ok_, (__m256i)sh_okv);
-        for (i = 0; i < count; ++i) {
-            rs_ray r;
-            if (!ok_[i])
-                continue;
-            r.o = rs_v3(o_[0][i], o_[1][i], o_[2][i]);
-            r.d = rs_v3(d_[0][i], d_[1][i], d_[2][i]);
-            r.tmin = 0.0f;
-            r.tmax = tmax_[i];
-            r.time = time_[i];
-            paths->pending[path_[i]] = rs_v3(pend_[0][i], pend_[1][i], pend_[2][i]);
-            rs_ray_soa_set(shadow, (*os)++, &r, path_[i]);
-        }
-    }
-    if (count == 8 && all8(nx_okv)) {
-        uint32_t k = *on;
-        store8(next->ox + k, origin.x);
-        store8(next->oy + k, origin.y);
-        store8(next->oz + k, origin.z);
-        store8(next->dx + k, nx_d.x);
-        store8(next->dy + k, nx_d.y);
-        store8(next->dz + k, nx_d.z);
-        store8(next->tmin + k, splat(0.0f));
-        store8(next->tmax + k, splat(FLT_MAX));
-        store8(next->time + k, timev);
-        _mm256_storeu_si256((__m256i *)(void *)(next->path + k), (__m256i)pathv);
-        *on = k + 8;
-        for (i = 0; i < 8; ++i) {
+    m = put_rays(next, on, nx_okv, count, origin, nx_d, splat(FLT_MAX), timev, pathv);
+    for (i = 0; i < count; ++i)
+        if (m >> i & 1u) {
             uint32_t p = path_[i];
             paths->throughput[p] = rs_v3(beta_[0][i], beta_[1][i], beta_[2][i]);
             paths->bsdf_pdf[p] = pdf_[i];
             paths->env_pdf[p] = envpdf_[i];
             paths->flags[p] = (uint8_t)(paths->flags[p] & RS_PATH_NEGATIVE);
         }
-    } else if (any8(nx_okv)) {
-        float o_[3][8], d_[3][8];
-        uint32_t ok_[8];
-        store3(o_, origin);
-        store3(d_, nx_d);
-        _mm256_storeu_si256((__m256i *)ok_, (__m256i)nx_okv);
-        for (i = 0; i < count; ++i) {
-            uint32_t p = path_[i];
-            rs_ray r;
-            if (!ok_[i])
-                continue;
-            r.o = rs_v3(o_[0][i], o_[1][i], o_[2][i]);
-            r.d = rs_v3(d_[0][i], d_[1][i], d_[2][i]);
-            r.tmin = 0.0f;
-            r.tmax = FLT_MAX;
-            r.time = time_[i];
-            rs_ray_soa_set(next, (*on)++, &r, p);
-            paths->throughput[p] = rs_v3(beta_[0][i], beta_[1][i], beta_[2][i]);
-            paths->bsdf_pdf[p] = pdf_[i];
-            paths->env_pdf[p] = envpdf_[i];
-            paths->flags[p] = (uint8_t)(paths->flags[p] & RS_PATH_NEGATIVE);
-        }
-    }
 }
 
 #endif
