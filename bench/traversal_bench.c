@@ -22,7 +22,11 @@
  *
  *   traversal_bench [--quick] [--scene SPEC]... [--models DIR] [--bvh NAME] [--size W]
  *                   [--secondary N] [--runs N] [--threads N] [--no-embree] [--csv FILE]
- *   --quick: builtin:cornell, 64x64 primary and 4096 secondary rays, one run (the smoke test). */
+ *                   [--rays FILE]
+ *   --quick: builtin:cornell, 64x64 primary and 4096 secondary rays, one run (the smoke test).
+ *   --rays FILE: instead of the three sets above, a render's own rays, recorded with
+ *   RS_RECORD_RAYS=FILE (cpu/cpu_paths.c) from a render of the one --scene given: its first
+ *   W x W camera rays and first --secondary bounce and shadow rays, in the render's order. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,7 +64,68 @@ typedef struct settings {
     uint32_t size, n_secondary;
     int runs, threads, embree;
     FILE *csv;
+    const char *rays; /* --rays: a render's recorded rays instead of the three made-up sets */
 } settings;
+
+/* ---- a render's own rays (--rays FILE, recorded with RS_RECORD_RAYS: cpu/cpu_paths.c) ------ */
+
+/* Fills sets[] from the recording at `path`: its camera rays (closest-hit queries of bounce 0,
+ * at most w x w), bounce rays (closest-hit queries of later bounces) and shadow rays (any-hit
+ * queries), each the first of its kind in the render's order, at most n of each.  0 with a
+ * message where the file cannot be read or is not a recording. */
+static int recorded_rays(const char *path, uint32_t w, uint32_t n, bs_rays sets[BS_N_SETS])
+{
+    FILE *f = fopen(path, "rb");
+    char magic[8];
+    unsigned char rec[36];
+    uint32_t cap[BS_N_SETS], k;
+    int ok = 0;
+    memset(sets, 0, BS_N_SETS * sizeof sets[0]);
+    sets[BS_PRIMARY].name = "camera (recorded)";
+    sets[BS_DIFFUSE].name = "bounce (recorded)";
+    sets[BS_SHADOW].name = "shadow (recorded)";
+    cap[BS_PRIMARY] = w * w;
+    cap[BS_DIFFUSE] = cap[BS_SHADOW] = n;
+    if (!f) {
+        fprintf(stderr, "traversal_bench: --rays %s: cannot open it\n", path);
+        return 0;
+    }
+    if (fread(magic, 1, 8, f) != 8 || memcmp(magic, "RSRAYS01", 8) != 0) {
+        fprintf(stderr, "traversal_bench: --rays %s: not a ray recording (RS_RECORD_RAYS)\n",
+                path);
+        goto out;
+    }
+    for (k = 0; k < BS_N_SETS; ++k)
+        if (!(sets[k].rays = (rs_ray *)malloc((size_t)cap[k] * sizeof(rs_ray)))) {
+            fprintf(stderr, "traversal_bench: out of memory for the rays\n");
+            goto out;
+        }
+    while (fread(rec, sizeof rec, 1, f) == 1) {
+        float v[8];
+        rs_ray *r;
+        k = rec[32] ? BS_SHADOW : rec[33] ? BS_DIFFUSE : BS_PRIMARY;
+        if (sets[k].n == cap[k])
+            continue;
+        memcpy(v, rec, sizeof v);
+        r = &sets[k].rays[sets[k].n++];
+        r->o = rs_v3(v[0], v[1], v[2]);
+        r->d = rs_v3(v[3], v[4], v[5]);
+        r->tmin = v[6];
+        r->tmax = v[7];
+        r->time = 0.0f;
+    }
+    if (sets[BS_PRIMARY].n == 0 || sets[BS_DIFFUSE].n == 0 || sets[BS_SHADOW].n == 0) {
+        fprintf(stderr, "traversal_bench: --rays %s: no %s rays in it\n", path,
+                sets[BS_PRIMARY].n == 0 ? "camera" : sets[BS_DIFFUSE].n == 0 ? "bounce" : "shadow");
+        goto out;
+    }
+    ok = 1;
+out:
+    fclose(f);
+    if (!ok)
+        bs_rays_free(sets, BS_N_SETS);
+    return ok;
+}
 
 /* ---- our kernel ---------------------------------------------------------------------------- */
 
@@ -428,7 +493,8 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     memset(&ours, 0, sizeof ours);
     memset(bad, 0, sizeof bad);
     memset(m, 0, sizeof m);
-    if (!bs_make_rays(sc, st->size, st->n_secondary, sets))
+    if (st->rays ? !recorded_rays(st->rays, st->size, st->n_secondary, sets)
+                 : !bs_make_rays(sc, st->size, st->n_secondary, sets))
         return 0;
     memset(&bo, 0, sizeof bo);
     bo.builder = st->builder;
@@ -476,8 +542,9 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     }
 #endif
     {
-        uint32_t most =
-            sets[BS_PRIMARY].n > sets[BS_DIFFUSE].n ? sets[BS_PRIMARY].n : sets[BS_DIFFUSE].n;
+        uint32_t most = 0;
+        for (k = 0; k < BS_N_SETS; ++k)
+            most = sets[k].n > most ? sets[k].n : most;
         for (e = 0; e < N_ENGINES; ++e)
             if (!answers_alloc(&ans[e], most)) {
                 fprintf(stderr, "traversal_bench: out of memory\n");
@@ -522,13 +589,21 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
             }
         }
 
-    printf("\n### %s: %u primitives; %u primary rays (%ux%u), %u diffuse and %u shadow rays\n\n",
-           sc->label, rs_geom_prim_count(&sc->g), sets[0].n, st->size, st->size, sets[1].n,
-           sets[2].n);
+    if (st->rays)
+        printf("\n### %s: %u primitives; a render's rays from %s: %u camera, %u bounce and %u "
+               "shadow rays\n\n",
+               sc->label, rs_geom_prim_count(&sc->g), st->rays, sets[0].n, sets[1].n, sets[2].n);
+    else
+        printf("\n### %s: %u primitives; %u primary rays (%ux%u), %u diffuse and %u shadow rays\n\n",
+               sc->label, rs_geom_prim_count(&sc->g), sets[0].n, st->size, st->size, sets[1].n,
+               sets[2].n);
     printf("BVH %s: %u nodes, SAH cost %.2f, built in %.1f ms; 4-wide: %u nodes, depth %u; 8-wide: "
            "%u nodes, depth %u (binary %u)",
            st->bvh_name, bvh->n_nodes, rs_bvh_sah_cost(bvh), 1e3 * build_s, bvh4->n_nodes,
            bvh4->depth, bvh8->n_nodes, bvh8->depth, bvh->depth);
+    if (bvh8->n_tri8)
+        printf(", %u triangle blocks of 8 (%.2f triangles a block)", bvh8->n_tri8,
+               (double)sc->g.n_tris / bvh8->n_tri8);
     if (embree)
         printf("; Embree scene committed in %.1f ms", 1e3 * embree_build_s);
     if (!on1[ENGINE_BVH8])
@@ -615,11 +690,13 @@ int main(int argc, char **argv)
             st.embree = 0;
         } else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
             csv = argv[++i];
+        } else if (strcmp(argv[i], "--rays") == 0 && i + 1 < argc) {
+            st.rays = argv[++i];
         } else {
             fprintf(stderr,
                     "usage: traversal_bench [--quick] [--scene soup:N|builtin:NAME|FILE]... "
                     "[--models DIR] [--bvh NAME] [--size W] [--secondary N] [--runs N] "
-                    "[--threads N] [--no-embree] [--csv FILE]\n");
+                    "[--threads N] [--no-embree] [--csv FILE] [--rays FILE]\n");
             return 2;
         }
     }
@@ -633,6 +710,10 @@ int main(int argc, char **argv)
     if (st.size < 1 || st.n_secondary < 1 || st.runs < 1 || st.runs > MAX_RUNS || st.threads < 1) {
         fprintf(stderr, "traversal_bench: size, secondary, threads must be >= 1, runs 1..%d\n",
                 MAX_RUNS);
+        return 2;
+    }
+    if (st.rays && n_scenes != 1) {
+        fprintf(stderr, "traversal_bench: --rays goes with the one --scene it was recorded in\n");
         return 2;
     }
     if (rs_bvh_builder_parse(st.bvh_name, &st.builder) != RS_OK) {

@@ -18,6 +18,8 @@
  * the waves taken are always a prefix of the call's paths, and all of them are on the film. */
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/alloc.h"
@@ -59,6 +61,57 @@ struct cpu_walk_picks {
 
 size_t rs_cpu_walk_picks_size(void) { return sizeof(struct cpu_walk_picks); }
 
+/* ---- Recording the rays a render traces (a benchmark's input) ----
+ * With RS_RECORD_RAYS=FILE in the environment, the first RS_RECORD_RAYS_MAX rays (default
+ * 4,000,000) the waves trace are appended to FILE as they are traced, in the waves' order:
+ * bench/traversal_bench --rays FILE races the walks and Embree on a real render's camera, bounce
+ * and shadow rays (docs/traversal.md).  The file: the 8 bytes "RSRAYS01", then per ray
+ * o.x o.y o.z d.x d.y d.z tmin tmax (floats), the query (0 closest hit, 1 any hit) and the bounce
+ * (bytes, the bounce capped at 255) and two zero bytes, all little-endian, 36 bytes a ray.  A
+ * file that cannot be opened is reported once on stderr and nothing is recorded. */
+#define RECORD_MAX_DEFAULT 4000000u
+
+static pthread_mutex_t record_lock = PTHREAD_MUTEX_INITIALIZER;
+static FILE *record_file;
+static uint64_t record_left;
+static atomic_int record_state; /* 0 not looked at yet, 1 recording, 2 off (read unlocked) */
+
+static void record_rays(const rs_trace_batch *tb, uint32_t bounce)
+{
+    uint32_t i;
+    pthread_mutex_lock(&record_lock);
+    if (atomic_load(&record_state) == 0) {
+        const char *path = getenv("RS_RECORD_RAYS"), *max = getenv("RS_RECORD_RAYS_MAX");
+        atomic_store(&record_state, 2);
+        if (path && *path) {
+            record_file = fopen(path, "wb");
+            if (!record_file || fwrite("RSRAYS01", 1, 8, record_file) != 8)
+                fprintf(stderr, "raystream: RS_RECORD_RAYS: cannot write %s: no rays recorded\n",
+                        path);
+            else
+                atomic_store(&record_state, 1);
+            record_left = max && *max ? strtoull(max, NULL, 10) : RECORD_MAX_DEFAULT;
+        }
+    }
+    for (i = 0; atomic_load(&record_state) == 1 && i < tb->count && record_left > 0;
+         ++i, --record_left) {
+        rs_ray r = rs_ray_soa_get(&tb->rays, i);
+        float f[8];
+        unsigned char tail[4] = {(unsigned char)(tb->kind == RS_TRACE_CLOSEST ? 0 : 1),
+                                 (unsigned char)(bounce < 255u ? bounce : 255u), 0, 0};
+        f[0] = r.o.x, f[1] = r.o.y, f[2] = r.o.z, f[3] = r.d.x, f[4] = r.d.y, f[5] = r.d.z;
+        f[6] = r.tmin, f[7] = r.tmax;
+        if (fwrite(f, sizeof f, 1, record_file) != 1 || fwrite(tail, 4, 1, record_file) != 1)
+            record_left = 1; /* stop at a write error */
+    }
+    if (atomic_load(&record_state) == 1 && record_left == 0) {
+        fclose(record_file);
+        record_file = NULL;
+        atomic_store(&record_state, 2);
+    }
+    pthread_mutex_unlock(&record_lock);
+}
+
 /* Traces tb's rays of bounce `bounce` on this thread with the walk c->walk and `picks` say. */
 static void trace_wave(const cpu_impl *c, struct cpu_walk_picks *picks, const rs_trace_batch *tb,
                        uint32_t bounce)
@@ -66,6 +119,8 @@ static void trace_wave(const cpu_impl *c, struct cpu_walk_picks *picks, const rs
     walk_pick *w;
     uint32_t m;
     double t0;
+    if (atomic_load_explicit(&record_state, memory_order_relaxed) != 2)
+        record_rays(tb, bounce);
     if (!c->bvh8 || c->walk == RS_CPU_WALK_SINGLE) {
         rs_cpu_trace_range(c, tb, 0, tb->count);
         return;
