@@ -22,11 +22,15 @@
  *
  *   traversal_bench [--quick] [--scene SPEC]... [--models DIR] [--bvh NAME] [--size W]
  *                   [--secondary N] [--runs N] [--threads N] [--no-embree] [--csv FILE]
- *                   [--rays FILE]
+ *                   [--rays FILE] [--batch-walk packets|single]
  *   --quick: builtin:cornell, 64x64 primary and 4096 secondary rays, one run (the smoke test).
  *   --rays FILE: instead of the three sets above, a render's own rays, recorded with
  *   RS_RECORD_RAYS=FILE (cpu/cpu_paths.c) from a render of the one --scene given: its first
- *   W x W camera rays and first --secondary bounce and shadow rays, in the render's order. */
+ *   W x W camera rays and first --secondary bounce and shadow rays, in the render's order.
+ *   --batch-walk: what the "8-wide batch" column runs over each chunk of CHUNK rays: the packet
+ *   walk (rs_bvh8_trace_packets, the default) or the single-ray walk (rs_bvh8_trace), the two
+ *   the CPU device's waves choose between (the "8-wide" column calls rs_bvh8_closest and
+ *   rs_bvh8_occluded ray by ray, whose setup a batch makes eight rays at a time). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -65,7 +69,13 @@ typedef struct settings {
     int runs, threads, embree;
     FILE *csv;
     const char *rays; /* --rays: a render's recorded rays instead of the three made-up sets */
+    int batch_walk;   /* --batch-walk: what the batch column runs (BATCH_*) */
 } settings;
+
+/* The batch column's walk over a batch of rays (rs_bvh8_trace_packets, rs_bvh8_trace), the two
+ * the CPU device's waves choose between. */
+enum { BATCH_PACKETS = 0, BATCH_SINGLE, BATCH_N };
+static const char *const BATCH_NAME[BATCH_N] = {"packets", "single"};
 
 /* ---- a render's own rays (--rays FILE, recorded with RS_RECORD_RAYS: cpu/cpu_paths.c) ------ */
 
@@ -136,6 +146,7 @@ typedef struct ours_ctx {
     const rs_geom *g;
     const bs_rays *sets;             /* the packet walk's rays: sets[k] as a stream, batch[k] */
     rs_trace_batch batch[BS_N_SETS];
+    int batch_walk;
 } ours_ctx;
 
 /* Our kernel `e` (ENGINE_BIN, _BVH4, _BVH8) over the set. */
@@ -373,9 +384,9 @@ static double run_bvh8(const void *ctx, const bs_rays *s, int q, int threads, an
     return trace_ours((const ours_ctx *)ctx, ENGINE_BVH8, s, q, threads, a);
 }
 
-/* The 8-wide tree's packet walk (rs_bvh8_trace_packets: eight neighbouring rays at a time, what
- * the CPU device's waves pick where it is faster) over the set, from its stream copy, in chunks of
- * CHUNK rays. */
+/* The 8-wide tree's batch walk over the set, from its stream copy, in chunks of CHUNK rays: the
+ * packet walk (rs_bvh8_trace_packets: eight neighbouring rays at a time) or, with --batch-walk
+ * single, rs_bvh8_trace, as the CPU device's waves run them. */
 static double run_pk(const void *ctx, const bs_rays *s, int q, int threads, answers *a)
 {
     const ours_ctx *c = (const ours_ctx *)ctx;
@@ -387,7 +398,11 @@ static double run_pk(const void *ctx, const bs_rays *s, int q, int threads, answ
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (i = 0; i < n; ++i) {
         uint32_t b0 = (uint32_t)i * CHUNK;
-        rs_bvh8_trace_packets(c->b8, c->g, &b, b0, s->n - b0 < CHUNK ? s->n : b0 + CHUNK);
+        uint32_t b1 = s->n - b0 < CHUNK ? s->n : b0 + CHUNK;
+        if (c->batch_walk == BATCH_SINGLE)
+            rs_bvh8_trace(c->b8, c->g, &b, b0, b1);
+        else
+            rs_bvh8_trace_packets(c->b8, c->g, &b, b0, b1);
     }
     dt = rs_now_s() - t0;
     for (i = 0; i < (long)s->n; ++i) {
@@ -469,7 +484,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
 {
     const settings *st = (const settings *)ctx;
     static const char *const QNAME[2] = {"closest", "any"};
-    static const char *const ENAME[4] = {"binary", "4-wide", "8-wide", "8-wide packets"};
+    static const char *const ENAME[4] = {"binary", "4-wide", "8-wide", "8-wide batch"};
     bs_rays sets[BS_N_SETS];
     rs_bvh_build_opts bo;
     rs_bvh *bvh = NULL;
@@ -514,6 +529,7 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
     ours.b4 = bvh4;
     ours.b8 = bvh8;
     ours.g = &sc->g;
+    ours.batch_walk = st->batch_walk;
     on1[ENGINE_BVH8] = on1[ENGINE_PK] = rs_bvh8_supported();
     if (on1[ENGINE_PK] && !pk_batches(&ours, sets)) {
         fprintf(stderr, "traversal_bench: out of memory\n");
@@ -610,8 +626,8 @@ static int bench_scene(const bs_scene *sc, const void *ctx)
         printf("; this CPU has no AVX2: the 8-wide kernel is left out");
     printf("\n\n");
     printf("| rays | query | hit %% | binary Mrays/s 1 thr | 4-wide 1 thr | 8-wide 1 thr | 8-wide "
-           "packets 1 thr | %s %d thr | %s vs binary 1 thr",
-           ENAME[best], st->threads, ENAME[best]);
+           "batch (%s) 1 thr | %s %d thr | %s vs binary 1 thr",
+           BATCH_NAME[st->batch_walk], ENAME[best], st->threads, ENAME[best]);
     if (embree)
         printf(" | Embree 1 thr | Embree %d thr | ours/Embree 1 thr | ours/Embree %d thr | "
                "answers differ",
@@ -692,11 +708,21 @@ int main(int argc, char **argv)
             csv = argv[++i];
         } else if (strcmp(argv[i], "--rays") == 0 && i + 1 < argc) {
             st.rays = argv[++i];
+        } else if (strcmp(argv[i], "--batch-walk") == 0 && i + 1 < argc) {
+            const char *w = argv[++i];
+            for (st.batch_walk = 0; st.batch_walk < BATCH_N; ++st.batch_walk)
+                if (strcmp(w, BATCH_NAME[st.batch_walk]) == 0)
+                    break;
+            if (st.batch_walk == BATCH_N) {
+                fprintf(stderr, "traversal_bench: --batch-walk %s: packets or single\n", w);
+                return 2;
+            }
         } else {
             fprintf(stderr,
                     "usage: traversal_bench [--quick] [--scene soup:N|builtin:NAME|FILE]... "
                     "[--models DIR] [--bvh NAME] [--size W] [--secondary N] [--runs N] "
-                    "[--threads N] [--no-embree] [--csv FILE] [--rays FILE]\n");
+                    "[--threads N] [--no-embree] [--csv FILE] [--rays FILE] "
+                    "[--batch-walk packets|single]\n");
             return 2;
         }
     }
