@@ -25,6 +25,9 @@
  *                               tests (the mask of lanes hit inside (tmin, tmax), t, u, v per
  *                               lane); optionally RS_WIDE_SPHERES_OF(b) and
  *                               RS_WIDE_SPHERE_HIT(block, RAY *, tmin, tmax, t)
+ *   RS_WIDE_PREFETCH(b, node, lane)
+ *                               optional: ask for the memory lane `lane` of `node` leads to (the
+ *                               closest-hit walk calls it for every lane hit)
  *
  * It defines FN(closest) and FN(occluded), the walks they and an instance's bottom level share
  * (FN(walk_closest), FN(walk_occluded), FN(instance_closest), FN(instance_occluded)), the leaf
@@ -186,6 +189,16 @@ RS_HD_HOT void RS_WIDE_FN(walk_closest)(const RS_WIDE_TREE *b, const rs_geom *g,
             const RS_WIDE_NODE *n = &b->nodes[ref];
             RS_WIDE_TN tnv;
             uint32_t mask = RS_WIDE_FN(lanes)(n, r, in != NULL, ray->tmin, ray->tmax, &tnv);
+#ifdef RS_WIDE_PREFETCH
+            {
+                /* every lane hit asked for now, while the lanes are ordered and pushed */
+                uint32_t m = mask;
+                while (m) {
+                    RS_WIDE_PREFETCH(b, n, (uint32_t)__builtin_ctz(m));
+                    m &= m - 1;
+                }
+            }
+#endif
             if (mask != 0) {
                 float tn[RS_WIDE_W];
                 uint32_t first = (uint32_t)__builtin_ctz(mask), second;
@@ -372,6 +385,7 @@ RS_WIDE_ENTRY int RS_WIDE_FN(occluded)(const RS_WIDE_TREE *b, const rs_geom *g, 
 }
 
 #undef RS_WIDE_REF
+#undef RS_WIDE_PREFETCH
 #undef RS_WIDE_ENTRY
 #undef RS_WIDE_W
 #undef RS_WIDE_SHIFT
