@@ -271,9 +271,9 @@ static inline uint32_t sphere8_hit(const rs_bvh8_sphere8 *b, const ray8 *r, floa
  * from an inner node's start (its 256 bytes and the next node's first line) or from a packed
  * leaf's first block (a tri8's 320 bytes; the first 320 of a quad8, a sphere8 and the next).  The
  * closest-hit walk then orders and pushes the lanes while the lines come in from L2 or L3: on the
- * interior's recorded bounce and shadow rays its closest hits run 4-8% faster (docs/traversal.md,
- * "Prefetching the lanes hit").  Always five lines: a count that varied with the kind would be a
- * branch mispredicted as often as the kinds alternate. */
+ * interior's recorded bounce and shadow rays its closest hits run 3-7% faster (docs/performance.md,
+ * "A render's own rays, and prefetching the lanes hit").  Always five lines: a count that varied
+ * with the kind would be a branch mispredicted as often as the kinds alternate. */
 static inline void walk8_prefetch(const rs_bvh8 *b, const rs_bvh8_node *n, uint32_t l)
 {
     uint32_t count = n->count[l], c = n->child[l];

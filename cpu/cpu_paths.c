@@ -101,9 +101,16 @@ static void record_rays(const rs_trace_batch *tb, uint32_t bounce)
                                  (unsigned char)(bounce < 255u ? bounce : 255u), 0, 0};
         f[0] = r.o.x, f[1] = r.o.y, f[2] = r.o.z, f[3] = r.d.x, f[4] = r.d.y, f[5] = r.d.z;
         f[6] = r.tmin, f[7] = r.tmax;
-        if (fwrite(f, sizeof f, 1, record_file) != 1 || fwrite(tail, 4, 1, record_file) != 1)
-            record_left = 1; /* stop at a write error */
+        if (fwrite(f, sizeof f, 1, record_file) != 1 || fwrite(tail, 4, 1, record_file) != 1) {
+            fprintf(stderr, "raystream: RS_RECORD_RAYS: a write failed: recording stopped\n");
+            record_left = 0;
+            break;
+        }
     }
+    /* each batch on disk as it is traced: a render that ends short of the limit (or a library
+     * caller that goes on) leaves no rays in stdio's buffer */
+    if (atomic_load(&record_state) == 1 && record_left > 0)
+        fflush(record_file);
     if (atomic_load(&record_state) == 1 && record_left == 0) {
         fclose(record_file);
         record_file = NULL;
